@@ -1,0 +1,86 @@
+// Sampling routines; each says in its name the measure of the density it returns.
+#pragma once
+#include <cmath>
+#include <vector>
+
+#include "base/vec.h"
+
+namespace bpm {
+
+inline Vec2 sample_uniform_disk_concentric(Vec2 u) {
+  float ox = 2 * u.x - 1, oy = 2 * u.y - 1;
+  if (ox == 0 && oy == 0) return {0, 0};
+  float r, theta;
+  if (std::fabs(ox) > std::fabs(oy)) {
+    r = ox;
+    theta = (kPi / 4) * (oy / ox);
+  } else {
+    r = oy;
+    theta = kPi / 2 - (kPi / 4) * (ox / oy);
+  }
+  return {r * std::cos(theta), r * std::sin(theta)};
+}
+
+// Cosine-weighted direction about +z; pdf_solid_angle = cos(theta) / pi.
+inline Vec3 sample_cosine_hemisphere(Vec2 u) {
+  Vec2 d = sample_uniform_disk_concentric(u);
+  float z = std::sqrt(std::fmax(0.0f, 1 - d.x * d.x - d.y * d.y));
+  return {d.x, d.y, z};
+}
+inline float cosine_hemisphere_pdf_solid_angle(float cos_theta) { return cos_theta * kInvPi; }
+
+inline Vec3 sample_uniform_sphere(Vec2 u) {
+  float z = 1 - 2 * u.x;
+  float r = std::sqrt(std::fmax(0.0f, 1 - z * z));
+  float phi = 2 * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+constexpr float kUniformSpherePdfSolidAngle = 1 / (4 * kPi);
+
+// Uniform direction inside a cone about +z with cos of the half angle cos_max.
+inline Vec3 sample_uniform_cone(Vec2 u, float cos_max) {
+  float cos_t = (1 - u.x) + u.x * cos_max;
+  float sin_t = std::sqrt(std::fmax(0.0f, 1 - cos_t * cos_t));
+  float phi = u.y * 2 * kPi;
+  return {std::cos(phi) * sin_t, std::sin(phi) * sin_t, cos_t};
+}
+inline float uniform_cone_pdf_solid_angle(float cos_max) { return 1 / (2 * kPi * (1 - cos_max)); }
+
+// Uniform point on a triangle, returned as barycentrics (b0, b1); b2 = 1 - b0 - b1.
+inline Vec2 sample_uniform_triangle(Vec2 u) {
+  float b0, b1;
+  if (u.x < u.y) {
+    b0 = u.x / 2;
+    b1 = u.y - b0;
+  } else {
+    b1 = u.y / 2;
+    b0 = u.x - b1;
+  }
+  return {b0, b1};
+}
+
+inline float power_heuristic(float pdf_a, float pdf_b) {
+  float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+  if (std::isinf(a)) return 1;
+  return a + b > 0 ? a / (a + b) : 0;
+}
+
+// Discrete distribution by inverse CDF over non-negative weights.
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  explicit Distribution1D(const std::vector<float>& weights);
+  bool empty() const { return pmf_.empty(); }
+  int size() const { return static_cast<int>(pmf_.size()); }
+  // Returns an index with probability pmf(index); u is remapped to [0,1) for reuse.
+  int sample(float u, float* pmf_out = nullptr, float* u_remapped = nullptr) const;
+  float pmf(int i) const { return pmf_[i]; }
+  double total() const { return total_; }
+
+ private:
+  std::vector<float> pmf_;
+  std::vector<double> cdf_;
+  double total_ = 0;
+};
+
+}  // namespace bpm

@@ -1,0 +1,64 @@
+// Per-pixel accumulation of weighted radiance samples. A pixel is only ever written by the thread
+// rendering it, so no atomics are needed. Alongside the weighted sums, the film keeps per pixel the
+// sum and sum of squares of per-pass luminance estimates, from which the error estimate of the
+// paper's eq. (5) follows.
+#pragma once
+#include <vector>
+
+#include "base/spectrum.h"
+
+namespace bpm {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // width * height * 3, row-major from the top
+  Spectrum at(int x, int y) const {
+    size_t i = 3 * (size_t(y) * width + x);
+    return Spectrum(rgb[i], rgb[i + 1], rgb[i + 2]);
+  }
+};
+
+class Film {
+ public:
+  Film(int width, int height);
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+  void add_sample(int x, int y, const Spectrum& L, float weight) {
+    Pixel& p = pixels_[size_t(y) * width_ + x];
+    for (int c = 0; c < 3; ++c) p.sum_wl[c] += double(weight) * L[c];
+    p.sum_w += weight;
+    p.pass_wl += double(weight) * L.luminance();
+    p.pass_w += weight;
+  }
+  // Ends the current pass for one pixel: its pass estimate joins the running moments.
+  void end_pass(int x, int y) {
+    Pixel& p = pixels_[size_t(y) * width_ + x];
+    if (p.pass_w != 0) {
+      double e = p.pass_wl / p.pass_w;
+      p.sum_e += e;
+      p.sum_e2 += e * e;
+      ++p.passes;
+    }
+    p.pass_wl = p.pass_w = 0;
+  }
+
+  Image image(float scale = 1) const;
+  // Per-pixel standard error of the luminance mean (eq. 5), and the image error delta (eq. 4).
+  std::vector<float> rms() const;
+  double relative_error() const;
+  std::vector<float> pass_counts() const;
+
+ private:
+  struct Pixel {
+    double sum_wl[3] = {0, 0, 0};
+    double sum_w = 0;
+    double pass_wl = 0, pass_w = 0;
+    double sum_e = 0, sum_e2 = 0;
+    int passes = 0;
+  };
+  int width_, height_;
+  std::vector<Pixel> pixels_;
+};
+
+}  // namespace bpm

@@ -1,0 +1,198 @@
+#include "lights/light.h"
+
+#include <cmath>
+
+#include "base/sampling.h"
+
+namespace bpm {
+
+bool light_is_delta(const Light& l) {
+  return std::holds_alternative<PointLight>(l) || std::holds_alternative<SpotLight>(l) ||
+         std::holds_alternative<DistantLight>(l);
+}
+bool light_is_infinite(const Light& l) {
+  return std::holds_alternative<DistantLight>(l) || std::holds_alternative<UniformInfiniteLight>(l);
+}
+
+float spot_falloff(const SpotLight& l, Vec3 w) {
+  float c = w.z;
+  if (c >= l.cos_falloff_start) return 1;
+  if (c <= l.cos_falloff_end) return 0;
+  float t = (c - l.cos_falloff_end) / (l.cos_falloff_start - l.cos_falloff_end);
+  return t * t * (3 - 2 * t);
+}
+
+float primitive_area(const Shape& shape, int prim) {
+  if (auto* m = std::get_if<TriangleMesh>(&shape)) {
+    Vec3 p0 = m->positions[m->indices[3 * prim]], p1 = m->positions[m->indices[3 * prim + 1]],
+         p2 = m->positions[m->indices[3 * prim + 2]];
+    return 0.5f * length(cross(p1 - p0, p2 - p0));
+  }
+  if (auto* s = std::get_if<Sphere>(&shape)) {
+    float scale = 1;
+    s->world_from_object.is_similarity(&scale);
+    float r = s->radius * scale;
+    return s->phi_max * r * (std::fmin(s->z_max, s->radius) - std::fmax(s->z_min, -s->radius)) * scale;
+  }
+  const Disk& k = std::get<Disk>(shape);
+  float scale = 1;
+  k.world_from_object.is_similarity(&scale);
+  return 0.5f * k.phi_max * (k.radius * k.radius - k.inner_radius * k.inner_radius) * scale * scale;
+}
+
+namespace {
+
+struct AreaSample {
+  Vec3 p, n;
+  float pdf_area;
+};
+
+// Uniform point on the primitive (triangles, full spheres and disks under similarity transforms,
+// which flatten.cpp guarantees for emitters).
+AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
+  if (auto* m = std::get_if<TriangleMesh>(&shape)) {
+    Vec2 b = sample_uniform_triangle(u);
+    SurfacePoint sp = surface_point(shape, l.primitive, {b.y, 1 - b.x - b.y}, {});
+    (void)m;
+    return {sp.p, sp.ng, 1 / l.area};
+  }
+  if (auto* s = std::get_if<Sphere>(&shape)) {
+    Vec3 po = sample_uniform_sphere(u) * s->radius;
+    SurfacePoint sp = surface_point(shape, 0, {}, s->world_from_object.point(po));
+    return {sp.p, sp.ng, 1 / l.area};
+  }
+  const Disk& k = std::get<Disk>(shape);
+  Vec2 d = sample_uniform_disk_concentric(u);
+  Vec3 po(d.x * k.radius, d.y * k.radius, k.height);
+  SurfacePoint sp = surface_point(shape, 0, {}, k.world_from_object.point(po));
+  return {sp.p, sp.ng, 1 / l.area};
+}
+
+struct SphereWorld {
+  Vec3 center;
+  float radius;
+};
+SphereWorld sphere_world(const Sphere& s) {
+  float scale = 1;
+  s.world_from_object.is_similarity(&scale);
+  return {s.world_from_object.point(Vec3(0, 0, 0)), s.radius * scale};
+}
+
+}  // namespace
+
+std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec2 u,
+                                             const SceneBoundsInfo& bounds) {
+  LightLiSample ls;
+  if (auto* l = std::get_if<PointLight>(&light)) {
+    Vec3 d = l->position - p_ref;
+    float d2 = length_squared(d);
+    if (d2 == 0) return std::nullopt;
+    ls.wi = d / std::sqrt(d2);
+    ls.radiance = l->intensity / d2;
+    ls.p_light = l->position;
+    ls.pdf_solid_angle = 1;
+    ls.is_delta = true;
+    return ls;
+  }
+  if (auto* l = std::get_if<SpotLight>(&light)) {
+    Vec3 d = l->position - p_ref;
+    float d2 = length_squared(d);
+    if (d2 == 0) return std::nullopt;
+    ls.wi = d / std::sqrt(d2);
+    float fall = spot_falloff(*l, l->frame.to_local(-ls.wi));
+    if (fall == 0) return std::nullopt;
+    ls.radiance = l->intensity * (fall / d2);
+    ls.p_light = l->position;
+    ls.pdf_solid_angle = 1;
+    ls.is_delta = true;
+    return ls;
+  }
+  if (auto* l = std::get_if<DistantLight>(&light)) {
+    ls.wi = l->direction_to_light;
+    ls.radiance = l->radiance;
+    ls.p_light = p_ref + ls.wi * (2 * bounds.radius);
+    ls.pdf_solid_angle = 1;
+    ls.is_delta = true;
+    ls.is_infinite = true;
+    return ls;
+  }
+  if (auto* l = std::get_if<UniformInfiniteLight>(&light)) {
+    ls.wi = sample_uniform_sphere(u);
+    ls.radiance = l->radiance;
+    ls.p_light = p_ref + ls.wi * (2 * bounds.radius);
+    ls.pdf_solid_angle = kUniformSpherePdfSolidAngle;
+    ls.is_infinite = true;
+    return ls;
+  }
+  const AreaLight& l = std::get<AreaLight>(light);
+  if (auto* s = std::get_if<Sphere>(shape)) {
+    SphereWorld sw = sphere_world(*s);
+    Vec3 to_center = sw.center - p_ref;
+    float dc2 = length_squared(to_center);
+    if (dc2 > sw.radius * sw.radius * 1.0001f) {
+      // Outside: sample the cone of directions the sphere subtends (pbrt-v4 Sphere::Sample).
+      float dc = std::sqrt(dc2);
+      float sin2_max = sw.radius * sw.radius / dc2;
+      float cos_max = std::sqrt(std::fmax(0.0f, 1 - sin2_max));
+      Frame f = Frame::from_z(to_center / dc);
+      Vec3 w = f.to_world(sample_uniform_cone(u, cos_max));
+      // Nearest intersection of the sampled direction with the sphere.
+      float b = dot(w, to_center);
+      float disc = std::fmax(0.0f, b * b - (dc2 - sw.radius * sw.radius));
+      float t = b - std::sqrt(disc);
+      Vec3 p = p_ref + w * t;
+      SurfacePoint sp = surface_point(*shape, 0, {}, p);
+      ls.wi = w;
+      ls.p_light = sp.p;
+      ls.n_light = sp.ng;
+      ls.radiance = area_light_radiance(l, sp.ng, -w);
+      ls.pdf_solid_angle = uniform_cone_pdf_solid_angle(cos_max);
+      if (ls.radiance.is_black()) return std::nullopt;
+      return ls;
+    }
+  }
+  AreaSample as = sample_area(l, *shape, u);
+  Vec3 d = as.p - p_ref;
+  float d2 = length_squared(d);
+  if (d2 == 0) return std::nullopt;
+  ls.wi = d / std::sqrt(d2);
+  float cos_l = absdot(as.n, ls.wi);
+  if (cos_l == 0) return std::nullopt;
+  ls.p_light = as.p;
+  ls.n_light = as.n;
+  ls.radiance = area_light_radiance(l, as.n, -ls.wi);
+  ls.pdf_solid_angle = as.pdf_area * d2 / cos_l;
+  if (ls.radiance.is_black()) return std::nullopt;
+  return ls;
+}
+
+float light_pdf_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light) {
+  if (light_is_delta(light)) return 0;
+  if (std::holds_alternative<UniformInfiniteLight>(light)) return kUniformSpherePdfSolidAngle;
+  const AreaLight& l = std::get<AreaLight>(light);
+  if (auto* s = std::get_if<Sphere>(shape)) {
+    SphereWorld sw = sphere_world(*s);
+    float dc2 = length_squared(sw.center - p_ref);
+    if (dc2 > sw.radius * sw.radius * 1.0001f) {
+      float cos_max = std::sqrt(std::fmax(0.0f, 1 - sw.radius * sw.radius / dc2));
+      return uniform_cone_pdf_solid_angle(cos_max);
+    }
+  }
+  float d2 = length_squared(p_light - p_ref);
+  float cos_l = absdot(n_light, wi);
+  if (cos_l == 0) return 0;
+  return d2 / (cos_l * l.area);
+}
+
+Spectrum light_power(const Light& light, const SceneBoundsInfo& bounds) {
+  if (auto* l = std::get_if<PointLight>(&light)) return l->intensity * (4 * kPi);
+  if (auto* l = std::get_if<SpotLight>(&light))
+    return l->intensity * (2 * kPi * ((1 - l->cos_falloff_start) + (l->cos_falloff_start - l->cos_falloff_end) / 2));
+  if (auto* l = std::get_if<DistantLight>(&light)) return l->radiance * (kPi * bounds.radius * bounds.radius);
+  if (auto* l = std::get_if<UniformInfiniteLight>(&light))
+    return l->radiance * (4 * kPi * kPi * bounds.radius * bounds.radius);
+  const AreaLight& l = std::get<AreaLight>(light);
+  return l.radiance * (kPi * (l.two_sided ? 2 : 1) * l.area);
+}
+
+}  // namespace bpm

@@ -1,0 +1,86 @@
+// Lights as a closed set, with pbrt-v4's interface split into free functions: sample_li (a
+// direction toward the light from a reference point), pdf_li (its density, for MIS), emitted
+// radiance, and power (for choosing lights in proportion to their flux).
+#pragma once
+#include <optional>
+#include <variant>
+
+#include "base/spectrum.h"
+#include "base/vec.h"
+#include "scene/shapes.h"
+
+namespace bpm {
+
+struct PointLight {
+  Vec3 position;
+  Spectrum intensity;  // W/sr per channel
+};
+
+// pbrt-v4 spot light: full intensity inside cos_falloff_start, smoothstep to zero at
+// cos_falloff_end.
+struct SpotLight {
+  Vec3 position;
+  Frame frame;  // frame.n is the axis of the cone
+  Spectrum intensity;
+  float cos_falloff_start = 1, cos_falloff_end = 1;
+};
+
+struct DistantLight {
+  Vec3 direction_to_light;  // unit
+  Spectrum radiance;        // irradiance on a surface facing the light
+};
+
+struct UniformInfiniteLight {
+  Spectrum radiance;
+};
+
+// Diffuse emission from one primitive of an object (a triangle, a full sphere or a disk).
+struct AreaLight {
+  int object = 0;
+  int primitive = 0;
+  Spectrum radiance;
+  bool two_sided = false;
+  float area = 0;
+};
+
+using Light = std::variant<PointLight, SpotLight, DistantLight, UniformInfiniteLight, AreaLight>;
+
+struct LightLiSample {
+  Spectrum radiance;    // arriving at the reference point along -wi
+  Vec3 wi;              // unit, toward the light
+  Vec3 p_light;         // point on the light (for shadow rays); far away for distant lights
+  Vec3 n_light;         // surface normal there (zero for lights without a surface)
+  float pdf_solid_angle = 0;  // 1 for delta lights
+  bool is_delta = false;
+  bool is_infinite = false;
+};
+
+struct SceneBoundsInfo {
+  Vec3 center;
+  float radius = 1;
+};
+
+bool light_is_delta(const Light& l);
+bool light_is_infinite(const Light& l);
+
+// The shape is needed only for area lights (pass the object's shape).
+std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec2 u,
+                                             const SceneBoundsInfo& bounds);
+// Solid-angle density of light_sample_li choosing direction wi that reaches the light at
+// p_light (area lights) or escapes (infinite lights).
+float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light);
+// Radiance leaving an area light with geometric normal n toward w.
+inline Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec3 w) {
+  if (!l.two_sided && dot(n, w) <= 0) return {};
+  return l.radiance;
+}
+// Total emitted power (W per channel), used by the power light sampler.
+Spectrum light_power(const Light& l, const SceneBoundsInfo& bounds);
+
+// pbrt-v4's smoothstep falloff of spot lights.
+float spot_falloff(const SpotLight& l, Vec3 w_light_local);
+
+// Area of one primitive of a shape in world space.
+float primitive_area(const Shape& shape, int prim);
+
+}  // namespace bpm

@@ -1,0 +1,276 @@
+#include <complex>
+
+#include "base/sampling.h"
+#include "materials/material.h"
+#include "materials/microfacet.h"
+
+namespace bpm {
+
+// pbrt-v4 treats alpha below 1e-3 as a perfect mirror or smooth boundary.
+bool Roughness::effectively_smooth() const { return std::fmax(alpha_x, alpha_y) < 1e-3f; }
+
+float fresnel_dielectric(float cos_i, float eta) {
+  cos_i = std::clamp(cos_i, -1.0f, 1.0f);
+  if (cos_i < 0) {
+    eta = 1 / eta;
+    cos_i = -cos_i;
+  }
+  float sin2_i = 1 - cos_i * cos_i;
+  float sin2_t = sin2_i / (eta * eta);
+  if (sin2_t >= 1) return 1;
+  float cos_t = std::sqrt(std::fmax(0.0f, 1 - sin2_t));
+  float r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return (r_parl * r_parl + r_perp * r_perp) / 2;
+}
+
+Spectrum fresnel_complex(float cos_i, const Spectrum& eta, const Spectrum& k) {
+  using C = std::complex<float>;
+  cos_i = std::clamp(cos_i, 0.0f, 1.0f);
+  Spectrum out;
+  for (int c = 0; c < Spectrum::kChannels; ++c) {
+    C e(eta[c], k[c]);
+    float sin2_i = 1 - cos_i * cos_i;
+    C sin2_t = sin2_i / (e * e);
+    C cos_t = std::sqrt(C(1) - sin2_t);
+    C r_parl = (e * cos_i - cos_t) / (e * cos_i + cos_t);
+    C r_perp = (cos_i - e * cos_t) / (cos_i + e * cos_t);
+    out[c] = (std::norm(r_parl) + std::norm(r_perp)) / 2;
+  }
+  return out;
+}
+
+namespace {
+
+inline Vec3 reflect(Vec3 wo, Vec3 n) { return -wo + n * (2 * dot(wo, n)); }
+
+// Refraction of wi about n (both pointing away from the surface); eta = inside/outside with the
+// outside on n's side. Returns false for total internal reflection.
+bool refract(Vec3 wi, Vec3 n, float eta, float* etap, Vec3* wt) {
+  float cos_i = dot(n, wi);
+  if (cos_i < 0) {
+    eta = 1 / eta;
+    cos_i = -cos_i;
+    n = -n;
+  }
+  float sin2_i = std::fmax(0.0f, 1 - cos_i * cos_i);
+  float sin2_t = sin2_i / (eta * eta);
+  if (sin2_t >= 1) return false;
+  float cos_t = std::sqrt(1 - sin2_t);
+  *wt = -wi / eta + n * (cos_i / eta - cos_t);
+  if (etap) *etap = eta;
+  return true;
+}
+
+// ---- diffuse ----
+Spectrum f_of(const DiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  return same_hemisphere(wo, wi) ? m.reflectance * kInvPi : Spectrum();
+}
+float pdf_of(const DiffuseMaterial&, Vec3 wo, Vec3 wi, TransportMode) {
+  return same_hemisphere(wo, wi) ? cosine_hemisphere_pdf_solid_angle(std::fabs(wi.z)) : 0;
+}
+std::optional<BsdfSample> sample_of(const DiffuseMaterial& m, Vec3 wo, float, Vec2 u, TransportMode) {
+  Vec3 wi = sample_cosine_hemisphere(u);
+  if (wo.z < 0) wi.z = -wi.z;
+  float pdf = cosine_hemisphere_pdf_solid_angle(std::fabs(wi.z));
+  if (pdf == 0) return std::nullopt;
+  return BsdfSample{m.reflectance * kInvPi, wi, pdf, kReflection | kDiffuse};
+}
+
+// ---- conductor ----
+Spectrum f_of(const ConductorMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  if (!same_hemisphere(wo, wi) || m.roughness.effectively_smooth()) return {};
+  float co = std::fabs(wo.z), ci = std::fabs(wi.z);
+  if (co == 0 || ci == 0) return {};
+  Vec3 wm = wi + wo;
+  if (length_squared(wm) == 0) return {};
+  wm = normalize(wm);
+  TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
+  Spectrum F = fresnel_complex(absdot(wo, wm), m.eta, m.k);
+  return F * (d.d(wm) * d.g(wo, wi) / (4 * co * ci));
+}
+float pdf_of(const ConductorMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  if (!same_hemisphere(wo, wi) || m.roughness.effectively_smooth()) return 0;
+  Vec3 wm = wo + wi;
+  if (length_squared(wm) == 0) return 0;
+  wm = face_forward(normalize(wm), Vec3(0, 0, 1));
+  TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
+  return d.d_visible(wo, wm) / (4 * absdot(wo, wm));
+}
+std::optional<BsdfSample> sample_of(const ConductorMaterial& m, Vec3 wo, float, Vec2 u, TransportMode) {
+  if (m.roughness.effectively_smooth()) {
+    Vec3 wi(-wo.x, -wo.y, wo.z);
+    float c = std::fabs(wi.z);
+    if (c == 0) return std::nullopt;
+    return BsdfSample{fresnel_complex(c, m.eta, m.k) / c, wi, 1, kReflection | kSpecular};
+  }
+  if (wo.z == 0) return std::nullopt;
+  TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
+  Vec3 wm = d.sample_wm(wo, u);
+  Vec3 wi = reflect(wo, wm);
+  if (!same_hemisphere(wo, wi)) return std::nullopt;
+  float pdf = d.d_visible(wo, wm) / (4 * absdot(wo, wm));
+  float co = std::fabs(wo.z), ci = std::fabs(wi.z);
+  if (ci == 0 || pdf == 0) return std::nullopt;
+  Spectrum F = fresnel_complex(absdot(wo, wm), m.eta, m.k);
+  return BsdfSample{F * (d.d(wm) * d.g(wo, wi) / (4 * co * ci)), wi, pdf, kReflection | kGlossy};
+}
+
+// ---- dielectric ----
+// Half vector of a generalized (reflection or refraction) pair, or nullopt when degenerate or
+// when the microfacet faces away from either direction.
+struct HalfVector {
+  Vec3 wm;
+  float etap;
+  bool reflect;
+};
+std::optional<HalfVector> dielectric_half_vector(float eta, Vec3 wo, Vec3 wi) {
+  float co = wo.z, ci = wi.z;
+  bool reflect = co * ci > 0;
+  float etap = 1;
+  if (!reflect) etap = co > 0 ? eta : 1 / eta;
+  Vec3 wm = wi * etap + wo;
+  if (ci == 0 || co == 0 || length_squared(wm) == 0) return std::nullopt;
+  wm = face_forward(normalize(wm), Vec3(0, 0, 1));
+  if (dot(wm, wi) * ci < 0 || dot(wm, wo) * co < 0) return std::nullopt;
+  return HalfVector{wm, etap, reflect};
+}
+
+Spectrum f_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  if (m.eta == 1 || m.roughness.effectively_smooth()) return {};
+  auto h = dielectric_half_vector(m.eta, wo, wi);
+  if (!h) return {};
+  TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
+  float F = fresnel_dielectric(dot(wo, h->wm), m.eta);
+  if (h->reflect) return Spectrum(d.d(h->wm) * d.g(wo, wi) * F / std::fabs(4 * wi.z * wo.z));
+  float denom = dot(wi, h->wm) + dot(wo, h->wm) / h->etap;
+  denom = denom * denom * wi.z * wo.z;
+  float ft = d.d(h->wm) * (1 - F) * d.g(wo, wi) * std::fabs(dot(wi, h->wm) * dot(wo, h->wm) / denom);
+  if (mode == TransportMode::kRadiance) ft /= h->etap * h->etap;
+  return Spectrum(ft);
+}
+float pdf_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  if (m.eta == 1 || m.roughness.effectively_smooth()) return 0;
+  auto h = dielectric_half_vector(m.eta, wo, wi);
+  if (!h) return 0;
+  TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
+  float R = fresnel_dielectric(dot(wo, h->wm), m.eta), T = 1 - R;
+  float dvis = d.d_visible(wo, h->wm);  // symmetric in the sign of wo
+  if (h->reflect) return dvis / (4 * absdot(wo, h->wm)) * R / (R + T);
+  float denom = dot(wi, h->wm) + dot(wo, h->wm) / h->etap;
+  float dwm_dwi = absdot(wi, h->wm) / (denom * denom);
+  return dvis * dwm_dwi * T / (R + T);
+}
+std::optional<BsdfSample> sample_of(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+  if (m.eta == 1 || m.roughness.effectively_smooth()) {
+    float R = fresnel_dielectric(wo.z, m.eta), T = 1 - R;
+    if (uc < R / (R + T)) {
+      Vec3 wi(-wo.x, -wo.y, wo.z);
+      return BsdfSample{Spectrum(R / std::fabs(wi.z)), wi, R / (R + T), kReflection | kSpecular};
+    }
+    Vec3 wi;
+    float etap;
+    if (!refract(wo, Vec3(0, 0, 1), m.eta, &etap, &wi) || wi.z == 0) return std::nullopt;
+    float ft = T / std::fabs(wi.z);
+    if (mode == TransportMode::kRadiance) ft /= etap * etap;
+    return BsdfSample{Spectrum(ft), wi, T / (R + T), kTransmission | kSpecular, etap};
+  }
+  TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
+  // wm lies in the upper hemisphere whichever side wo is on, so that dot(wo, wm) < 0 tells the
+  // Fresnel term and refract() that the ray comes from inside.
+  Vec3 wm = d.sample_wm(wo, u);
+  float R = fresnel_dielectric(dot(wo, wm), m.eta), T = 1 - R;
+  float dvis = d.d_visible(wo, wm);
+  if (uc < R / (R + T)) {
+    Vec3 wi = reflect(wo, wm);
+    if (!same_hemisphere(wo, wi)) return std::nullopt;
+    float pdf = dvis / (4 * absdot(wo, wm)) * R / (R + T);
+    Spectrum f(d.d(wm) * d.g(wo, wi) * R / std::fabs(4 * wi.z * wo.z));
+    return BsdfSample{f, wi, pdf, kReflection | kGlossy};
+  }
+  Vec3 wi;
+  float etap;
+  if (!refract(wo, wm, m.eta, &etap, &wi) || same_hemisphere(wo, wi) || wi.z == 0) return std::nullopt;
+  float denom = dot(wi, wm) + dot(wo, wm) / etap;
+  denom *= denom;
+  float dwm_dwi = absdot(wi, wm) / denom;
+  float pdf = dvis * dwm_dwi * T / (R + T);
+  float ft = T * d.d(wm) * d.g(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
+  if (mode == TransportMode::kRadiance) ft /= etap * etap;
+  return BsdfSample{Spectrum(ft), wi, pdf, kTransmission | kGlossy, etap};
+}
+
+// ---- thin dielectric ----
+Spectrum f_of(const ThinDielectricMaterial&, Vec3, Vec3, TransportMode) { return {}; }
+float pdf_of(const ThinDielectricMaterial&, Vec3, Vec3, TransportMode) { return 0; }
+std::optional<BsdfSample> sample_of(const ThinDielectricMaterial& m, Vec3 wo, float uc, Vec2, TransportMode) {
+  float R = fresnel_dielectric(std::fabs(wo.z), m.eta), T = 1 - R;
+  // Sum of the geometric series of inter-reflections inside the slab.
+  if (R < 1) {
+    R += T * T * R / (1 - R * R);
+    T = 1 - R;
+  }
+  if (wo.z == 0) return std::nullopt;
+  if (uc < R / (R + T)) {
+    Vec3 wi(-wo.x, -wo.y, wo.z);
+    return BsdfSample{Spectrum(R / std::fabs(wi.z)), wi, R / (R + T), kReflection | kSpecular};
+  }
+  Vec3 wi = -wo;
+  return BsdfSample{Spectrum(T / std::fabs(wi.z)), wi, T / (R + T), kTransmission | kSpecular};
+}
+
+// ---- diffuse transmission ----
+Spectrum f_of(const DiffuseTransmissionMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  return (same_hemisphere(wo, wi) ? m.reflectance : m.transmittance) * kInvPi;
+}
+float pdf_of(const DiffuseTransmissionMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  float pr = m.reflectance.max_component(), pt = m.transmittance.max_component();
+  if (pr + pt == 0) return 0;
+  float c = cosine_hemisphere_pdf_solid_angle(std::fabs(wi.z));
+  return (same_hemisphere(wo, wi) ? pr : pt) / (pr + pt) * c;
+}
+std::optional<BsdfSample> sample_of(const DiffuseTransmissionMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode) {
+  float pr = m.reflectance.max_component(), pt = m.transmittance.max_component();
+  if (pr + pt == 0) return std::nullopt;
+  Vec3 wi = sample_cosine_hemisphere(u);
+  float c = cosine_hemisphere_pdf_solid_angle(wi.z);
+  if (c == 0) return std::nullopt;
+  if (uc < pr / (pr + pt)) {
+    if (wo.z < 0) wi.z = -wi.z;
+    return BsdfSample{m.reflectance * kInvPi, wi, pr / (pr + pt) * c, kReflection | kDiffuse};
+  }
+  if (wo.z > 0) wi.z = -wi.z;
+  return BsdfSample{m.transmittance * kInvPi, wi, pt / (pr + pt) * c, kTransmission | kDiffuse};
+}
+
+// ---- interface: no scattering; the integrators skip such surfaces ----
+Spectrum f_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return {}; }
+float pdf_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return 0; }
+std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2, TransportMode) { return std::nullopt; }
+
+}  // namespace
+
+Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return std::visit([&](const auto& x) { return f_of(x, wo, wi, mode); }, m);
+}
+float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return std::visit([&](const auto& x) { return pdf_of(x, wo, wi, mode); }, m);
+}
+std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+  auto s = std::visit([&](const auto& x) { return sample_of(x, wo, uc, u, mode); }, m);
+  if (s && (s->pdf_solid_angle <= 0 || !s->f.is_finite() || !std::isfinite(s->pdf_solid_angle))) return std::nullopt;
+  return s;
+}
+bool bsdf_is_specular(const Material& m) {
+  struct V {
+    bool operator()(const DiffuseMaterial&) const { return false; }
+    bool operator()(const ConductorMaterial& c) const { return c.roughness.effectively_smooth(); }
+    bool operator()(const DielectricMaterial& d) const { return d.eta == 1 || d.roughness.effectively_smooth(); }
+    bool operator()(const ThinDielectricMaterial&) const { return true; }
+    bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
+    bool operator()(const InterfaceMaterial&) const { return true; }
+  };
+  return std::visit(V{}, m);
+}
+
+}  // namespace bpm

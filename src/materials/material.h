@@ -1,0 +1,86 @@
+// Materials as a closed set (std::variant) of plain parameter structs, and the BSDF functions
+// that evaluate and sample them in the local shading frame (z = shading normal).
+//
+// Conventions (as pbrt-v4): wo and wi point away from the surface; f() includes no cosine;
+// sample() returns f, wi, and pdf_solid_angle; `mode` says whether radiance (camera paths) or
+// importance (light paths) flows, which matters for refraction (eta^2 scaling, Veach 1997 5.2).
+#pragma once
+#include <optional>
+#include <variant>
+
+#include "base/spectrum.h"
+#include "base/vec.h"
+
+namespace bpm {
+
+enum class TransportMode { kRadiance, kImportance };
+
+struct DiffuseMaterial {
+  Spectrum reflectance{0.5f};
+};
+
+// Trowbridge-Reitz (GGX) roughness; below kSmoothAlpha the lobe is treated as a delta lobe.
+struct Roughness {
+  float alpha_x = 0, alpha_y = 0;
+  bool effectively_smooth() const;
+};
+
+struct ConductorMaterial {
+  Spectrum eta{1.0f}, k{0.0f};  // complex index of refraction per channel
+  Roughness roughness;
+};
+
+struct DielectricMaterial {
+  float eta = 1.5f;  // inside over outside; the outside is the side the normal points to
+  Roughness roughness;
+};
+
+struct ThinDielectricMaterial {
+  float eta = 1.5f;
+};
+
+struct DiffuseTransmissionMaterial {
+  Spectrum reflectance{0.25f}, transmittance{0.25f};
+};
+
+// Marks a boundary that does not scatter (pbrt-v4 "interface"): rays pass straight through.
+struct InterfaceMaterial {};
+
+using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMaterial,
+                              ThinDielectricMaterial, DiffuseTransmissionMaterial, InterfaceMaterial>;
+
+enum BsdfFlags : unsigned {
+  kReflection = 1,
+  kTransmission = 2,
+  kDiffuse = 4,
+  kGlossy = 8,
+  kSpecular = 16,
+};
+
+struct BsdfSample {
+  Spectrum f;
+  Vec3 wi;
+  float pdf_solid_angle = 0;
+  unsigned flags = 0;
+  float eta = 1;  // relative index of refraction across the boundary, 1 for reflection
+  bool is_specular() const { return flags & kSpecular; }
+  bool is_transmission() const { return flags & kTransmission; }
+};
+
+// f(wo, wi); zero for delta lobes.
+Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
+// Density with which bsdf_sample returns wi; zero for delta lobes.
+float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
+// uc picks among lobes, u picks the direction.
+std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode);
+// All lobes of the material are delta lobes (no use in next-event estimation).
+bool bsdf_is_specular(const Material& m);
+// True when the material has a non-delta lobe (a diffuse vertex in DESIGN.md's sense).
+inline bool bsdf_has_nonspecular(const Material& m) { return !bsdf_is_specular(m); }
+
+// Fresnel reflectance of a dielectric boundary; cos_i may be negative (ray from inside).
+float fresnel_dielectric(float cos_theta_i, float eta);
+// Fresnel reflectance of a conductor with complex index eta + i k, per channel.
+Spectrum fresnel_complex(float cos_theta_i, const Spectrum& eta, const Spectrum& k);
+
+}  // namespace bpm

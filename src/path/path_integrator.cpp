@@ -1,0 +1,118 @@
+#include "path/path_integrator.h"
+
+#include <cmath>
+
+#include "base/sampling.h"
+
+namespace bpm {
+namespace {
+
+// Direct light at a non-specular vertex by sampling one light (Veach 1997, 9.2.4).
+Spectrum sample_direct(const RenderScene& scene, const SurfacePoint& sp, const Material& m,
+                       const Frame& frame, Vec3 wo_local, Rng& rng, PathCounters& counters) {
+  if (scene.lights.empty()) return {};
+  float pmf;
+  float ul = rng.uniform();
+  int li = scene.light_distribution.sample(ul, &pmf);
+  const Light& light = scene.lights[li];
+  Vec2 u{rng.uniform(), rng.uniform()};
+  auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info);
+  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
+  Vec3 wi_local = frame.to_local(ls->wi);
+  Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
+  if (f.is_black()) return {};
+  ++counters.shadow_rays;
+  Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi);
+  Vec3 target = ls->is_delta && !ls->is_infinite ? ls->p_light
+                                                 : (ls->n_light.x == 0 && ls->n_light.y == 0 && ls->n_light.z == 0
+                                                        ? ls->p_light
+                                                        : offset_origin(ls->p_light, ls->n_light, -ls->wi));
+  if (scene.occluded(origin, target)) return {};
+  float p_light = pmf * ls->pdf_solid_angle;
+  if (ls->is_delta) return ls->radiance * f / p_light;
+  float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance);
+  return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
+}
+
+}  // namespace
+
+Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, Rng& rng,
+                       PathCounters& counters) {
+  Spectrum L, beta(1.0f);
+  bool specular_bounce = false;
+  float eta_scale = 1;
+  float prev_pdf_bsdf = 0;
+  Vec3 prev_p;
+  int depth = 0;
+  ++counters.camera_rays;
+  for (int guard = 0; guard < 10000; ++guard) {
+    Hit hit;
+    if (!scene.intersect(ray, &hit)) {
+      for (int li : scene.infinite_lights) {
+        const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
+        if (!inf) continue;
+        if (depth == 0 || specular_bounce) {
+          L += beta * inf->radiance;
+        } else {
+          float p_l = scene.light_distribution.pmf(li) * kUniformSpherePdfSolidAngle;
+          L += beta * inf->radiance * power_heuristic(prev_pdf_bsdf, p_l);
+        }
+      }
+      break;
+    }
+    SurfacePoint sp = scene.surface(ray, hit);
+    Vec3 wo = -ray.d;
+    int light_index = scene.light_of_hit(hit);
+    if (light_index >= 0) {
+      const AreaLight& al = std::get<AreaLight>(scene.lights[light_index]);
+      Spectrum Le = area_light_radiance(al, sp.ng, wo);
+      if (!Le.is_black()) {
+        if (depth == 0 || specular_bounce) {
+          L += beta * Le;
+        } else {
+          const Light& light = scene.lights[light_index];
+          float p_l = scene.light_distribution.pmf(light_index) *
+                      light_pdf_li(light, scene.light_shape(light), prev_p, ray.d, sp.p, sp.ng);
+          L += beta * Le * power_heuristic(prev_pdf_bsdf, p_l);
+        }
+      }
+    }
+    const Material& m = scene.materials[scene.objects[hit.object].material];
+    if (std::holds_alternative<InterfaceMaterial>(m)) {
+      // A boundary that does not scatter: continue the same ray past it.
+      ray = spawn_ray(sp, ray.d);
+      ++counters.bounce_rays;
+      continue;
+    }
+    if (depth++ == settings.max_depth) break;
+    Frame frame = Frame::from_z(sp.ns);
+    Vec3 wo_local = frame.to_local(wo);
+    if (wo_local.z == 0) break;
+    if (!bsdf_is_specular(m)) L += beta * sample_direct(scene, sp, m, frame, wo_local, rng, counters);
+
+    float uc = rng.uniform();
+    Vec2 u{rng.uniform(), rng.uniform()};
+    auto bs = bsdf_sample(m, wo_local, uc, u, TransportMode::kRadiance);
+    if (!bs) break;
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+    specular_bounce = bs->is_specular();
+    prev_pdf_bsdf = bs->pdf_solid_angle;
+    if (bs->is_transmission()) eta_scale *= bs->eta * bs->eta;
+    prev_p = sp.p;
+    Vec3 wi = frame.to_world(bs->wi);
+    ray = spawn_ray(sp, wi);
+    ++counters.bounce_rays;
+    if (beta.is_black()) break;
+    // Russian roulette on the throughput without the radiance scaling of refraction
+    // (pbrt-v4's etaScale), after the first two bounces.
+    Spectrum rr_beta = beta * eta_scale;
+    if (rr_beta.max_component() < 1 && depth > 1) {
+      float q = std::fmax(0.0f, 1 - rr_beta.max_component());
+      if (rng.uniform() < q) break;
+      beta /= 1 - q;
+    }
+  }
+  return L;
+}
+
+}  // namespace bpm

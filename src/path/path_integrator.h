@@ -1,0 +1,30 @@
+// Unidirectional path tracer: next-event estimation with multiple importance sampling (power
+// heuristic) against BSDF sampling, Russian roulette, lights chosen in proportion to power. It is
+// bpm's reference: its expectation equals pbrt-v4's PathIntegrator on the same scene.
+#pragma once
+#include <cstdint>
+
+#include "base/rng.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+struct PathCounters {
+  uint64_t camera_rays = 0, bounce_rays = 0, shadow_rays = 0;
+  void add(const PathCounters& o) {
+    camera_rays += o.camera_rays;
+    bounce_rays += o.bounce_rays;
+    shadow_rays += o.shadow_rays;
+  }
+  uint64_t total() const { return camera_rays + bounce_rays + shadow_rays; }
+};
+
+struct PathSettings {
+  int max_depth = 5;  // scattering events, as pbrt-v4's maxdepth
+};
+
+// Radiance arriving along -ray.d at the ray's origin.
+Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, Rng& rng,
+                       PathCounters& counters);
+
+}  // namespace bpm

@@ -1,0 +1,91 @@
+#include "render/renderer.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+
+#include "base/error.h"
+#include "camera/camera.h"
+
+namespace bpm {
+
+std::atomic<bool>& interrupt_flag() {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+
+namespace {
+void on_signal(int) { interrupt_flag().store(true); }
+}  // namespace
+
+void install_interrupt_handlers() {
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+}
+
+RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) {
+  if (opt.integrator != "path")
+    throw Error("integrator \"" + opt.integrator + "\" is not available in this build (available: path)");
+  std::unique_ptr<tbb::global_control> limit;
+  if (opt.threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
+
+  const int w = film->width(), h = film->height();
+  PerspectiveCamera camera(ls.camera, w, h);
+  Filter filter(ls.filter);
+  PathSettings ps{opt.max_depth};
+  const float max_value = ls.film.max_component_value;
+  tbb::enumerable_thread_specific<PathCounters> counters;
+  RenderStats stats;
+  auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  stats.stop_reason = "samples";
+
+  for (int pass = 0; pass < opt.spp; ++pass) {
+    if (interrupt_flag().load()) {
+      stats.stop_reason = "interrupted";
+      break;
+    }
+    if (opt.time_limit_s > 0 && pass > 0 && elapsed() >= opt.time_limit_s) {
+      stats.stop_reason = "time";
+      break;
+    }
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 16, 0, w, 16), [&](const tbb::blocked_range2d<int>& r) {
+      if (interrupt_flag().load(std::memory_order_relaxed)) return;
+      PathCounters& c = counters.local();
+      for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+        for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+          Rng rng(stream_key(opt.seed, uint64_t(pass), uint64_t(y) * w + x));
+          FilterSample fs = filter.sample({rng.uniform(), rng.uniform()});
+          Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
+          Vec2 u_lens{rng.uniform(), rng.uniform()};
+          Ray ray = camera.generate_ray(p_film, u_lens);
+          Spectrum L = path_radiance(ls.scene, ray, ps, rng, c);
+          if (!L.is_finite() || L.has_negative()) L = Spectrum();  // never let one sample poison a pixel
+          float m = L.max_component();
+          if (m > max_value) L *= max_value / m;
+          film->add_sample(x, y, L, fs.weight);
+          film->end_pass(x, y);
+        }
+    });
+    stats.passes = pass + 1;
+    if (opt.progress) {
+      double t = elapsed();
+      std::fprintf(stderr, "\rbpm: pass %d/%d  %.1f s  (%.2f s/pass)   ", pass + 1, opt.spp, t, t / (pass + 1));
+      std::fflush(stderr);
+    }
+  }
+  if (opt.progress) std::fprintf(stderr, "\n");
+  if (interrupt_flag().load()) stats.stop_reason = "interrupted";
+  stats.render_seconds = elapsed();
+  for (const PathCounters& c : counters) stats.rays.add(c);
+  stats.relative_error = film->relative_error();
+  return stats;
+}
+
+}  // namespace bpm

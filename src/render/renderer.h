@@ -1,0 +1,45 @@
+// The render loop: passes of one sample per pixel over tiles, in parallel with oneTBB, until the
+// sample budget, the time budget or an interrupt ends it. Every pixel sample draws from a random
+// stream keyed by (seed, pass, pixel), so the image does not depend on the number of threads.
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "film/film.h"
+#include "path/path_integrator.h"
+#include "scene/flatten.h"
+
+namespace bpm {
+
+struct RenderOptions {
+  std::string integrator = "path";
+  int spp = 16;
+  double time_limit_s = 0;  // 0: none
+  int threads = 0;          // 0: all hardware threads
+  uint64_t seed = 0;
+  int max_depth = 5;
+  bool progress = true;
+};
+
+struct StageTime {
+  std::string name;
+  double seconds = 0;
+};
+
+struct RenderStats {
+  int passes = 0;
+  std::string stop_reason;  // "samples", "time", "interrupted"
+  PathCounters rays;
+  double render_seconds = 0;
+  double relative_error = 0;  // eq. (4) over per-pass estimates
+};
+
+// Set by SIGINT/SIGTERM handlers; the loop stops at the next tile and the image so far is kept.
+std::atomic<bool>& interrupt_flag();
+void install_interrupt_handlers();
+
+RenderStats render(const LoadedScene& scene, const RenderOptions& options, Film* film);
+
+}  // namespace bpm

@@ -1,0 +1,204 @@
+// Embree 3 acceleration structure: one geometry per object (triangle meshes natively, spheres
+// and disks as user geometry with analytic intersection).
+#include <cmath>
+#include <limits>
+
+#include "base/error.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+namespace {
+
+void embree_error(void*, RTCError code, const char* str) {
+  // Embree reports misuse and allocation failures here; neither is recoverable mid-render.
+  std::fprintf(stderr, "Embree error %d: %s\n", int(code), str ? str : "");
+}
+
+struct UserShape {
+  const Shape* shape;
+};
+
+void user_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto* us = static_cast<const UserShape*>(args->geometryUserPtr);
+  Bounds3 b = world_bounds(*us->shape, 0);
+  args->bounds_o->lower_x = b.lo.x;
+  args->bounds_o->lower_y = b.lo.y;
+  args->bounds_o->lower_z = b.lo.z;
+  args->bounds_o->upper_x = b.hi.x;
+  args->bounds_o->upper_y = b.hi.y;
+  args->bounds_o->upper_z = b.hi.z;
+}
+
+double user_hit(const UserShape* us, RTCRayN* ray, unsigned N, unsigned i) {
+  Vec3 o(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i));
+  Vec3 d(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i));
+  double t0 = RTCRayN_tnear(ray, N, i), t1 = RTCRayN_tfar(ray, N, i);
+  if (auto* s = std::get_if<Sphere>(us->shape)) return intersect_sphere(*s, o, d, t0, t1);
+  return intersect_disk(std::get<Disk>(*us->shape), o, d, t0, t1);
+}
+
+void user_intersect(const RTCIntersectFunctionNArguments* args) {
+  const auto* us = static_cast<const UserShape*>(args->geometryUserPtr);
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    double t = user_hit(us, ray, args->N, i);
+    if (t <= 0) continue;
+    RTCRayN_tfar(ray, args->N, i) = float(t);
+    RTCHitN_Ng_x(hit, args->N, i) = 0;
+    RTCHitN_Ng_y(hit, args->N, i) = 0;
+    RTCHitN_Ng_z(hit, args->N, i) = 1;
+    RTCHitN_u(hit, args->N, i) = 0;
+    RTCHitN_v(hit, args->N, i) = 0;
+    RTCHitN_primID(hit, args->N, i) = args->primID;
+    RTCHitN_geomID(hit, args->N, i) = args->geomID;
+    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void user_occluded(const RTCOccludedFunctionNArguments* args) {
+  const auto* us = static_cast<const UserShape*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    if (user_hit(us, args->ray, args->N, i) > 0)
+      RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
+  }
+}
+
+}  // namespace
+
+class Accel {
+ public:
+  explicit Accel(const std::vector<Object>& objects) {
+    device_ = rtcNewDevice(nullptr);
+    if (!device_) throw Error("cannot create the Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+    scene_ = rtcNewScene(device_);
+    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    user_shapes_.reserve(objects.size());
+    for (size_t id = 0; id < objects.size(); ++id) {
+      const Object& obj = objects[id];
+      RTCGeometry g;
+      if (auto* m = std::get_if<TriangleMesh>(&obj.shape)) {
+        g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m->positions.data(), 0,
+                                   sizeof(Vec3), m->positions.size());
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->indices.data(), 0,
+                                   3 * sizeof(uint32_t), m->indices.size() / 3);
+        triangles_ += m->indices.size() / 3;
+      } else {
+        g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+        user_shapes_.push_back(UserShape{&obj.shape});
+        rtcSetGeometryUserPrimitiveCount(g, 1);
+        rtcSetGeometryUserData(g, &user_shapes_.back());
+        rtcSetGeometryBoundsFunction(g, user_bounds, nullptr);
+        rtcSetGeometryIntersectFunction(g, user_intersect);
+        rtcSetGeometryOccludedFunction(g, user_occluded);
+      }
+      rtcCommitGeometry(g);
+      unsigned gid = rtcAttachGeometry(scene_, g);
+      BPM_CHECK(gid == id);
+      rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(scene_);
+    RTCError err = rtcGetDeviceError(device_);
+    if (err != RTC_ERROR_NONE) throw Error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
+  }
+  ~Accel() {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+  }
+
+  bool intersect(const Ray& ray, Hit* hit) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = ray.o.x;
+    rh.ray.org_y = ray.o.y;
+    rh.ray.org_z = ray.o.z;
+    rh.ray.dir_x = ray.d.x;
+    rh.ray.dir_y = ray.d.y;
+    rh.ray.dir_z = ray.d.z;
+    rh.ray.tnear = 0;
+    rh.ray.tfar = ray.t_max;
+    rh.ray.time = 0;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene_, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit->object = int(rh.hit.geomID);
+    hit->primitive = int(rh.hit.primID);
+    hit->barycentric = {rh.hit.u, rh.hit.v};
+    hit->t = rh.ray.tfar;
+    return true;
+  }
+
+  bool occluded(const Ray& ray) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    r.org_x = ray.o.x;
+    r.org_y = ray.o.y;
+    r.org_z = ray.o.z;
+    r.dir_x = ray.d.x;
+    r.dir_y = ray.d.y;
+    r.dir_z = ray.d.z;
+    r.tnear = 0;
+    r.tfar = ray.t_max;
+    r.time = 0;
+    r.mask = ~0u;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(scene_, &ctx, &r);
+    return r.tfar < 0;
+  }
+
+  size_t triangles() const { return triangles_; }
+
+ private:
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  std::vector<UserShape> user_shapes_;
+  size_t triangles_ = 0;
+};
+
+RenderScene::RenderScene() = default;
+RenderScene::~RenderScene() = default;
+RenderScene::RenderScene(RenderScene&&) noexcept = default;
+RenderScene& RenderScene::operator=(RenderScene&&) noexcept = default;
+
+void RenderScene::commit() {
+  bounds = Bounds3();
+  for (const Object& o : objects)
+    for (int p = 0; p < primitive_count(o.shape); ++p) bounds.expand(world_bounds(o.shape, p));
+  if (bounds.empty()) bounds.expand(Vec3(0, 0, 0));
+  bounds_info.center = bounds.center();
+  bounds_info.radius = std::fmax(1e-3f, 0.5f * length(bounds.diagonal()));
+  std::vector<float> weights;
+  infinite_lights.clear();
+  for (size_t i = 0; i < lights.size(); ++i) {
+    weights.push_back(std::fmax(0.0f, light_power(lights[i], bounds_info).average()));
+    if (light_is_infinite(lights[i])) infinite_lights.push_back(int(i));
+  }
+  light_distribution = Distribution1D(weights);
+  accel_ = std::make_unique<Accel>(objects);
+}
+
+bool RenderScene::intersect(const Ray& ray, Hit* hit) const { return accel_->intersect(ray, hit); }
+bool RenderScene::occluded_ray(const Ray& ray) const { return accel_->occluded(ray); }
+bool RenderScene::occluded(Vec3 a, Vec3 b) const {
+  Vec3 d = b - a;
+  float len = length(d);
+  if (len == 0) return false;
+  return accel_->occluded(Ray{a, d / len, len * (1 - 1e-4f)});
+}
+size_t RenderScene::triangle_count() const { return accel_ ? accel_->triangles() : 0; }
+
+}  // namespace bpm

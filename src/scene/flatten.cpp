@@ -1,0 +1,469 @@
+#include "scene/flatten.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "scene/ply.h"
+#include "scene/spectra.h"
+
+namespace bpm {
+namespace {
+
+namespace fs = std::filesystem;
+
+float radians(float deg) { return deg * kPi / 180; }
+
+class Flattener {
+ public:
+  explicit Flattener(const ParsedScene& p) : parsed_(p) {
+    for (const TextureEntity& t : p.textures) textures_[t.texture_name] = &t;
+  }
+
+  LoadedScene run() {
+    LoadedScene out;
+    read_camera(&out);
+    read_film(&out);
+    read_filter(&out);
+    read_sampler_and_integrator(&out);
+    // Default material (pbrt-v4: diffuse, reflectance 0.5) is material 0.
+    scene().materials.push_back(DiffuseMaterial{});
+    for (const ShapeEntity& s : parsed_.shapes) add_shape(s, &out.scene);
+    for (const LightEntity& l : parsed_.lights) add_light(l, &out.scene);
+    out.scene.commit();
+    // Distant and infinite lights needed the scene bounds; nothing more to do after commit.
+    return out;
+  }
+
+ private:
+  const ParsedScene& parsed_;
+  std::map<std::string, const TextureEntity*> textures_;
+  std::map<int, int> anonymous_material_ids_;
+  std::map<std::string, int> named_material_ids_;
+  RenderScene* scene_ = nullptr;
+  RenderScene& scene() { return *scene_; }
+
+  // ---- camera, film, filter, sampler, integrator ----
+  void read_camera(LoadedScene* out) {
+    scene_ = &out->scene;
+    if (!parsed_.camera) {
+      out->camera.world_from_camera = Transform();
+      return;
+    }
+    const CameraEntity& c = *parsed_.camera;
+    if (c.name != "perspective")
+      throw Error(c.loc, "camera \"" + c.name + "\" is not supported (only perspective)");
+    out->camera.world_from_camera = c.camera_from_world.inverse();
+    out->camera.fov_degrees = c.params.get_float("fov", 90);
+    if (!(out->camera.fov_degrees > 0 && out->camera.fov_degrees < 180))
+      throw Error(c.loc, "fov must lie in (0, 180) degrees");
+    out->camera.lens_radius = c.params.get_float("lensradius", 0);
+    out->camera.focal_distance = c.params.get_float("focaldistance", 1e6f);
+    if (out->camera.lens_radius < 0) throw Error(c.loc, "lensradius must not be negative");
+    if (!(out->camera.focal_distance > 0)) throw Error(c.loc, "focaldistance must be positive");
+    auto sw = c.params.get_floats("screenwindow");
+    if (!sw.empty()) {
+      if (sw.size() != 4) throw Error(c.params.find_any("screenwindow")->loc, "screenwindow needs 4 values");
+      for (int i = 0; i < 4; ++i) out->camera.screen_window[i] = sw[i];
+    }
+    float open = c.params.get_float("shutteropen", 0), close = c.params.get_float("shutterclose", 1);
+    if (close < open) throw Error(c.loc, "shutterclose is before shutteropen");
+    out->film.imaging_ratio = close - open;
+    if (c.params.find_any("frameaspectratio"))
+      warning(c.params.find_any("frameaspectratio")->loc, "frameaspectratio is ignored; the film resolution sets the aspect");
+    c.params.find_any("frameaspectratio") ? (void)(c.params.find_any("frameaspectratio")->used = true) : (void)0;
+    c.params.warn_unused("camera");
+  }
+
+  void read_film(LoadedScene* out) {
+    const SceneEntity& f = parsed_.film;
+    if (f.name != "rgb") throw Error(f.loc, "film \"" + f.name + "\" is not supported (only rgb)");
+    out->film.width = f.params.get_int("xresolution", 1280);
+    out->film.height = f.params.get_int("yresolution", 720);
+    if (out->film.width <= 0 || out->film.height <= 0 || out->film.width > 65536 || out->film.height > 65536)
+      throw Error(f.loc, "film resolution must be between 1 and 65536 pixels per axis");
+    out->film.filename = f.params.get_string("filename", "pbrt.exr");
+    float iso = f.params.get_float("iso", 100);
+    if (!(iso > 0)) throw Error(f.loc, "iso must be positive");
+    out->film.imaging_ratio *= iso / 100;
+    std::string sensor = f.params.get_string("sensor", "cie1931");
+    if (sensor != "cie1931") throw Error(f.params.find_any("sensor")->loc, "sensor \"" + sensor + "\" is not supported (only cie1931)");
+    if (f.params.get_float("whitebalance", 0) != 0)
+      throw Error(f.params.find_any("whitebalance")->loc, "white balancing is not supported");
+    out->film.max_component_value = f.params.get_float("maxcomponentvalue", kInf);
+    if (auto* cw = f.params.find_any("cropwindow")) throw Error(cw->loc, "cropwindow is not supported");
+    if (auto* pb = f.params.find_any("pixelbounds")) throw Error(pb->loc, "pixelbounds is not supported");
+    f.params.get_bool("savefp16", true);  // bpm always writes 32-bit float EXR
+    f.params.warn_unused("film");
+  }
+
+  void read_filter(LoadedScene* out) {
+    const SceneEntity& f = parsed_.filter;
+    FilterSettings& s = out->filter;
+    float def = 0.5f;
+    if (f.name == "box") s.type = FilterType::kBox, def = 0.5f;
+    else if (f.name == "triangle") s.type = FilterType::kTriangle, def = 2;
+    else if (f.name == "gaussian") s.type = FilterType::kGaussian, def = 1.5f;
+    else if (f.name == "mitchell") s.type = FilterType::kMitchell, def = 2;
+    else if (f.name == "sinc") s.type = FilterType::kLanczos, def = 4;
+    else throw Error(f.loc, "pixel filter \"" + f.name + "\" is unknown");
+    s.radius = {f.params.get_float("xradius", def), f.params.get_float("yradius", def)};
+    if (!(s.radius.x > 0 && s.radius.y > 0)) throw Error(f.loc, "filter radius must be positive");
+    s.sigma = f.params.get_float("sigma", 0.5f);
+    s.b = f.params.get_float("B", 1.0f / 3);
+    s.c = f.params.get_float("C", 1.0f / 3);
+    s.tau = f.params.get_float("tau", 3);
+    f.params.warn_unused("pixel filter");
+  }
+
+  void read_sampler_and_integrator(LoadedScene* out) {
+    const SceneEntity& s = parsed_.sampler;
+    static const char* samplers[] = {"zsobol", "sobol", "paddedsobol", "halton", "independent", "pmj02bn", "stratified"};
+    bool known = false;
+    for (const char* n : samplers) known = known || s.name == n;
+    if (!known) throw Error(s.loc, "sampler \"" + s.name + "\" is unknown");
+    out->render.spp = s.params.get_int("pixelsamples", 16);
+    if (s.name == "stratified")
+      out->render.spp = s.params.get_int("xsamples", 4) * s.params.get_int("ysamples", 4);
+    if (out->render.spp <= 0) throw Error(s.loc, "pixelsamples must be positive");
+    out->render.seed = s.params.get_int("seed", 0);
+    s.params.get_bool("jitter", true);
+    s.params.get_string("randomization", "");
+    s.params.warn_unused("sampler");
+
+    const SceneEntity& in = parsed_.integrator;
+    out->render.integrator_as_written = in.name;
+    out->render.max_depth = in.params.get_int("maxdepth", 5);
+    if (out->render.max_depth < 0) throw Error(in.loc, "maxdepth must not be negative");
+    if (in.name == "path" || in.name == "bpm" || in.name == "fpm") {
+      out->render.integrator = in.name;
+    } else if (in.name == "volpath" || in.name == "bdpt" || in.name == "mlt" || in.name == "sppm" ||
+               in.name == "simplepath" || in.name == "lightpath" || in.name == "randomwalk" ||
+               in.name == "simplevolpath") {
+      // These estimate the same image for scenes without media; bpm's reference for them is path.
+      out->render.integrator = "path";
+      if (parsed_.integrator_given)
+        warning(in.loc, "integrator \"" + in.name + "\" is rendered with bpm's \"path\" integrator (same image for surfaces)");
+    } else {
+      throw Error(in.loc, "integrator \"" + in.name + "\" is not supported");
+    }
+    for (const Param& p : in.params.all()) p.used = true;  // integrator-specific knobs are advisory
+  }
+
+  // ---- materials ----
+  std::optional<Spectrum> spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
+    const Param* p = ps.find_any(name);
+    if (p && p->type == "texture") {
+      p->used = true;
+      auto it = textures_.find(p->strings[0]);
+      if (it == textures_.end()) throw Error(p->loc, "unknown texture \"" + p->strings[0] + "\"");
+      const TextureEntity& t = *it->second;
+      if (t.name != "constant")
+        throw Error(p->loc, "texture \"" + p->strings[0] + "\" of class \"" + t.name + "\" is not supported (only constant textures)");
+      if (t.value_type == "float") {
+        float v = t.params.get_float("value", 1);
+        return Spectrum(v);
+      }
+      auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
+      return v ? *v : Spectrum(1.0f);
+    }
+    return get_spectrum(ps, name, kind, parsed_.base_directory);
+  }
+  float float_param(const ParamSet& ps, const std::string& name, float def) {
+    const Param* p = ps.find_any(name);
+    if (p && p->type == "texture") {
+      p->used = true;
+      auto it = textures_.find(p->strings[0]);
+      if (it == textures_.end()) throw Error(p->loc, "unknown texture \"" + p->strings[0] + "\"");
+      if (it->second->name != "constant" || it->second->value_type != "float")
+        throw Error(p->loc, "texture \"" + p->strings[0] + "\" is not a constant float texture");
+      return it->second->params.get_float("value", 1);
+    }
+    return ps.get_float(name, def);
+  }
+
+  Roughness roughness(const ParamSet& ps, const FileLoc& loc) {
+    float r = float_param(ps, "roughness", 0);
+    float u = ps.find_any("uroughness") ? float_param(ps, "uroughness", r) : r;
+    float v = ps.find_any("vroughness") ? float_param(ps, "vroughness", r) : r;
+    if (u < 0 || v < 0) throw Error(loc, "roughness must not be negative");
+    if (ps.get_bool("remaproughness", true)) {
+      u = std::sqrt(u);  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha
+      v = std::sqrt(v);
+    }
+    return Roughness{u, v};
+  }
+
+  Material make_material(const SceneEntity& e) {
+    const ParamSet& ps = e.params;
+    for (const char* unsupported : {"displacement", "normalmap"})
+      if (auto* p = ps.find_any(unsupported)) throw Error(p->loc, std::string(unsupported) + " is not supported");
+    Material m;
+    if (e.name == "diffuse") {
+      DiffuseMaterial d;
+      if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
+      m = d;
+    } else if (e.name == "conductor") {
+      ConductorMaterial c;
+      if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) {
+        // pbrt-v4: a reflectance is turned into k with eta = 1.
+        c.eta = Spectrum(1.0f);
+        for (int i = 0; i < 3; ++i) {
+          float rr = std::clamp((*r)[i], 0.0f, 0.9999f);
+          c.k[i] = 2 * std::sqrt(rr) / std::sqrt(1 - rr);
+        }
+        if (ps.find_any("eta") || ps.find_any("k")) throw Error(e.loc, "conductor has both reflectance and eta/k");
+      } else {
+        c.eta = spectrum_param(ps, "eta", SpectrumKind::kUnbounded).value_or(*named_spectrum_rgb("metal-Cu-eta", SpectrumKind::kUnbounded));
+        c.k = spectrum_param(ps, "k", SpectrumKind::kUnbounded).value_or(*named_spectrum_rgb("metal-Cu-k", SpectrumKind::kUnbounded));
+      }
+      c.roughness = roughness(ps, e.loc);
+      m = c;
+    } else if (e.name == "dielectric" || e.name == "thindielectric") {
+      float eta = 1.5f;
+      const Param* p = ps.find_any("eta");
+      if (p && p->type == "float") {
+        eta = ps.get_float("eta", 1.5f);
+      } else if (p) {
+        Spectrum s = *spectrum_param(ps, "eta", SpectrumKind::kUnbounded);
+        if (s.max_component() - s.min_component() > 1e-4f)
+          warning(p->loc, "a wavelength-dependent eta is reduced to its green value (no dispersion)");
+        eta = s[1];
+      }
+      if (!(eta > 0)) throw Error(p ? p->loc : e.loc, "eta must be positive");
+      if (e.name == "dielectric") m = DielectricMaterial{eta, roughness(ps, e.loc)};
+      else m = ThinDielectricMaterial{eta};
+    } else if (e.name == "diffusetransmission") {
+      DiffuseTransmissionMaterial d;
+      if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
+      if (auto t = spectrum_param(ps, "transmittance", SpectrumKind::kAlbedo)) d.transmittance = *t;
+      float s = ps.get_float("scale", 1);
+      d.reflectance *= s;
+      d.transmittance *= s;
+      if ((d.reflectance + d.transmittance).max_component() > 1.0001f)
+        throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
+      m = d;
+    } else if (e.name == "interface" || e.name == "" || e.name == "none") {
+      m = InterfaceMaterial{};
+    } else {
+      throw Error(e.loc, "material \"" + e.name + "\" is not supported");
+    }
+    ps.find_any("type") ? (void)(ps.find_any("type")->used = true) : (void)0;
+    ps.warn_unused("material \"" + e.name + "\"");
+    return m;
+  }
+
+  int material_id(const MaterialRef& ref) {
+    if (!ref.named.empty()) {
+      auto it = named_material_ids_.find(ref.named);
+      if (it != named_material_ids_.end()) return it->second;
+      auto e = parsed_.named_materials.find(ref.named);
+      if (e == parsed_.named_materials.end()) throw Error(ref.loc, "unknown named material \"" + ref.named + "\"");
+      scene().materials.push_back(make_material(e->second));
+      return named_material_ids_[ref.named] = int(scene().materials.size()) - 1;
+    }
+    if (ref.index < 0) return 0;
+    auto it = anonymous_material_ids_.find(ref.index);
+    if (it != anonymous_material_ids_.end()) return it->second;
+    scene().materials.push_back(make_material(parsed_.materials[ref.index]));
+    return anonymous_material_ids_[ref.index] = int(scene().materials.size()) - 1;
+  }
+
+  // ---- shapes ----
+  static void check_indices(const std::vector<int>& idx, size_t n, const FileLoc& loc) {
+    for (int i : idx)
+      if (i < 0 || size_t(i) >= n)
+        throw Error(loc, "vertex index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
+  }
+
+  TriangleMesh mesh_from(const Transform& xf, bool flip, std::vector<Vec3> P, std::vector<Vec3> N,
+                         std::vector<Vec2> uv, const std::vector<int>& idx) {
+    TriangleMesh m;
+    m.positions.reserve(P.size() + 2);  // Embree reads vertex buffers in 16-byte chunks
+    for (Vec3 p : P) m.positions.push_back(xf.point(p));
+    for (Vec3 n : N) m.normals.push_back(normalize(xf.normal(n)));
+    m.uvs = std::move(uv);
+    m.indices.assign(idx.begin(), idx.end());
+    m.flip_normal = flip;
+    return m;
+  }
+
+  void add_shape(const ShapeEntity& s, RenderScene* rs) {
+    const ParamSet& ps = s.params;
+    bool flip = s.reverse_orientation != s.world_from_object.swaps_handedness();
+    if (auto* a = ps.find_any("alpha")) {
+      if (!(a->type == "float" && a->numbers.size() == 1 && a->numbers[0] == 1))
+        throw Error(a->loc, "alpha cut-outs are not supported");
+      a->used = true;
+    }
+    for (const char* ignored : {"emission", "faceIndices"})
+      if (auto* p = ps.find_any(ignored)) p->used = true;
+    Object obj;
+    obj.source = s.loc.str();
+    if (s.name == "trianglemesh" || s.name == "bilinearmesh") {
+      bool bilinear = s.name == "bilinearmesh";
+      auto P = ps.get_point3s("P");
+      if (P.empty()) throw Error(s.loc, s.name + " has no \"point3 P\"");
+      auto idx = ps.get_ints("indices");
+      size_t per = bilinear ? 4 : 3;
+      if (idx.empty()) {
+        if (P.size() != per) throw Error(s.loc, s.name + " has no \"integer indices\"");
+        for (size_t i = 0; i < per; ++i) idx.push_back(int(i));
+      }
+      const FileLoc& iloc = ps.find_any("indices") ? ps.find_any("indices")->loc : s.loc;
+      if (idx.size() % per != 0)
+        throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of " + std::to_string(per));
+      check_indices(idx, P.size(), iloc);
+      auto N = ps.get_normals("N");
+      auto uv = ps.get_point2s("uv");
+      if (uv.empty()) uv = ps.get_point2s("st");
+      if (!N.empty() && N.size() != P.size())
+        throw Error(ps.find_any("N")->loc, "\"N\" has " + std::to_string(N.size()) + " normals for " + std::to_string(P.size()) + " vertices");
+      if (!uv.empty() && uv.size() != P.size())
+        throw Error(ps.find_any("uv") ? ps.find_any("uv")->loc : s.loc, "\"uv\" count differs from the vertex count");
+      if (auto* S = ps.find_any("S")) {
+        S->used = true;
+        warning(S->loc, "per-vertex tangents \"S\" are ignored");
+      }
+      if (bilinear) idx = bilinear_to_triangles(P, idx, s.loc);
+      obj.shape = mesh_from(s.world_from_object, flip, P, N, uv, idx);
+    } else if (s.name == "plymesh") {
+      std::string file = ps.get_string("filename", "");
+      if (file.empty()) throw Error(s.loc, "plymesh has no \"string filename\"");
+      if (auto* d = ps.find_any("displacement")) throw Error(d->loc, "displacement is not supported");
+      ps.get_float("edgelength", 1);
+      fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(s.directory) / file;
+      PlyMesh ply = read_ply(path.string(), ps.find_any("filename")->loc);
+      obj.shape = mesh_from(s.world_from_object, flip, ply.positions, ply.normals, ply.uvs, ply.indices);
+    } else if (s.name == "sphere") {
+      Sphere sp;
+      sp.world_from_object = s.world_from_object;
+      sp.radius = ps.get_float("radius", 1);
+      if (!(sp.radius > 0)) throw Error(s.loc, "sphere radius must be positive");
+      sp.z_min = std::clamp(ps.get_float("zmin", -sp.radius), -sp.radius, sp.radius);
+      sp.z_max = std::clamp(ps.get_float("zmax", sp.radius), -sp.radius, sp.radius);
+      if (sp.z_min > sp.z_max) std::swap(sp.z_min, sp.z_max);
+      sp.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
+      sp.flip_normal = flip;
+      obj.shape = sp;
+    } else if (s.name == "disk") {
+      Disk d;
+      d.world_from_object = s.world_from_object;
+      d.height = ps.get_float("height", 0);
+      d.radius = ps.get_float("radius", 1);
+      d.inner_radius = ps.get_float("innerradius", 0);
+      if (!(d.radius > 0) || d.inner_radius < 0 || d.inner_radius >= d.radius)
+        throw Error(s.loc, "disk needs 0 <= innerradius < radius");
+      d.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
+      d.flip_normal = flip;
+      obj.shape = d;
+    } else {
+      throw Error(s.loc, "shape \"" + s.name + "\" is not supported");
+    }
+    ps.warn_unused("shape \"" + s.name + "\"");
+    obj.material = material_id(s.material);
+    int id = int(rs->objects.size());
+    if (s.area_light) add_area_light(*s.area_light, &obj, id, rs);
+    rs->objects.push_back(std::move(obj));
+  }
+
+  static std::vector<int> bilinear_to_triangles(const std::vector<Vec3>& P, const std::vector<int>& idx, const FileLoc& loc) {
+    std::vector<int> tris;
+    for (size_t i = 0; i < idx.size(); i += 4) {
+      int a = idx[i], b = idx[i + 1], c = idx[i + 2], d = idx[i + 3];  // p00 p10 p01 p11
+      Vec3 n = cross(P[b] - P[a], P[c] - P[a]);
+      float size = std::fmax(length(P[b] - P[a]), length(P[c] - P[a]));
+      float ln = length(n);
+      if (ln > 0 && std::fabs(dot(P[d] - P[a], n / ln)) > 1e-4f * size)
+        throw Error(loc, "non-planar bilinear patches are not supported (patch " + std::to_string(i / 4) + ")");
+      int t[6] = {a, b, d, a, d, c};
+      tris.insert(tris.end(), t, t + 6);
+    }
+    return tris;
+  }
+
+  void add_area_light(const SceneEntity& a, Object* obj, int id, RenderScene* rs) {
+    if (a.name != "diffuse") throw Error(a.loc, "area light \"" + a.name + "\" is not supported");
+    const ParamSet& ps = a.params;
+    if (auto* f = ps.find_any("filename")) throw Error(f->loc, "image area lights are not supported");
+    Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+    float scale = ps.get_float("scale", 1);
+    bool two_sided = ps.get_bool("twosided", false);
+    float power = ps.get_float("power", -1);
+    ps.warn_unused("area light");
+    if (std::holds_alternative<Sphere>(obj->shape) || std::holds_alternative<Disk>(obj->shape)) {
+      const Transform& xf = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).world_from_object
+                                                                        : std::get<Disk>(obj->shape).world_from_object;
+      bool full = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).is_full()
+                                                             : std::get<Disk>(obj->shape).is_full();
+      if (!xf.is_similarity() || !full)
+        throw Error(a.loc, "emitting spheres and disks must be whole and not non-uniformly scaled");
+    }
+    obj->first_light = int(rs->lights.size());
+    for (int p = 0; p < primitive_count(obj->shape); ++p) {
+      AreaLight l;
+      l.object = id;
+      l.primitive = p;
+      l.two_sided = two_sided;
+      l.area = primitive_area(obj->shape, p);
+      float s = scale;
+      // pbrt-v4 applies "power" to each shape it creates, i.e. to each triangle of a mesh.
+      if (power > 0 && l.area > 0) s *= power / (kPi * (two_sided ? 2 : 1) * l.area);
+      l.radiance = L * s;
+      rs->lights.push_back(l);
+    }
+  }
+
+  // ---- light sources ----
+  void add_light(const LightEntity& e, RenderScene* rs) {
+    const ParamSet& ps = e.params;
+    const Transform& xf = e.world_from_light;
+    float scale = ps.get_float("scale", 1);
+    if (e.name == "point") {
+      Spectrum I = get_spectrum(ps, "I", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      float power = ps.get_float("power", -1);
+      if (power > 0) scale *= power / (4 * kPi);
+      rs->lights.push_back(PointLight{xf.point(ps.get_point3("from", Vec3(0, 0, 0))), I * scale});
+    } else if (e.name == "spot") {
+      Spectrum I = get_spectrum(ps, "I", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      Vec3 from = ps.get_point3("from", Vec3(0, 0, 0)), to = ps.get_point3("to", Vec3(0, 0, 1));
+      if (length(to - from) == 0) throw Error(e.loc, "spot light with from == to");
+      float cone = ps.get_float("coneangle", 30), delta = ps.get_float("conedelta", 5);
+      SpotLight l;
+      l.position = xf.point(from);
+      l.frame = Frame::from_z(normalize(xf.vector(to - from)));
+      l.cos_falloff_end = std::cos(radians(cone));
+      l.cos_falloff_start = std::cos(radians(cone - delta));
+      float power = ps.get_float("power", -1);
+      if (power > 0)
+        scale *= power / (2 * kPi * ((1 - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2));
+      l.intensity = I * scale;
+      rs->lights.push_back(l);
+    } else if (e.name == "distant") {
+      Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      Vec3 from = ps.get_point3("from", Vec3(0, 0, 0)), to = ps.get_point3("to", Vec3(0, 0, 1));
+      if (length(to - from) == 0) throw Error(e.loc, "distant light with from == to");
+      float E = ps.get_float("illuminance", -1);
+      if (E > 0) scale *= E;
+      rs->lights.push_back(DistantLight{normalize(xf.vector(from - to)), L * scale});
+    } else if (e.name == "infinite") {
+      if (auto* f = ps.find_any("filename")) throw Error(f->loc, "environment map lights are not supported");
+      if (auto* p = ps.find_any("portal")) throw Error(p->loc, "light portals are not supported");
+      Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      float E = ps.get_float("illuminance", -1);
+      if (E > 0) scale *= E / kPi;
+      rs->lights.push_back(UniformInfiniteLight{L * scale});
+    } else {
+      throw Error(e.loc, "light \"" + e.name + "\" is not supported");
+    }
+    if (!(scale >= 0) || !std::isfinite(scale)) throw Error(e.loc, "light scale must be a non-negative number");
+    ps.warn_unused("light \"" + e.name + "\"");
+  }
+};
+
+}  // namespace
+
+LoadedScene flatten_scene(const ParsedScene& parsed) { return Flattener(parsed).run(); }
+
+}  // namespace bpm

@@ -1,0 +1,87 @@
+// The scene as the integrators see it: flat arrays of objects, materials and lights, plus one
+// Embree 3 scene in which geometry id == object id.
+#pragma once
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "base/sampling.h"
+#include "lights/light.h"
+#include "materials/material.h"
+#include "scene/shapes.h"
+
+namespace bpm {
+
+struct Object {
+  Shape shape;
+  int material = 0;
+  int first_light = -1;  // index of the area light of primitive 0; primitive i is first_light + i
+  std::string source;    // file:line of the Shape directive, for statistics and messages
+};
+
+struct Ray {
+  Vec3 o, d;
+  float t_max = kInf;
+};
+
+struct Hit {
+  int object = -1;
+  int primitive = -1;
+  Vec2 barycentric;
+  float t = 0;
+};
+
+class Accel;
+
+class RenderScene {
+ public:
+  RenderScene();
+  ~RenderScene();
+  RenderScene(RenderScene&&) noexcept;
+  RenderScene& operator=(RenderScene&&) noexcept;
+
+  std::vector<Object> objects;
+  std::vector<Material> materials;
+  std::vector<Light> lights;
+  std::vector<int> infinite_lights;
+  Distribution1D light_distribution;  // in proportion to power
+  Bounds3 bounds;
+  SceneBoundsInfo bounds_info;
+
+  // Builds the Embree scene and the light distribution; call once after filling the arrays.
+  void commit();
+
+  bool intersect(const Ray& ray, Hit* hit) const;
+  // True when something blocks the open segment between a and b.
+  bool occluded(Vec3 a, Vec3 b) const;
+  bool occluded_ray(const Ray& ray) const;
+  SurfacePoint surface(const Ray& ray, const Hit& hit) const {
+    return surface_point(objects[hit.object].shape, hit.primitive, hit.barycentric, ray.o + ray.d * hit.t);
+  }
+  const Shape* light_shape(const Light& l) const {
+    auto* a = std::get_if<AreaLight>(&l);
+    return a ? &objects[a->object].shape : nullptr;
+  }
+  int light_of_hit(const Hit& h) const {
+    int f = objects[h.object].first_light;
+    return f < 0 ? -1 : f + h.primitive;
+  }
+
+  // Embree counts.
+  size_t triangle_count() const;
+
+ private:
+  std::unique_ptr<Accel> accel_;
+};
+
+// Offsets a ray origin off the surface at p (normal n) toward direction w, to avoid
+// re-intersecting the surface it leaves.
+inline Vec3 offset_origin(Vec3 p, Vec3 n, Vec3 w) {
+  float eps = 2e-5f * (1 + max_abs_component(p));
+  return p + n * (dot(n, w) > 0 ? eps : -eps);
+}
+inline Ray spawn_ray(const SurfacePoint& sp, Vec3 w) { return Ray{offset_origin(sp.p, sp.ng, w), w, kInf}; }
+
+}  // namespace bpm

@@ -1,0 +1,157 @@
+#include "scene/shapes.h"
+
+#include <cmath>
+
+namespace bpm {
+namespace {
+
+struct DVec {
+  double x, y, z;
+};
+DVec to_object(const Transform& world_from_object, Vec3 v, bool point) {
+  const Matrix4& inv = world_from_object.inverse_matrix();
+  DVec r{0, 0, 0};
+  double* out[3] = {&r.x, &r.y, &r.z};
+  for (int i = 0; i < 3; ++i)
+    *out[i] = inv[i][0] * v.x + inv[i][1] * v.y + inv[i][2] * v.z + (point ? inv[i][3] : 0.0);
+  return r;
+}
+double phi_of(double x, double y) {
+  double phi = std::atan2(y, x);
+  return phi < 0 ? phi + 2 * M_PI : phi;
+}
+
+}  // namespace
+
+double intersect_sphere(const Sphere& s, Vec3 o_world, Vec3 d_world, double t_min, double t_max) {
+  DVec o = to_object(s.world_from_object, o_world, true);
+  DVec d = to_object(s.world_from_object, d_world, false);
+  double a = d.x * d.x + d.y * d.y + d.z * d.z;
+  double b = 2 * (d.x * o.x + d.y * o.y + d.z * o.z);
+  double c = o.x * o.x + o.y * o.y + o.z * o.z - double(s.radius) * s.radius;
+  // Numerically stable discriminant (Hearn and Baker's form, as pbrt-v4 uses).
+  DVec f{o.x - b / (2 * a) * d.x, o.y - b / (2 * a) * d.y, o.z - b / (2 * a) * d.z};
+  double fl2 = f.x * f.x + f.y * f.y + f.z * f.z;
+  double disc = 4 * a * (double(s.radius) * s.radius - fl2);
+  if (disc < 0) return -1;
+  double root = std::sqrt(disc);
+  double q = b < 0 ? -0.5 * (b - root) : -0.5 * (b + root);
+  double t0 = q / a, t1 = c / q;
+  if (t0 > t1) std::swap(t0, t1);
+  for (double t : {t0, t1}) {
+    if (!(t > t_min && t < t_max)) continue;
+    if (!s.is_full()) {
+      double px = o.x + t * d.x, py = o.y + t * d.y, pz = o.z + t * d.z;
+      if (px == 0 && py == 0) px = 1e-5 * s.radius;
+      if ((s.z_min > -s.radius && pz < s.z_min) || (s.z_max < s.radius && pz > s.z_max) ||
+          phi_of(px, py) > s.phi_max)
+        continue;
+    }
+    return t;
+  }
+  return -1;
+}
+
+double intersect_disk(const Disk& k, Vec3 o_world, Vec3 d_world, double t_min, double t_max) {
+  DVec o = to_object(k.world_from_object, o_world, true);
+  DVec d = to_object(k.world_from_object, d_world, false);
+  if (d.z == 0) return -1;
+  double t = (k.height - o.z) / d.z;
+  if (!(t > t_min && t < t_max)) return -1;
+  double px = o.x + t * d.x, py = o.y + t * d.y;
+  double r2 = px * px + py * py;
+  if (r2 > double(k.radius) * k.radius || r2 < double(k.inner_radius) * k.inner_radius) return -1;
+  if (k.phi_max < 2 * kPi && phi_of(px, py) > k.phi_max) return -1;
+  return t;
+}
+
+namespace {
+
+SurfacePoint mesh_point(const TriangleMesh& m, int prim, Vec2 b) {
+  uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1], i2 = m.indices[3 * prim + 2];
+  Vec3 p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
+  float b0 = 1 - b.x - b.y;
+  SurfacePoint sp;
+  sp.p = p0 * b0 + p1 * b.x + p2 * b.y;
+  Vec3 ng = cross(p0 - p2, p1 - p2);
+  float len = length(ng);
+  ng = len > 0 ? ng / len : Vec3(0, 0, 1);
+  if (m.flip_normal) ng = -ng;
+  sp.ng = sp.ns = ng;
+  if (!m.normals.empty()) {
+    Vec3 ns = m.normals[i0] * b0 + m.normals[i1] * b.x + m.normals[i2] * b.y;
+    if (length_squared(ns) > 0) {
+      sp.ns = normalize(ns);
+      sp.ng = face_forward(ng, sp.ns);
+    }
+  }
+  if (!m.uvs.empty()) {
+    Vec2 a = m.uvs[i0], c = m.uvs[i1], d = m.uvs[i2];
+    sp.uv = {a.x * b0 + c.x * b.x + d.x * b.y, a.y * b0 + c.y * b.x + d.y * b.y};
+  } else {
+    sp.uv = {b.x + b.y, b.y};  // pbrt-v4's default vertex uvs: (0,0), (1,0), (1,1)
+  }
+  return sp;
+}
+
+}  // namespace
+
+SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) {
+  if (auto* m = std::get_if<TriangleMesh>(&shape)) return mesh_point(*m, prim, bary);
+  SurfacePoint sp;
+  if (auto* s = std::get_if<Sphere>(&shape)) {
+    Vec3 po = s->world_from_object.inverse().point(p_hit);
+    float l = length(po);
+    if (l > 0) po = po * (s->radius / l);  // re-project onto the surface
+    sp.p = s->world_from_object.point(po);
+    Vec3 n = normalize(s->world_from_object.normal(po));
+    sp.ng = sp.ns = s->flip_normal ? -n : n;
+    float phi = float(phi_of(po.x, po.y));
+    float theta = std::acos(std::clamp(po.z / s->radius, -1.0f, 1.0f));
+    sp.uv = {phi / s->phi_max, theta / kPi};
+    return sp;
+  }
+  const Disk& k = std::get<Disk>(shape);
+  Vec3 po = k.world_from_object.inverse().point(p_hit);
+  po.z = k.height;
+  sp.p = k.world_from_object.point(po);
+  Vec3 n = normalize(k.world_from_object.normal(Vec3(0, 0, 1)));
+  sp.ng = sp.ns = k.flip_normal ? -n : n;
+  float r = std::sqrt(po.x * po.x + po.y * po.y);
+  sp.uv = {float(phi_of(po.x, po.y)) / k.phi_max, (k.radius - r) / (k.radius - k.inner_radius)};
+  return sp;
+}
+
+Bounds3 world_bounds(const Shape& shape, int prim) {
+  Bounds3 b;
+  if (auto* m = std::get_if<TriangleMesh>(&shape)) {
+    for (int j = 0; j < 3; ++j) b.expand(m->positions[m->indices[3 * prim + j]]);
+    return b;
+  }
+  const Transform* t;
+  Vec3 lo, hi;
+  if (auto* s = std::get_if<Sphere>(&shape)) {
+    t = &s->world_from_object;
+    lo = Vec3(-s->radius, -s->radius, std::fmax(s->z_min, -s->radius));
+    hi = Vec3(s->radius, s->radius, std::fmin(s->z_max, s->radius));
+  } else {
+    const Disk& k = std::get<Disk>(shape);
+    t = &k.world_from_object;
+    lo = Vec3(-k.radius, -k.radius, k.height);
+    hi = Vec3(k.radius, k.radius, k.height);
+  }
+  for (int c = 0; c < 8; ++c)
+    b.expand(t->point(Vec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z)));
+  // Pad so that analytic hits just on the box still count.
+  Vec3 pad = b.diagonal() * 1e-4f + Vec3(1e-6f, 1e-6f, 1e-6f);
+  b.lo = b.lo - pad;
+  b.hi = b.hi + pad;
+  return b;
+}
+
+int primitive_count(const Shape& shape) {
+  if (auto* m = std::get_if<TriangleMesh>(&shape)) return m->triangle_count();
+  return 1;
+}
+
+}  // namespace bpm

@@ -1,0 +1,60 @@
+// Render-time shapes: triangle meshes in world space, and analytic spheres and disks kept in
+// their object space (a tessellated sphere would bend caustics wrongly).
+#pragma once
+#include <variant>
+#include <vector>
+
+#include "base/transform.h"
+#include "base/vec.h"
+
+namespace bpm {
+
+struct TriangleMesh {
+  std::vector<Vec3> positions;  // world space
+  std::vector<Vec3> normals;    // world space, per vertex, or empty
+  std::vector<Vec2> uvs;        // per vertex, or empty
+  std::vector<uint32_t> indices;
+  // pbrt-v4: the geometric normal is cross(p0 - p2, p1 - p2), negated when ReverseOrientation
+  // and the transform's handedness say so, unless per-vertex normals decide its side.
+  bool flip_normal = false;
+  int triangle_count() const { return int(indices.size() / 3); }
+};
+
+struct Sphere {
+  Transform world_from_object;
+  float radius = 1;
+  float z_min = -1, z_max = 1;
+  float phi_max = 2 * kPi;  // radians
+  bool flip_normal = false;
+  bool is_full() const { return z_min <= -radius && z_max >= radius && phi_max >= 2 * kPi; }
+};
+
+struct Disk {
+  Transform world_from_object;
+  float height = 0, radius = 1, inner_radius = 0;
+  float phi_max = 2 * kPi;
+  bool flip_normal = false;
+  bool is_full() const { return inner_radius == 0 && phi_max >= 2 * kPi; }
+};
+
+using Shape = std::variant<TriangleMesh, Sphere, Disk>;
+
+// A point on a surface as the integrators see it.
+struct SurfacePoint {
+  Vec3 p;
+  Vec3 ng;  // geometric normal, on the side pbrt-v4's orientation rules give
+  Vec3 ns;  // shading normal, in ng's hemisphere
+  Vec2 uv;
+};
+
+// Analytic ray intersection in object space (double precision). Returns the ray parameter of
+// the nearest hit in (t_min, t_max) or a negative value.
+double intersect_sphere(const Sphere& s, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
+double intersect_disk(const Disk& d, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
+
+// Surface point of a hit: for meshes from the primitive and Embree's barycentrics (b1, b2).
+SurfacePoint surface_point(const Shape& shape, int prim, Vec2 barycentric, Vec3 p_hit);
+Bounds3 world_bounds(const Shape& shape, int prim);
+int primitive_count(const Shape& shape);
+
+}  // namespace bpm
