@@ -1,0 +1,154 @@
+// Analytic checks of the path integrator and of the render loop.
+#include <cmath>
+
+#include "camera/camera.h"
+#include "test_util.h"
+
+namespace bpm {
+namespace {
+
+using test::load;
+using test::render_film;
+
+// A convex diffuse object under a uniform environment L sees L over its whole hemisphere, so it
+// reflects exactly rho * L; the background shows L.
+TEST(PathIntegrator, ConvexDiffuseSphereUnderUniformSky) {
+  const float rho = 0.8f;
+  LoadedScene ls = load(R"(
+    LookAt 0 0 -4  0 0 0  0 1 0
+    Camera "perspective" "float fov" 30
+    Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.001 "float yradius" 0.001
+    Integrator "path" "integer maxdepth" 10
+    WorldBegin
+    LightSource "infinite" "rgb L" [1 1 1]
+    Material "diffuse" "rgb reflectance" [0.8 0.8 0.8]
+    Shape "sphere" "float radius" 1
+  )");
+  Film film = render_film(ls, 64);
+  Image img = film.image();
+  std::vector<float> rms = film.rms();
+  // Centre pixels see the sphere, corner pixels the sky.
+  for (int y = 6; y < 10; ++y)
+    for (int x = 6; x < 10; ++x) {
+      float v = img.at(x, y).average();
+      float sigma = rms[y * 16 + x];
+      EXPECT_NEAR(v, rho, 4 * sigma + 1e-4f) << x << "," << y;
+    }
+  EXPECT_NEAR(img.at(0, 0).average(), 1.0f, 1e-6f);
+}
+
+// White furnace: inside a closed emitting sphere of albedo rho, radiance is Le / (1 - rho)
+// everywhere (the Neumann series of the rendering equation). Exercises NEE, MIS between light
+// and BSDF sampling, and Russian roulette over many bounces.
+TEST(PathIntegrator, WhiteFurnaceEnclosure) {
+  const float Le = 0.5f, rho = 0.5f;
+  LoadedScene ls = load(R"(
+    LookAt 0 0 0  0 0 1  0 1 0
+    Camera "perspective" "float fov" 60
+    Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+    PixelFilter "box"
+    Integrator "path" "integer maxdepth" 200
+    WorldBegin
+    AreaLightSource "diffuse" "rgb L" [0.5 0.5 0.5] "bool twosided" true
+    Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+    Shape "sphere" "float radius" 3
+  )");
+  Film film = render_film(ls, 256);
+  Image img = film.image();
+  std::vector<float> rms = film.rms();
+  double sum = 0, var = 0;
+  for (int i = 0; i < 64; ++i) {
+    sum += img.at(i % 8, i / 8).average();
+    var += double(rms[i]) * rms[i];
+  }
+  double mean = sum / 64, sigma = std::sqrt(var) / 64;
+  EXPECT_NEAR(mean, Le / (1 - rho), 4 * sigma);
+  EXPECT_LT(sigma, 0.02);  // the test has power: the tolerance is tight relative to the answer
+}
+
+// A diffuse plane under a point light: L = rho/pi * I cos(theta) / d^2, exactly, at every pixel
+// (direct light from a delta light has no variance).
+TEST(PathIntegrator, PlaneUnderPointLight) {
+  const float rho = 0.6f, I = 3.0f, h = 2.0f;
+  LoadedScene ls = load(R"(
+    LookAt 0 5 -3  0 0 0  0 1 0
+    Camera "perspective" "float fov" 50
+    Film "rgb" "integer xresolution" 24 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+    Integrator "path" "integer maxdepth" 1
+    WorldBegin
+    LightSource "point" "rgb I" [3 3 3] "point3 from" [0.5 2 0.3]
+    Material "diffuse" "rgb reflectance" [0.6 0.6 0.6]
+    Shape "trianglemesh" "point3 P" [-50 0 -50  50 0 -50  50 0 50  -50 0 50]
+      "integer indices" [0 1 2 0 2 3]
+  )");
+  Film film = render_film(ls, 2);
+  Image img = film.image();
+  PerspectiveCamera cam(ls.camera, 24, 16);
+  Vec3 light(0.5f, h, 0.3f);
+  int checked = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 24; ++x) {
+      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+      if (r.d.y >= 0) continue;
+      Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
+      Vec3 to_light = light - p;
+      float d2 = length_squared(to_light);
+      float expected = rho / kPi * I * (to_light.y / std::sqrt(d2)) / d2;
+      EXPECT_NEAR(img.at(x, y)[0], expected, 2e-3f * expected) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 200);
+}
+
+// Same seed and budget give the same image whatever the number of threads.
+TEST(Renderer, SameImageWithOneAndTwoThreads) {
+  LoadedScene ls = load(R"(
+    LookAt 0.5 0.5 -1.2  0.5 0.5 0  0 1 0
+    Camera "perspective" "float fov" 45
+    Film "rgb" "integer xresolution" 40 "integer yresolution" 30
+    Integrator "path" "integer maxdepth" 6
+    WorldBegin
+    Material "diffuse" "rgb reflectance" [0.7 0.6 0.5]
+    Shape "bilinearmesh" "point3 P" [0 0 0  1 0 0  0 0 1  1 0 1]
+    Shape "bilinearmesh" "point3 P" [0 0 1  1 0 1  0 1 1  1 1 1]
+    Material "dielectric"
+    AttributeBegin
+      Translate 0.5 0.2 0.5
+      Shape "sphere" "float radius" 0.2
+    AttributeEnd
+    AttributeBegin
+      AreaLightSource "diffuse" "rgb L" [4 4 4]
+      Shape "bilinearmesh" "point3 P" [0.3 0.9 0.3  0.7 0.9 0.3  0.3 0.9 0.7  0.7 0.9 0.7]
+    AttributeEnd
+  )");
+  Image a = render_film(ls, 8, 1, 7).image();
+  Image b = render_film(ls, 8, 2, 7).image();
+  Image c = render_film(ls, 8, 2, 8).image();
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  EXPECT_EQ(a.rgb, b.rgb);
+  EXPECT_NE(a.rgb, c.rgb);  // and the seed matters
+}
+
+// Light emitted by a one-sided area light leaves only the side its normal faces.
+TEST(PathIntegrator, OneSidedAreaLightEmitsOnItsNormalSide) {
+  const char* tmpl = R"(
+    LookAt 0 0 -3  0 0 0  0 1 0
+    Camera "perspective" "float fov" 20
+    Film "rgb" "integer xresolution" 4 "integer yresolution" 4
+    PixelFilter "box"
+    WorldBegin
+    AreaLightSource "diffuse" "rgb L" [2 2 2]
+    %s
+    Shape "disk" "float radius" 5
+  )";
+  char a[1024], b[1024];
+  std::snprintf(a, sizeof a, tmpl, "Rotate 180 0 1 0");  // disk normal +z rotated to face the camera
+  std::snprintf(b, sizeof b, tmpl, "");
+  EXPECT_NEAR(render_film(load(a), 1).image().at(1, 1)[0], 2.0f, 1e-5f);
+  EXPECT_EQ(render_film(load(b), 1).image().at(1, 1)[0], 0.0f);
+}
+
+}  // namespace
+}  // namespace bpm
