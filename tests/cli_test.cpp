@@ -1,0 +1,165 @@
+// End-to-end tests of the bpm program: outputs, bad input, interruption.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "film/image_io.h"
+
+namespace bpm {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exit_code;
+  std::string err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("bpm_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  CliRun run(const std::string& args) {
+    std::string err = (dir_ / "stderr.txt").string();
+    std::string cmd = std::string(BPM_BINARY) + " " + args + " > /dev/null 2> " + err;
+    int status = std::system(cmd.c_str());
+    std::ifstream in(err);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+  }
+  std::string write(const std::string& name, const std::string& text) {
+    fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  // Only the input files and the captured stderr: no output, not even a temporary one.
+  std::vector<std::string> outputs() const {
+    std::vector<std::string> out;
+    for (auto& e : fs::directory_iterator(dir_)) {
+      std::string n = e.path().filename().string();
+      if (n != "stderr.txt" && e.path().extension() != ".pbrt") out.push_back(n);
+    }
+    return out;
+  }
+  fs::path dir_;
+};
+
+const char* kTinyScene = R"(
+LookAt 0 0 -3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 32 "integer yresolution" 24
+Sampler "independent" "integer pixelsamples" 4
+WorldBegin
+LightSource "point" "rgb I" [5 5 5] "point3 from" [0 2 -2]
+Material "diffuse"
+Shape "sphere" "float radius" 1
+)";
+
+TEST_F(Cli, RendersAllOutputs) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  CliRun r = run("render " + scene + " -q --spp 3 --seed 5 -o " + (dir_ / "out.exr").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"out.exr", "out.png", "out.error.png", "out.json"}) EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+  Image img = read_exr((dir_ / "out.exr").string());
+  EXPECT_EQ(img.width, 32);
+  EXPECT_EQ(img.height, 24);
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["result"]["passes"], 3);
+  EXPECT_EQ(rec["settings"]["seed"], 5);
+  EXPECT_EQ(rec["result"]["stop_reason"], "samples");
+  EXPECT_GT(rec["rays"]["total"].get<uint64_t>(), 32u * 24u * 3u);
+}
+
+TEST_F(Cli, ResolutionFlagOverridesTheFile) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  CliRun r = run("render " + scene + " -q --spp 1 --resolution 20x10 -o " + (dir_ / "out.exr").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Image img = read_exr((dir_ / "out.exr").string());
+  EXPECT_EQ(img.width, 20);
+  EXPECT_EQ(img.height, 10);
+}
+
+TEST_F(Cli, SceneErrorNamesFileLineAndWritesNothing) {
+  std::string scene = write("bad.pbrt", "WorldBegin\nShape \"sphere\" \"float radius\" [ -1 ]\n");
+  CliRun r = run("render " + scene + " -q -o " + (dir_ / "out.exr").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad.pbrt:2:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("radius"), std::string::npos) << r.err;
+  EXPECT_TRUE(outputs().empty());
+}
+
+TEST_F(Cli, TruncatedFileIsAnError) {
+  std::string scene = write("cut.pbrt", "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0");
+  CliRun r = run("render " + scene + " -q -o " + (dir_ / "out.exr").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("cut.pbrt:2:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("end of file"), std::string::npos) << r.err;
+  EXPECT_TRUE(outputs().empty());
+}
+
+TEST_F(Cli, MissingSceneFileIsAnError) {
+  CliRun r = run("render " + (dir_ / "nope.pbrt").string() + " -q");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("nope.pbrt"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, BadFlagsAreErrors) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  EXPECT_NE(run("render " + scene + " --spp 0").exit_code, 0);
+  EXPECT_NE(run("render " + scene + " --resolution 12").exit_code, 0);
+  EXPECT_NE(run("render " + scene + " --integrator magic").exit_code, 0);
+  EXPECT_NE(run("render " + scene + " -o out.png").exit_code, 0);
+  EXPECT_NE(run("render " + scene + " -o " + (dir_ / "no/such/dir/x.exr").string()).exit_code, 0);
+  EXPECT_NE(run("frobnicate").exit_code, 0);
+  EXPECT_TRUE(outputs().empty());
+}
+
+TEST_F(Cli, SigtermStillWritesTheImageSoFar) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  std::string out = (dir_ / "out.exr").string();
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    int devnull = ::open("/dev/null", 1);
+    dup2(devnull, 2);
+    execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--spp", "10000000", "-o", out.c_str(), nullptr);
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  ASSERT_TRUE(fs::exists(out));
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["result"]["stop_reason"], "interrupted");
+  EXPECT_GT(rec["result"]["passes"].get<int>(), 0);
+}
+
+TEST_F(Cli, CompareReportsMeans) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  std::string out = (dir_ / "out.exr").string();
+  ASSERT_EQ(run("render " + scene + " -q --spp 1 -o " + out).exit_code, 0);
+  CliRun r = run("compare " + out + " " + out);
+  EXPECT_EQ(r.exit_code, 0);
+}
+
+}  // namespace
+}  // namespace bpm
