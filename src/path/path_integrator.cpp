@@ -27,6 +27,11 @@ Spectrum sample_direct(const RenderScene& scene, const SurfacePoint& sp, const M
                                                  : (ls->n_light.x == 0 && ls->n_light.y == 0 && ls->n_light.z == 0
                                                         ? ls->p_light
                                                         : offset_origin(ls->p_light, ls->n_light, -ls->wi));
+  if (counters.log) {
+    Vec3 d = target - origin;
+    float len = length(d);
+    counters.log->shadow.push_back(Ray{origin, d / len, len * (1 - 1e-4f)});
+  }
   if (scene.occluded(origin, target)) return {};
   float p_light = pmf * ls->pdf_solid_angle;
   if (ls->is_delta) return ls->radiance * f / p_light;
@@ -47,6 +52,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
   ++counters.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
+    if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) {
       for (int li : scene.infinite_lights) {
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);

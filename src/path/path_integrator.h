@@ -3,14 +3,22 @@
 // bpm's reference: its expectation equals pbrt-v4's PathIntegrator on the same scene.
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "base/rng.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
 
+// Every ray a path traces, for benchmarks that replay them through bare Embree.
+struct RayLog {
+  std::vector<Ray> closest_hit;  // camera and bounce rays
+  std::vector<Ray> shadow;       // shadow rays (t_max is the segment length)
+};
+
 struct PathCounters {
   uint64_t camera_rays = 0, bounce_rays = 0, shadow_rays = 0;
+  RayLog* log = nullptr;  // null except in benchmarks
   void add(const PathCounters& o) {
     camera_rays += o.camera_rays;
     bounce_rays += o.bounce_rays;
