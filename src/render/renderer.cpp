@@ -8,6 +8,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <limits>
 
 #include "base/error.h"
 #include "camera/camera.h"
@@ -45,6 +46,7 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
   auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   stats.stop_reason = "samples";
+  double last_progress = -1;
 
   for (int pass = 0; pass < opt.spp; ++pass) {
     if (interrupt_flag().load()) {
@@ -74,9 +76,13 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
         }
     });
     stats.passes = pass + 1;
-    if (opt.progress) {
+    if (opt.progress && (elapsed() - last_progress >= 0.5 || pass + 1 == opt.spp)) {
       double t = elapsed();
-      std::fprintf(stderr, "\rbpm: pass %d/%d  %.1f s  (%.2f s/pass)   ", pass + 1, opt.spp, t, t / (pass + 1));
+      last_progress = t;
+      if (opt.spp == std::numeric_limits<int>::max())
+        std::fprintf(stderr, "\rbpm: pass %d  %.1f s of %.1f s   ", pass + 1, t, opt.time_limit_s);
+      else
+        std::fprintf(stderr, "\rbpm: pass %d/%d  %.1f s  (%.2f s/pass)   ", pass + 1, opt.spp, t, t / (pass + 1));
       std::fflush(stderr);
     }
   }

@@ -1,0 +1,1672 @@
+// Tests of the pbrt-v4 scene parser (parser.cpp, tokenizer.cpp, params.cpp), of the checks that
+// flatten.cpp applies while turning the parsed scene into the render scene, of spectrum parameters
+// (spectra.cpp) and of the PLY reader (ply.cpp).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "base/error.h"
+#include "scene/flatten.h"
+#include "scene/parsed_scene.h"
+#include "scene/ply.h"
+#include "scene/spectra.h"
+
+namespace bpm {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+
+// The Error message that parsing and flattening scene_text produces, or "" when both succeed.
+std::string error_of(const std::string& scene_text, const std::string& directory = ".") {
+  try {
+    ParsedScene parsed = parse_scene_string(scene_text, directory);
+    (void)flatten_scene(parsed);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The Error message of parsing alone, or "" when parsing succeeds.
+std::string parse_error_of(const std::string& scene_text, const std::string& directory = ".") {
+  try {
+    (void)parse_scene_string(scene_text, directory);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// "<string>:LINE:COL", the location prefix of errors in in-memory scene text.
+std::string at(int line, int column) {
+  return "<string>:" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+// 1-based column at which needle starts in line (-1 when absent, which makes the test fail).
+int col(const std::string& line, const std::string& needle) {
+  size_t p = line.find(needle);
+  return p == std::string::npos ? -1 : int(p) + 1;
+}
+
+// The message starts with "WHERE: " and contains phrase.
+::testing::AssertionResult IsError(const std::string& message, const std::string& where,
+                                   const std::string& phrase) {
+  if (message.empty())
+    return ::testing::AssertionFailure() << "no error; expected \"" << where << ": ..." << phrase << "...\"";
+  if (!message.starts_with(where + ": "))
+    return ::testing::AssertionFailure() << "error \"" << message << "\" is not located at " << where;
+  if (message.find(phrase) == std::string::npos)
+    return ::testing::AssertionFailure() << "error \"" << message << "\" does not contain \"" << phrase << "\"";
+  return ::testing::AssertionSuccess();
+}
+
+::testing::AssertionResult Contains(const std::string& haystack, const std::string& needle) {
+  if (haystack.find(needle) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "\"" << haystack << "\" does not contain \"" << needle << "\"";
+}
+
+void expect_vec_near(Vec3 a, Vec3 b, float eps = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, eps);
+  EXPECT_NEAR(a.y, b.y, eps);
+  EXPECT_NEAR(a.z, b.z, eps);
+}
+
+void expect_spectrum_near(const Spectrum& a, const Spectrum& b, float eps = 1e-5f) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(a[i], b[i], eps) << "channel " << i;
+}
+
+Vec3 origin_of(const Transform& t) { return t.point(Vec3(0, 0, 0)); }
+
+// A fresh folder under the system temp directory, removed with its contents at the end.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = "bpm_parser_test_";
+    if (info) name += std::string(info->test_suite_name()) + "_" + info->name() + "_";
+    name += std::to_string(std::random_device{}());
+    path_ = fs::temp_directory_path() / name;
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const fs::path& path() const { return path_; }
+  std::string str() const { return path_.string(); }
+  fs::path write(const std::string& name, const std::string& content) const {
+    fs::path p = path_ / name;
+    fs::create_directories(p.parent_path());
+    std::ofstream out(p, std::ios::binary);
+    out << content;
+    return p;
+  }
+
+ private:
+  fs::path path_;
+};
+
+template <typename T>
+void put_le(std::string* s, T v) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) std::reverse(b, b + sizeof(T));
+  s->append(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+template <typename T>
+void put_be(std::string* s, T v) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if constexpr (std::endian::native == std::endian::little) std::reverse(b, b + sizeof(T));
+  s->append(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+const char* kTriangleP = R"("point3 P" [0 0 0  1 0 0  0 1 0])";
+
+const std::string kAsciiQuadPly =
+    "ply\n"
+    "format ascii 1.0\n"
+    "comment a unit quad\n"
+    "element vertex 4\n"
+    "property float x\n"
+    "property float y\n"
+    "property float z\n"
+    "element face 1\n"
+    "property list uchar int vertex_indices\n"
+    "end_header\n"
+    "0 0 0\n"
+    "1 0 0\n"
+    "1 1 0\n"
+    "0 1 0\n"
+    "4 0 1 2 3\n";
+
+// ---------------------------------------------------------------------------------------------
+// Directives
+
+TEST(SceneParse, MinimalSceneFlattens) {
+  ParsedScene p = parse_scene_string("WorldBegin\n");
+  EXPECT_FALSE(p.camera.has_value());
+  EXPECT_TRUE(p.shapes.empty());
+  EXPECT_EQ(p.film.name, "rgb");
+  EXPECT_EQ(p.sampler.name, "zsobol");
+  EXPECT_EQ(p.filter.name, "gaussian");
+  EXPECT_EQ(p.integrator.name, "volpath");
+  EXPECT_FALSE(p.integrator_given);
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_TRUE(ls.scene.objects.empty());
+  ASSERT_EQ(ls.scene.materials.size(), 1u);  // the default material
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(ls.scene.materials[0]));
+  expect_spectrum_near(std::get<DiffuseMaterial>(ls.scene.materials[0]).reflectance, Spectrum(0.5f));
+  EXPECT_EQ(ls.render.integrator, "path");
+  EXPECT_EQ(ls.film.width, 1280);
+  EXPECT_EQ(ls.film.height, 720);
+}
+
+TEST(SceneParse, CommentsAndLocations) {
+  ParsedScene p = parse_scene_string("# a comment\nWorldBegin # trailing\n\n   Shape \"sphere\" # x\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  EXPECT_EQ(p.shapes[0].loc.file, "<string>");
+  EXPECT_EQ(p.shapes[0].loc.line, 4);
+  EXPECT_EQ(p.shapes[0].loc.column, 4);
+  EXPECT_EQ(p.shapes[0].name, "sphere");
+}
+
+TEST(SceneParse, TranslateMovesShape) {
+  ParsedScene p = parse_scene_string("WorldBegin\nTranslate 1 2 3\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 2, 3));
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<Sphere>(ls.scene.objects[0].shape));
+  expect_vec_near(origin_of(std::get<Sphere>(ls.scene.objects[0].shape).world_from_object), Vec3(1, 2, 3));
+}
+
+TEST(SceneParse, BracketedTranslate) {
+  ParsedScene p = parse_scene_string("WorldBegin\nTranslate [ -1 +2 3.5e0 ]\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(-1, 2, 3.5f));
+}
+
+TEST(SceneParse, TransformsConcatenateInOrder) {
+  // Translate then Scale: the scale applies first to object points.
+  ParsedScene p = parse_scene_string("WorldBegin\nTranslate 1 0 0\nScale 2 3 4\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(p.shapes[0].world_from_object.point(Vec3(1, 1, 1)), Vec3(3, 3, 4));
+}
+
+TEST(SceneParse, Scale) {
+  ParsedScene p = parse_scene_string("WorldBegin\nScale 2 3 4\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(p.shapes[0].world_from_object.point(Vec3(1, 1, 1)), Vec3(2, 3, 4));
+}
+
+TEST(SceneParse, RotateDegreesAboutAxis) {
+  ParsedScene p = parse_scene_string("WorldBegin\nRotate 90 0 0 1\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(p.shapes[0].world_from_object.point(Vec3(1, 0, 0)), Vec3(0, 1, 0));
+  expect_vec_near(p.shapes[0].world_from_object.point(Vec3(0, 1, 0)), Vec3(-1, 0, 0));
+}
+
+TEST(SceneParse, LookAtMapsEyeToCameraOrigin) {
+  ParsedScene p = parse_scene_string(
+      "LookAt 1 2 3  1 2 10  0 1 0\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\n");
+  ASSERT_TRUE(p.camera.has_value());
+  EXPECT_EQ(p.camera->name, "perspective");
+  const Transform& cfw = p.camera->camera_from_world;
+  expect_vec_near(cfw.point(Vec3(1, 2, 3)), Vec3(0, 0, 0));
+  expect_vec_near(cfw.point(Vec3(1, 2, 10)), Vec3(0, 0, 7));  // looks down +z
+  expect_vec_near(cfw.point(Vec3(1, 3, 3)), Vec3(0, 1, 0));   // up is +y
+  expect_vec_near(cfw.point(Vec3(2, 2, 3)), Vec3(1, 0, 0));
+  LoadedScene ls = flatten_scene(p);
+  expect_vec_near(origin_of(ls.camera.world_from_camera), Vec3(1, 2, 3));
+  EXPECT_FLOAT_EQ(ls.camera.fov_degrees, 45);
+}
+
+TEST(SceneParse, TransformReadsColumnByColumn) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTranslate 100 0 0\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  // Transform replaces the current transform (the Translate is gone).
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(5, 6, 7));
+}
+
+TEST(SceneParse, TransformNonTranslationPart) {
+  // Columns: x axis -> (0 1 0), y axis -> (-1 0 0), z axis -> (0 0 1).
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTransform [0 1 0 0  -1 0 0 0  0 0 1 0  0 0 0 1]\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(p.shapes[0].world_from_object.point(Vec3(1, 0, 0)), Vec3(0, 1, 0));
+  expect_vec_near(p.shapes[0].world_from_object.point(Vec3(0, 1, 0)), Vec3(-1, 0, 0));
+}
+
+TEST(SceneParse, ConcatTransformMultiplies) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTranslate 1 0 0\nConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(6, 6, 7));
+}
+
+TEST(SceneParse, IdentityResets) {
+  ParsedScene p = parse_scene_string("WorldBegin\nTranslate 1 2 3\nIdentity\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  EXPECT_TRUE(p.shapes[0].world_from_object.is_identity());
+}
+
+TEST(SceneParse, WorldBeginResetsTransform) {
+  ParsedScene p = parse_scene_string("Translate 1 2 3\nWorldBegin\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  EXPECT_TRUE(p.shapes[0].world_from_object.is_identity());
+}
+
+TEST(SceneParse, CoordinateSystemAndCoordSysTransform) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTranslate 1 0 0\nCoordinateSystem \"a\"\nIdentity\nTranslate 0 5 0\n"
+      "CoordSysTransform \"a\"\nShape \"sphere\"\nCoordSysTransform \"world\"\nShape \"disk\"\n");
+  ASSERT_EQ(p.shapes.size(), 2u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 0, 0));
+  EXPECT_TRUE(p.shapes[1].world_from_object.is_identity());
+}
+
+TEST(SceneParse, CameraCoordinateSystem) {
+  ParsedScene p = parse_scene_string(
+      "LookAt 1 2 3  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nCoordSysTransform \"camera\"\n"
+      "Shape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 2, 3));
+}
+
+TEST(SceneParse, ReverseOrientationIsPartOfAttributes) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nAttributeBegin\nReverseOrientation\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 2u);
+  EXPECT_TRUE(p.shapes[0].reverse_orientation);
+  EXPECT_FALSE(p.shapes[1].reverse_orientation);
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 2u);
+  EXPECT_TRUE(std::get<Sphere>(ls.scene.objects[0].shape).flip_normal);
+  EXPECT_FALSE(std::get<Sphere>(ls.scene.objects[1].shape).flip_normal);
+}
+
+TEST(SceneParse, ReverseOrientationAndMirrorCancel) {
+  ParsedScene p = parse_scene_string("WorldBegin\nScale -1 1 1\nReverseOrientation\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  EXPECT_TRUE(p.shapes[0].world_from_object.swaps_handedness());
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_FALSE(std::get<Sphere>(ls.scene.objects[0].shape).flip_normal);
+}
+
+TEST(SceneParse, AttributeBeginEndRestoresTransformAndMaterial) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nAttributeBegin\nTranslate 1 0 0\nMaterial \"conductor\"\nShape \"sphere\"\n"
+      "AttributeEnd\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 2u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 0, 0));
+  EXPECT_EQ(p.shapes[0].material.index, 0);
+  EXPECT_TRUE(p.shapes[1].world_from_object.is_identity());
+  EXPECT_EQ(p.shapes[1].material.index, -1);
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 2u);
+  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(ls.scene.materials[ls.scene.objects[0].material]));
+  EXPECT_EQ(ls.scene.objects[1].material, 0);  // the default diffuse material
+}
+
+TEST(SceneParse, TransformBeginEndRestoresOnlyTransform) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTransformBegin\nTranslate 1 0 0\nMaterial \"conductor\"\nReverseOrientation\n"
+      "TransformEnd\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  EXPECT_TRUE(p.shapes[0].world_from_object.is_identity());
+  EXPECT_EQ(p.shapes[0].material.index, 0);
+  EXPECT_TRUE(p.shapes[0].reverse_orientation);
+}
+
+TEST(SceneParse, NestedAttributes) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nAttributeBegin\nTranslate 1 0 0\nAttributeBegin\nTranslate 0 1 0\nShape \"sphere\"\n"
+      "AttributeEnd\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 3u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 1, 0));
+  expect_vec_near(origin_of(p.shapes[1].world_from_object), Vec3(1, 0, 0));
+  expect_vec_near(origin_of(p.shapes[2].world_from_object), Vec3(0, 0, 0));
+}
+
+TEST(SceneParse, CameraParameters) {
+  ParsedScene p = parse_scene_string(
+      "Camera \"perspective\" \"float fov\" 30 \"float lensradius\" 0.1 \"float focaldistance\" 4\nWorldBegin\n");
+  ASSERT_TRUE(p.camera.has_value());
+  EXPECT_EQ(p.camera->loc.line, 1);
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_FLOAT_EQ(ls.camera.fov_degrees, 30);
+  EXPECT_FLOAT_EQ(ls.camera.lens_radius, 0.1f);
+  EXPECT_FLOAT_EQ(ls.camera.focal_distance, 4);
+  EXPECT_TRUE(ls.camera.world_from_camera.is_identity());
+}
+
+TEST(SceneParse, Film) {
+  ParsedScene p = parse_scene_string(
+      "Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" [32] \"string filename\" \"out.exr\"\n"
+      "WorldBegin\n");
+  EXPECT_EQ(p.film.name, "rgb");
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_EQ(ls.film.width, 64);
+  EXPECT_EQ(ls.film.height, 32);
+  EXPECT_EQ(ls.film.filename, "out.exr");
+}
+
+TEST(SceneParse, Sampler) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "Sampler \"independent\" \"integer pixelsamples\" 4 \"integer seed\" 9\nWorldBegin\n"));
+  EXPECT_EQ(ls.render.spp, 4);
+  EXPECT_EQ(ls.render.seed, 9);
+  LoadedScene st = flatten_scene(parse_scene_string(
+      "Sampler \"stratified\" \"integer xsamples\" 2 \"integer ysamples\" 3\nWorldBegin\n"));
+  EXPECT_EQ(st.render.spp, 6);
+}
+
+TEST(SceneParse, PixelFilter) {
+  LoadedScene box = flatten_scene(parse_scene_string("PixelFilter \"box\"\nWorldBegin\n"));
+  EXPECT_EQ(box.filter.type, FilterType::kBox);
+  EXPECT_FLOAT_EQ(box.filter.radius.x, 0.5f);
+  LoadedScene tri = flatten_scene(parse_scene_string("PixelFilter \"triangle\" \"float xradius\" 1\nWorldBegin\n"));
+  EXPECT_EQ(tri.filter.type, FilterType::kTriangle);
+  EXPECT_FLOAT_EQ(tri.filter.radius.x, 1);
+  EXPECT_FLOAT_EQ(tri.filter.radius.y, 2);
+  LoadedScene mit = flatten_scene(parse_scene_string(
+      "PixelFilter \"mitchell\" \"float B\" 0.5 \"float C\" 0.25\nWorldBegin\n"));
+  EXPECT_EQ(mit.filter.type, FilterType::kMitchell);
+  EXPECT_FLOAT_EQ(mit.filter.b, 0.5f);
+  EXPECT_FLOAT_EQ(mit.filter.c, 0.25f);
+}
+
+TEST(SceneParse, Integrator) {
+  ParsedScene p = parse_scene_string("Integrator \"bpm\" \"integer maxdepth\" 7\nWorldBegin\n");
+  EXPECT_TRUE(p.integrator_given);
+  EXPECT_EQ(p.integrator.name, "bpm");
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_EQ(ls.render.integrator, "bpm");
+  EXPECT_EQ(ls.render.integrator_as_written, "bpm");
+  EXPECT_EQ(ls.render.max_depth, 7);
+}
+
+TEST(SceneParse, VolpathIntegratorIsRenderedAsPathWithWarning) {
+  ParsedScene p = parse_scene_string("Integrator \"volpath\" \"integer maxdepth\" 3\nWorldBegin\n");
+  int before = warning_count();
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_EQ(warning_count() - before, 1);
+  EXPECT_EQ(ls.render.integrator, "path");
+  EXPECT_EQ(ls.render.integrator_as_written, "volpath");
+  EXPECT_EQ(ls.render.max_depth, 3);
+}
+
+TEST(SceneParse, AcceleratorIsAcceptedAndIgnored) {
+  int before = warning_count();
+  ParsedScene p = parse_scene_string("Accelerator \"bvh\" \"integer maxnodeprims\" 4\nWorldBegin\n");
+  (void)flatten_scene(p);
+  EXPECT_EQ(warning_count(), before);
+  EXPECT_EQ(p.film.name, "rgb");
+  EXPECT_EQ(p.integrator.name, "volpath");
+  EXPECT_TRUE(IsError(parse_error_of("WorldBegin\nAccelerator \"bvh\"\n"), at(2, 1),
+                      "Accelerator is not allowed after WorldBegin"));
+}
+
+TEST(SceneParse, ColorSpaceSrgbAccepted) {
+  ParsedScene p = parse_scene_string("ColorSpace \"srgb\"\nWorldBegin\nShape \"sphere\"\n");
+  EXPECT_EQ(p.shapes.size(), 1u);
+}
+
+TEST(SceneParse, OptionWarns) {
+  int before = warning_count();
+  ParsedScene p = parse_scene_string("Option \"bool disablepixeljitter\" true\nWorldBegin\n");
+  EXPECT_EQ(warning_count() - before, 1);
+}
+
+TEST(SceneParse, WorldEndAccepted) {
+  ParsedScene p = parse_scene_string("WorldBegin\nShape \"sphere\"\nWorldEnd\n");
+  EXPECT_EQ(p.shapes.size(), 1u);
+}
+
+TEST(SceneParse, AttributeDirectiveWarnsAndIsIgnored) {
+  int before = warning_count();
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nAttribute \"shape\" \"float radius\" 2 \"float zmin\" 0\nShape \"sphere\"\n");
+  EXPECT_EQ(warning_count() - before, 2);
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 1u);
+  EXPECT_FLOAT_EQ(std::get<Sphere>(ls.scene.objects[0].shape).radius, 1);
+}
+
+TEST(SceneParse, MaterialAppliesToFollowingShapes) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.3]\nShape \"sphere\"\nShape \"disk\"\n"
+      "Material \"dielectric\" \"float eta\" 1.33\nShape \"sphere\"\n");
+  ASSERT_EQ(p.materials.size(), 2u);
+  EXPECT_EQ(p.materials[0].name, "diffuse");
+  EXPECT_EQ(p.materials[1].name, "dielectric");
+  ASSERT_EQ(p.shapes.size(), 3u);
+  EXPECT_EQ(p.shapes[0].material.index, 0);
+  EXPECT_EQ(p.shapes[1].material.index, 0);
+  EXPECT_EQ(p.shapes[2].material.index, 1);
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 3u);
+  EXPECT_EQ(ls.scene.objects[0].material, ls.scene.objects[1].material);  // shared, not duplicated
+  const Material& m0 = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m0));
+  expect_spectrum_near(std::get<DiffuseMaterial>(m0).reflectance, Spectrum(0.1f, 0.2f, 0.3f));
+  const Material& m2 = ls.scene.materials[ls.scene.objects[2].material];
+  ASSERT_TRUE(std::holds_alternative<DielectricMaterial>(m2));
+  EXPECT_FLOAT_EQ(std::get<DielectricMaterial>(m2).eta, 1.33f);
+}
+
+TEST(SceneParse, NamedMaterialResolvesAtFlatten) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nMakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" "
+      "\"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.04\n"
+      "NamedMaterial \"gold\"\nShape \"sphere\"\nShape \"disk\"\n");
+  ASSERT_EQ(p.named_materials.count("gold"), 1u);
+  EXPECT_EQ(p.named_materials.at("gold").name, "conductor");
+  ASSERT_EQ(p.shapes.size(), 2u);
+  EXPECT_EQ(p.shapes[0].material.named, "gold");
+  EXPECT_EQ(p.shapes[0].material.index, -1);
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 2u);
+  EXPECT_EQ(ls.scene.objects[0].material, ls.scene.objects[1].material);
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m));
+  const ConductorMaterial& c = std::get<ConductorMaterial>(m);
+  expect_spectrum_near(c.eta, *named_spectrum_rgb("metal-Au-eta", SpectrumKind::kUnbounded));
+  expect_spectrum_near(c.k, *named_spectrum_rgb("metal-Au-k", SpectrumKind::kUnbounded));
+  EXPECT_NEAR(c.roughness.alpha_x, 0.2f, 1e-6f);  // remapped: sqrt(0.04)
+  EXPECT_NEAR(c.roughness.alpha_y, 0.2f, 1e-6f);
+}
+
+TEST(SceneParse, NamedMaterialMayBeDefinedAfterUse) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nNamedMaterial \"glass\"\nShape \"sphere\"\n"
+      "MakeNamedMaterial \"glass\" \"string type\" \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 1u);
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DielectricMaterial>(m));
+  EXPECT_NEAR(std::get<DielectricMaterial>(m).eta, 1.5168f, 1e-5f);
+}
+
+TEST(SceneParse, ConductorDefaultsToCopper) {
+  LoadedScene ls = flatten_scene(parse_scene_string("WorldBegin\nMaterial \"conductor\"\nShape \"sphere\"\n"));
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m));
+  expect_spectrum_near(std::get<ConductorMaterial>(m).eta, *named_spectrum_rgb("metal-Cu-eta", SpectrumKind::kUnbounded));
+  expect_spectrum_near(std::get<ConductorMaterial>(m).k, *named_spectrum_rgb("metal-Cu-k", SpectrumKind::kUnbounded));
+}
+
+TEST(SceneParse, ConstantTextures) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\n"
+      "Texture \"tex\" \"spectrum\" \"constant\" \"rgb value\" [0.2 0.3 0.4]\n"
+      "Texture \"grey\" \"float\" \"constant\" \"float value\" 0.7\n"
+      "Texture \"rough\" \"float\" \"constant\" \"float value\" 0.25\n"
+      "Texture \"old\" \"color\" \"constant\" \"rgb value\" [0.5 0.5 0.5]\n"
+      "Material \"diffuse\" \"texture reflectance\" \"tex\"\nShape \"sphere\"\n"
+      "Material \"diffuse\" \"texture reflectance\" \"grey\"\nShape \"sphere\"\n"
+      "Material \"conductor\" \"texture roughness\" \"rough\" \"bool remaproughness\" false\nShape \"sphere\"\n");
+  ASSERT_EQ(p.textures.size(), 4u);
+  EXPECT_EQ(p.textures[0].texture_name, "tex");
+  EXPECT_EQ(p.textures[0].value_type, "spectrum");
+  EXPECT_EQ(p.textures[0].name, "constant");
+  EXPECT_EQ(p.textures[1].value_type, "float");
+  EXPECT_EQ(p.textures[3].value_type, "spectrum");  // "color" is the old name
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 3u);
+  const Material& m0 = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m0));
+  expect_spectrum_near(std::get<DiffuseMaterial>(m0).reflectance, Spectrum(0.2f, 0.3f, 0.4f));
+  const Material& m1 = ls.scene.materials[ls.scene.objects[1].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m1));
+  expect_spectrum_near(std::get<DiffuseMaterial>(m1).reflectance, Spectrum(0.7f));
+  const Material& m2 = ls.scene.materials[ls.scene.objects[2].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m2));
+  EXPECT_FLOAT_EQ(std::get<ConductorMaterial>(m2).roughness.alpha_x, 0.25f);
+  EXPECT_FLOAT_EQ(std::get<ConductorMaterial>(m2).roughness.alpha_y, 0.25f);
+}
+
+TEST(SceneParse, PointLight) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTranslate 1 0 0\nLightSource \"point\" \"rgb I\" [1 2 3] \"point3 from\" [1 2 3]\n");
+  ASSERT_EQ(p.lights.size(), 1u);
+  EXPECT_EQ(p.lights[0].name, "point");
+  expect_vec_near(origin_of(p.lights[0].world_from_light), Vec3(1, 0, 0));
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.lights.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<PointLight>(ls.scene.lights[0]));
+  const PointLight& l = std::get<PointLight>(ls.scene.lights[0]);
+  expect_vec_near(l.position, Vec3(2, 2, 3));
+  expect_spectrum_near(l.intensity, Spectrum(1, 2, 3));
+}
+
+TEST(SceneParse, DistantAndInfiniteLights) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nLightSource \"distant\" \"point3 from\" [0 10 0] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1]\n"
+      "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3] \"float scale\" 2\n"));
+  ASSERT_EQ(ls.scene.lights.size(), 2u);
+  ASSERT_TRUE(std::holds_alternative<DistantLight>(ls.scene.lights[0]));
+  expect_vec_near(std::get<DistantLight>(ls.scene.lights[0]).direction_to_light, Vec3(0, 1, 0));
+  ASSERT_TRUE(std::holds_alternative<UniformInfiniteLight>(ls.scene.lights[1]));
+  expect_spectrum_near(std::get<UniformInfiniteLight>(ls.scene.lights[1]).radiance, Spectrum(0.2f, 0.4f, 0.6f));
+  ASSERT_EQ(ls.scene.infinite_lights.size(), 1u);
+  EXPECT_EQ(ls.scene.infinite_lights[0], 1);
+}
+
+TEST(SceneParse, SpotLight) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nLightSource \"spot\" \"point3 from\" [0 0 5] \"point3 to\" [0 0 0] \"float coneangle\" 60 "
+      "\"float conedelta\" 10\n"));
+  ASSERT_EQ(ls.scene.lights.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<SpotLight>(ls.scene.lights[0]));
+  const SpotLight& s = std::get<SpotLight>(ls.scene.lights[0]);
+  expect_vec_near(s.position, Vec3(0, 0, 5));
+  expect_vec_near(s.frame.n, Vec3(0, 0, -1));
+  EXPECT_NEAR(s.cos_falloff_end, 0.5f, 1e-5f);
+  EXPECT_NEAR(s.cos_falloff_start, std::cos(50 * kPi / 180), 1e-5f);
+}
+
+TEST(SceneParse, AreaLightOnMesh) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 3] \"bool twosided\" true\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  1 1 0  0 1 0] \"integer indices\" [0 1 2  0 2 3]\n"
+      "AttributeEnd\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 2u);
+  ASSERT_TRUE(p.shapes[0].area_light.has_value());
+  EXPECT_EQ(p.shapes[0].area_light->name, "diffuse");
+  EXPECT_FALSE(p.shapes[1].area_light.has_value());
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 2u);
+  EXPECT_EQ(ls.scene.objects[0].first_light, 0);
+  EXPECT_EQ(ls.scene.objects[1].first_light, -1);
+  ASSERT_EQ(ls.scene.lights.size(), 2u);  // one per triangle
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE(std::holds_alternative<AreaLight>(ls.scene.lights[i]));
+    const AreaLight& a = std::get<AreaLight>(ls.scene.lights[i]);
+    EXPECT_EQ(a.object, 0);
+    EXPECT_EQ(a.primitive, i);
+    EXPECT_TRUE(a.two_sided);
+    EXPECT_NEAR(a.area, 0.5f, 1e-6f);
+    expect_spectrum_near(a.radiance, Spectrum(1, 2, 3));
+  }
+}
+
+TEST(SceneParse, AreaLightOnWholeSphere) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4] \"float scale\" 0.5\nShape \"sphere\" \"float radius\" 2\n"));
+  ASSERT_EQ(ls.scene.lights.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<AreaLight>(ls.scene.lights[0]));
+  const AreaLight& a = std::get<AreaLight>(ls.scene.lights[0]);
+  expect_spectrum_near(a.radiance, Spectrum(2.0f));
+  EXPECT_FALSE(a.two_sided);
+  EXPECT_NEAR(a.area, 4 * kPi * 4, 1e-3f);
+}
+
+TEST(SceneParse, Shapes) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\n"
+      "Shape \"sphere\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 1.5 \"float phimax\" 180\n"
+      "Shape \"disk\" \"float radius\" 3 \"float innerradius\" 1 \"float height\" 0.5\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"point2 uv\" [0 0 1 0 0 1]\n"
+      "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 4u);
+  const Sphere& s = std::get<Sphere>(ls.scene.objects[0].shape);
+  EXPECT_FLOAT_EQ(s.radius, 2);
+  EXPECT_FLOAT_EQ(s.z_min, -1);
+  EXPECT_FLOAT_EQ(s.z_max, 1.5f);
+  EXPECT_NEAR(s.phi_max, kPi, 1e-6f);
+  EXPECT_FALSE(s.is_full());
+  const Disk& d = std::get<Disk>(ls.scene.objects[1].shape);
+  EXPECT_FLOAT_EQ(d.radius, 3);
+  EXPECT_FLOAT_EQ(d.inner_radius, 1);
+  EXPECT_FLOAT_EQ(d.height, 0.5f);
+  const TriangleMesh& t = std::get<TriangleMesh>(ls.scene.objects[2].shape);
+  EXPECT_EQ(t.positions.size(), 3u);
+  EXPECT_EQ(t.indices, (std::vector<uint32_t>{0, 1, 2}));  // implied for a single triangle
+  ASSERT_EQ(t.uvs.size(), 3u);
+  EXPECT_FLOAT_EQ(t.uvs[1].x, 1);
+  EXPECT_FLOAT_EQ(t.uvs[2].y, 1);
+  const TriangleMesh& b = std::get<TriangleMesh>(ls.scene.objects[3].shape);
+  EXPECT_EQ(b.triangle_count(), 2);
+}
+
+TEST(SceneParse, TriangleMeshTransformsPositionsAndNormals) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nTranslate 0 0 5\nRotate 90 0 0 1\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"integer indices\" [0 1 2] "
+      "\"normal N\" [1 0 0  1 0 0  2 0 0]\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 1u);
+  const TriangleMesh& m = std::get<TriangleMesh>(ls.scene.objects[0].shape);
+  ASSERT_EQ(m.positions.size(), 3u);
+  expect_vec_near(m.positions[0], Vec3(0, 0, 5));
+  expect_vec_near(m.positions[1], Vec3(0, 1, 5));
+  ASSERT_EQ(m.normals.size(), 3u);
+  for (Vec3 n : m.normals) expect_vec_near(n, Vec3(0, 1, 0));  // rotated and normalised
+}
+
+TEST(SceneParse, ObjectInstancesCopyShapesWithInstanceTransform) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\n"
+      "ObjectBegin \"thing\"\nTranslate 1 0 0\nShape \"sphere\"\nShape \"disk\"\nObjectEnd\n"
+      "Translate 0 10 0\nObjectInstance \"thing\"\n"
+      "Translate 0 0 100\nObjectInstance \"thing\"\n");
+  // The definition itself adds nothing; each instance adds both shapes.
+  ASSERT_EQ(p.shapes.size(), 4u);
+  EXPECT_EQ(p.shapes[0].name, "sphere");
+  EXPECT_EQ(p.shapes[1].name, "disk");
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 10, 0));
+  expect_vec_near(origin_of(p.shapes[1].world_from_object), Vec3(1, 10, 0));
+  expect_vec_near(origin_of(p.shapes[2].world_from_object), Vec3(1, 10, 100));
+  expect_vec_near(origin_of(p.shapes[3].world_from_object), Vec3(1, 10, 100));
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 4u);
+  expect_vec_near(origin_of(std::get<Sphere>(ls.scene.objects[2].shape).world_from_object), Vec3(1, 10, 100));
+}
+
+TEST(SceneParse, IncludeAndImport) {
+  TempDir dir;
+  dir.write("inc.pbrt", "# included\nShape \"sphere\" \"float radius\" 3\n");
+  dir.write("imp.pbrt", "Shape \"disk\"\n");
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nTranslate 1 0 0\nInclude \"inc.pbrt\"\nImport \"imp.pbrt\"\nShape \"sphere\"\n", dir.str());
+  ASSERT_EQ(p.shapes.size(), 3u);
+  EXPECT_EQ(p.shapes[0].name, "sphere");
+  EXPECT_TRUE(Contains(p.shapes[0].loc.file, "inc.pbrt"));
+  EXPECT_EQ(p.shapes[0].loc.line, 2);
+  EXPECT_TRUE(fs::equivalent(p.shapes[0].directory, dir.path()));
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 0, 0));
+  EXPECT_EQ(p.shapes[1].name, "disk");
+  EXPECT_TRUE(Contains(p.shapes[1].loc.file, "imp.pbrt"));
+  EXPECT_EQ(p.shapes[2].loc.file, "<string>");
+  EXPECT_EQ(p.shapes[2].loc.line, 5);
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_FLOAT_EQ(std::get<Sphere>(ls.scene.objects[0].shape).radius, 3);
+}
+
+TEST(SceneParse, IncludedFileMayChangeGraphicsState) {
+  TempDir dir;
+  dir.write("state.pbrt", "Translate 0 2 0\nMaterial \"conductor\"\n");
+  ParsedScene p = parse_scene_string("WorldBegin\nInclude \"state.pbrt\"\nShape \"sphere\"\n", dir.str());
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(0, 2, 0));
+  EXPECT_EQ(p.shapes[0].material.index, 0);
+}
+
+// The last directive of an included file has no parameters, so looking for them reads past the
+// end of that file. Under a sanitizer build this also checks that nothing of the finished file is
+// used afterwards.
+TEST(SceneParse, IncludedFileEndingWithParameterlessDirectives) {
+  TempDir dir;
+  dir.write("settings.pbrt",
+            "# render settings kept apart from the geometry of the scene\n"
+            "Film \"rgb\" \"integer xresolution\" 40 \"integer yresolution\" 30\n"
+            "Sampler \"halton\"\n");
+  dir.write("geometry.pbrt", "# geometry\nShape \"sphere\"\n");
+  ParsedScene p = parse_scene_string(
+      "Include \"settings.pbrt\"\nWorldBegin\nInclude \"geometry.pbrt\"\nShape \"disk\"\n", dir.str());
+  EXPECT_EQ(p.sampler.name, "halton");
+  EXPECT_EQ(p.film.name, "rgb");
+  ASSERT_EQ(p.shapes.size(), 2u);
+  EXPECT_EQ(p.shapes[0].name, "sphere");
+  EXPECT_EQ(p.shapes[1].name, "disk");
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_EQ(ls.film.width, 40);
+  EXPECT_EQ(ls.film.height, 30);
+}
+
+TEST(SceneParse, SameFileIncludedTwiceIsNotACycle) {
+  TempDir dir;
+  dir.write("one.pbrt", "Shape \"sphere\"\n");
+  ParsedScene p = parse_scene_string("WorldBegin\nInclude \"one.pbrt\"\nInclude \"one.pbrt\"\n", dir.str());
+  EXPECT_EQ(p.shapes.size(), 2u);
+}
+
+TEST(SceneParse, ParseSceneFileResolvesRelativeToItsDirectory) {
+  TempDir dir;
+  dir.write("quad.ply", kAsciiQuadPly);
+  fs::path main = dir.write("main.pbrt",
+                            "WorldBegin\nTranslate 0 0 2\nShape \"plymesh\" \"string filename\" \"quad.ply\"\n");
+  ParsedScene p = parse_scene_file(main.string());
+  EXPECT_TRUE(fs::equivalent(p.base_directory, dir.path()));
+  ASSERT_EQ(p.shapes.size(), 1u);
+  EXPECT_TRUE(Contains(p.shapes[0].loc.file, "main.pbrt"));
+  LoadedScene ls = flatten_scene(p);
+  ASSERT_EQ(ls.scene.objects.size(), 1u);
+  const TriangleMesh& m = std::get<TriangleMesh>(ls.scene.objects[0].shape);
+  EXPECT_EQ(m.triangle_count(), 2);
+  ASSERT_EQ(m.positions.size(), 4u);
+  expect_vec_near(m.positions[2], Vec3(1, 1, 2));
+}
+
+TEST(SceneParse, MakeNamedMediumOnlyWarns) {
+  int before = warning_count();
+  ParsedScene p = parse_scene_string(
+      "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 1 1]\nWorldBegin\n"
+      "Shape \"sphere\"\n");
+  EXPECT_EQ(warning_count() - before, 1);
+  EXPECT_EQ(p.shapes.size(), 1u);
+}
+
+TEST(SceneParse, EmptyMediumInterfaceIsAccepted) {
+  ParsedScene p = parse_scene_string("WorldBegin\nMediumInterface \"\" \"\"\nShape \"sphere\"\n");
+  EXPECT_EQ(p.shapes.size(), 1u);
+}
+
+TEST(SceneParse, ActiveTransformEndTimeIsIgnored) {
+  int before = warning_count();
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nActiveTransform EndTime\nTranslate 5 0 0\nActiveTransform All\nTranslate 0 1 0\n"
+      "ActiveTransform StartTime\nTranslate 0 0 2\nActiveTransform All\nShape \"sphere\"\n");
+  EXPECT_EQ(warning_count() - before, 1);  // the EndTime Translate
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(0, 1, 2));
+}
+
+TEST(SceneParse, TransformTimesAccepted) {
+  ParsedScene p = parse_scene_string("TransformTimes 0 1\nWorldBegin\nTranslate 1 0 0\nShape \"sphere\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 0, 0));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Typed parameters
+
+TEST(SceneParams, AllTypes) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nShape \"anything\"\n"
+      "  \"float f\" 1.5  \"float fs\" [1 2 3]  \"integer i\" [1 -2 3]  \"integer one\" 7\n"
+      "  \"bool b1\" \"true\"  \"bool b2\" false  \"bool b3\" true  \"bool bs\" [\"false\" true]\n"
+      "  \"string s\" \"hello world\"  \"string esc\" \"a\\\"b\"\n"
+      "  \"rgb c\" [0.1 0.2 0.3]  \"color col\" [0.4 0.5 0.6]\n"
+      "  \"spectrum named\" \"metal-Cu-eta\"  \"spectrum pairs\" [400 0.5 700 0.25]\n"
+      "  \"blackbody bb\" 6500  \"blackbody bb2\" [3000 2]\n"
+      "  \"point2 p2\" [1 2 3 4]  \"vector2 v2\" [5 6]\n"
+      "  \"point3 p3\" [1 2 3]  \"point pt\" [4 5 6]\n"
+      "  \"vector3 v3\" [0 0 1]  \"vector vv\" [7 8 9]\n"
+      "  \"normal n\" [0 1 0]  \"normal3 n3\" [1 0 0]\n"
+      "  \"texture tx\" \"mytex\"\n");
+  ASSERT_EQ(p.shapes.size(), 1u);
+  const ParamSet& ps = p.shapes[0].params;
+  EXPECT_EQ(ps.all().size(), 25u);
+
+  EXPECT_FLOAT_EQ(ps.get_float("f", 0), 1.5f);
+  EXPECT_FLOAT_EQ(ps.get_float("absent", 4.5f), 4.5f);
+  EXPECT_EQ(ps.get_floats("fs"), (std::vector<float>{1, 2, 3}));
+  EXPECT_EQ(ps.get_ints("i"), (std::vector<int>{1, -2, 3}));
+  EXPECT_EQ(ps.get_int("one", 0), 7);
+
+  EXPECT_TRUE(ps.get_bool("b1", false));
+  EXPECT_FALSE(ps.get_bool("b2", true));
+  EXPECT_TRUE(ps.get_bool("b3", false));
+  ASSERT_NE(ps.find("bs", "bool"), nullptr);
+  EXPECT_EQ(ps.find("bs", "bool")->bools, (std::vector<bool>{false, true}));
+
+  EXPECT_EQ(ps.get_string("s", ""), "hello world");
+  EXPECT_EQ(ps.get_string("esc", ""), "a\"b");
+
+  ASSERT_NE(ps.find("c", "rgb"), nullptr);
+  EXPECT_EQ(ps.find("c", "rgb")->numbers, (std::vector<double>{0.1, 0.2, 0.3}));
+  ASSERT_NE(ps.find("col", "rgb"), nullptr);  // "color" is an alias of rgb
+  EXPECT_EQ(ps.find("col", "rgb")->numbers, (std::vector<double>{0.4, 0.5, 0.6}));
+
+  const Param* named = ps.find("named", "spectrum");
+  ASSERT_NE(named, nullptr);
+  EXPECT_EQ(named->strings, (std::vector<std::string>{"metal-Cu-eta"}));
+  EXPECT_TRUE(named->numbers.empty());
+  const Param* pairs = ps.find("pairs", "spectrum");
+  ASSERT_NE(pairs, nullptr);
+  EXPECT_EQ(pairs->numbers, (std::vector<double>{400, 0.5, 700, 0.25}));
+
+  ASSERT_NE(ps.find("bb", "blackbody"), nullptr);
+  EXPECT_EQ(ps.find("bb", "blackbody")->numbers, (std::vector<double>{6500}));
+  EXPECT_EQ(ps.find("bb2", "blackbody")->numbers, (std::vector<double>{3000, 2}));
+
+  auto p2 = ps.get_point2s("p2");
+  ASSERT_EQ(p2.size(), 2u);
+  EXPECT_FLOAT_EQ(p2[1].x, 3);
+  EXPECT_FLOAT_EQ(p2[1].y, 4);
+  ASSERT_NE(ps.find("v2", "vector2"), nullptr);
+  EXPECT_EQ(ps.find("v2", "vector2")->numbers, (std::vector<double>{5, 6}));
+
+  auto p3 = ps.get_point3s("p3");
+  ASSERT_EQ(p3.size(), 1u);
+  expect_vec_near(p3[0], Vec3(1, 2, 3));
+  expect_vec_near(ps.get_point3("pt", Vec3(0, 0, 0)), Vec3(4, 5, 6));  // "point" is point3
+  auto v3 = ps.get_vector3s("v3");
+  ASSERT_EQ(v3.size(), 1u);
+  expect_vec_near(v3[0], Vec3(0, 0, 1));
+  auto vv = ps.get_vector3s("vv");  // "vector" is vector3
+  ASSERT_EQ(vv.size(), 1u);
+  expect_vec_near(vv[0], Vec3(7, 8, 9));
+  auto n = ps.get_normals("n");
+  ASSERT_EQ(n.size(), 1u);
+  expect_vec_near(n[0], Vec3(0, 1, 0));
+  auto n3 = ps.get_normals("n3");  // "normal3" is normal
+  ASSERT_EQ(n3.size(), 1u);
+  expect_vec_near(n3[0], Vec3(1, 0, 0));
+
+  const Param* tx = ps.find("tx", "texture");
+  ASSERT_NE(tx, nullptr);
+  EXPECT_EQ(tx->strings, (std::vector<std::string>{"mytex"}));
+  EXPECT_EQ(tx->loc.line, 15);
+}
+
+TEST(SceneParams, CanonicalTypeNames) {
+  EXPECT_EQ(canonical_param_type("point"), "point3");
+  EXPECT_EQ(canonical_param_type("vector"), "vector3");
+  EXPECT_EQ(canonical_param_type("normal3"), "normal");
+  EXPECT_EQ(canonical_param_type("color"), "rgb");
+  EXPECT_EQ(canonical_param_type("float"), "float");
+  EXPECT_EQ(canonical_param_type("texture"), "texture");
+  EXPECT_EQ(canonical_param_type("double"), "");
+}
+
+TEST(SceneParams, GetterMarksUsed) {
+  ParsedScene p = parse_scene_string("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float other\" 1\n");
+  const ParamSet& ps = p.shapes[0].params;
+  EXPECT_FALSE(ps.find_any("radius")->used);
+  EXPECT_FLOAT_EQ(ps.get_float("radius", 1), 2);
+  EXPECT_TRUE(ps.find_any("radius")->used);
+  EXPECT_FALSE(ps.find_any("other")->used);
+}
+
+TEST(SceneParams, RgbReflectance) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"diffuse\" \"color reflectance\" [0.25 0.5 0.75]\nShape \"sphere\"\n"));
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m));
+  expect_spectrum_near(std::get<DiffuseMaterial>(m).reflectance, Spectrum(0.25f, 0.5f, 0.75f));
+}
+
+TEST(SceneParams, InlineSpectrumReflectance) {
+  // Constant over the whole visible range: a grey reflectance of that value.
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" [360 0.5 830 0.5]\nShape \"sphere\"\n"));
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m));
+  expect_spectrum_near(std::get<DiffuseMaterial>(m).reflectance, Spectrum(0.5f), 1e-4f);
+}
+
+TEST(SceneParams, SpectrumFile) {
+  TempDir dir;
+  dir.write("grey.spd", "# wavelength value\n360 0.25\n600 0.25 # middle\n830 0.25\n");
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"grey.spd\"\nShape \"sphere\"\n", dir.str()));
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m));
+  expect_spectrum_near(std::get<DiffuseMaterial>(m).reflectance, Spectrum(0.25f), 1e-4f);
+}
+
+TEST(SceneParams, NamedSpectrumEta) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-Ag-eta\" \"spectrum k\" \"metal-Ag-k\"\n"
+      "Shape \"sphere\"\n"));
+  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m));
+  expect_spectrum_near(std::get<ConductorMaterial>(m).eta, Spectrum(0.155265f, 0.116723f, 0.138342f));
+  expect_spectrum_near(std::get<ConductorMaterial>(m).k, Spectrum(4.828181f, 3.122249f, 2.146961f));
+}
+
+TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nLightSource \"point\" \"blackbody I\" 6500\nLightSource \"point\" \"blackbody I\" 3000 "
+      "\"float scale\" 2\n"));
+  ASSERT_EQ(ls.scene.lights.size(), 2u);
+  const PointLight& a = std::get<PointLight>(ls.scene.lights[0]);
+  expect_spectrum_near(a.intensity, blackbody_rgb(6500));
+  EXPECT_NEAR(a.intensity.luminance(), 1.0f, 2e-3f);
+  const PointLight& b = std::get<PointLight>(ls.scene.lights[1]);
+  EXPECT_NEAR(b.intensity.luminance(), 2.0f, 4e-3f);
+  EXPECT_GT(b.intensity[0], b.intensity[2]);  // 3000 K is reddish
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parse errors
+
+TEST(SceneParseError, UnknownDirective) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n  Bogus 1 2\n"), at(2, 3), "unknown directive 'Bogus'"));
+}
+
+TEST(SceneParseError, StringWhereDirectiveExpected) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n\"sphere\"\n"), at(2, 1), "expected a directive"));
+}
+
+TEST(SceneParseError, UnterminatedStringAtEndOfFile) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sphere"), at(2, 7), "unterminated string at end of file"));
+}
+
+TEST(SceneParseError, UnterminatedStringAtNewline) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sph\nere\"\n"), at(2, 7), "unterminated string"));
+}
+
+TEST(SceneParseError, ParameterValueMissingAtEndOfFile) {
+  const std::string l2 = R"(Shape "sphere" "float radius")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2), at(2, col(l2, "\"float")),
+                      "unexpected end of file: expected a parameter value"));
+}
+
+TEST(SceneParseError, UnclosedParameterBracket) {
+  const std::string l2 = R"(Shape "sphere" "float radius" [ 1)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")),
+                      "expected ] closing the parameter values"));
+}
+
+TEST(SceneParseError, NestedParameterBracket) {
+  const std::string l2 = R"(Shape "sphere" "float radius" [ 1 [2] ])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "[2")), "nested '['"));
+}
+
+TEST(SceneParseError, UnknownParameterType) {
+  const std::string l2 = R"(Shape "sphere" "floot radius" 1)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"floot")),
+                      "unknown parameter type \"floot\""));
+}
+
+TEST(SceneParseError, DeclarationWithoutName) {
+  const std::string l2 = R"(Shape "sphere" "float" 1)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float\"")),
+                      "expected a parameter declaration \"type name\"; got \"float\""));
+}
+
+TEST(SceneParseError, DeclarationWithExtraWords) {
+  const std::string l2 = R"(Shape "sphere" "float radius extra" 1)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")),
+                      "malformed parameter declaration \"float radius extra\""));
+}
+
+TEST(SceneParseError, StringWhereNumbersExpected) {
+  const std::string l2 = R"(Shape "sphere" "float radius" "one")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"one\"")),
+                      "parameter \"radius\" expects numbers; got a string"));
+}
+
+TEST(SceneParseError, NumberWhereStringExpected) {
+  const std::string l2 = R"(Shape "plymesh" "string filename" 5)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "5")),
+                      "parameter \"filename\" expects strings; got '5'"));
+}
+
+TEST(SceneParseError, BadBool) {
+  const std::string l2 = R"(Shape "sphere" "bool flag" "yes")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"yes\"")),
+                      "parameter \"flag\" expects true or false"));
+}
+
+TEST(SceneParseError, BadBareBool) {
+  const std::string l2 = R"(Shape "sphere" "bool flag" [true 1])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "1]")),
+                      "expects true or false; got '1'"));
+}
+
+TEST(SceneParseError, NonIntegerInteger) {
+  const std::string l2 = R"(Shape "trianglemesh" "integer indices" [0 1 2.5])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
+                      "parameter \"indices\" expects integers"));
+}
+
+TEST(SceneParseError, RgbWithTwoValues) {
+  const std::string l2 = R"(Material "diffuse" "rgb reflectance" [0.1 0.2])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"rgb")),
+                      "parameter \"reflectance\" of type rgb needs 3 values; got 2"));
+}
+
+TEST(SceneParseError, Point3WithFourValues) {
+  const std::string l2 = R"(Shape "trianglemesh" "point3 P" [0 0 0 1])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"point3")),
+                      "parameter \"P\" of type point3 needs a multiple of 3 values; got 4 values"));
+}
+
+TEST(SceneParseError, SpectrumWithOddCount) {
+  const std::string l2 = R"(Material "conductor" "spectrum eta" [400 1 700])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"spectrum")),
+                      "needs wavelength/value pairs; got 3 values"));
+}
+
+TEST(SceneParseError, BlackbodyWithThreeValues) {
+  const std::string l2 = R"(LightSource "point" "blackbody I" [6500 1 2])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"blackbody")),
+                      "of type blackbody needs a temperature"));
+}
+
+TEST(SceneParseError, DuplicateParameter) {
+  const std::string l2 = R"(Shape "sphere" "float radius" 1 "float radius" 2)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, int(l2.rfind("\"float")) + 1),
+                      "parameter \"radius\" given twice"));
+}
+
+TEST(SceneParseError, DirectiveNumberMissing) {
+  EXPECT_TRUE(IsError(error_of("Translate 1 2\nWorldBegin\n"), at(2, 1), "expected a number; got 'WorldBegin'"));
+}
+
+TEST(SceneParseError, DirectiveNumbersAtEndOfFile) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTranslate 1"), at(2, 1), "unexpected end of file: expected a number"));
+}
+
+TEST(SceneParseError, BracketedDirectiveWithTooManyNumbers) {
+  const std::string l2 = "Translate [1 2 3 4]";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "4")), "Translate takes 3 numbers"));
+}
+
+TEST(SceneParseError, AttributeEndWithoutBegin) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sphere\"\nAttributeEnd\n"), at(3, 1),
+                      "AttributeEnd without a matching begin"));
+}
+
+TEST(SceneParseError, TransformEndWithoutBegin) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTransformEnd\n"), at(2, 1), "TransformEnd without a matching begin"));
+}
+
+TEST(SceneParseError, AttributeBeginWithoutEndReportedAtEnd) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAttributeBegin\nAttributeBegin\nAttributeEnd\nShape \"sphere\"\n"),
+                      at(2, 1), "AttributeBegin without a matching AttributeEnd"));
+}
+
+TEST(SceneParseError, CameraAfterWorldBegin) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nCamera \"perspective\"\n"), at(2, 1),
+                      "Camera is not allowed after WorldBegin"));
+}
+
+TEST(SceneParseError, WorldBeginTwice) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nWorldBegin\n"), at(2, 1), "WorldBegin is not allowed after WorldBegin"));
+}
+
+TEST(SceneParseError, ShapeBeforeWorldBegin) {
+  EXPECT_TRUE(IsError(error_of("Shape \"sphere\"\nWorldBegin\n"), at(1, 1),
+                      "Shape is only allowed after WorldBegin"));
+}
+
+TEST(SceneParseError, MaterialBeforeWorldBegin) {
+  EXPECT_TRUE(IsError(error_of("Material \"diffuse\"\nWorldBegin\n"), at(1, 1),
+                      "Material is only allowed after WorldBegin"));
+}
+
+TEST(SceneParseError, NoWorldBegin) {
+  // Reported at the last token read.
+  EXPECT_TRUE(IsError(error_of("Camera \"perspective\"\nFilm \"rgb\"\n"), at(2, 6), "the scene has no WorldBegin"));
+}
+
+TEST(SceneParseError, UnknownCoordinateSystem) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nCoordSysTransform \"nowhere\"\n"), at(2, 1),
+                      "unknown coordinate system \"nowhere\""));
+}
+
+TEST(SceneParseError, UnknownObjectInstance) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectInstance \"thing\"\n"), at(2, 1), "unknown object \"thing\""));
+}
+
+TEST(SceneParseError, ObjectEndWithoutObjectBegin) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectEnd\n"), at(2, 1), "ObjectEnd without ObjectBegin"));
+}
+
+TEST(SceneParseError, ObjectDefinedTwice) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectEnd\nObjectBegin \"a\"\nObjectEnd\n"), at(4, 1),
+                      "object \"a\" defined twice"));
+}
+
+TEST(SceneParseError, NestedObjectBegin) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectBegin \"b\"\n"), at(3, 1),
+                      "ObjectBegin inside another ObjectBegin"));
+}
+
+TEST(SceneParseError, ObjectInstanceInsideObject) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectInstance \"a\"\nObjectEnd\n"), at(3, 1),
+                      "ObjectInstance inside ObjectBegin"));
+}
+
+TEST(SceneParseError, ObjectBeginWithoutEnd) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nShape \"sphere\"\n"), at(2, 1), "without"));
+}
+
+TEST(SceneParseError, IncludeMissingFile) {
+  TempDir dir;
+  std::string msg = error_of("WorldBegin\nInclude \"no_such_file.pbrt\"\n", dir.str());
+  EXPECT_TRUE(IsError(msg, at(2, 1), "cannot open scene file"));
+  EXPECT_TRUE(Contains(msg, "no_such_file.pbrt\""));
+}
+
+TEST(SceneParseError, IncludeCycle) {
+  TempDir dir;
+  dir.write("a.pbrt", "Include \"b.pbrt\"\n");
+  dir.write("b.pbrt", "# b includes a\nInclude \"a.pbrt\"\n");
+  std::string msg = error_of("Include \"a.pbrt\"\nWorldBegin\n", dir.str());
+  std::string where = (fs::path(dir.str()) / "b.pbrt").lexically_normal().string() + ":2:1";
+  EXPECT_TRUE(IsError(msg, where, "file \"a.pbrt\" includes itself"));
+}
+
+TEST(SceneParseError, ErrorInIncludedFileNamesThatFile) {
+  TempDir dir;
+  dir.write("bad.pbrt", "Shape \"sphere\"\n  Bogus\n");
+  std::string msg = error_of("WorldBegin\nInclude \"bad.pbrt\"\n", dir.str());
+  std::string where = (fs::path(dir.str()) / "bad.pbrt").lexically_normal().string() + ":2:3";
+  EXPECT_TRUE(IsError(msg, where, "unknown directive 'Bogus'"));
+}
+
+TEST(SceneParseError, MissingSceneFile) {
+  TempDir dir;
+  std::string path = (dir.path() / "absent.pbrt").string();
+  try {
+    (void)parse_scene_file(path);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(Contains(e.what(), "cannot open scene file \"" + path + "\""));
+  }
+}
+
+TEST(SceneParseError, SingularTransform) {
+  EXPECT_TRUE(IsError(error_of("Transform [1 0 0 0  0 1 0 0  0 0 0 0  0 0 0 1]\nWorldBegin\n"), at(1, 1),
+                      "Transform matrix is singular"));
+}
+
+TEST(SceneParseError, SingularConcatTransform) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nConcatTransform [0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0]\n"), at(2, 1),
+                      "ConcatTransform matrix is singular"));
+}
+
+TEST(SceneParseError, ScaleByZero) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 0 1\n"), at(2, 1), "Scale by zero makes the transform singular"));
+}
+
+TEST(SceneParseError, RotateAboutZeroAxis) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nRotate 30 0 0 0\n"), at(2, 1), "Rotate about a zero axis"));
+}
+
+TEST(SceneParseError, LookAtCoincidentEyeAndTarget) {
+  EXPECT_TRUE(IsError(error_of("LookAt 1 1 1  1 1 1  0 1 0\nWorldBegin\n"), at(1, 1),
+                      "LookAt with coincident eye and target"));
+}
+
+TEST(SceneParseError, LookAtUpParallelToViewDirection) {
+  EXPECT_TRUE(IsError(error_of("LookAt 0 0 0  0 5 0  0 1 0\nWorldBegin\n"), at(1, 1),
+                      "up parallel to the view direction"));
+}
+
+TEST(SceneParseError, ActiveTransformBadArgument) {
+  const std::string l2 = "ActiveTransform Sometimes";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "Sometimes")),
+                      "ActiveTransform takes StartTime, EndTime or All"));
+}
+
+TEST(SceneParseError, TextureBadValueType) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"t\" \"vector\" \"constant\"\n"), at(2, 1),
+                      "texture type must be \"float\" or \"spectrum\""));
+}
+
+TEST(SceneParseError, MakeNamedMaterialWithoutType) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nMakeNamedMaterial \"m\" \"rgb reflectance\" [0.5 0.5 0.5]\n"), at(2, 1),
+                      "MakeNamedMaterial \"m\" has no \"string type\""));
+}
+
+TEST(SceneParseError, NamedMaterialDefinedTwice) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"diffuse\"\n"
+                               "MakeNamedMaterial \"m\" \"string type\" \"conductor\"\n"),
+                      at(3, 1), "named material \"m\" defined twice"));
+}
+
+TEST(SceneParseError, MediumInterfaceWithMedium) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nMediumInterface \"fog\" \"\"\nShape \"sphere\"\n"), at(2, 1),
+                      "participating media are not supported"));
+}
+
+TEST(SceneParseError, ColorSpaceOtherThanSrgb) {
+  EXPECT_TRUE(IsError(error_of("ColorSpace \"aces2065-1\"\nWorldBegin\n"), at(1, 1),
+                      "color space \"aces2065-1\" is not supported"));
+}
+
+TEST(SceneParseError, NanInDirective) {
+  // std::from_chars reads "nan" as a number, so the error is the non-finite check.
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTranslate nan 0 0\n"), at(2, 1), "Translate has a non-finite value"));
+}
+
+TEST(SceneParseError, MalformedNumber) {
+  const std::string l2 = R"(Shape "sphere" "float radius" 1.2.3)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "1.2.3")),
+                      "expected a number; got '1.2.3'"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors found while flattening
+
+TEST(SceneFlattenError, UnknownNamedMaterial) {
+  const std::string text = "WorldBegin\nNamedMaterial \"gold\"\nShape \"sphere\"\n";
+  EXPECT_EQ(parse_error_of(text), "");
+  EXPECT_TRUE(IsError(error_of(text), at(2, 1), "unknown named material \"gold\""));
+}
+
+TEST(SceneFlattenError, TriangleMeshWithoutP) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"trianglemesh\" \"integer indices\" [0 1 2]\n"), at(2, 1),
+                      "trianglemesh has no \"point3 P\""));
+}
+
+TEST(SceneFlattenError, TriangleMeshWithoutIndices) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"), at(2, 1),
+                      "trianglemesh has no \"integer indices\""));
+}
+
+TEST(SceneFlattenError, IndicesNotMultipleOfThree) {
+  const std::string l2 = R"(Shape "trianglemesh" "integer indices" [0 1 2 3] "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
+                      "\"indices\" has 4 values, not a multiple of 3"));
+}
+
+TEST(SceneFlattenError, IndexOutOfRange) {
+  const std::string l2 = std::string(R"(Shape "trianglemesh" "integer indices" [0 1 5] )") + kTriangleP;
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
+                      "vertex index 5 out of range (3 vertices)"));
+}
+
+TEST(SceneFlattenError, NegativeIndex) {
+  const std::string l2 = std::string(R"(Shape "trianglemesh" "integer indices" [0 -1 2] )") + kTriangleP;
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
+                      "vertex index -1 out of range"));
+}
+
+TEST(SceneFlattenError, NormalCountMismatch) {
+  const std::string l2 = std::string(R"(Shape "trianglemesh" )") + kTriangleP + R"( "normal N" [0 0 1 0 0 1])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"normal N")),
+                      "\"N\" has 2 normals for 3 vertices"));
+}
+
+TEST(SceneFlattenError, UvCountMismatch) {
+  const std::string l2 = std::string(R"(Shape "trianglemesh" )") + kTriangleP + R"( "point2 uv" [0 0 1 0])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"point2")),
+                      "\"uv\" count differs from the vertex count"));
+}
+
+TEST(SceneFlattenError, NonPlanarBilinearPatch) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 1]\n"),
+                      at(2, 1), "non-planar bilinear patches are not supported"));
+}
+
+TEST(SceneFlattenError, PlymeshWithoutFilename) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"plymesh\"\n"), at(2, 1), "plymesh has no \"string filename\""));
+}
+
+TEST(SceneFlattenError, PlymeshMissingFile) {
+  TempDir dir;
+  const std::string l2 = R"(Shape "plymesh" "string filename" "missing.ply")";
+  std::string msg = error_of("WorldBegin\n" + l2 + "\n", dir.str());
+  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"string")), "cannot open PLY file"));
+  EXPECT_TRUE(Contains(msg, "missing.ply\""));
+}
+
+TEST(SceneFlattenError, PlymeshTruncatedBinary) {
+  TempDir dir;
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f}) put_le(&ply, v);  // two of the three vertices
+  dir.write("cut.ply", ply);
+  const std::string l2 = R"(Shape "plymesh" "string filename" "cut.ply")";
+  std::string msg = error_of("WorldBegin\n" + l2 + "\n", dir.str());
+  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"string")), "truncated data"));
+  EXPECT_TRUE(Contains(msg, "cut.ply\""));
+}
+
+TEST(SceneFlattenError, PlymeshAsciiIndexOutOfRange) {
+  TempDir dir;
+  dir.write("bad.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  const std::string l2 = R"(Shape "plymesh" "string filename" "bad.ply")";
+  std::string msg = error_of("WorldBegin\n" + l2 + "\n", dir.str());
+  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"string")), "vertex index 7 out of range (the file has 3 vertices)"));
+  EXPECT_TRUE(Contains(msg, "bad.ply\""));
+}
+
+TEST(SceneFlattenError, SphereNegativeRadius) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sphere\" \"float radius\" -1\n"), at(2, 1),
+                      "sphere radius must be positive"));
+}
+
+TEST(SceneFlattenError, DiskInnerRadiusNotBelowRadius) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"disk\" \"float radius\" 1 \"float innerradius\" 2\n"), at(2, 1),
+                      "disk needs 0 <= innerradius < radius"));
+}
+
+TEST(SceneFlattenError, UnsupportedShape) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n"), at(2, 1),
+                      "shape \"curve\" is not supported"));
+}
+
+TEST(SceneFlattenError, AlphaCutout) {
+  const std::string l2 = R"(Shape "sphere" "float alpha" 0.5)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")),
+                      "alpha cut-outs are not supported"));
+}
+
+TEST(SceneFlattenError, UnsupportedMaterial) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nMaterial \"hair\"\nShape \"sphere\"\n"), at(2, 1),
+                      "material \"hair\" is not supported"));
+}
+
+TEST(SceneFlattenError, UnsupportedLight) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"goniometric\" \"string filename\" \"g.exr\"\n"), at(2, 1),
+                      "light \"goniometric\" is not supported"));
+}
+
+TEST(SceneFlattenError, NegativeReflectance) {
+  const std::string l2 = R"(Material "diffuse" "rgb reflectance" [-0.1 0.5 0.5])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"rgb")),
+                      "parameter \"reflectance\" has a negative or non-finite value"));
+}
+
+TEST(SceneFlattenError, ReflectanceAboveOne) {
+  const std::string l2 = R"(Material "diffuse" "rgb reflectance" [1.5 0.5 0.5])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"rgb")),
+                      "parameter \"reflectance\" is a reflectance and must not exceed 1"));
+}
+
+TEST(SceneFlattenError, NanParameter) {
+  // std::from_chars accepts "nan", so parsing succeeds and the getter rejects the value.
+  const std::string l2 = R"(Shape "sphere" "float radius" nan)";
+  std::string msg = error_of("WorldBegin\n" + l2 + "\n");
+  EXPECT_FALSE(msg.empty());
+  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"float")), "parameter \"radius\" has a non-finite value"));
+}
+
+TEST(SceneFlattenError, InfiniteLightWithFilename) {
+  const std::string l2 = R"(LightSource "infinite" "string filename" "sky.exr")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"string")),
+                      "environment map lights are not supported"));
+}
+
+TEST(SceneFlattenError, AreaLightOnPartialSphere) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\"\n"
+                               "Shape \"sphere\" \"float zmax\" 0.5\nAttributeEnd\n"),
+                      at(3, 1), "emitting spheres and disks must be whole"));
+}
+
+TEST(SceneFlattenError, AreaLightOnNonUniformlyScaledDisk) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 2 1\nAreaLightSource \"diffuse\"\nShape \"disk\"\n"),
+                      at(3, 1), "not non-uniformly scaled"));
+}
+
+TEST(SceneFlattenError, UnsupportedAreaLight) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"projection\"\nShape \"sphere\"\n"), at(2, 1),
+                      "area light \"projection\" is not supported"));
+}
+
+TEST(SceneFlattenError, UnknownCameraType) {
+  EXPECT_TRUE(IsError(error_of("Camera \"orthographic\"\nWorldBegin\n"), at(1, 1),
+                      "camera \"orthographic\" is not supported"));
+}
+
+TEST(SceneFlattenError, FovOutOfRange) {
+  EXPECT_TRUE(IsError(error_of("Camera \"perspective\" \"float fov\" 180\nWorldBegin\n"), at(1, 1),
+                      "fov must lie in (0, 180) degrees"));
+}
+
+TEST(SceneFlattenError, FilmResolutionZero) {
+  EXPECT_TRUE(IsError(error_of("Film \"rgb\" \"integer xresolution\" 0\nWorldBegin\n"), at(1, 1),
+                      "film resolution must be between 1 and 65536"));
+}
+
+TEST(SceneFlattenError, UnsupportedFilm) {
+  EXPECT_TRUE(IsError(error_of("Film \"gbuffer\"\nWorldBegin\n"), at(1, 1), "film \"gbuffer\" is not supported"));
+}
+
+TEST(SceneFlattenError, UnknownPixelFilter) {
+  EXPECT_TRUE(IsError(error_of("PixelFilter \"blackman\"\nWorldBegin\n"), at(1, 1),
+                      "pixel filter \"blackman\" is unknown"));
+}
+
+TEST(SceneFlattenError, UnknownSampler) {
+  EXPECT_TRUE(IsError(error_of("Sampler \"lowdiscrepancy\"\nWorldBegin\n"), at(1, 1),
+                      "sampler \"lowdiscrepancy\" is unknown"));
+}
+
+TEST(SceneFlattenError, UnsupportedIntegrator) {
+  EXPECT_TRUE(IsError(error_of("Integrator \"ambientocclusion\"\nWorldBegin\n"), at(1, 1),
+                      "integrator \"ambientocclusion\" is not supported"));
+}
+
+TEST(SceneFlattenError, ParameterOfWrongType) {
+  const std::string l2 = R"(Shape "sphere" "integer radius" 2)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
+                      "parameter \"radius\" has type \"integer\"; expected \"float\""));
+}
+
+TEST(SceneFlattenError, ParameterTakesOneValue) {
+  const std::string l2 = R"(Shape "sphere" "float radius" [1 2])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")),
+                      "parameter \"radius\" takes one value; got 2"));
+}
+
+TEST(SceneFlattenError, UnknownNamedSpectrum) {
+  TempDir dir;
+  const std::string l2 = R"(Material "conductor" "spectrum eta" "metal-Unobtainium")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n", dir.str()), at(2, col(l2, "\"spectrum")),
+                      "\"metal-Unobtainium\" is neither a known named spectrum nor a readable spectrum file"));
+}
+
+TEST(SceneFlattenError, SpectrumFileWithText) {
+  TempDir dir;
+  dir.write("bad.spd", "400 0.5\n500 half\n");
+  const std::string l2 = R"(Material "diffuse" "spectrum reflectance" "bad.spd")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n", dir.str()), at(2, col(l2, "\"spectrum")),
+                      "spectrum file \"bad.spd\" holds something other than numbers"));
+}
+
+TEST(SceneFlattenError, SpectrumWavelengthsMustIncrease) {
+  const std::string l2 = R"(Material "diffuse" "spectrum reflectance" [500 0.5 400 0.5])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"spectrum")),
+                      "spectrum wavelengths must increase"));
+}
+
+TEST(SceneFlattenError, BlackbodyNonPositive) {
+  const std::string l2 = R"(LightSource "point" "blackbody I" -10)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"blackbody")),
+                      "blackbody temperature must be positive"));
+}
+
+TEST(SceneFlattenError, UnknownTexture) {
+  const std::string l2 = R"(Material "diffuse" "texture reflectance" "nope")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(3, col(l2, "\"texture")),
+                      "unknown texture \"nope\"").operator bool() == false);
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"texture")),
+                      "unknown texture \"nope\""));
+}
+
+TEST(SceneFlattenError, NonConstantTexture) {
+  const std::string l3 = R"(Material "diffuse" "texture reflectance" "img")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"a.png\"\n" +
+                               l3 + "\nShape \"sphere\"\n"),
+                      at(3, col(l3, "\"texture")), "of class \"imagemap\" is not supported (only constant textures)"));
+}
+
+TEST(SceneFlattenError, ConductorWithReflectanceAndEta) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nMaterial \"conductor\" \"rgb reflectance\" [0.5 0.5 0.5] "
+                               "\"spectrum eta\" \"metal-Au-eta\"\nShape \"sphere\"\n"),
+                      at(2, 1), "conductor has both reflectance and eta/k"));
+}
+
+TEST(SceneFlattenError, DielectricNegativeEta) {
+  const std::string l2 = R"(Material "dielectric" "float eta" -1.5)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"float")),
+                      "eta must be positive"));
+}
+
+TEST(SceneFlattenError, SpotLightFromEqualsTo) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"spot\" \"point3 from\" [1 1 1] \"point3 to\" [1 1 1]\n"),
+                      at(2, 1), "spot light with from == to"));
+}
+
+TEST(SceneFlattenError, NegativeLightScale) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"point\" \"float scale\" -1\n"), at(2, 1),
+                      "light scale must be a non-negative number"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Warnings
+
+TEST(SceneWarnings, UnusedParameterWarns) {
+  ParsedScene p = parse_scene_string("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float bogus\" 1\n");
+  int before = warning_count();
+  (void)flatten_scene(p);
+  EXPECT_EQ(warning_count() - before, 1);
+  EXPECT_FALSE(p.shapes[0].params.find_any("bogus")->used);
+  EXPECT_TRUE(p.shapes[0].params.find_any("radius")->used);
+}
+
+TEST(SceneWarnings, NoWarningWhenAllParametersAreUsed) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\nShape \"sphere\" \"float radius\" 2\n");
+  int before = warning_count();
+  (void)flatten_scene(p);
+  EXPECT_EQ(warning_count(), before);
+}
+
+TEST(SceneWarnings, UnusedMaterialParameterWarns) {
+  ParsedScene p = parse_scene_string(
+      "WorldBegin\nMaterial \"diffuse\" \"float sigma\" 20\nShape \"sphere\"\n");
+  int before = warning_count();
+  (void)flatten_scene(p);
+  EXPECT_EQ(warning_count() - before, 1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// PLY reader
+
+TEST(PlyReader, AsciiQuadIsTwoTriangles) {
+  TempDir dir;
+  fs::path path = dir.write("quad.ply", kAsciiQuadPly);
+  PlyMesh m = read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+  ASSERT_EQ(m.positions.size(), 4u);
+  expect_vec_near(m.positions[2], Vec3(1, 1, 0));
+  EXPECT_TRUE(m.normals.empty());
+  EXPECT_TRUE(m.uvs.empty());
+  EXPECT_EQ(m.quads, 1);
+  EXPECT_EQ(m.indices.size(), 6u);  // two triangles
+  EXPECT_EQ(m.indices, (std::vector<int>{0, 1, 2, 0, 2, 3}));
+}
+
+TEST(PlyReader, BinaryLittleEndianRoundTrip) {
+  TempDir dir;
+  std::string ply =
+      "ply\r\nformat binary_little_endian 1.0\r\n"
+      "element vertex 4\r\n"
+      "property float x\r\nproperty float y\r\nproperty float z\r\n"
+      "property float nx\r\nproperty float ny\r\nproperty float nz\r\n"
+      "property float u\r\nproperty float v\r\n"
+      "element face 2\r\nproperty list uchar int vertex_indices\r\nend_header\n";
+  const float verts[4][8] = {{0, 0, 0, 0, 0, 1, 0, 0},
+                             {1, 0, 0, 0, 0, 1, 1, 0},
+                             {1, 1, 0, 0, 0, 1, 1, 1},
+                             {0, 1, 0.5f, 0, 0, 1, 0, 1}};
+  for (const auto& v : verts)
+    for (float x : v) put_le(&ply, x);
+  put_le<uint8_t>(&ply, 3);
+  for (int i : {0, 1, 2}) put_le<int32_t>(&ply, i);
+  put_le<uint8_t>(&ply, 4);
+  for (int i : {0, 1, 2, 3}) put_le<int32_t>(&ply, i);
+  fs::path path = dir.write("mesh.ply", ply);
+
+  PlyMesh m = read_ply(path.string(), FileLoc{"scene.pbrt", 1, 1});
+  ASSERT_EQ(m.positions.size(), 4u);
+  ASSERT_EQ(m.normals.size(), 4u);
+  ASSERT_EQ(m.uvs.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    expect_vec_near(m.positions[i], Vec3(verts[i][0], verts[i][1], verts[i][2]), 0);
+    expect_vec_near(m.normals[i], Vec3(verts[i][3], verts[i][4], verts[i][5]), 0);
+    EXPECT_EQ(m.uvs[i].x, verts[i][6]);
+    EXPECT_EQ(m.uvs[i].y, verts[i][7]);
+  }
+  EXPECT_EQ(m.quads, 1);
+  EXPECT_EQ(m.indices, (std::vector<int>{0, 1, 2, 0, 1, 2, 0, 2, 3}));
+}
+
+TEST(PlyReader, BinaryBigEndianWithDoublesAndExtraProperties) {
+  TempDir dir;
+  std::string ply =
+      "ply\nformat binary_big_endian 1.0\n"
+      "element vertex 3\n"
+      "property double x\nproperty double y\nproperty double z\nproperty uchar red\n"
+      "element face 1\nproperty uchar flags\nproperty list ushort uint vertex_indices\nend_header\n";
+  const double verts[3][3] = {{0, 0, 0}, {2, 0, 0}, {0, 3, -1}};
+  for (const auto& v : verts) {
+    for (double x : v) put_be(&ply, x);
+    put_be<uint8_t>(&ply, 200);
+  }
+  put_be<uint8_t>(&ply, 7);
+  put_be<uint16_t>(&ply, 3);
+  for (uint32_t i : {2u, 1u, 0u}) put_be(&ply, i);
+  fs::path path = dir.write("be.ply", ply);
+
+  PlyMesh m = read_ply(path.string(), FileLoc{});
+  ASSERT_EQ(m.positions.size(), 3u);
+  expect_vec_near(m.positions[2], Vec3(0, 3, -1), 0);
+  EXPECT_TRUE(m.normals.empty());
+  EXPECT_EQ(m.quads, 0);
+  EXPECT_EQ(m.indices, (std::vector<int>{2, 1, 0}));
+}
+
+TEST(PlyReader, MissingFile) {
+  TempDir dir;
+  std::string path = (dir.path() / "nope.ply").string();
+  try {
+    (void)read_ply(path, FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "cannot open PLY file \"" + path + "\""));
+  }
+}
+
+TEST(PlyReader, NotAPlyFile) {
+  TempDir dir;
+  fs::path path = dir.write("x.ply", "OFF\n3 1 0\n");
+  try {
+    (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "missing 'ply' magic"));
+  }
+}
+
+TEST(PlyReader, FaceWithFiveVertices) {
+  TempDir dir;
+  fs::path path = dir.write("penta.ply",
+                            "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                            "0 0 0\n1 0 0\n1 1 0\n0 1 0\n-1 0.5 0\n5 0 1 2 3 4\n");
+  try {
+    (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "face with 5 vertices"));
+  }
+}
+
+TEST(PlyReader, TruncatedAscii) {
+  TempDir dir;
+  fs::path path = dir.write("short.ply",
+                            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                            "0 0 0\n1 0 0\n");
+  try {
+    (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "truncated or malformed data"));
+  }
+}
+
+}  // namespace
+}  // namespace bpm
