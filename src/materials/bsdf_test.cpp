@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -242,7 +243,6 @@ TEST_P(BsdfCaseTest, AlbedoAtMostOne) {
       EXPECT_LE(albedo[ch].max, bound * (1 + 1e-4)) << c.name << " channel " << ch << " mode " << int(mode);
       EXPECT_GE(albedo[ch].min, 0.0) << c.name;
     }
-    if (mode == TransportMode::kRadiance && bound == 1) continue;
   }
 }
 
@@ -296,7 +296,7 @@ TEST(BsdfEnergy, SmoothDielectricWhiteFurnace) {
   // (T / cos) cos / T = 1, so the weights average to exactly R + T = 1. Radiance transport divides
   // the transmitted weight by etap^2, so the average is R + T / etap^2.
   Material m = smooth_dielectric();
-  for (float co : {0.9f, 0.5f, 0.1f, -0.9f, -0.6f, -0.5f}) {
+  for (float co : {0.9f, 0.5f, 0.1f, -0.9f, -0.8f, -0.5f}) {  // -0.5: total internal reflection
     Vec3 wo = spherical(co, 0.3f);
     float R = fresnel_dielectric(co, kEta), T = 1 - R;
     float etap = co > 0 ? kEta : 1 / kEta;

@@ -163,6 +163,8 @@ class Flattener {
         throw Error(p->loc, "texture \"" + p->strings[0] + "\" of class \"" + t.name + "\" is not supported (only constant textures)");
       if (t.value_type == "float") {
         float v = t.params.get_float("value", 1);
+        if (v < 0 || (kind == SpectrumKind::kAlbedo && v > 1))
+          throw Error(t.loc, "constant texture \"" + t.texture_name + "\" used as a reflectance must lie in [0, 1]");
         return Spectrum(v);
       }
       auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
@@ -389,6 +391,7 @@ class Flattener {
     if (auto* f = ps.find_any("filename")) throw Error(f->loc, "image area lights are not supported");
     Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
     float scale = ps.get_float("scale", 1);
+    if (scale < 0) throw Error(ps.find_any("scale")->loc, "area light scale must not be negative");
     bool two_sided = ps.get_bool("twosided", false);
     float power = ps.get_float("power", -1);
     ps.warn_unused("area light");

@@ -29,8 +29,8 @@ class Parser {
   void run(std::unique_ptr<Tokenizer> top) {
     push_file(std::move(top));
     while (auto tok = next_token()) directive(*tok);
-    if (!stack_.empty()) throw Error(stack_.back().loc, "AttributeBegin without a matching AttributeEnd");
     if (object_name_) throw Error(object_loc_, "ObjectBegin \"" + *object_name_ + "\" without ObjectEnd");
+    if (!stack_.empty()) throw Error(stack_.back().loc, "AttributeBegin without a matching AttributeEnd");
     if (!world_begun_) throw Error(last_loc_, "the scene has no WorldBegin");
   }
 
@@ -42,11 +42,13 @@ class Parser {
   };
   struct FileInput {
     std::unique_ptr<Tokenizer> tok;
-    std::string directory;
   };
 
   ParsedScene* scene_;
   std::vector<FileInput> files_;
+  // Tokens are views into their file's text, and a look-ahead may run past the end of an
+  // included file: finished files stay alive until parsing ends.
+  std::vector<std::unique_ptr<Tokenizer>> finished_;
   std::optional<Token> peeked_;
   GraphicsState gs_;
   std::vector<Saved> stack_;
@@ -59,11 +61,7 @@ class Parser {
   FileLoc last_loc_;
   std::set<std::string> include_chain_;
 
-  void push_file(std::unique_ptr<Tokenizer> t) {
-    std::string dir = fs::path(t->file_name()).parent_path().string();
-    if (dir.empty()) dir = files_.empty() ? scene_->base_directory : files_.back().directory;
-    files_.push_back({std::move(t), dir});
-  }
+  void push_file(std::unique_ptr<Tokenizer> t) { files_.push_back({std::move(t)}); }
 
   std::optional<Token> next_token() {
     if (peeked_) {
@@ -77,6 +75,7 @@ class Parser {
         return t;
       }
       include_chain_.erase(files_.back().tok->file_name());
+      finished_.push_back(std::move(files_.back().tok));
       files_.pop_back();
     }
     return std::nullopt;
@@ -221,9 +220,9 @@ class Parser {
       throw Error(d.loc, std::string(d.text) + " is not allowed after WorldBegin");
   }
 
-  std::string current_directory() const {
-    return files_.empty() ? scene_->base_directory : files_.back().directory;
-  }
+  // pbrt-v4 resolves every relative file name against the directory of the main scene file,
+  // whichever file names it.
+  std::string current_directory() const { return scene_->base_directory; }
 
   void directive(const Token& d) {
     const std::string_view k = d.text;

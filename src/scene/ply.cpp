@@ -170,6 +170,7 @@ PlyMesh read_ply(const std::string& path, const FileLoc& from) {
       }
     }
   } catch (const Error& e) {
+    if (!e.loc().file.empty()) throw;  // already names the scene line
     throw Error(from, e.what());
   }
   for (int idx : mesh.indices)

@@ -45,7 +45,7 @@ class RenderScene {
   std::vector<Object> objects;
   std::vector<Material> materials;
   std::vector<Light> lights;
-  std::vector<int> infinite_lights;
+  std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
   Distribution1D light_distribution;  // in proportion to power
   Bounds3 bounds;
   SceneBoundsInfo bounds_info;

@@ -60,7 +60,10 @@ std::optional<Token> Tokenizer::next() {
       ++pos_;
       while (pos_ < text_.size() && text_[pos_] != '"') {
         if (text_[pos_] == '\n') throw Error(loc, "unterminated string (newline inside quotes)");
-        if (text_[pos_] == '\\') ++pos_;
+        if (text_[pos_] == '\\') {
+          ++pos_;
+          if (pos_ < text_.size() && text_[pos_] == '\n') throw Error(loc, "unterminated string (newline inside quotes)");
+        }
         ++pos_;
       }
       if (pos_ >= text_.size()) throw Error(loc, "unterminated string at end of file");

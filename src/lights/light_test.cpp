@@ -1,0 +1,370 @@
+// Tests of lights: emitted power against numerical integrals, the density of light_sample_li
+// (Monte Carlo estimates of solid-angle integrals, agreement with light_pdf_li, and a chi-square
+// test of the sampled directions), and the spot light falloff.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <optional>
+
+#include "base/chi2_test_util.h"
+#include "base/rng.h"
+#include "base/sampling.h"
+#include "base/transform.h"
+#include "lights/light.h"
+#include "scene/shapes.h"
+
+namespace bpm {
+namespace {
+
+const SceneBoundsInfo kBounds{Vec3(0, 0, 0), 10};
+const Spectrum kL(1.0f, 2.0f, 0.5f);
+
+struct D3 {
+  double x, y, z;
+};
+D3 d3(Vec3 v) { return {v.x, v.y, v.z}; }
+D3 sub(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+double ddot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+D3 dcross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double dlen(D3 a) { return std::sqrt(ddot(a, a)); }
+
+TriangleMesh make_triangle(bool flip = false) {
+  TriangleMesh m;
+  m.positions = {Vec3(0.2f, -0.1f, 1.0f), Vec3(1.7f, 0.3f, 1.2f), Vec3(0.4f, 1.4f, 0.7f)};
+  m.indices = {0, 1, 2};
+  m.flip_normal = flip;
+  return m;
+}
+double triangle_area(const TriangleMesh& m) {
+  D3 p0 = d3(m.positions[0]), p1 = d3(m.positions[1]), p2 = d3(m.positions[2]);
+  return 0.5 * dlen(dcross(sub(p1, p0), sub(p2, p0)));
+}
+// The documented orientation (shapes.h, pbrt-v4): cross(p0 - p2, p1 - p2).
+Vec3 triangle_normal(const TriangleMesh& m) {
+  Vec3 n = normalize(cross(m.positions[0] - m.positions[2], m.positions[1] - m.positions[2]));
+  return m.flip_normal ? -n : n;
+}
+// Solid angle of the triangle seen from p (Van Oosterom and Strackee 1983).
+double triangle_solid_angle(const TriangleMesh& m, Vec3 p) {
+  D3 a = sub(d3(m.positions[0]), d3(p)), b = sub(d3(m.positions[1]), d3(p)), c = sub(d3(m.positions[2]), d3(p));
+  double la = dlen(a), lb = dlen(b), lc = dlen(c);
+  double num = std::fabs(ddot(a, dcross(b, c)));
+  double den = la * lb * lc + ddot(a, b) * lc + ddot(a, c) * lb + ddot(b, c) * la;
+  return 2 * std::atan2(num, den);
+}
+
+Sphere make_sphere(Vec3 center, float radius) {
+  Sphere s;
+  s.world_from_object = Transform::translate(center);
+  s.radius = radius;
+  return s;
+}
+
+AreaLight make_area_light(const Shape& shape, bool two_sided) {
+  AreaLight l;
+  l.object = 0;
+  l.primitive = 0;
+  l.radiance = kL;
+  l.two_sided = two_sided;
+  l.area = primitive_area(shape, 0);
+  return l;
+}
+
+void expect_mean(const MeanAccumulator& a, double expected, double extra, const char* what) {
+  EXPECT_NEAR(a.mean, expected, kMeanTestSigmas * a.standard_error() + extra)
+      << what << ": mean " << a.mean << " +- " << a.standard_error() << ", expected " << expected;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Power.
+
+// Power of a diffuse emitter = integral over its area and over the sphere of directions of
+// L(p, w) |cos|: estimated with uniform points (own barycentric sampling) and uniform directions.
+template <class PointSampler>
+void check_area_light_power(const Shape& shape, const AreaLight& l, double area, PointSampler&& sample_point,
+                            uint64_t seed) {
+  Spectrum power = light_power(Light(l), kBounds);
+  Rng rng(seed);
+  MeanAccumulator est[Spectrum::kChannels];
+  for (int k = 0; k < 200000; ++k) {
+    Vec3 n = sample_point(rng);
+    Vec3 w = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+    Spectrum le = area_light_radiance(l, n, w);
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      est[c].add(double(le[c]) * std::fabs(dot(n, w)) * area / kUniformSpherePdfSolidAngle);
+  }
+  for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], power[c], 0, l.two_sided ? "two-sided" : "one-sided");
+  // And the closed form: pi A L per emitting side.
+  for (int c = 0; c < Spectrum::kChannels; ++c)
+    EXPECT_NEAR(power[c], kPi * area * kL[c] * (l.two_sided ? 2 : 1), 1e-5 * power[c]);
+  (void)shape;
+}
+
+TEST(LightPower, TriangleAreaLight) {
+  Shape shape = make_triangle();
+  const auto& mesh = std::get<TriangleMesh>(shape);
+  double area = triangle_area(mesh);
+  EXPECT_NEAR(primitive_area(shape, 0), area, 1e-6 * area);
+  for (bool two_sided : {false, true}) {
+    AreaLight l = make_area_light(shape, two_sided);
+    check_area_light_power(
+        shape, l, area,
+        [&](Rng& rng) {
+          float su = std::sqrt(rng.uniform()), v = rng.uniform();
+          SurfacePoint sp = surface_point(shape, 0, {su * (1 - v), su * v}, {});
+          return sp.ng;
+        },
+        two_sided ? 2 : 1);
+  }
+}
+
+TEST(LightPower, SphereAreaLight) {
+  Vec3 c(1, 2, 3);
+  float r = 0.5f;
+  Shape shape = make_sphere(c, r);
+  double area = 4 * M_PI * r * r;
+  EXPECT_NEAR(primitive_area(shape, 0), area, 1e-5 * area);
+  for (bool two_sided : {false, true}) {
+    AreaLight l = make_area_light(shape, two_sided);
+    check_area_light_power(
+        shape, l, area,
+        [&](Rng& rng) {
+          Vec3 d = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+          SurfacePoint sp = surface_point(shape, 0, {}, c + d * r);
+          EXPECT_GT(dot(sp.ng, d), 0.999f);  // outward normal
+          return sp.ng;
+        },
+        3 + two_sided);
+  }
+}
+
+TEST(LightPower, PrimitiveAreaUnderScaleAndForPartialShapes) {
+  Sphere s = make_sphere(Vec3(1, 2, 3), 0.5f);
+  s.world_from_object = Transform::translate(Vec3(1, 2, 3)) * Transform::scale(Vec3(2, 2, 2));
+  EXPECT_NEAR(primitive_area(Shape(s), 0), 4 * M_PI * 1.0 * 1.0, 1e-4);  // world radius 1
+  Sphere part = make_sphere(Vec3(0, 0, 0), 0.5f);
+  part.z_min = -0.25f;
+  part.z_max = 0.5f;
+  part.phi_max = kPi;
+  // A spherical zone has area 2 pi r h; half of it in phi.
+  EXPECT_NEAR(primitive_area(Shape(part), 0), M_PI * 0.5 * 0.75, 1e-5);
+  Disk d;
+  d.radius = 2;
+  d.inner_radius = 1;
+  d.world_from_object = Transform::scale(Vec3(3, 3, 3));
+  EXPECT_NEAR(primitive_area(Shape(d), 0), M_PI * (4 - 1) * 9, 1e-3);
+}
+
+TEST(LightPower, PointLight) {
+  PointLight p{Vec3(1, 2, 3), Spectrum(2.0f, 3.0f, 4.0f)};
+  Spectrum power = light_power(Light(p), kBounds);
+  for (int c = 0; c < Spectrum::kChannels; ++c) EXPECT_NEAR(power[c], 4 * M_PI * p.intensity[c], 1e-5 * power[c]);
+  auto s = light_sample_li(Light(p), nullptr, Vec3(1, 2, 5), {0.5f, 0.5f}, kBounds);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_TRUE(s->is_delta);
+  EXPECT_NEAR(s->radiance[0], 2.0f / 4, 1e-6f);
+  EXPECT_NEAR(s->wi.z, -1.0f, 1e-6f);
+}
+
+SpotLight make_spot() {
+  SpotLight l;
+  l.position = Vec3(0.5f, -1, 2);
+  l.frame = Frame::from_z(normalize(Vec3(0.3f, -0.4f, 0.87f)));
+  l.intensity = Spectrum(2.0f, 1.0f, 0.5f);
+  l.cos_falloff_start = std::cos(20 * kPi / 180);
+  l.cos_falloff_end = std::cos(35 * kPi / 180);
+  return l;
+}
+
+TEST(LightPower, SpotLightMatchesIntegralOfFalloff) {
+  SpotLight l = make_spot();
+  Spectrum power = light_power(Light(l), kBounds);
+  // Power = I * integral over the sphere of falloff = I * 2 pi * integral_{-1}^{1} falloff(cos) dcos.
+  const int n = 200000;
+  double integral = 0;
+  for (int k = 0; k < n; ++k) {
+    double c = -1 + (k + 0.5) * 2.0 / n;
+    integral += spot_falloff(l, Vec3(float(std::sqrt(1 - c * c)), 0, float(c)));
+  }
+  integral *= 2 * M_PI * 2.0 / n;
+  for (int c = 0; c < Spectrum::kChannels; ++c)
+    EXPECT_NEAR(power[c], l.intensity[c] * integral, 1e-3 * power[c]) << c;
+}
+
+// The intensity that light_sample_li delivers, integrated over all directions from the light.
+TEST(LightPower, SpotLightMatchesSampledIntensity) {
+  SpotLight l = make_spot();
+  Spectrum power = light_power(Light(l), kBounds);
+  Rng rng(7);
+  MeanAccumulator est[Spectrum::kChannels];
+  for (int k = 0; k < 200000; ++k) {
+    Vec3 w = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+    const float d = 2;
+    auto s = light_sample_li(Light(l), nullptr, l.position + w * d, {0.5f, 0.5f}, kBounds);
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      est[c].add(s ? double(s->radiance[c]) * d * d / kUniformSpherePdfSolidAngle : 0.0);
+    if (s) {
+      ASSERT_TRUE(s->is_delta);
+      ASSERT_NEAR(dot(s->wi, w), -1.0f, 1e-5f);
+    }
+  }
+  for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], power[c], 0, "spot power");
+}
+
+TEST(SpotLight, Falloff) {
+  SpotLight l = make_spot();
+  auto f = [&](double c) { return spot_falloff(l, Vec3(float(std::sqrt(std::fmax(0.0, 1 - c * c))), 0, float(c))); };
+  EXPECT_EQ(f(1.0), 1.0f);
+  EXPECT_EQ(f(l.cos_falloff_start + 1e-4), 1.0f);
+  EXPECT_EQ(f(l.cos_falloff_end - 1e-4), 0.0f);
+  EXPECT_EQ(f(-1.0), 0.0f);
+  EXPECT_EQ(f(0.0), 0.0f);
+  // Smoothstep: 1/2 halfway between the two cosines.
+  EXPECT_NEAR(f(0.5 * (l.cos_falloff_start + l.cos_falloff_end)), 0.5f, 1e-4f);
+  float prev = -1;
+  for (int k = 0; k <= 20000; ++k) {
+    double c = -1 + 2.0 * k / 20000;
+    float v = f(c);
+    ASSERT_GE(v, 0.0f);
+    ASSERT_LE(v, 1.0f);
+    ASSERT_GE(v, prev) << "not monotone at cos " << c;
+    prev = v;
+  }
+  // The cone axis is frame.n: a point along the axis receives the full intensity.
+  auto s = light_sample_li(Light(l), nullptr, l.position + l.frame.n * 3, {}, kBounds);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_NEAR(s->radiance[0], l.intensity[0] / 9, 1e-5f);
+  EXPECT_FALSE(light_sample_li(Light(l), nullptr, l.position - l.frame.n * 3, {}, kBounds).has_value());
+}
+
+// ---------------------------------------------------------------------------------------------
+// light_sample_li densities.
+
+// E[Li / pdf] over light_sample_li equals the integral of the incident radiance over solid
+// angle; each sample's pdf equals light_pdf_li at the sampled point.
+struct LiCheck {
+  MeanAccumulator est[Spectrum::kChannels];
+  int n_samples = 0, n_none = 0;
+};
+
+template <class PerSample>
+LiCheck run_li(const Light& light, const Shape& shape, Vec3 p_ref, uint64_t seed, int n, PerSample&& per_sample) {
+  LiCheck r;
+  Rng rng(seed);
+  for (int k = 0; k < n; ++k) {
+    auto s = light_sample_li(light, &shape, p_ref, {rng.uniform(), rng.uniform()}, kBounds);
+    ++r.n_samples;
+    if (!s) {
+      ++r.n_none;
+      for (auto& e : r.est) e.add(0);
+      continue;
+    }
+    EXPECT_FALSE(s->is_delta);
+    EXPECT_NEAR(length(s->wi), 1.0f, 1e-5f);
+    EXPECT_GT(s->pdf_solid_angle, 0);
+    float pdf = light_pdf_li(light, &shape, p_ref, s->wi, s->p_light, s->n_light);
+    EXPECT_NEAR(pdf, s->pdf_solid_angle, 1e-3f * s->pdf_solid_angle);
+    for (int c = 0; c < Spectrum::kChannels; ++c) r.est[c].add(double(s->radiance[c]) / s->pdf_solid_angle);
+    per_sample(*s);
+  }
+  return r;
+}
+
+TEST(LightSampleLi, TriangleSolidAngle) {
+  for (bool flip : {false, true}) {
+    Shape shape = make_triangle(flip);
+    const auto& mesh = std::get<TriangleMesh>(shape);
+    Vec3 ng = triangle_normal(mesh);
+    Vec3 centroid = (mesh.positions[0] + mesh.positions[1] + mesh.positions[2]) / 3;
+    Vec3 front = centroid + ng * 0.6f + Vec3(0.3f, -0.2f, 0.1f);
+    ASSERT_GT(dot(front - mesh.positions[0], ng), 0.1f);
+    Vec3 back = centroid - (front - centroid);
+    for (bool two_sided : {false, true}) {
+      Light light = make_area_light(shape, two_sided);
+      for (bool from_front : {true, false}) {
+        Vec3 p_ref = from_front ? front : back;
+        bool lit = two_sided || from_front;
+        double omega = triangle_solid_angle(mesh, p_ref);
+        auto check = [&](const LightLiSample& s) {
+          // On the triangle, in its plane, with its normal, and in the direction of wi.
+          EXPECT_NEAR(dot(s.p_light - mesh.positions[0], ng), 0.0f, 1e-5f);
+          EXPECT_NEAR(dot(s.n_light, ng), 1.0f, 1e-5f);
+          EXPECT_NEAR(dot(normalize(s.p_light - p_ref), s.wi), 1.0f, 1e-5f);
+          EXPECT_NEAR(s.radiance[1], kL[1], 1e-6f);
+        };
+        LiCheck r = run_li(light, shape, p_ref, 100 + 10 * flip + 2 * two_sided + lit, 100000, check);
+        if (!lit) {
+          EXPECT_EQ(r.n_none, r.n_samples) << "the back of a one-sided emitter must be dark";
+          continue;
+        }
+        EXPECT_EQ(r.n_none, 0);
+        for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(r.est[c], kL[c] * omega, 0, "triangle");
+      }
+    }
+  }
+}
+
+TEST(LightSampleLi, SphereFromOutsideSamplesTheCone) {
+  Vec3 c(1, 2, 3);
+  float radius = 0.5f;
+  Sphere sphere = make_sphere(c, radius);
+  Shape shape = sphere;
+  Light light = make_area_light(shape, false);
+  Vec3 p_ref = c + Vec3(0.9f, -1.1f, 0.6f);
+  double d = dlen(sub(d3(p_ref), d3(c)));
+  double cos_max = std::sqrt(1 - radius * radius / (d * d));
+  double omega = 2 * M_PI * (1 - cos_max);
+  Vec3 axis = normalize(c - p_ref);
+  auto check = [&](const LightLiSample& s) {
+    EXPECT_GE(dot(s.wi, axis), cos_max - 1e-5);
+    EXPECT_NEAR(length(s.p_light - c), radius, 1e-4f);
+    // The nearest intersection along wi.
+    double t = intersect_sphere(sphere, p_ref, s.wi, 1e-4, 1e30);
+    if (t > 0) {  // (a direction within float rounding of the silhouette may miss in double)
+      EXPECT_LT(length(p_ref + s.wi * float(t) - s.p_light), 2e-3f);
+    }
+    EXPECT_GT(dot(s.n_light, normalize(s.p_light - c)), 0.999f);
+    EXPECT_GE(dot(s.n_light, -s.wi), 0.0f);
+  };
+  LiCheck r = run_li(light, shape, p_ref, 200, 100000, check);
+  // Every sample returns L / pdf = L * omega: a zero-variance estimator; 1e-4 covers float rounding.
+  for (int ch = 0; ch < Spectrum::kChannels; ++ch) expect_mean(r.est[ch], kL[ch] * omega, 1e-4 * kL[ch] * omega, "sphere");
+}
+
+// From inside, points are sampled by area; a two-sided sphere surrounds p_ref with radiance L.
+TEST(LightSampleLi, SphereFromInside) {
+  Vec3 c(1, 2, 3);
+  float radius = 0.5f;
+  Sphere sphere = make_sphere(c, radius);
+  Shape shape = sphere;
+  Vec3 p_ref = c + Vec3(0.1f, -0.15f, 0.2f);
+  auto none = [](const LightLiSample&) {};
+  LiCheck dark = run_li(make_area_light(shape, false), shape, p_ref, 300, 10000, none);
+  EXPECT_EQ(dark.n_none, dark.n_samples) << "a one-sided sphere emits outward only";
+  Light light = make_area_light(shape, true);
+  LiCheck r = run_li(light, shape, p_ref, 301, 100000, none);
+  for (int ch = 0; ch < Spectrum::kChannels; ++ch) expect_mean(r.est[ch], kL[ch] * 4 * M_PI, 0, "inside sphere");
+
+  // The directions follow light_pdf_li (the chi-square harness of the BSDF tests; this is the
+  // only chi-square test in this file, hence n_tests = 1).
+  chi2::Options o;
+  o.n_tests = 1;
+  auto res = chi2::run(
+      [&](Rng& rng) -> std::optional<Vec3> {
+        auto s = light_sample_li(light, &shape, p_ref, {rng.uniform(), rng.uniform()}, kBounds);
+        if (!s) return std::nullopt;
+        return s->wi;
+      },
+      [&](Vec3 w) {
+        double t = intersect_sphere(sphere, p_ref, w, 0, 1e30);
+        if (!(t > 0)) return 0.0;
+        Vec3 p = p_ref + w * float(t);
+        SurfacePoint sp = surface_point(shape, 0, {}, p);
+        return double(light_pdf_li(light, &shape, p_ref, w, sp.p, sp.ng));
+      },
+      302, o);
+  EXPECT_TRUE(res.passed()) << res.report;
+}
+
+}  // namespace
+}  // namespace bpm
