@@ -125,7 +125,12 @@ struct Options {
   int n_cos = 10;             // cells in cos(theta), over [-1, 1]
   int n_phi = 20;             // cells in phi, over [0, 2 pi)
   long long n_samples = 200000;
-  int sub = 32;               // pdf evaluations per cell side (even)
+  // pdf evaluations per cell side (even). The midpoint rule errs by O(h^2) where the pdf is
+  // smooth but by O(h) across a discontinuity inside a cell (a rough dielectric's transmission
+  // pdf drops to zero where the generalized half vector reaches the horizon, while GGX's D there
+  // is not zero); 64 keeps the resulting systematic part of the statistic below ~1 for the BSDFs
+  // tested here (about 5 with 32).
+  int sub = 64;
   double min_expected = 5;    // pooling threshold
   double alpha = 0.01;        // family-wise significance level
   int n_tests = 1;            // chi-square tests in the suite, for the Sidak correction
@@ -216,11 +221,12 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
     if (expected[c] == 0) r.n_in_zero_cells += (long long)observed[c];
 
   // Mass check: n_valid is binomial(n, pdf_mass) when the pdf is right; allow 5 standard
-  // deviations of that, the integration error estimate (difference between the resolutions),
+  // deviations of that, twice the integration error estimate (the difference between the two
+  // resolutions, doubled because across discontinuities the error does not shrink monotonically)
   // and 1e-5 for the float rounding of pdf values.
   r.sample_mass = double(r.n_valid) / n;
   double pm = std::clamp(r.pdf_mass, 0.0, 1.0);
-  r.mass_tolerance = 5 * std::sqrt(pm * (1 - pm) / n) + std::fabs(r.pdf_mass - mass_half) + 1e-5;
+  r.mass_tolerance = 5 * std::sqrt(pm * (1 - pm) / n) + 2 * std::fabs(r.pdf_mass - mass_half) + 1e-5;
   r.mass_mismatch = std::fabs(r.sample_mass - r.pdf_mass) > r.mass_tolerance;
 
   // Categories: cells plus "sampler failed".

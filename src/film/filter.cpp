@@ -36,7 +36,7 @@ float sample_tent(float u, float r) {
 
 Filter::Filter(const FilterSettings& s) : s_(s) {
   if (s_.type == FilterType::kBox || s_.type == FilterType::kTriangle) return;
-  // 32 cells per unit of radius, as pbrt-v4's FilterSampler.
+  // 32 cells per pixel of filter extent (pbrt-v4 uses 32 per unit of radius).
   nx_ = std::max(1, int(32 * s_.radius.x * 2));
   ny_ = std::max(1, int(32 * s_.radius.y * 2));
   values_.resize(size_t(nx_) * ny_);
