@@ -42,6 +42,8 @@ struct Case {
   bool channels[3];
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.scene; }
+
 class Reference : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Reference, MatchesPbrtV4) {
