@@ -36,7 +36,7 @@ Image error_false_colour(const Film& film) {
   return out;
 }
 
-void write_outputs(const OutputPaths& paths, const Film& film, float imaging_ratio, const nlohmann::json& record) {
+void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio) {
   Image img = film.image(imaging_ratio);
   std::vector<float> rms = film.rms();
   for (float& r : rms) r *= imaging_ratio;
@@ -44,7 +44,6 @@ void write_outputs(const OutputPaths& paths, const Film& film, float imaging_rat
   write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}});
   write_png(paths.png, img);
   write_png_display(paths.error_png, error_false_colour(film));
-  write_text_atomic(paths.json, record.dump(2) + "\n");
 }
 
 }  // namespace bpm

@@ -50,10 +50,9 @@ struct AreaSample {
 // Uniform point on the primitive (triangles, full spheres and disks under similarity transforms,
 // which flatten.cpp guarantees for emitters).
 AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
-  if (auto* m = std::get_if<TriangleMesh>(&shape)) {
-    Vec2 b = sample_uniform_triangle(u);
+  if (std::holds_alternative<TriangleMesh>(shape)) {
+    Vec2 b = sample_uniform_triangle(u);  // (b0, b1); surface_point takes (b1, b2)
     SurfacePoint sp = surface_point(shape, l.primitive, {b.y, 1 - b.x - b.y}, {});
-    (void)m;
     return {sp.p, sp.ng, 1 / l.area};
   }
   if (auto* s = std::get_if<Sphere>(&shape)) {

@@ -23,10 +23,9 @@ Spectrum sample_direct(const RenderScene& scene, const SurfacePoint& sp, const M
   if (f.is_black()) return {};
   ++counters.shadow_rays;
   Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi);
-  Vec3 target = ls->is_delta && !ls->is_infinite ? ls->p_light
-                                                 : (ls->n_light.x == 0 && ls->n_light.y == 0 && ls->n_light.z == 0
-                                                        ? ls->p_light
-                                                        : offset_origin(ls->p_light, ls->n_light, -ls->wi));
+  // Lights with a surface get the shadow ray's end lifted off that surface.
+  bool has_surface = length_squared(ls->n_light) > 0;
+  Vec3 target = has_surface ? offset_origin(ls->p_light, ls->n_light, -ls->wi) : ls->p_light;
   if (counters.log) {
     Vec3 d = target - origin;
     float len = length(d);

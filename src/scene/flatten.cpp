@@ -70,9 +70,6 @@ class Flattener {
     float open = c.params.get_float("shutteropen", 0), close = c.params.get_float("shutterclose", 1);
     if (close < open) throw Error(c.loc, "shutterclose is before shutteropen");
     out->film.imaging_ratio = close - open;
-    if (c.params.find_any("frameaspectratio"))
-      warning(c.params.find_any("frameaspectratio")->loc, "frameaspectratio is ignored; the film resolution sets the aspect");
-    c.params.find_any("frameaspectratio") ? (void)(c.params.find_any("frameaspectratio")->used = true) : (void)0;
     c.params.warn_unused("camera");
   }
 
@@ -251,7 +248,7 @@ class Flattener {
     } else {
       throw Error(e.loc, "material \"" + e.name + "\" is not supported");
     }
-    ps.find_any("type") ? (void)(ps.find_any("type")->used = true) : (void)0;
+    if (const Param* type = ps.find_any("type")) type->used = true;  // MakeNamedMaterial's own
     ps.warn_unused("material \"" + e.name + "\"");
     return m;
   }
