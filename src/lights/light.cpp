@@ -183,6 +183,68 @@ float light_pdf_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec3 wi, 
   return d2 / (cos_l * l.area);
 }
 
+std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
+                                             const SceneBoundsInfo& bounds) {
+  LightLeSample s;
+  if (auto* l = std::get_if<PointLight>(&light)) {
+    s.origin = l->position;
+    s.direction = sample_uniform_sphere(u_dir);
+    s.flux = l->intensity / kUniformSpherePdfSolidAngle;
+    return s;
+  }
+  if (auto* l = std::get_if<SpotLight>(&light)) {
+    Vec3 w = sample_uniform_cone(u_dir, l->cos_falloff_end);
+    float fall = spot_falloff(*l, w);
+    if (fall == 0) return std::nullopt;
+    s.origin = l->position;
+    s.direction = l->frame.to_world(w);
+    s.flux = l->intensity * (fall / uniform_cone_pdf_solid_angle(l->cos_falloff_end));
+    return s;
+  }
+  // Infinite lights emit through a disk of the scene's bounding radius, facing the direction of
+  // travel, placed outside the scene (pbrt-v4 DistantLight/UniformInfiniteLight::SampleLe).
+  auto disk_origin = [&](Vec3 d) {
+    Frame f = Frame::from_z(d);
+    Vec2 q = sample_uniform_disk_concentric(u_pos);
+    return bounds.center + f.to_world(Vec3(q.x, q.y, -1)) * bounds.radius;
+  };
+  float disk_area = kPi * bounds.radius * bounds.radius;
+  if (auto* l = std::get_if<DistantLight>(&light)) {
+    s.direction = -l->direction_to_light;
+    s.origin = disk_origin(s.direction);
+    s.flux = l->radiance * disk_area;
+    return s;
+  }
+  if (auto* l = std::get_if<UniformInfiniteLight>(&light)) {
+    s.direction = sample_uniform_sphere(u_dir);
+    s.origin = disk_origin(s.direction);
+    s.flux = l->radiance * (disk_area / kUniformSpherePdfSolidAngle);
+    return s;
+  }
+  const AreaLight& l = std::get<AreaLight>(light);
+  AreaSample as = sample_area(l, *shape, u_pos);
+  // Cosine-weighted about the normal; a two-sided emitter picks its side with probability 1/2.
+  float side = 1, side_pdf = 1;
+  if (l.two_sided) {
+    side_pdf = 0.5f;
+    if (u_dir.x < 0.5f) {
+      u_dir.x *= 2;
+    } else {
+      u_dir.x = 2 * u_dir.x - 1;
+      side = -1;
+    }
+  }
+  Vec3 w_local = sample_cosine_hemisphere(u_dir);
+  float pdf_dir = side_pdf * cosine_hemisphere_pdf_solid_angle(w_local.z);
+  if (pdf_dir == 0) return std::nullopt;
+  Vec3 n = as.n * side;
+  s.direction = Frame::from_z(n).to_world(w_local);
+  s.origin = as.p;
+  s.n_light = as.n;
+  s.flux = l.radiance * (w_local.z / (as.pdf_area * pdf_dir));
+  return s;
+}
+
 Spectrum light_power(const Light& light, const SceneBoundsInfo& bounds) {
   if (auto* l = std::get_if<PointLight>(&light)) return l->intensity * (4 * kPi);
   if (auto* l = std::get_if<SpotLight>(&light))

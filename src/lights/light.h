@@ -60,6 +60,15 @@ struct SceneBoundsInfo {
   float radius = 1;
 };
 
+// A photon leaving a light (pbrt-v4's SampleLe): origin, direction, and the flux weight
+// Le |cos| / (pdf_area * pdf_solid_angle), whose expectation over samples is light_power().
+struct LightLeSample {
+  Vec3 origin;
+  Vec3 direction;  // unit
+  Vec3 n_light;    // surface normal at the origin (zero for lights without a surface)
+  Spectrum flux;
+};
+
 bool light_is_delta(const Light& l);
 bool light_is_infinite(const Light& l);
 
@@ -74,6 +83,9 @@ inline Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec3 w) {
   if (!l.two_sided && dot(n, w) <= 0) return {};
   return l.radiance;
 }
+// Samples an emitted photon; u_pos picks the point, u_dir the direction.
+std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
+                                             const SceneBoundsInfo& bounds);
 // Total emitted power (W per channel), used by the power light sampler.
 Spectrum light_power(const Light& l, const SceneBoundsInfo& bounds);
 

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <string>
 #include <optional>
 
 #include "base/chi2_test_util.h"
@@ -365,6 +367,65 @@ TEST(LightSampleLi, SphereFromInside) {
       },
       302, o);
   EXPECT_TRUE(res.passed()) << res.report;
+}
+
+
+// Photon emission: the mean flux weight of light_sample_le is the light's power (what the photon
+// passes divide by the number of photons), and photons leave where and whither the light emits.
+void check_emission(const char* name, const Light& light, const Shape* shape,
+                    const std::function<void(const LightLeSample&)>& check_sample) {
+  Spectrum power = light_power(light, kBounds);
+  Rng rng(stream_key(41, std::string(name).size()));
+  MeanAccumulator est[Spectrum::kChannels];
+  for (int k = 0; k < 200000; ++k) {
+    auto s = light_sample_le(light, shape, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds);
+    for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
+    if (!s) continue;
+    ASSERT_NEAR(length(s->direction), 1.0f, 1e-4f) << name;
+    check_sample(*s);
+  }
+  for (int c = 0; c < Spectrum::kChannels; ++c)
+    EXPECT_NEAR(est[c].mean, power[c], 4 * est[c].standard_error() + 1e-6 * power[c]) << name << " channel " << c;
+}
+
+TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
+  check_emission("point", Light(PointLight{Vec3(1, 2, 3), kL}), nullptr, [](const LightLeSample& s) {
+    EXPECT_EQ(length(s.origin - Vec3(1, 2, 3)), 0.0f);
+  });
+  SpotLight spot = make_spot();
+  check_emission("spot", Light(spot), nullptr, [&](const LightLeSample& s) {
+    EXPECT_GE(dot(s.direction, spot.frame.n), spot.cos_falloff_end - 1e-5f);
+  });
+  Vec3 to_light = normalize(Vec3(0.3f, 1, -0.2f));
+  auto crosses_scene = [](const LightLeSample& s) {
+    // The photon starts outside the bounding sphere, heading through it.
+    Vec3 oc = kBounds.center - s.origin;
+    float along = dot(oc, s.direction);
+    EXPECT_GE(length(oc), kBounds.radius * 0.999f);
+    EXPECT_LE(length(oc - s.direction * along), kBounds.radius * 1.0001f);
+  };
+  check_emission("distant", Light(DistantLight{to_light, kL}), nullptr, [&](const LightLeSample& s) {
+    EXPECT_NEAR(dot(s.direction, to_light), -1.0f, 1e-5f);
+    crosses_scene(s);
+  });
+  check_emission("uniform infinite", Light(UniformInfiniteLight{kL}), nullptr, crosses_scene);
+  for (bool two_sided : {false, true}) {
+    Shape tri = make_triangle();
+    AreaLight l = make_area_light(tri, two_sided);
+    Vec3 n = triangle_normal(std::get<TriangleMesh>(tri));
+    int back = 0;
+    check_emission(two_sided ? "triangle two-sided" : "triangle", Light(l), &tri, [&](const LightLeSample& s) {
+      EXPECT_NEAR(dot(s.origin - std::get<TriangleMesh>(tri).positions[0], n), 0.0f, 1e-4f);
+      if (dot(s.direction, n) < 0) ++back;
+    });
+    if (two_sided) EXPECT_NEAR(back, 100000, 1500);
+    else EXPECT_EQ(back, 0);
+  }
+  Shape sphere = make_sphere(Vec3(1, 2, 3), 0.5f);
+  check_emission("sphere", Light(make_area_light(sphere, false)), &sphere, [&](const LightLeSample& s) {
+    EXPECT_NEAR(length(s.origin - Vec3(1, 2, 3)), 0.5f, 1e-4f);
+    EXPECT_GT(dot(s.direction, s.origin - Vec3(1, 2, 3)), 0.0f);
+  });
 }
 
 }  // namespace

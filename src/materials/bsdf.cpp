@@ -243,6 +243,36 @@ std::optional<BsdfSample> sample_of(const DiffuseTransmissionMaterial& m, Vec3 w
   return BsdfSample{m.transmittance * kInvPi, wi, pt / (pr + pt) * c, kTransmission | kDiffuse};
 }
 
+// ---- phong (not reciprocal; see material.h) ----
+// Lobe density about the mirror direction of wo, which is also the sampling pdf.
+float phong_lobe(const PhongMaterial& m, Vec3 wo, Vec3 wi) {
+  if (!same_hemisphere(wo, wi)) return 0;
+  float c = dot(wi, Vec3(-wo.x, -wo.y, wo.z));
+  if (c <= 0) return 0;
+  return (m.exponent + 1) * (0.5f * kInvPi) * std::pow(c, m.exponent);
+}
+Spectrum f_of(const PhongMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  float lobe = phong_lobe(m, wo, wi);
+  if (lobe == 0) return {};
+  // The physical direction of light flow is wi -> wo for radiance and wo -> wi for importance;
+  // the 1/cos belongs to the direction the light leaves in.
+  float cos_out = std::fabs(mode == TransportMode::kRadiance ? wo.z : wi.z);
+  return m.reflectance * (lobe / cos_out);
+}
+float pdf_of(const PhongMaterial& m, Vec3 wo, Vec3 wi, TransportMode) { return phong_lobe(m, wo, wi); }
+std::optional<BsdfSample> sample_of(const PhongMaterial& m, Vec3 wo, float, Vec2 u, TransportMode mode) {
+  if (wo.z == 0) return std::nullopt;
+  // cos^n lobe about the mirror direction (pdf (n+1)/(2 pi) cos^n).
+  float cos_a = std::pow(u.x, 1 / (m.exponent + 1));
+  float sin_a = std::sqrt(std::fmax(0.0f, 1 - cos_a * cos_a));
+  float phi = 2 * kPi * u.y;
+  Frame frame = Frame::from_z(Vec3(-wo.x, -wo.y, wo.z));
+  Vec3 wi = frame.to_world(Vec3(sin_a * std::cos(phi), sin_a * std::sin(phi), cos_a));
+  float pdf = phong_lobe(m, wo, wi);
+  if (pdf == 0) return std::nullopt;
+  return BsdfSample{f_of(m, wo, wi, mode), wi, pdf, kReflection | kGlossy};
+}
+
 // ---- interface: no scattering; the integrators skip such surfaces ----
 Spectrum f_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return {}; }
 float pdf_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return 0; }
@@ -268,6 +298,7 @@ bool bsdf_is_specular(const Material& m) {
     bool operator()(const DielectricMaterial& d) const { return d.eta == 1 || d.roughness.effectively_smooth(); }
     bool operator()(const ThinDielectricMaterial&) const { return true; }
     bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
+    bool operator()(const PhongMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return true; }
   };
   return std::visit(V{}, m);

@@ -61,6 +61,8 @@ Material diffuse_transmission() {
   return m;
 }
 
+Material phong() { return PhongMaterial{Spectrum(0.8f, 0.6f, 0.4f), 12}; }
+bool is_phong(const Material& m) { return std::holds_alternative<PhongMaterial>(m); }
 bool is_dielectric(const Material& m) { return std::holds_alternative<DielectricMaterial>(m); }
 
 // For a rough dielectric: whether the microfacet normal of the pair (wo, wi), the generalized half
@@ -96,6 +98,7 @@ std::vector<BsdfCase> bsdf_cases() {
        {"CosMinus0p3", -0.3f}});
   add("DiffuseTransmission", diffuse_transmission(),
       {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}, {"CosMinus0p6", -0.6f}});
+  add("Phong12", phong(), {{"Cos0p9", 0.9f}, {"Cos0p3", 0.3f}, {"CosMinus0p7", -0.7f}});
   return v;
 }
 
@@ -249,6 +252,9 @@ TEST_P(BsdfCaseTest, AlbedoAtMostOne) {
   for (TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
     float bound = 1;
     if (mode == TransportMode::kRadiance && is_dielectric(c.material) && wo.z < 0) bound = kEta * kEta;
+    // The non-reciprocal lobe conserves energy in the direction light flows (importance); camera
+    // paths carry |cos theta_i| / |cos theta_o|, which is not bounded by one.
+    if (mode == TransportMode::kRadiance && is_phong(c.material)) continue;
     Rng rng(stream_key(c.seed, 3, int(mode)));
     MeanAccumulator albedo[Spectrum::kChannels];
     for (int k = 0; k < 100000; ++k) {
@@ -355,6 +361,38 @@ TEST(BsdfEnergy, RoughPerfectConductorLosesLittleEnergyAtLowRoughness) {
 
 // ---------------------------------------------------------------------------------------------
 // Reciprocity.
+
+// The phong lobe is the non-reciprocal case: its radiance and importance values differ, each is
+// the other with the arguments swapped (the adjoint), and light-direction samples carry exactly
+// the reflectance as weight (the lobe is normalised per incident direction).
+TEST(BsdfReciprocity, PhongIsNotReciprocalButHasAnAdjoint) {
+  Material m = phong();
+  Rng rng(stream_key(37, 0));
+  int n_asymmetric = 0, n_pairs = 0;
+  for (int k = 0; k < 20000; ++k) {
+    Vec3 wo = random_direction(rng), wi = random_direction(rng);
+    wi.z = std::copysign(wi.z, wo.z);
+    Spectrum rad = bsdf_f(m, wo, wi, TransportMode::kRadiance);
+    Spectrum imp = bsdf_f(m, wi, wo, TransportMode::kImportance);
+    for (int ch = 0; ch < Spectrum::kChannels; ++ch) ASSERT_TRUE(near_rel(rad[ch], imp[ch], 1e-5, 1e-9));
+    if (rad.is_black()) continue;
+    ++n_pairs;
+    Spectrum swapped = bsdf_f(m, wi, wo, TransportMode::kRadiance);
+    if (!near_rel(rad[0], swapped[0], 1e-2)) ++n_asymmetric;
+  }
+  EXPECT_GT(n_pairs, 500);
+  EXPECT_GT(n_asymmetric, n_pairs / 2);
+  for (float cos_o : {0.95f, 0.5f}) {
+    Vec3 wo = spherical(cos_o, 0.3f);
+    for (int k = 0; k < 2000; ++k) {
+      auto s = bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kImportance);
+      if (!s) continue;
+      Spectrum w = s->f * (std::fabs(s->wi.z) / s->pdf_solid_angle);
+      for (int ch = 0; ch < Spectrum::kChannels; ++ch)
+        ASSERT_TRUE(near_rel(w[ch], std::get<PhongMaterial>(m).reflectance[ch], 1e-4));
+    }
+  }
+}
 
 TEST(BsdfReciprocity, ReflectionIsSymmetric) {
   std::vector<std::pair<const char*, Material>> materials = {

@@ -43,11 +43,26 @@ struct DiffuseTransmissionMaterial {
   Spectrum reflectance{0.25f}, transmittance{0.25f};
 };
 
+// A glossy lobe that is not reciprocal (bpm's own "phong", not a pbrt-v4 material): light arriving
+// from w_l leaves toward w_v with
+//   f(w_l -> w_v) = R (n + 1) / (2 pi) cos^n(angle(w_v, reflect(w_l))) / |cos theta_v|,
+// so that for every incident direction the scattered power is R times the part of the lobe above
+// the horizon (normalised per incident direction, as measured BSDFs are). Swapping the directions
+// changes the value (the 1/cos follows the outgoing direction), so f(wo, wi) != f(wi, wo): the
+// case the paper's Helmholtz compensation (section 2) is for. Sampling draws the lobe about the
+// mirror direction, which is exact for light transport; camera paths carry the ratio of the two
+// BSDF values, |cos theta_i| / |cos theta_o|, as their compensation.
+struct PhongMaterial {
+  Spectrum reflectance{0.5f};
+  float exponent = 20;
+};
+
 // Marks a boundary that does not scatter (pbrt-v4 "interface"): rays pass straight through.
 struct InterfaceMaterial {};
 
 using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMaterial,
-                              ThinDielectricMaterial, DiffuseTransmissionMaterial, InterfaceMaterial>;
+                              ThinDielectricMaterial, DiffuseTransmissionMaterial, PhongMaterial,
+                              InterfaceMaterial>;
 
 enum BsdfFlags : unsigned {
   kReflection = 1,

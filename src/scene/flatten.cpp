@@ -243,6 +243,15 @@ class Flattener {
       if ((d.reflectance + d.transmittance).max_component() > 1.0001f)
         throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
       m = d;
+    } else if (e.name == "phong") {
+      // bpm's own non-reciprocal glossy lobe (material.h); pbrt-v4 does not know it.
+      PhongMaterial ph;
+      if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) ph.reflectance = *r;
+      if (const Param* p = ps.find_any("exponent")) {
+        ph.exponent = ps.get_float("exponent", 20);
+        if (!(ph.exponent >= 0 && ph.exponent <= 1e5f)) throw Error(p->loc, "phong exponent must be in [0, 1e5]");
+      }
+      m = ph;
     } else if (e.name == "interface" || e.name == "" || e.name == "none") {
       m = InterfaceMaterial{};
     } else {
