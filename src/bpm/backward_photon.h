@@ -1,0 +1,38 @@
+// The records the two passes exchange. A backward photon is a diffuse vertex of an eye path
+// (DESIGN.md, vocabulary) with the sphere over which it gathers; a photon's class says how the
+// light reached the surface it hit, and each backward photon accepts some classes only.
+#pragma once
+#include <cstdint>
+
+#include "base/spectrum.h"
+#include "base/vec.h"
+
+namespace bpm {
+
+// How a forward photon arrived: straight from the light, through specular vertices only, or
+// after at least one diffuse vertex.
+enum class PhotonClass : uint8_t { kDirect, kCaustic, kIndirect };
+
+enum AcceptMask : uint8_t { kAcceptsCaustic = 1, kAcceptsIndirect = 2 };
+
+struct BackwardPhoton {
+  Vec3 p;
+  float radius;  // world units
+  Vec3 ng, ns;   // geometric and shading normals
+  Vec3 wo;       // toward the previous eye vertex
+  Spectrum tau;  // throughput from the camera (the paper's transmittance)
+  uint32_t pixel;
+  uint32_t material;
+  uint16_t eye_depth;      // scattering events on the eye path, this vertex included
+  uint8_t accepts;         // AcceptMask bits
+  uint8_t diffuse_index;   // j - 1 for the j-th diffuse vertex (0..3)
+
+  bool accepts_class(PhotonClass c) const {
+    return (c == PhotonClass::kCaustic && (accepts & kAcceptsCaustic)) ||
+           (c == PhotonClass::kIndirect && (accepts & kAcceptsIndirect));
+  }
+  // Sort key that fixes the order of backward photons whatever thread stored them.
+  uint64_t key() const { return (uint64_t(pixel) << 2) | diffuse_index; }
+};
+
+}  // namespace bpm

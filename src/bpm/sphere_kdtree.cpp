@@ -1,0 +1,157 @@
+#include "bpm/sphere_kdtree.h"
+
+#include <algorithm>
+
+namespace bpm {
+namespace {
+
+// Cost of descending one level in units of testing one sphere (a node visit is a likely cache
+// miss; leaf spheres are tested from contiguous memory). A split is made only when
+// the expected number of sphere tests per query (query points spread uniformly over the cell)
+// falls by more than this.
+constexpr float kTraversalCost = 24;
+constexpr size_t kMinLeaf = 8;
+constexpr int kMaxDepth = 48;
+
+int longest_axis(const Bounds3& b) {
+  Vec3 d = b.hi - b.lo;
+  return d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
+}
+
+}  // namespace
+
+void SphereKdTree::build(const std::vector<SphereRef>& spheres) {
+  nodes_.clear();
+  items_.clear();
+  spheres_.clear();
+  input_count_ = spheres.size();
+  if (spheres.empty()) return;
+  std::vector<uint32_t> ids(spheres.size());
+  Bounds3 cell;
+  for (uint32_t i = 0; i < ids.size(); ++i) {
+    ids[i] = i;
+    cell.expand(spheres[i].c - Vec3(spheres[i].r, spheres[i].r, spheres[i].r));
+    cell.expand(spheres[i].c + Vec3(spheres[i].r, spheres[i].r, spheres[i].r));
+  }
+  nodes_.reserve(2 * spheres.size() / kMinLeaf + 1);
+  build_node(ids, cell, 0, spheres);
+  nodes_.shrink_to_fit();
+}
+
+void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth,
+                              const std::vector<SphereRef>& spheres) {
+  uint32_t self = uint32_t(nodes_.size());
+  nodes_.push_back({});
+  auto make_leaf = [&] {
+    nodes_[self] = {0, kLeaf, uint32_t(items_.size()), uint32_t(ids.size())};
+    for (uint32_t i : ids) {
+      items_.push_back(i);
+      spheres_.push_back(spheres[i]);
+    }
+  };
+  size_t n = ids.size();
+  if (n <= kMinLeaf || depth >= kMaxDepth) return make_leaf();
+  // Tighten the cell to the spheres in it: no query outside their union finds anything.
+  Bounds3 tight;
+  for (uint32_t i : ids) {
+    Vec3 r(spheres[i].r, spheres[i].r, spheres[i].r);
+    tight.expand(spheres[i].c - r);
+    tight.expand(spheres[i].c + r);
+  }
+  cell.lo = vmax(cell.lo, tight.lo);
+  cell.hi = vmin(cell.hi, tight.hi);
+  int axis = longest_axis(cell);
+  float lo = cell.lo[axis], hi = cell.hi[axis];
+  if (!(hi > lo)) return make_leaf();
+  // Split at the median centre (balanced trees for clustered photons), unless it sits on the
+  // cell's boundary, then at the middle.
+  std::vector<float> cs(n);
+  for (size_t k = 0; k < n; ++k) cs[k] = spheres[ids[k]].c[axis];
+  std::nth_element(cs.begin(), cs.begin() + n / 2, cs.end());
+  float split = cs[n / 2];
+  if (!(split > lo && split < hi)) split = 0.5f * (lo + hi);
+  size_t nl = 0, nr = 0;
+  for (uint32_t i : ids) {
+    const SphereRef& s = spheres[i];
+    nl += s.c[axis] - s.r < split;
+    nr += s.c[axis] + s.r >= split;
+  }
+  float pl = (split - lo) / (hi - lo);
+  float cost_split = kTraversalCost + pl * float(nl) + (1 - pl) * float(nr);
+  if (cost_split >= float(n) || nl == n || nr == n) return make_leaf();
+
+  std::vector<uint32_t> left, right;
+  left.reserve(nl);
+  right.reserve(nr);
+  for (uint32_t i : ids) {
+    const SphereRef& s = spheres[i];
+    if (s.c[axis] - s.r < split) left.push_back(i);
+    if (s.c[axis] + s.r >= split) right.push_back(i);
+  }
+  std::vector<uint32_t>().swap(ids);
+  Bounds3 lcell = cell, rcell = cell;
+  lcell.hi[axis] = split;
+  rcell.lo[axis] = split;
+  build_node(left, lcell, depth + 1, spheres);
+  std::vector<uint32_t>().swap(left);
+  uint32_t right_index = uint32_t(nodes_.size());
+  build_node(right, rcell, depth + 1, spheres);
+  nodes_[self] = {split, uint32_t(axis), right_index, 0};
+}
+
+size_t SphereKdTree::bytes() const {
+  return nodes_.size() * sizeof(Node) + items_.size() * (sizeof(uint32_t) + sizeof(SphereRef));
+}
+
+double SphereKdTree::duplication() const {
+  return input_count_ ? double(items_.size()) / double(input_count_) : 0.0;
+}
+
+void CentreKdTree::build(const std::vector<SphereRef>& spheres) {
+  nodes_.clear();
+  max_radius_ = 0;
+  spheres_ = spheres;
+  items_.resize(spheres.size());
+  for (uint32_t i = 0; i < items_.size(); ++i) {
+    items_[i] = i;
+    max_radius_ = std::max(max_radius_, spheres[i].r);
+  }
+  if (spheres.empty()) return;
+  nodes_.reserve(2 * spheres.size() / 8 + 1);
+  build_node(0, uint32_t(spheres.size()), 0);
+}
+
+void CentreKdTree::build_node(uint32_t begin, uint32_t end, int depth) {
+  uint32_t self = uint32_t(nodes_.size());
+  nodes_.push_back({0, kLeaf, begin, end - begin});
+  if (end - begin <= 8 || depth >= 60) return;
+  Bounds3 b;
+  for (uint32_t k = begin; k < end; ++k) b.expand(spheres_[k].c);
+  int axis = longest_axis(b);
+  if (!(b.hi[axis] > b.lo[axis])) return;
+  uint32_t mid = begin + (end - begin) / 2;
+  // Keep items_ and spheres_ in step: sort an index permutation, then apply it.
+  std::vector<uint32_t> perm(end - begin);
+  for (uint32_t k = 0; k < perm.size(); ++k) perm[k] = begin + k;
+  std::nth_element(perm.begin(), perm.begin() + (mid - begin), perm.end(),
+                   [&](uint32_t x, uint32_t y) { return spheres_[x].c[axis] < spheres_[y].c[axis]; });
+  std::vector<SphereRef> s(perm.size());
+  std::vector<uint32_t> it(perm.size());
+  for (uint32_t k = 0; k < perm.size(); ++k) {
+    s[k] = spheres_[perm[k]];
+    it[k] = items_[perm[k]];
+  }
+  std::copy(s.begin(), s.end(), spheres_.begin() + begin);
+  std::copy(it.begin(), it.end(), items_.begin() + begin);
+  float split = spheres_[mid].c[axis];
+  build_node(begin, mid, depth + 1);
+  uint32_t right_index = uint32_t(nodes_.size());
+  build_node(mid, end, depth + 1);
+  nodes_[self] = {split, uint32_t(axis), right_index, 0};
+}
+
+size_t CentreKdTree::bytes() const {
+  return nodes_.size() * sizeof(Node) + items_.size() * (sizeof(uint32_t) + sizeof(SphereRef));
+}
+
+}  // namespace bpm

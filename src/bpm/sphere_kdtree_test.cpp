@@ -1,0 +1,67 @@
+// The kd-trees over backward photons return exactly the spheres a brute-force scan finds.
+#include "bpm/sphere_kdtree.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "base/rng.h"
+
+namespace bpm {
+namespace {
+
+// Spheres clustered on a plane (like backward photons on a wall) with two radius classes (like
+// r0 and r1), plus a few isolated large ones.
+std::vector<SphereRef> random_spheres(Rng& rng, int n) {
+  std::vector<SphereRef> s;
+  for (int i = 0; i < n; ++i) {
+    Vec3 c(rng.uniform() * 10, rng.uniform() * 10, rng.uniform() * 0.05f);
+    float r = (i % 3 == 0) ? 0.4f * rng.uniform() : 0.05f * rng.uniform();
+    if (i % 97 == 0) r = 3;
+    s.push_back({c, r});
+  }
+  return s;
+}
+
+template <class Tree>
+void check_against_brute_force(const char* name, int n) {
+  Rng rng(stream_key(5, n));
+  std::vector<SphereRef> spheres = random_spheres(rng, n);
+  Tree tree;
+  tree.build(spheres);
+  size_t total = 0;
+  for (int q = 0; q < 3000; ++q) {
+    Vec3 p(rng.uniform() * 11 - 0.5f, rng.uniform() * 11 - 0.5f, rng.uniform() * 0.3f - 0.1f);
+    // Some queries exactly at centres, where boundaries are tightest.
+    if (q % 10 == 0 && n > 0) p = spheres[q % n].c;
+    std::vector<uint32_t> expected, got;
+    for (uint32_t i = 0; i < spheres.size(); ++i)
+      if (length_squared(p - spheres[i].c) < spheres[i].r * spheres[i].r) expected.push_back(i);
+    tree.query(p, [&](uint32_t i) { got.push_back(i); });
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, expected) << name << " n=" << n << " query " << q;
+    total += got.size();
+  }
+  if (n >= 1000) EXPECT_GT(total, 3000u) << name;  // the queries do find spheres
+}
+
+TEST(SphereKdTree, MatchesBruteForce) {
+  for (int n : {0, 1, 3, 50, 1000, 20000}) check_against_brute_force<SphereKdTree>("sphere tree", n);
+}
+
+TEST(CentreKdTree, MatchesBruteForce) {
+  for (int n : {0, 1, 3, 50, 1000, 20000}) check_against_brute_force<CentreKdTree>("centre tree", n);
+}
+
+TEST(SphereKdTree, IdenticalSpheresDoNotRecurseForever) {
+  std::vector<SphereRef> s(5000, SphereRef{Vec3(1, 2, 3), 0.5f});
+  SphereKdTree t;
+  t.build(s);
+  int hits = 0;
+  t.query(Vec3(1.1f, 2, 3), [&](uint32_t) { ++hits; });
+  EXPECT_EQ(hits, 5000);
+  EXPECT_LT(t.duplication(), 1.01);
+}
+
+}  // namespace
+}  // namespace bpm
