@@ -35,7 +35,35 @@ struct RenderArgs {
   int max_depth = -1;
   std::string output;
   bool quiet = false;
+  int iterations = 0;
+  // bpm; negative or empty means "the scene file's value or the default"
+  int diffuse_depth = -1;
+  float k0 = -1, k1 = -1, alpha = -1, coverage = -1;
+  std::string radius_policy, tree;
+  int photons_per_batch = 0, max_batches = 0;
 };
+
+// The bpm statistics a user wants to see at the end of a run (all of them are in the JSON).
+void print_bpm_summary(const nlohmann::json& d) {
+  const auto &eye = d["eye"], &light = d["light"], &maps = d["maps"], &st = d["stages_s"];
+  std::fprintf(stderr,
+               "bpm: eye: %.3g rays, %.3g backward photons (%.3f per backward ray), %.2f Mrays/s\n"
+               "bpm: maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s, sphere duplication %.2f\n"
+               "bpm: light: %.3g photons, %.3g rays, %.2f Mrays/s, %.3g queries (%.2f M/s), %.1f batches/iteration, "
+               "coverage %.2f\n"
+               "bpm: stages: eye %.2f s, trees %.2f s, light %.2f + %.2f s, accumulate %.2f s\n",
+               double(eye["camera_rays"].get<uint64_t>() + eye["bounce_rays"].get<uint64_t>() +
+                      eye["shadow_rays"].get<uint64_t>()),
+               double(eye["backward_photons"].get<uint64_t>()), eye["backward_photons_per_backward_ray"].get<double>(),
+               eye["rays_per_second"].get<double>() * 1e-6, maps["peak_photon_bytes"].get<double>() * 1e-6,
+               maps["peak_tree_bytes"].get<double>() * 1e-6, maps["tree_build_s"].get<double>(),
+               maps["mean_sphere_duplication"].get<double>(), double(light["photons"].get<uint64_t>()),
+               double(light["light_rays"].get<uint64_t>()), light["rays_per_second"].get<double>() * 1e-6,
+               double(light["queries"].get<uint64_t>()), light["queries_per_second"].get<double>() * 1e-6,
+               light["batches_per_iteration"].get<double>(), light["coverage_mean"].get<double>(),
+               st["eye"].get<double>(), st["tree_build"].get<double>(), st["light_trace"].get<double>(),
+               st["light_apply"].get<double>(), st["accumulate"].get<double>());
+}
 
 int run_render(const RenderArgs& a) {
   auto t_start = Clock::now();
@@ -63,7 +91,19 @@ int run_render(const RenderArgs& a) {
   opt.seed = a.seed >= 0 ? uint64_t(a.seed) : uint64_t(ls.render.seed);
   opt.max_depth = a.max_depth >= 0 ? a.max_depth : ls.render.max_depth;
   opt.progress = !a.quiet;
-  if (a.time > 0 && a.spp <= 0) opt.spp = std::numeric_limits<int>::max();  // the time budget decides
+  if (a.iterations > 0) opt.spp = a.iterations;  // one eye sample per pixel per iteration
+  if (a.time > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // the time budget decides
+  opt.bpm = ls.render.bpm;
+  if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
+  if (a.k0 > 0) opt.bpm.k0 = a.k0;
+  if (a.k1 > 0) opt.bpm.k1 = a.k1;
+  if (a.alpha > 0) opt.bpm.alpha = a.alpha;
+  if (a.coverage >= 0) opt.bpm.coverage = a.coverage;
+  if (!a.radius_policy.empty())
+    opt.bpm.radius_policy = a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
+  if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
+  if (a.photons_per_batch > 0) opt.bpm.photons_per_batch = a.photons_per_batch;
+  if (a.max_batches > 0) opt.bpm.max_batches = a.max_batches;
 
   std::string out = a.output;
   if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
@@ -101,15 +141,18 @@ int run_render(const RenderArgs& a) {
                      {"filter", Filter(ls.filter).name()},
                      {"filter_radius", {ls.filter.radius.x, ls.filter.radius.y}},
                      {"imaging_ratio", ls.film.imaging_ratio}};
+  if (!st.details.is_null()) rec[opt.integrator] = st.details;
   rec["result"] = {{"passes", st.passes},
+                   {"iterations", st.passes},
                    {"samples_per_pixel", st.passes},
                    {"stop_reason", st.stop_reason},
                    {"relative_error_delta", st.relative_error}};
   rec["rays"] = {{"camera", st.rays.camera_rays},
                  {"bounce", st.rays.bounce_rays},
                  {"shadow", st.rays.shadow_rays},
-                 {"total", st.rays.total()},
-                 {"per_second", st.render_seconds > 0 ? double(st.rays.total()) / st.render_seconds : 0.0}};
+                 {"light", st.light_rays},
+                 {"total", st.total_rays()},
+                 {"per_second", st.render_seconds > 0 ? double(st.total_rays()) / st.render_seconds : 0.0}};
   rec["scene_stats"] = {{"objects", ls.scene.objects.size()},
                         {"triangles", ls.scene.triangle_count()},
                         {"lights", ls.scene.lights.size()},
@@ -119,10 +162,13 @@ int run_render(const RenderArgs& a) {
   rec["outputs"] = {{"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
   rec["stages_s"] = {{"parse", t_parse}, {"build", t_build}, {"render", st.render_seconds}, {"write_images", t_write}};
   write_text_atomic(paths.json, rec.dump(2) + "\n");
-  if (!a.quiet)
-    std::fprintf(stderr, "bpm: %d spp in %.2f s (%s), %.2f Mrays/s, delta %.4f -> %s\n", st.passes, st.render_seconds,
-                 st.stop_reason.c_str(), st.render_seconds > 0 ? st.rays.total() / st.render_seconds * 1e-6 : 0.0,
-                 st.relative_error, paths.exr.c_str());
+  if (!a.quiet) {
+    if (opt.integrator == "bpm") print_bpm_summary(st.details);
+    std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f -> %s\n", st.passes,
+                 opt.integrator == "path" ? "spp" : "iterations", st.render_seconds, st.stop_reason.c_str(),
+                 st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0, st.relative_error,
+                 paths.exr.c_str());
+  }
   return st.stop_reason == "interrupted" ? 130 : 0;
 }
 
@@ -156,7 +202,7 @@ int main(int argc, char** argv) {
   RenderArgs ra;
   CLI::App* render = app.add_subcommand("render", "Render a pbrt-v4 scene to EXR, PNG, error PNG and JSON");
   render->add_option("scene", ra.scene, "Scene file (.pbrt)")->required();
-  render->add_option("--integrator", ra.integrator, "Integrator (path); default: the scene file's")
+  render->add_option("--integrator", ra.integrator, "Integrator: path or bpm; default: the scene file's")
       ->check(CLI::IsMember({"path", "bpm", "fpm"}));
   render->add_option("--spp", ra.spp, "Samples per pixel; default: the scene file's pixelsamples")
       ->check(CLI::Range(1, 1 << 24));
@@ -170,6 +216,28 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000));
   render->add_option("-o,--output", ra.output, "Output EXR; PNG, .error.png and .json are written beside it");
   render->add_flag("-q,--quiet", ra.quiet, "No progress output");
+  render->add_option("--iterations", ra.iterations,
+                     "Iterations (each one eye sample per pixel and a photon pass); same as --spp")
+      ->check(CLI::Range(1, 1 << 24));
+  const char* g = "Backward photon mapping (--integrator bpm)";
+  render->add_option("--diffuse-depth", ra.diffuse_depth, "Diffuse vertices before the last backward photon (0..3; default 1)")
+      ->check(CLI::Range(0, 3))->group(g);
+  render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")->check(CLI::Range(1e-4, 1e4))->group(g);
+  render->add_option("--k1", ra.k1, "Radius at the last diffuse vertex in pixel footprints (default 3)")
+      ->check(CLI::Range(1e-4, 1e4))->group(g);
+  render->add_option("--radius-policy", ra.radius_policy, "fixed, or progressive shrinking (default)")
+      ->check(CLI::IsMember({"fixed", "progressive"}))->group(g);
+  render->add_option("--alpha", ra.alpha, "Progressive radius alpha: r2 *= (i+alpha)/(i+1) (default 2/3)")
+      ->check(CLI::Range(1e-3, 0.999))->group(g);
+  render->add_option("--photons-per-batch", ra.photons_per_batch, "Photons per light-pass batch (default 100000)")
+      ->check(CLI::Range(1, 1 << 30))->group(g);
+  render->add_option("--coverage", ra.coverage,
+                     "Fraction of last-vertex backward photons hit that ends the photon phase (default 0.9)")
+      ->check(CLI::Range(0.0, 1.0))->group(g);
+  render->add_option("--max-batches", ra.max_batches, "Cap on photon batches per iteration (default 16)")
+      ->check(CLI::Range(1, 1 << 20))->group(g);
+  render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
+      ->check(CLI::IsMember({"spheres", "centres"}))->group(g);
 
   std::string cmp_a, cmp_b;
   CLI::App* compare = app.add_subcommand("compare", "Compare two EXR images (channel means, relative MSE)");

@@ -5,11 +5,9 @@
 #include "base/sampling.h"
 
 namespace bpm {
-namespace {
 
-// Direct light at a non-specular vertex by sampling one light (Veach 1997, 9.2.4).
-Spectrum sample_direct(const RenderScene& scene, const SurfacePoint& sp, const Material& m,
-                       const Frame& frame, Vec3 wo_local, Rng& rng, PathCounters& counters) {
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, const Material& m, const Frame& frame,
+                             Vec3 wo_local, bool use_mis, Rng& rng, PathCounters& counters) {
   if (scene.lights.empty()) return {};
   float pmf;
   float ul = rng.uniform();
@@ -33,12 +31,10 @@ Spectrum sample_direct(const RenderScene& scene, const SurfacePoint& sp, const M
   }
   if (scene.occluded(origin, target)) return {};
   float p_light = pmf * ls->pdf_solid_angle;
-  if (ls->is_delta) return ls->radiance * f / p_light;
+  if (ls->is_delta || !use_mis) return ls->radiance * f / p_light;
   float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance);
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
 }
-
-}  // namespace
 
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, Rng& rng,
                        PathCounters& counters) {
@@ -93,7 +89,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     Frame frame = Frame::from_z(sp.ns);
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
-    if (!bsdf_is_specular(m)) L += beta * sample_direct(scene, sp, m, frame, wo_local, rng, counters);
+    if (!bsdf_is_specular(m)) L += beta * sample_direct_light(scene, sp, m, frame, wo_local, true, rng, counters);
 
     float uc = rng.uniform();
     Vec2 u{rng.uniform(), rng.uniform()};

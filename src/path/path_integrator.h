@@ -31,6 +31,12 @@ struct PathSettings {
   int max_depth = 5;  // scattering events, as pbrt-v4's maxdepth
 };
 
+// Direct light at a non-specular vertex by sampling one light chosen by power (Veach 1997,
+// 9.2.4), with the power heuristic against BSDF sampling when use_mis (the caller then weights
+// the emitters its BSDF samples hit), else with full weight.
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, const Material& m, const Frame& frame,
+                             Vec3 wo_local, bool use_mis, Rng& rng, PathCounters& counters);
+
 // Radiance arriving along -ray.d at the ray's origin.
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, Rng& rng,
                        PathCounters& counters);

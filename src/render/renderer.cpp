@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "base/error.h"
+#include "bpm/bpm_integrator.h"
 #include "camera/camera.h"
 
 namespace bpm {
@@ -30,8 +31,9 @@ void install_interrupt_handlers() {
 }
 
 RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) {
+  if (opt.integrator == "bpm") return render_bpm(ls, opt, film);
   if (opt.integrator != "path")
-    throw Error("integrator \"" + opt.integrator + "\" is not available in this build (available: path)");
+    throw Error("integrator \"" + opt.integrator + "\" is not available in this build (available: path, bpm)");
   std::unique_ptr<tbb::global_control> limit;
   if (opt.threads > 0)
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);

@@ -1,12 +1,14 @@
-// The render loop: passes of one sample per pixel over tiles, in parallel with oneTBB, until the
+// The render loop of the path integrator (bpm's is in bpm/bpm_integrator.h): passes of one sample per pixel over tiles, in parallel with oneTBB, until the
 // sample budget, the time budget or an interrupt ends it. Every pixel sample draws from a random
 // stream keyed by (seed, pass, pixel), so the image does not depend on the number of threads.
 #pragma once
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 
+#include "bpm/settings.h"
 #include "film/film.h"
 #include "path/path_integrator.h"
 #include "scene/flatten.h"
@@ -21,6 +23,7 @@ struct RenderOptions {
   uint64_t seed = 0;
   int max_depth = 5;
   bool progress = true;
+  BpmSettings bpm;  // used by the bpm integrator
 };
 
 struct StageTime {
@@ -31,9 +34,12 @@ struct StageTime {
 struct RenderStats {
   int passes = 0;
   std::string stop_reason;  // "samples", "time", "interrupted"
-  PathCounters rays;
+  PathCounters rays;       // eye rays (camera, bounce, shadow)
+  uint64_t light_rays = 0;  // photon rays (bpm)
   double render_seconds = 0;
   double relative_error = 0;  // eq. (4) over per-pass estimates
+  nlohmann::json details;     // integrator-specific statistics
+  uint64_t total_rays() const { return rays.total() + light_rays; }
 };
 
 // Set by SIGINT/SIGTERM handlers; the loop stops at the next tile and the image so far is kept.

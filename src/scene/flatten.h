@@ -5,6 +5,7 @@
 #pragma once
 #include <string>
 
+#include "bpm/settings.h"
 #include "camera/camera.h"
 #include "film/filter.h"
 #include "scene/parsed_scene.h"
@@ -26,6 +27,7 @@ struct FileRenderSettings {
   int max_depth = 5;
   int spp = 16;
   int seed = 0;
+  BpmSettings bpm;  // from `Integrator "bpm"` parameters, else defaults
 };
 
 struct LoadedScene {
