@@ -21,6 +21,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
+    if (counters.rays.log) counters.rays.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) {
       for (int li : scene.infinite_lights) {
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);

@@ -50,6 +50,7 @@ void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Ligh
   ++counters.light_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
+    if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) break;
     SurfacePoint sp = scene.surface(ray, hit);
     const Material& m = scene.materials[scene.objects[hit.object].material];

@@ -9,6 +9,7 @@
 
 #include "base/rng.h"
 #include "bpm/backward_maps.h"
+#include "path/path_integrator.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -29,6 +30,7 @@ struct LightCounters {
   uint64_t diffuse_hits = 0;  // photon hits on diffuse surfaces (each a forward photon of fpm)
   uint64_t queries = 0;       // tree queries
   uint64_t entries = 0;       // accepted (backward photon, photon) pairs
+  RayLog* log = nullptr;      // null except in benchmarks
   void add(const LightCounters& o) {
     photons += o.photons;
     light_rays += o.light_rays;

@@ -1,0 +1,203 @@
+// Figures for the backward photon mapping integrator (prints them; never fails):
+//   1. trees: the kd-tree over whole integration spheres against the kd-tree over centres on the
+//      backward photon maps of a real render: build time, queries per second, light pass time;
+//   2. rays: eye-pass and light-pass rays per second beside bare Embree casting the same rays;
+//   3. equal time: relative MSE of bpm and path at equal render times against a converged
+//      reference (path with a long budget, cached next to the binary).
+//   bench_bpm [scene.pbrt] [--res WxH] [--iterations N] [--times 30,60] [--reference-time S]
+//             [--only trees|rays|equal-time]
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <thread>
+
+#include "bpm/eye_pass.h"
+#include "bpm/light_pass.h"
+#include "camera/camera.h"
+#include "film/image_io.h"
+#include "render/renderer.h"
+#include "scene/flatten.h"
+
+using namespace bpm;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double replay(const RenderScene& scene, const RayLog& log, int threads) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  auto t0 = Clock::now();
+  std::atomic<uint64_t> sink{0};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, log.closest_hit.size(), 4096), [&](const auto& r) {
+    uint64_t hits = 0;
+    Hit h;
+    for (size_t i = r.begin(); i < r.end(); ++i) hits += scene.intersect(log.closest_hit[i], &h);
+    sink += hits;
+  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, log.shadow.size(), 4096), [&](const auto& r) {
+    uint64_t hits = 0;
+    for (size_t i = r.begin(); i < r.end(); ++i) hits += scene.occluded_ray(log.shadow[i]);
+    sink += hits;
+  });
+  return double(log.closest_hit.size() + log.shadow.size()) / seconds(t0);
+}
+
+RenderStats run(const LoadedScene& ls, const std::string& integrator, int iterations, double time_s, int threads,
+                const BpmSettings& bs, Film* film) {
+  RenderOptions opt;
+  opt.integrator = integrator;
+  opt.spp = iterations;
+  opt.time_limit_s = time_s;
+  opt.threads = threads;
+  opt.seed = 1;
+  opt.max_depth = ls.render.max_depth;
+  opt.progress = false;
+  opt.bpm = bs;
+  return render(ls, opt, film);
+}
+
+double rel_mse(const Image& a, const Image& ref) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    double d = double(a.rgb[i]) - ref.rgb[i];
+    num += d * d;
+    den += double(ref.rgb[i]) * ref.rgb[i];
+  }
+  return num / den;
+}
+
+void trees(const LoadedScene& ls, int iterations, int threads, const BpmSettings& base) {
+  std::printf("\n== sphere tree vs centre tree: %d iterations, %d threads ==\n", iterations, threads);
+  std::printf("%-8s %10s %12s %12s %14s %12s %10s\n", "tree", "build s", "tree MB", "queries", "queries/s (M)",
+              "light s", "dup");
+  Image images[2];
+  for (int centres = 0; centres < 2; ++centres) {
+    BpmSettings bs = base;
+    bs.centre_tree = centres;
+    Film film(ls.film.width, ls.film.height);
+    RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
+    images[centres] = film.image();
+    const auto& d = st.details;
+    double light_s = d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+    std::printf("%-8s %10.3f %12.2f %12.3g %14.2f %12.3f %10.2f\n", centres ? "centres" : "spheres",
+                d["maps"]["tree_build_s"].get<double>(), d["maps"]["peak_tree_bytes"].get<double>() * 1e-6,
+                double(d["light"]["queries"].get<uint64_t>()), d["light"]["queries_per_second"].get<double>() * 1e-6,
+                light_s, d["maps"]["mean_sphere_duplication"].get<double>());
+  }
+  std::printf("images identical: %s\n", images[0].rgb == images[1].rgb ? "yes" : "NO");
+}
+
+void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) {
+  std::printf("\n== eye and light passes against bare Embree on the same rays ==\n");
+  int w = ls.film.width, h = ls.film.height;
+  RayLog eye_log, light_log;
+  {
+    PerspectiveCamera cam(ls.camera, w, h);
+    EyePassParams ep{bs.diffuse_depth, ls.render.max_depth, 1e-3f, 3e-3f};
+    ObjectPhotonLists lists(ls.scene.objects.size());
+    EyeCounters c;
+    c.rays.log = &eye_log;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        Rng rng(stream_key(99, 0, uint64_t(y) * w + x));
+        Ray r = cam.generate_ray({x + rng.uniform(), y + rng.uniform()}, {0.5f, 0.5f});
+        trace_eye_path(ls.scene, ep, r, uint32_t(y * w + x), rng, lists, c);
+      }
+    BackwardMaps empty;
+    empty.object_begin.assign(ls.scene.objects.size() + 1, 0);
+    std::vector<uint16_t> owner(size_t(w) * h, 0);
+    std::vector<std::vector<PhotonEntry>> out(1);
+    LightCounters lc;
+    lc.log = &light_log;
+    for (int k = 0; k < bs.photons_per_batch; ++k) {
+      Rng rng(stream_key(98, 0, k));
+      trace_photon(ls.scene, empty, LightPassParams{ls.render.max_depth, bs.normal_cos}, owner, rng, out, lc);
+    }
+  }
+  std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n", eye_log.closest_hit.size(),
+              eye_log.shadow.size(), light_log.closest_hit.size());
+  for (int threads : {1, hw}) {
+    Film film(w, h);
+    RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
+    const auto& d = st.details;
+    double eye_rate = d["eye"]["rays_per_second"].get<double>();
+    double light_s = d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+    double light_rate = double(d["light"]["light_rays"].get<uint64_t>()) / light_s;
+    double eye_embree = replay(ls.scene, eye_log, threads), light_embree = replay(ls.scene, light_log, threads);
+    std::printf("threads %2d: eye %.2f Mrays/s vs Embree %.2f (%.0f%% slower); light %.2f Mrays/s vs Embree %.2f "
+                "(%.0f%% slower)\n",
+                threads, eye_rate * 1e-6, eye_embree * 1e-6, 100 * (1 - eye_rate / eye_embree), light_rate * 1e-6,
+                light_embree * 1e-6, 100 * (1 - light_rate / light_embree));
+    if (hw == 1) break;
+  }
+}
+
+void equal_time(const LoadedScene& ls, const std::string& scene_path, const std::vector<double>& times,
+                double reference_s, const BpmSettings& bs) {
+  int w = ls.film.width, h = ls.film.height;
+  std::printf("\n== equal time, %dx%d, against path run for %.0f s ==\n", w, h, reference_s);
+  std::ostringstream name;
+  name << "bench_bpm_reference_" << std::filesystem::path(scene_path).stem().string() << "_" << w << "x" << h << "_"
+       << int(reference_s) << "s.exr";
+  std::string ref_path = name.str();
+  Image ref;
+  if (std::filesystem::exists(ref_path)) {
+    ref = read_exr(ref_path);
+    std::printf("reference: %s (cached)\n", ref_path.c_str());
+  } else {
+    Film film(w, h);
+    RenderStats st = run(ls, "path", std::numeric_limits<int>::max(), reference_s, 0, bs, &film);
+    ref = film.image();
+    write_exr(ref_path, ref);
+    std::printf("reference: %s, %d spp, delta %.4f\n", ref_path.c_str(), st.passes, st.relative_error);
+  }
+  std::printf("%8s %14s %14s %10s %14s\n", "time s", "path relMSE", "bpm relMSE", "path/bpm", "bpm iterations");
+  for (double t : times) {
+    Film fp(w, h), fb(w, h);
+    run(ls, "path", std::numeric_limits<int>::max(), t, 0, bs, &fp);
+    RenderStats sb = run(ls, "bpm", std::numeric_limits<int>::max(), t, 0, bs, &fb);
+    double ep = rel_mse(fp.image(), ref), eb = rel_mse(fb.image(), ref);
+    std::printf("%8.0f %14.3e %14.3e %10.2f %14d\n", t, ep, eb, ep / eb, sb.passes);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path = std::string(BPM_SOURCE_DIR) + "/scenes/caustic-sphere.pbrt", only;
+  int w = 160, h = 120, iterations = 32;
+  double reference_s = 600;
+  std::vector<double> times = {30, 60};
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
+    if (!std::strcmp(argv[i], "--res")) std::sscanf(next().c_str(), "%dx%d", &w, &h);
+    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--reference-time")) reference_s = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--only")) only = next();
+    else if (!std::strcmp(argv[i], "--times")) {
+      times.clear();
+      std::stringstream ss(next());
+      for (std::string t; std::getline(ss, t, ',');) times.push_back(std::atof(t.c_str()));
+    } else scene_path = argv[i];
+  }
+  LoadedScene ls = flatten_scene(parse_scene_file(scene_path));
+  ls.film.width = w;
+  ls.film.height = h;
+  int hw = int(std::thread::hardware_concurrency());
+  BpmSettings bs = ls.render.bpm;
+  std::printf("scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per batch\n",
+              scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1, bs.photons_per_batch);
+  if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
+  if (only.empty() || only == "rays") rays(ls, iterations, bs, hw);
+  if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);
+  return 0;
+}
