@@ -130,6 +130,56 @@ TEST_F(Cli, BadFlagsAreErrors) {
   EXPECT_TRUE(outputs().empty());
 }
 
+TEST_F(Cli, BpmWritesItsStatistics) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  CliRun r = run("render " + scene + " --integrator bpm --iterations 2 --photons-per-batch 2000 --diffuse-depth 0 "
+                 "--k1 2 --radius-policy fixed --tree centres -o " + (dir_ / "out.exr").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("backward photons"), std::string::npos) << r.err;
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["settings"]["integrator"], "bpm");
+  EXPECT_EQ(rec["result"]["iterations"], 2);
+  const auto& b = rec["bpm"];
+  EXPECT_EQ(b["settings"]["diffuse_depth"], 0);
+  EXPECT_EQ(b["settings"]["k1"], 2.0);
+  EXPECT_EQ(b["settings"]["radius_policy"], "fixed");
+  EXPECT_EQ(b["settings"]["tree"], "centres");
+  EXPECT_GT(b["eye"]["backward_photons"].get<uint64_t>(), 0u);
+  EXPECT_GE(b["light"]["photons"].get<uint64_t>(), 4000u);
+  EXPECT_GT(rec["rays"]["light"].get<uint64_t>(), 0u);
+  for (const char* f : {"out.exr", "out.png", "out.error.png"}) EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+}
+
+TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
+  std::string text = kTinyScene;
+  text.replace(text.find("WorldBegin"), 0,
+               "Integrator \"bpm\" \"integer diffusedepth\" 2 \"float k0\" 0.5 \"integer photonsperbatch\" 1500\n");
+  std::string scene = write("s.pbrt", text);
+  CliRun r = run("render " + scene + " -q --spp 1 --k0 0.75 -o " + (dir_ / "out.exr").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["settings"]["integrator"], "bpm");
+  EXPECT_EQ(rec["bpm"]["settings"]["diffuse_depth"], 2);
+  EXPECT_EQ(rec["bpm"]["settings"]["k0"], 0.75);
+  EXPECT_EQ(rec["bpm"]["settings"]["photons_per_batch"], 1500);
+}
+
+TEST_F(Cli, BadBpmSettingsAreErrors) {
+  std::string text = kTinyScene;
+  text.replace(text.find("WorldBegin"), 0, "Integrator \"bpm\"\n  \"integer diffusedepth\" 5\n");
+  std::string scene = write("bad.pbrt", text);
+  CliRun r = run("render " + scene + " -q -o " + (dir_ / "out.exr").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad.pbrt:7:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("diffusedepth"), std::string::npos) << r.err;
+  std::string good = write("s.pbrt", kTinyScene);
+  EXPECT_NE(run("render " + good + " --integrator bpm --diffuse-depth 4").exit_code, 0);
+  EXPECT_NE(run("render " + good + " --integrator bpm --k1 0").exit_code, 0);
+  EXPECT_NE(run("render " + good + " --integrator bpm --radius-policy wild").exit_code, 0);
+  EXPECT_NE(run("render " + good + " --integrator bpm --coverage 1.5").exit_code, 0);
+  EXPECT_TRUE(outputs().empty());
+}
+
 TEST_F(Cli, SigtermStillWritesTheImageSoFar) {
   std::string scene = write("s.pbrt", kTinyScene);
   std::string out = (dir_ / "out.exr").string();
