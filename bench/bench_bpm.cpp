@@ -5,7 +5,7 @@
 //   3. equal time: relative MSE of bpm and path at equal render times against a converged
 //      reference (path with a long budget, cached next to the binary).
 //   bench_bpm [scene.pbrt] [--res WxH] [--iterations N] [--times 30,60] [--reference-time S]
-//             [--only trees|rays|equal-time]
+//             [--only trees|rays|equal-time|reference]
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -22,50 +22,45 @@
 #include "bpm/eye_pass.h"
 #include "bpm/light_pass.h"
 #include "camera/camera.h"
+#include "embree_replay.h"
 #include "film/image_io.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 
 using namespace bpm;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-double replay(const RenderScene& scene, const RayLog& log, int threads) {
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  auto t0 = Clock::now();
-  std::atomic<uint64_t> sink{0};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, log.closest_hit.size(), 4096), [&](const auto& r) {
-    uint64_t hits = 0;
-    Hit h;
-    for (size_t i = r.begin(); i < r.end(); ++i) hits += scene.intersect(log.closest_hit[i], &h);
-    sink += hits;
-  });
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, log.shadow.size(), 4096), [&](const auto& r) {
-    uint64_t hits = 0;
-    for (size_t i = r.begin(); i < r.end(); ++i) hits += scene.occluded_ray(log.shadow[i]);
-    sink += hits;
-  });
-  return double(log.closest_hit.size() + log.shadow.size()) / seconds(t0);
-}
 
 RenderStats run(const LoadedScene& ls, const std::string& integrator, int iterations, double time_s, int threads,
-                const BpmSettings& bs, Film* film) {
+                const BpmSettings& bs, Film* film, uint64_t seed = 1) {
   RenderOptions opt;
   opt.integrator = integrator;
   opt.spp = iterations;
   opt.time_limit_s = time_s;
   opt.threads = threads;
-  opt.seed = 1;
+  opt.seed = seed;
   opt.max_depth = ls.render.max_depth;
   opt.progress = false;
   opt.bpm = bs;
   return render(ls, opt, film);
 }
 
+// Relative MSE as rendering papers use it: the mean over pixels and channels of
+// (a - ref)^2 / (ref^2 + 0.01), so that every pixel counts by its relative error (a few very
+// bright pixels, such as the light seen through the glass, do not decide it).
 double rel_mse(const Image& a, const Image& ref) {
+  double sum = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    double d = double(a.rgb[i]) - ref.rgb[i];
+    sum += d * d / (double(ref.rgb[i]) * ref.rgb[i] + 0.01);
+  }
+  return sum / double(a.rgb.size());
+}
+
+// The same, summed over the image before dividing: dominated by the brightest pixels.
+double global_rel_mse(const Image& a, const Image& ref) {
   double num = 0, den = 0;
   for (size_t i = 0; i < a.rgb.size(); ++i) {
     double d = double(a.rgb[i]) - ref.rgb[i];
@@ -132,7 +127,7 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     double eye_rate = d["eye"]["rays_per_second"].get<double>();
     double light_s = d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
     double light_rate = double(d["light"]["light_rays"].get<uint64_t>()) / light_s;
-    double eye_embree = replay(ls.scene, eye_log, threads), light_embree = replay(ls.scene, light_log, threads);
+    double eye_embree = embree_replay(ls.scene, eye_log, threads), light_embree = embree_replay(ls.scene, light_log, threads);
     std::printf("threads %2d: eye %.2f Mrays/s vs Embree %.2f (%.0f%% slower); light %.2f Mrays/s vs Embree %.2f "
                 "(%.0f%% slower)\n",
                 threads, eye_rate * 1e-6, eye_embree * 1e-6, 100 * (1 - eye_rate / eye_embree), light_rate * 1e-6,
@@ -147,7 +142,7 @@ void equal_time(const LoadedScene& ls, const std::string& scene_path, const std:
   std::printf("\n== equal time, %dx%d, against path run for %.0f s ==\n", w, h, reference_s);
   std::ostringstream name;
   name << "bench_bpm_reference_" << std::filesystem::path(scene_path).stem().string() << "_" << w << "x" << h << "_"
-       << int(reference_s) << "s.exr";
+       << int(reference_s) << "s_path.exr";
   std::string ref_path = name.str();
   Image ref;
   if (std::filesystem::exists(ref_path)) {
@@ -155,18 +150,24 @@ void equal_time(const LoadedScene& ls, const std::string& scene_path, const std:
     std::printf("reference: %s (cached)\n", ref_path.c_str());
   } else {
     Film film(w, h);
-    RenderStats st = run(ls, "path", std::numeric_limits<int>::max(), reference_s, 0, bs, &film);
+    // Its own seed: the timed path renders must not share its first samples.
+    RenderStats st = run(ls, "path", std::numeric_limits<int>::max(), reference_s, 0, bs, &film, 0x5eed);
     ref = film.image();
     write_exr(ref_path, ref);
     std::printf("reference: %s, %d spp, delta %.4f\n", ref_path.c_str(), st.passes, st.relative_error);
   }
-  std::printf("%8s %14s %14s %10s %14s\n", "time s", "path relMSE", "bpm relMSE", "path/bpm", "bpm iterations");
+  std::printf("relMSE: mean of (a-ref)^2/(ref^2+0.01); global: sum (a-ref)^2 / sum ref^2\n");
+  std::printf("%7s %12s %12s %9s %13s %13s %9s %8s %8s\n", "time s", "path relMSE", "bpm relMSE", "path/bpm",
+              "path global", "bpm global", "path/bpm", "path spp", "bpm its");
   for (double t : times) {
+    if (t <= 0) continue;
     Film fp(w, h), fb(w, h);
-    run(ls, "path", std::numeric_limits<int>::max(), t, 0, bs, &fp);
+    RenderStats sp = run(ls, "path", std::numeric_limits<int>::max(), t, 0, bs, &fp);
     RenderStats sb = run(ls, "bpm", std::numeric_limits<int>::max(), t, 0, bs, &fb);
-    double ep = rel_mse(fp.image(), ref), eb = rel_mse(fb.image(), ref);
-    std::printf("%8.0f %14.3e %14.3e %10.2f %14d\n", t, ep, eb, ep / eb, sb.passes);
+    Image ip = fp.image(), ib = fb.image();
+    double ep = rel_mse(ip, ref), eb = rel_mse(ib, ref), gp = global_rel_mse(ip, ref), gb = global_rel_mse(ib, ref);
+    std::printf("%7.0f %12.3e %12.3e %9.2f %13.3e %13.3e %9.2f %8d %8d\n", t, ep, eb, ep / eb, gp, gb, gp / gb,
+                sp.passes, sb.passes);
   }
 }
 
@@ -199,5 +200,6 @@ int main(int argc, char** argv) {
   if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
   if (only.empty() || only == "rays") rays(ls, iterations, bs, hw);
   if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);
+  if (only == "reference") equal_time(ls, scene_path, {}, reference_s, bs);
   return 0;
 }

@@ -12,37 +12,11 @@
 #include <thread>
 
 #include "camera/camera.h"
+#include "embree_replay.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 
 using namespace bpm;
-using Clock = std::chrono::steady_clock;
-
-namespace {
-
-double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// Bare Embree over the recorded rays; returns rays per second.
-double replay(const RenderScene& scene, const RayLog& log, int threads) {
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  auto t0 = Clock::now();
-  std::atomic<uint64_t> sink{0};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, log.closest_hit.size(), 4096), [&](const auto& r) {
-    uint64_t hits = 0;
-    Hit h;
-    for (size_t i = r.begin(); i < r.end(); ++i) hits += scene.intersect(log.closest_hit[i], &h);
-    sink += hits;
-  });
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, log.shadow.size(), 4096), [&](const auto& r) {
-    uint64_t hits = 0;
-    for (size_t i = r.begin(); i < r.end(); ++i) hits += scene.occluded_ray(log.shadow[i]);
-    sink += hits;
-  });
-  double t = seconds(t0);
-  return (log.closest_hit.size() + log.shadow.size()) / t;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   std::string scene_path;
@@ -89,7 +63,7 @@ int main(int argc, char** argv) {
     Film film(res, res);
     RenderStats st = render(ls, opt, &film);
     double path_rate = st.rays.total() / st.render_seconds;
-    double embree_rate = replay(ls.scene, log, threads);
+    double embree_rate = embree_replay(ls.scene, log, threads);
     std::printf("threads %2d: path %.2f Mrays/s, bare Embree %.2f Mrays/s on the same rays, path/Embree = %.2f\n",
                 threads, path_rate * 1e-6, embree_rate * 1e-6, path_rate / embree_rate);
     if (threads == hw && hw == 1) break;

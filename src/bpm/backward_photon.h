@@ -6,12 +6,10 @@
 
 #include "base/spectrum.h"
 #include "base/vec.h"
+#include "photons/light_path.h"
 
 namespace bpm {
 
-// How a forward photon arrived: straight from the light, through specular vertices only, or
-// after at least one diffuse vertex.
-enum class PhotonClass : uint8_t { kDirect, kCaustic, kIndirect };
 
 enum AcceptMask : uint8_t { kAcceptsCaustic = 1, kAcceptsIndirect = 2 };
 

@@ -1,5 +1,5 @@
-// The light pass, phase one (section 3 of the paper): photons leave the lights in proportion to
-// their power and travel with the adjoint BSDF; at each diffuse hit the hit object's tree gives
+// The light pass, phase one (section 3 of the paper): photons travel as photons/light_path.h
+// says; at each diffuse hit the hit object's tree gives
 // the backward photons whose spheres contain the hit, and each accepted pair is appended as
 // (backward photon, contribution) to the caller's lists, one per mask slot, so that phase two can
 // apply each slot's entries without locks.
@@ -9,7 +9,7 @@
 
 #include "base/rng.h"
 #include "bpm/backward_maps.h"
-#include "path/path_integrator.h"
+#include "photons/light_path.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -24,21 +24,6 @@ struct LightPassParams {
   float normal_cos = 0.5f;
 };
 
-struct LightCounters {
-  uint64_t photons = 0;       // emitted
-  uint64_t light_rays = 0;    // emitted and bounce rays
-  uint64_t diffuse_hits = 0;  // photon hits on diffuse surfaces (each a forward photon of fpm)
-  uint64_t queries = 0;       // tree queries
-  uint64_t entries = 0;       // accepted (backward photon, photon) pairs
-  RayLog* log = nullptr;      // null except in benchmarks
-  void add(const LightCounters& o) {
-    photons += o.photons;
-    light_rays += o.light_rays;
-    diffuse_hits += o.diffuse_hits;
-    queries += o.queries;
-    entries += o.entries;
-  }
-};
 
 // Traces one photon. owner[pixel] is the mask slot of the pixel; out has one list per slot.
 void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& params,
