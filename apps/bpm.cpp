@@ -41,6 +41,8 @@ struct RenderArgs {
   float k0 = -1, k1 = -1, alpha = -1, coverage = -1;
   std::string radius_policy, tree;
   int photons_per_batch = 0, max_batches = 0;
+  bool final_gather = false;
+  int knn = -1;
 };
 
 // The bpm statistics a user wants to see at the end of a run (all of them are in the JSON).
@@ -63,6 +65,19 @@ void print_bpm_summary(const nlohmann::json& d) {
                light["batches_per_iteration"].get<double>(), light["coverage_mean"].get<double>(),
                st["eye"].get<double>(), st["tree_build"].get<double>(), st["light_trace"].get<double>(),
                st["light_apply"].get<double>(), st["accumulate"].get<double>());
+}
+
+void print_fpm_summary(const nlohmann::json& d) {
+  const auto &light = d["light"], &maps = d["maps"], &st = d["stages_s"];
+  std::fprintf(stderr,
+               "bpm: fpm light: %.3g photons, %.3g rays, %.3g photons stored (%.3f per forward ray), %.2f Mrays/s\n"
+               "bpm: fpm maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s\n"
+               "bpm: fpm stages: light %.2f s, trees %.2f s, eye %.2f s\n",
+               double(light["photons"].get<uint64_t>()), double(light["light_rays"].get<uint64_t>()),
+               double(light["photons_stored"].get<uint64_t>()), light["photons_per_forward_ray"].get<double>(),
+               light["rays_per_second"].get<double>() * 1e-6, maps["peak_photon_bytes"].get<double>() * 1e-6,
+               maps["peak_tree_bytes"].get<double>() * 1e-6, maps["tree_build_s"].get<double>(),
+               st["light"].get<double>(), st["tree_build"].get<double>(), st["eye"].get<double>());
 }
 
 int run_render(const RenderArgs& a) {
@@ -104,6 +119,9 @@ int run_render(const RenderArgs& a) {
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
   if (a.photons_per_batch > 0) opt.bpm.photons_per_batch = a.photons_per_batch;
   if (a.max_batches > 0) opt.bpm.max_batches = a.max_batches;
+  opt.fpm = ls.render.fpm;
+  if (a.final_gather) opt.fpm.final_gather = true;
+  if (a.knn >= 0) opt.fpm.knn = a.knn;
 
   std::string out = a.output;
   if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
@@ -164,6 +182,7 @@ int run_render(const RenderArgs& a) {
   write_text_atomic(paths.json, rec.dump(2) + "\n");
   if (!a.quiet) {
     if (opt.integrator == "bpm") print_bpm_summary(st.details);
+    if (opt.integrator == "fpm") print_fpm_summary(st.details);
     std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f -> %s\n", st.passes,
                  opt.integrator == "path" ? "spp" : "iterations", st.render_seconds, st.stop_reason.c_str(),
                  st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0, st.relative_error,
@@ -202,7 +221,7 @@ int main(int argc, char** argv) {
   RenderArgs ra;
   CLI::App* render = app.add_subcommand("render", "Render a pbrt-v4 scene to EXR, PNG, error PNG and JSON");
   render->add_option("scene", ra.scene, "Scene file (.pbrt)")->required();
-  render->add_option("--integrator", ra.integrator, "Integrator: path or bpm; default: the scene file's")
+  render->add_option("--integrator", ra.integrator, "Integrator: path, bpm or fpm; default: the scene file's")
       ->check(CLI::IsMember({"path", "bpm", "fpm"}));
   render->add_option("--spp", ra.spp, "Samples per pixel; default: the scene file's pixelsamples")
       ->check(CLI::Range(1, 1 << 24));
@@ -238,6 +257,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1 << 20))->group(g);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))->group(g);
+  const char* gf = "Forward photon mapping (--integrator fpm; also uses --k0, --k1, --radius-policy, --alpha, "
+                   "--photons-per-batch as photons per iteration)";
+  render->add_flag("--final-gather", ra.final_gather, "Read indirect light one diffuse bounce after the first hit")
+      ->group(gf);
+  render->add_option("--knn", ra.knn, "Radius from the N nearest photons, capped by the k1 radius (0: off)")
+      ->check(CLI::Range(0, 100000))->group(gf);
 
   std::string cmp_a, cmp_b;
   CLI::App* compare = app.add_subcommand("compare", "Compare two EXR images (channel means, relative MSE)");

@@ -146,6 +146,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   LightPassParams lp{opt.max_depth, s.normal_cos};
 
   for (int iter = 0; iter < opt.spp; ++iter) {
+    const int it = opt.first_iteration + iter;  // the index random streams and radii follow
     if (interrupt_flag().load()) {
       stats.stop_reason = "interrupted";
       break;
@@ -156,7 +157,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     }
     // ---- 1. eye pass, block by block, each slot over its mask ----
     auto t_stage = Clock::now();
-    float scale = radius_scale(s, iter);
+    float scale = radius_scale(s, it);
     EyePassParams ep{s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale};
     const int slots = masks.slots();
     tbb::parallel_for(tbb::blocked_range<int>(0, masks.block_count() * slots, 1), [&](const tbb::blocked_range<int>& r) {
@@ -167,7 +168,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
         for (uint32_t pixel : masks.pixels(task / slots, task % slots)) {
           auto tp = Clock::now();
           int x = int(pixel % w), y = int(pixel / w);
-          Rng rng(stream_key(opt.seed, uint64_t(iter), pixel));
+          Rng rng(stream_key(opt.seed, uint64_t(it), pixel));
           FilterSample fs = filter.sample({rng.uniform(), rng.uniform()});
           Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
           Ray ray = camera.generate_ray(p_film, {rng.uniform(), rng.uniform()});
@@ -228,7 +229,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
           uint64_t last = std::min(first + kPhotonChunk, photons_per_batch);
           for (uint64_t k = first; k < last; ++k) {
             uint64_t index = uint64_t(batch) * photons_per_batch + k;
-            Rng rng(stream_key(opt.seed ^ kPhotonStream, uint64_t(iter), index, 1));
+            Rng rng(stream_key(opt.seed ^ kPhotonStream, uint64_t(it), index, 1));
             trace_photon(scene, maps, lp, masks.owner(), rng, ch.by_slot, lc);
           }
         }

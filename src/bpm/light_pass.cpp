@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "photons/density.h"
+
 namespace bpm {
 namespace {
 
@@ -15,16 +17,9 @@ void gather_at_hit(const RenderScene& scene, const BackwardMaps& maps, const Lig
     const BackwardPhoton& bp = maps.photons[g];
     if (!bp.accepts_class(cls) || int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
-    Frame frame = Frame::from_z(bp.ns);
-    Vec3 wo_local = frame.to_local(bp.wo), wi_local = frame.to_local(wi);
-    Spectrum f = bsdf_f(scene.materials[bp.material], wo_local, wi_local, TransportMode::kRadiance);
-    if (f.is_black()) return;
-    // The density estimate gives irradiance on the geometric surface; the BSDF wants it on the
-    // shading one.
-    float cos_g = std::fabs(dot(wi, bp.ng));
-    if (cos_g == 0) return;
-    float cos_ratio = std::fabs(wi_local.z) / cos_g;
-    out[owner[bp.pixel]].push_back({g, flux * f * cos_ratio});
+    Spectrum value = photon_contribution(scene.materials[bp.material], bp.ng, bp.ns, bp.wo, wi, flux);
+    if (value.is_black()) return;
+    out[owner[bp.pixel]].push_back({g, value});
     ++counters.entries;
   });
 }

@@ -29,6 +29,13 @@ struct BpmSettings {
   bool centre_tree = false;
 };
 
+// Forward photon mapping's own settings; its radii (k0 for the caustic map, k1 for the global
+// map), their policy and its photons per iteration (photons_per_batch) are BpmSettings'.
+struct FpmSettings {
+  bool final_gather = false;  // read indirect light one diffuse bounce later
+  int knn = 0;                // > 0: radius from the knn nearest photons (capped by the k radius)
+};
+
 inline const char* to_string(RadiusPolicy p) { return p == RadiusPolicy::kFixed ? "fixed" : "progressive"; }
 
 // Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.

@@ -6,6 +6,7 @@
 // largest radius; it is kept behind a switch so that the paper's claim (the sphere tree builds
 // 1.5-2x slower but answers much faster) can be measured.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -55,28 +56,21 @@ class SphereKdTree {
 class CentreKdTree {
  public:
   void build(const std::vector<SphereRef>& spheres);
+  // Calls f(i) for every sphere i with |p - c_i| < r_i (a range search with the largest radius).
   template <class F>
   void query(Vec3 p, F&& f) const {
-    if (nodes_.empty()) return;
-    uint32_t stack[64];
-    int top = 0;
-    stack[top++] = 0;
-    float R = max_radius_;
-    while (top > 0) {
-      const Node& nd = nodes_[stack[--top]];
-      if (nd.axis == kLeaf) {
-        for (uint32_t k = nd.a, e = nd.a + nd.b; k < e; ++k) {
-          const SphereRef& s = spheres_[k];
-          if (length_squared(p - s.c) < s.r * s.r) f(items_[k]);
-        }
-        continue;
-      }
-      float d = p[nd.axis] - nd.split;
-      uint32_t self = uint32_t(&nd - nodes_.data());
-      uint32_t near = d < 0 ? self + 1 : nd.a, far = d < 0 ? nd.a : self + 1;
-      if (std::fabs(d) < R) stack[top++] = far;
-      stack[top++] = near;
-    }
+    traverse(p, max_radius_, [&](uint32_t k) {
+      const SphereRef& s = spheres_[k];
+      if (length_squared(p - s.c) < s.r * s.r) f(items_[k]);
+    });
+  }
+  // Calls f(i) for every centre within `radius` of p, whatever the spheres' radii (a point
+  // kd-tree, as forward photon maps use).
+  template <class F>
+  void query_within(Vec3 p, float radius, F&& f) const {
+    traverse(p, radius, [&](uint32_t k) {
+      if (length_squared(p - spheres_[k].c) < radius * radius) f(items_[k]);
+    });
   }
   size_t bytes() const;
 
@@ -87,6 +81,26 @@ class CentreKdTree {
     uint32_t axis, a, b;
   };
   void build_node(uint32_t begin, uint32_t end, int depth);
+  // Visits every leaf slot k whose centre may lie within R of p.
+  template <class G>
+  void traverse(Vec3 p, float R, G&& g) const {
+    if (nodes_.empty()) return;
+    uint32_t stack[64];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      uint32_t self = stack[--top];
+      const Node& nd = nodes_[self];
+      if (nd.axis == kLeaf) {
+        for (uint32_t k = nd.a, e = nd.a + nd.b; k < e; ++k) g(k);
+        continue;
+      }
+      float d = p[nd.axis] - nd.split;
+      uint32_t near = d < 0 ? self + 1 : nd.a, far = d < 0 ? nd.a : self + 1;
+      if (std::fabs(d) < R) stack[top++] = far;
+      stack[top++] = near;
+    }
+  }
   std::vector<Node> nodes_;
   std::vector<uint32_t> items_;
   std::vector<SphereRef> spheres_;

@@ -53,6 +53,24 @@ TEST(CentreKdTree, MatchesBruteForce) {
   for (int n : {0, 1, 3, 50, 1000, 20000}) check_against_brute_force<CentreKdTree>("centre tree", n);
 }
 
+TEST(CentreKdTree, PointQueriesWithinARadiusMatchBruteForce) {
+  Rng rng(stream_key(6, 0));
+  std::vector<SphereRef> points = random_spheres(rng, 5000);
+  for (auto& p : points) p.r = 0;
+  CentreKdTree tree;
+  tree.build(points);
+  for (int q = 0; q < 2000; ++q) {
+    Vec3 p(rng.uniform() * 10, rng.uniform() * 10, rng.uniform() * 0.05f);
+    float R = 0.02f + 0.5f * rng.uniform();
+    std::vector<uint32_t> expected, got;
+    for (uint32_t i = 0; i < points.size(); ++i)
+      if (length_squared(p - points[i].c) < R * R) expected.push_back(i);
+    tree.query_within(p, R, [&](uint32_t i) { got.push_back(i); });
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, expected) << "query " << q;
+  }
+}
+
 TEST(SphereKdTree, IdenticalSpheresDoNotRecurseForever) {
   std::vector<SphereRef> s(5000, SphereRef{Vec3(1, 2, 3), 0.5f});
   SphereKdTree t;

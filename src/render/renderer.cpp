@@ -12,6 +12,7 @@
 
 #include "base/error.h"
 #include "bpm/bpm_integrator.h"
+#include "fpm/fpm_integrator.h"
 #include "camera/camera.h"
 
 namespace bpm {
@@ -32,8 +33,9 @@ void install_interrupt_handlers() {
 
 RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) {
   if (opt.integrator == "bpm") return render_bpm(ls, opt, film);
+  if (opt.integrator == "fpm") return render_fpm(ls, opt, film);
   if (opt.integrator != "path")
-    throw Error("integrator \"" + opt.integrator + "\" is not available in this build (available: path, bpm)");
+    throw Error("integrator \"" + opt.integrator + "\" is not available (available: path, bpm, fpm)");
   std::unique_ptr<tbb::global_control> limit;
   if (opt.threads > 0)
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
@@ -64,7 +66,7 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
       PathCounters& c = counters.local();
       for (int y = r.rows().begin(); y < r.rows().end(); ++y)
         for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-          Rng rng(stream_key(opt.seed, uint64_t(pass), uint64_t(y) * w + x));
+          Rng rng(stream_key(opt.seed, uint64_t(opt.first_iteration + pass), uint64_t(y) * w + x));
           FilterSample fs = filter.sample({rng.uniform(), rng.uniform()});
           Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
           Vec2 u_lens{rng.uniform(), rng.uniform()};

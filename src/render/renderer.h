@@ -17,13 +17,16 @@ namespace bpm {
 
 struct RenderOptions {
   std::string integrator = "path";
-  int spp = 16;
+  int spp = 16;              // passes (iterations for the photon integrators)
+  int first_iteration = 0;   // index of the first pass: random streams and radii follow it, so
+                             // passes [a, b) rendered apart average to the same image
   double time_limit_s = 0;  // 0: none
   int threads = 0;          // 0: all hardware threads
   uint64_t seed = 0;
   int max_depth = 5;
   bool progress = true;
-  BpmSettings bpm;  // used by the bpm integrator
+  BpmSettings bpm;  // used by the bpm integrator, and by fpm for radii and photon counts
+  FpmSettings fpm;
 };
 
 struct StageTime {

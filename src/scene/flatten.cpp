@@ -145,7 +145,15 @@ class Flattener {
     } else {
       throw Error(in.loc, "integrator \"" + in.name + "\" is not supported");
     }
-    if (in.name == "bpm") read_bpm_settings(in, &out->render.bpm);
+    if (in.name == "bpm" || in.name == "fpm") read_bpm_settings(in, &out->render.bpm);
+    if (in.name == "fpm") {
+      out->render.fpm.final_gather = in.params.get_bool("finalgather", false);
+      out->render.fpm.knn = in.params.get_int("knn", 0);
+      if (out->render.fpm.knn < 0) {
+        const Param* p = in.params.find_any("knn");
+        throw Error(p ? p->loc : in.loc, "knn must not be negative");
+      }
+    }
     for (const Param& p : in.params.all()) p.used = true;  // other integrators' knobs are advisory
   }
 

@@ -27,7 +27,8 @@ struct FileRenderSettings {
   int max_depth = 5;
   int spp = 16;
   int seed = 0;
-  BpmSettings bpm;  // from `Integrator "bpm"` parameters, else defaults
+  BpmSettings bpm;  // from `Integrator "bpm"` (or "fpm") parameters, else defaults
+  FpmSettings fpm;  // from `Integrator "fpm"` parameters
 };
 
 struct LoadedScene {

@@ -1,0 +1,316 @@
+#include "fpm/fpm_integrator.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+
+#include "base/error.h"
+#include "bpm/sphere_kdtree.h"
+#include "camera/camera.h"
+#include "photons/density.h"
+#include "photons/light_path.h"
+
+namespace bpm {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+constexpr int kPhotonChunk = 1024;
+constexpr uint64_t kPhotonStream = 0x66706d70686f74ull;
+
+struct ForwardPhoton {
+  Vec3 p;
+  Vec3 wi;  // toward where the photon came from
+  Vec3 ng;
+  Spectrum flux;
+  uint16_t bounces;
+  PhotonClass cls;
+};
+
+struct PhotonMap {
+  std::vector<ForwardPhoton> photons;
+  CentreKdTree tree;
+  void build() {
+    std::vector<SphereRef> points(photons.size());
+    for (size_t i = 0; i < photons.size(); ++i) points[i] = {photons[i].p, 0};
+    tree.build(points);
+  }
+  size_t photon_bytes() const { return photons.size() * sizeof(ForwardPhoton); }
+};
+
+struct EyeParams {
+  const FpmSettings* fpm;
+  int max_depth;
+  float normal_cos;
+  float radius_per_length0, radius_per_length1;
+  double emitted;
+};
+
+struct EyeCounters {
+  PathCounters rays;
+  uint64_t lookups = 0, photons_used = 0;
+  void add(const EyeCounters& o) {
+    rays.add(o.rays);
+    lookups += o.lookups;
+    photons_used += o.photons_used;
+  }
+};
+
+// Radiance reflected at sp toward wo from the map's photons of the accepted classes, eq. (2):
+// sum f dPhi / (pi r^2 N). With knn > 0 the radius is the distance to the knn-th nearest
+// photon within `radius` (Jensen's estimate), else `radius`.
+template <class Accept>
+Spectrum estimate(const RenderScene& scene, const PhotonMap& map, const Material& m, const SurfacePoint& sp, Vec3 wo,
+                  float radius, int eye_depth, const EyeParams& prm, Accept&& accept, EyeCounters& c) {
+  ++c.lookups;
+  auto usable = [&](const ForwardPhoton& ph) {
+    return accept(ph.cls) && eye_depth + int(ph.bounces) <= prm.max_depth && dot(ph.ng, sp.ng) >= prm.normal_cos;
+  };
+  float r = radius;
+  if (prm.fpm->knn > 0) {
+    std::vector<float> d2;
+    map.tree.query_within(sp.p, radius, [&](uint32_t i) {
+      if (usable(map.photons[i])) d2.push_back(length_squared(map.photons[i].p - sp.p));
+    });
+    if (int(d2.size()) > prm.fpm->knn) {
+      std::nth_element(d2.begin(), d2.begin() + prm.fpm->knn - 1, d2.end());
+      r = std::sqrt(d2[prm.fpm->knn - 1]) * 1.0001f;
+    }
+  }
+  Spectrum sum;
+  map.tree.query_within(sp.p, r, [&](uint32_t i) {
+    const ForwardPhoton& ph = map.photons[i];
+    if (!usable(ph)) return;
+    ++c.photons_used;
+    sum += photon_contribution(m, sp.ng, sp.ns, wo, ph.wi, ph.flux);
+  });
+  return sum * float(1.0 / (kPi * double(r) * r * prm.emitted));
+}
+
+// One eye path to its first diffuse vertex (and, with final gathering, one more).
+Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const PhotonMap& caustic,
+                      const EyeParams& prm, Ray ray, Rng& rng, EyeCounters& c) {
+  Spectrum L, beta(1.0f);
+  int depth = 0;
+  float length = 0;
+  bool gathering = false;  // between x1 and x2 on a final-gather ray
+  ++c.rays.camera_rays;
+  for (int guard = 0; guard < 10000; ++guard) {
+    Hit hit;
+    if (!scene.intersect(ray, &hit)) {
+      if (!gathering)
+        for (int li : scene.infinite_lights)
+          if (auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li])) L += beta * inf->radiance;
+      break;
+    }
+    length += hit.t * bpm::length(ray.d);
+    SurfacePoint sp = scene.surface(ray, hit);
+    Vec3 wo = -ray.d;
+    int light_index = scene.light_of_hit(hit);
+    if (light_index >= 0 && !gathering)
+      L += beta * area_light_radiance(std::get<AreaLight>(scene.lights[light_index]), sp.ng, wo);
+    const Material& m = scene.materials[scene.objects[hit.object].material];
+    if (std::holds_alternative<InterfaceMaterial>(m)) {
+      ray = spawn_ray(sp, ray.d);
+      ++c.rays.bounce_rays;
+      continue;
+    }
+    if (depth++ == prm.max_depth) break;
+    Frame frame = Frame::from_z(sp.ns);
+    Vec3 wo_local = frame.to_local(wo);
+    if (wo_local.z == 0) break;
+    if (!bsdf_is_specular(m)) {
+      float r1 = length * prm.radius_per_length1;
+      if (gathering) {
+        // x2: everything the global map holds, direct photons included.
+        L += beta * estimate(scene, global, m, sp, wo, r1, depth, prm, [](PhotonClass) { return true; }, c);
+        break;
+      }
+      // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
+      // counted), caustics from the caustic map.
+      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, false, rng, c.rays);
+      L += beta * estimate(scene, caustic, m, sp, wo, length * prm.radius_per_length0, depth, prm,
+                           [](PhotonClass k) { return k == PhotonClass::kCaustic; }, c);
+      if (!prm.fpm->final_gather) {
+        L += beta * estimate(scene, global, m, sp, wo, r1, depth, prm,
+                             [](PhotonClass k) { return k == PhotonClass::kIndirect; }, c);
+        break;
+      }
+      gathering = true;
+    }
+    auto bs = bsdf_sample(m, wo_local, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kRadiance);
+    if (!bs) break;
+    beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+    if (beta.is_black()) break;
+    ray = spawn_ray(sp, frame.to_world(bs->wi));
+    ++c.rays.bounce_rays;
+  }
+  return L;
+}
+
+}  // namespace
+
+RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* film) {
+  const BpmSettings& s = opt.bpm;  // radii, their policy and photons per iteration are shared
+  const FpmSettings& fs_ = opt.fpm;
+  if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: radius factors k0 and k1 must be positive");
+  if (s.photons_per_batch <= 0) throw Error("fpm: photons per iteration must be positive");
+  if (fs_.knn < 0) throw Error("fpm: knn must not be negative");
+  std::unique_ptr<tbb::global_control> limit;
+  if (opt.threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, opt.threads);
+  const int w = film->width(), h = film->height();
+  const RenderScene& scene = ls.scene;
+  PerspectiveCamera camera(ls.camera, w, h);
+  Filter filter(ls.filter);
+  const float pixel_angle = std::sqrt(camera.pixel_solid_angle());
+  const float max_value = ls.film.max_component_value;
+  const uint64_t n_photons = uint64_t(s.photons_per_batch);
+  const int n_chunks = int((n_photons + kPhotonChunk - 1) / kPhotonChunk);
+  const int min_eye_vertices = fs_.final_gather ? 2 : 1;
+
+  struct Chunk {
+    std::vector<ForwardPhoton> global, caustic;
+  };
+  std::vector<Chunk> chunks(n_chunks);
+  PhotonMap global, caustic;
+  tbb::enumerable_thread_specific<LightCounters> light_counters;
+  tbb::enumerable_thread_specific<EyeCounters> eye_counters;
+  RenderStats stats;
+  stats.stop_reason = "samples";
+  double light_s = 0, build_s = 0, eye_s = 0;
+  uint64_t stored = 0;
+  size_t peak_map_bytes = 0, peak_tree_bytes = 0;
+  auto t0 = Clock::now();
+  double last_progress = -1;
+
+  for (int iter = 0; iter < opt.spp; ++iter) {
+    const int it = opt.first_iteration + iter;  // the index random streams and radii follow
+    if (interrupt_flag().load()) {
+      stats.stop_reason = "interrupted";
+      break;
+    }
+    if (opt.time_limit_s > 0 && iter > 0 && since(t0) >= opt.time_limit_s) {
+      stats.stop_reason = "time";
+      break;
+    }
+    // ---- 1. light pass: a forward photon at every diffuse hit ----
+    auto t_stage = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<int>(0, n_chunks, 1), [&](const tbb::blocked_range<int>& r) {
+      LightCounters& lc = light_counters.local();
+      for (int c = r.begin(); c < r.end(); ++c) {
+        Chunk& ch = chunks[c];
+        ch.global.clear();
+        ch.caustic.clear();
+        uint64_t first = uint64_t(c) * kPhotonChunk, last = std::min(first + kPhotonChunk, n_photons);
+        for (uint64_t k = first; k < last; ++k) {
+          Rng rng(stream_key(opt.seed ^ kPhotonStream, uint64_t(it), k, 2));
+          trace_light_path(scene, opt.max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
+            if (hit.bounces + min_eye_vertices > opt.max_depth) return;
+            ForwardPhoton ph{hit.sp.p, hit.wi, hit.sp.ng, hit.flux, uint16_t(hit.bounces), hit.cls};
+            ch.global.push_back(ph);
+            if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
+            lc.entries += 1 + (hit.cls == PhotonClass::kCaustic);
+          });
+        }
+      }
+    });
+    light_s += since(t_stage);
+
+    // ---- 2. the maps, in chunk order (the same for any thread count), and their trees ----
+    t_stage = Clock::now();
+    global.photons.clear();
+    caustic.photons.clear();
+    for (const Chunk& ch : chunks) {
+      global.photons.insert(global.photons.end(), ch.global.begin(), ch.global.end());
+      caustic.photons.insert(caustic.photons.end(), ch.caustic.begin(), ch.caustic.end());
+    }
+    stored += global.photons.size() + caustic.photons.size();
+    tbb::parallel_invoke([&] { global.build(); }, [&] { caustic.build(); });
+    build_s += since(t_stage);
+    peak_map_bytes = std::max(peak_map_bytes, global.photon_bytes() + caustic.photon_bytes());
+    peak_tree_bytes = std::max(peak_tree_bytes, global.tree.bytes() + caustic.tree.bytes());
+
+    // ---- 3. eye pass ----
+    t_stage = Clock::now();
+    float scale = radius_scale(s, it);
+    EyeParams ep{&fs_, opt.max_depth, s.normal_cos, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale,
+                 double(n_photons)};
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 16, 0, w, 16), [&](const tbb::blocked_range2d<int>& r) {
+      EyeCounters& ec = eye_counters.local();
+      for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+        for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+          Rng rng(stream_key(opt.seed, uint64_t(it), uint64_t(y) * w + x));
+          FilterSample fsm = filter.sample({rng.uniform(), rng.uniform()});
+          Ray ray = camera.generate_ray({x + 0.5f + fsm.offset.x, y + 0.5f + fsm.offset.y}, {rng.uniform(), rng.uniform()});
+          Spectrum L = eye_radiance(scene, global, caustic, ep, ray, rng, ec);
+          if (!L.is_finite() || L.has_negative()) L = Spectrum();
+          float mx = L.max_component();
+          if (mx > max_value) L *= max_value / mx;
+          film->add_sample(x, y, L, fsm.weight);
+          film->end_pass(x, y);
+        }
+    });
+    eye_s += since(t_stage);
+    stats.passes = iter + 1;
+    if (opt.progress && (since(t0) - last_progress >= 0.5 || iter + 1 == opt.spp)) {
+      last_progress = since(t0);
+      std::fprintf(stderr, "\rbpm: fpm iteration %d  %.1f s  %zu photons stored   ", iter + 1, last_progress,
+                   global.photons.size() + caustic.photons.size());
+      std::fflush(stderr);
+    }
+  }
+  if (opt.progress) std::fprintf(stderr, "\n");
+  if (interrupt_flag().load()) stats.stop_reason = "interrupted";
+  stats.render_seconds = since(t0);
+  LightCounters lt;
+  for (const LightCounters& c : light_counters) lt.add(c);
+  EyeCounters et;
+  for (const EyeCounters& c : eye_counters) et.add(c);
+  stats.rays = et.rays;
+  stats.light_rays = lt.light_rays;
+  stats.relative_error = film->relative_error();
+  stats.details = {
+      {"settings",
+       {{"k0", s.k0},
+        {"k1", s.k1},
+        {"radius_policy", to_string(s.radius_policy)},
+        {"alpha", s.alpha},
+        {"photons_per_iteration", s.photons_per_batch},
+        {"final_gather", fs_.final_gather},
+        {"knn", fs_.knn},
+        {"normal_cos", s.normal_cos}}},
+      {"light",
+       {{"photons", lt.photons},
+        {"light_rays", lt.light_rays},
+        {"diffuse_hits", lt.diffuse_hits},
+        {"photons_stored", stored},
+        {"photons_per_forward_ray", lt.light_rays ? double(stored) / double(lt.light_rays) : 0.0},
+        {"rays_per_second", light_s > 0 ? double(lt.light_rays) / light_s : 0.0}}},
+      {"maps",
+       {{"peak_photon_bytes", peak_map_bytes},
+        {"peak_tree_bytes", peak_tree_bytes},
+        {"forward_photon_bytes_each", sizeof(ForwardPhoton)},
+        {"tree_build_s", build_s}}},
+      {"eye",
+       {{"camera_rays", et.rays.camera_rays},
+        {"bounce_rays", et.rays.bounce_rays},
+        {"shadow_rays", et.rays.shadow_rays},
+        {"lookups", et.lookups},
+        {"photons_used", et.photons_used},
+        {"rays_per_second", eye_s > 0 ? double(et.rays.total()) / eye_s : 0.0}}},
+      {"stages_s", {{"light", light_s}, {"tree_build", build_s}, {"eye", eye_s}}},
+  };
+  return stats;
+}
+
+}  // namespace bpm
