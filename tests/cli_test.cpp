@@ -150,6 +150,22 @@ TEST_F(Cli, BpmWritesItsStatistics) {
   for (const char* f : {"out.exr", "out.png", "out.error.png"}) EXPECT_TRUE(fs::exists(dir_ / f)) << f;
 }
 
+TEST_F(Cli, FpmWritesItsStatistics) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  CliRun r = run("render " + scene + " --integrator fpm --iterations 2 --photons-per-batch 2000 --final-gather --knn 8 -o " +
+                 (dir_ / "out.exr").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("per forward ray"), std::string::npos) << r.err;
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["settings"]["integrator"], "fpm");
+  const auto& f = rec["fpm"];
+  EXPECT_EQ(f["settings"]["final_gather"], true);
+  EXPECT_EQ(f["settings"]["knn"], 8);
+  EXPECT_EQ(f["light"]["photons"].get<uint64_t>(), 4000u);
+  EXPECT_GT(f["light"]["photons_stored"].get<uint64_t>(), 0u);
+  EXPECT_GT(f["light"]["photons_per_forward_ray"].get<double>(), 0.0);
+}
+
 TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   std::string text = kTinyScene;
   text.replace(text.find("WorldBegin"), 0,
@@ -182,25 +198,31 @@ TEST_F(Cli, BadBpmSettingsAreErrors) {
 
 TEST_F(Cli, SigtermStillWritesTheImageSoFar) {
   std::string scene = write("s.pbrt", kTinyScene);
-  std::string out = (dir_ / "out.exr").string();
-  pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    int devnull = ::open("/dev/null", 1);
-    dup2(devnull, 2);
-    execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--spp", "10000000", "-o", out.c_str(), nullptr);
-    _exit(127);
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    std::string out = (dir_ / (std::string(integrator) + ".exr")).string();
+    pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      int devnull = ::open("/dev/null", 1);
+      dup2(devnull, 2);
+      execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", integrator, "--spp", "10000000",
+            "--photons-per-batch", "5000", "-o", out.c_str(), nullptr);
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << integrator;
+    EXPECT_EQ(WEXITSTATUS(status), 130) << integrator;
+    ASSERT_TRUE(fs::exists(out)) << integrator;
+    EXPECT_TRUE(fs::exists(dir_ / (std::string(integrator) + ".png"))) << integrator;
+    Image img = read_exr(out);
+    EXPECT_EQ(img.width, 32);
+    auto rec = nlohmann::json::parse(std::ifstream(dir_ / (std::string(integrator) + ".json")));
+    EXPECT_EQ(rec["result"]["stop_reason"], "interrupted") << integrator;
+    EXPECT_GT(rec["result"]["passes"].get<int>(), 0) << integrator;
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));
-  kill(pid, SIGTERM);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 130);
-  ASSERT_TRUE(fs::exists(out));
-  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
-  EXPECT_EQ(rec["result"]["stop_reason"], "interrupted");
-  EXPECT_GT(rec["result"]["passes"].get<int>(), 0);
 }
 
 TEST_F(Cli, CompareReportsMeans) {
