@@ -49,7 +49,7 @@ struct RenderArgs {
 void print_bpm_summary(const nlohmann::json& d) {
   const auto &eye = d["eye"], &light = d["light"], &maps = d["maps"], &st = d["stages_s"];
   std::fprintf(stderr,
-               "bpm: eye: %.3g rays, %.3g backward photons (%.3f per backward ray), %.2f Mrays/s\n"
+               "bpm: eye: %.3g rays, %.3g backward photons (%.3f per eye path), %.2f Mrays/s\n"
                "bpm: maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s, sphere duplication %.2f\n"
                "bpm: light: %.3g photons, %.3g rays, %.2f Mrays/s, %.3g queries (%.2f M/s), %.1f batches/iteration, "
                "coverage %.2f\n"
@@ -70,7 +70,7 @@ void print_bpm_summary(const nlohmann::json& d) {
 void print_fpm_summary(const nlohmann::json& d) {
   const auto &light = d["light"], &maps = d["maps"], &st = d["stages_s"];
   std::fprintf(stderr,
-               "bpm: fpm light: %.3g photons, %.3g rays, %.3g photons stored (%.3f per forward ray), %.2f Mrays/s\n"
+               "bpm: fpm light: %.3g photons, %.3g rays, %.3g photons stored (%.3f per photon path, a forward ray), %.2f Mrays/s\n"
                "bpm: fpm maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s\n"
                "bpm: fpm stages: light %.2f s, trees %.2f s, eye %.2f s\n",
                double(light["photons"].get<uint64_t>()), double(light["light_rays"].get<uint64_t>()),

@@ -155,7 +155,7 @@ TEST_F(Cli, FpmWritesItsStatistics) {
   CliRun r = run("render " + scene + " --integrator fpm --iterations 2 --photons-per-batch 2000 --final-gather --knn 8 -o " +
                  (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("per forward ray"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("per photon path"), std::string::npos) << r.err;
   auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
   EXPECT_EQ(rec["settings"]["integrator"], "fpm");
   const auto& f = rec["fpm"];

@@ -70,7 +70,11 @@ nlohmann::json to_json(const BpmTotals& t, const BpmSettings& s, int iterations,
         {"bounce_rays", t.eye.rays.bounce_rays},
         {"shadow_rays", t.eye.rays.shadow_rays},
         {"backward_photons", t.eye.backward_photons},
-        {"backward_photons_per_backward_ray", backward_rays ? double(t.eye.backward_photons) / backward_rays : 0.0},
+        // The paper's Table 1 counts per ray traced from the camera with all its continuations
+        // (an eye path); per segment counts every camera and bounce ray.
+        {"backward_photons_per_backward_ray",
+         t.eye.rays.camera_rays ? double(t.eye.backward_photons) / double(t.eye.rays.camera_rays) : 0.0},
+        {"backward_photons_per_backward_segment", backward_rays ? double(t.eye.backward_photons) / backward_rays : 0.0},
         {"backward_photons_per_pixel_iteration",
          iterations && pixels ? double(t.eye.backward_photons) / (double(iterations) * pixels) : 0.0},
         {"rays_per_second", t.eye_s > 0 ? double(t.eye.rays.total()) / t.eye_s : 0.0}}},

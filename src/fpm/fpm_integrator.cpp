@@ -188,7 +188,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   RenderStats stats;
   stats.stop_reason = "samples";
   double light_s = 0, build_s = 0, eye_s = 0;
-  uint64_t stored = 0;
+  uint64_t stored = 0, stored_caustic = 0;
   size_t peak_map_bytes = 0, peak_tree_bytes = 0;
   auto t0 = Clock::now();
   double last_progress = -1;
@@ -219,7 +219,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
             ForwardPhoton ph{hit.sp.p, hit.wi, hit.sp.ng, hit.flux, uint16_t(hit.bounces), hit.cls};
             ch.global.push_back(ph);
             if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
-            lc.entries += 1 + (hit.cls == PhotonClass::kCaustic);
+            ++lc.entries;
           });
         }
       }
@@ -234,7 +234,8 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
       global.photons.insert(global.photons.end(), ch.global.begin(), ch.global.end());
       caustic.photons.insert(caustic.photons.end(), ch.caustic.begin(), ch.caustic.end());
     }
-    stored += global.photons.size() + caustic.photons.size();
+    stored += global.photons.size();  // every photon once; the caustic map holds copies of some
+    stored_caustic += caustic.photons.size();
     tbb::parallel_invoke([&] { global.build(); }, [&] { caustic.build(); });
     build_s += since(t_stage);
     peak_map_bytes = std::max(peak_map_bytes, global.photon_bytes() + caustic.photon_bytes());
@@ -294,7 +295,11 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
         {"light_rays", lt.light_rays},
         {"diffuse_hits", lt.diffuse_hits},
         {"photons_stored", stored},
-        {"photons_per_forward_ray", lt.light_rays ? double(stored) / double(lt.light_rays) : 0.0},
+        {"caustic_photons_stored", stored_caustic},
+        // The paper's Table 1 counts per ray traced from a light with all its continuations (a
+        // photon path); per segment counts every emitted and bounce ray.
+        {"photons_per_forward_ray", lt.photons ? double(stored) / double(lt.photons) : 0.0},
+        {"photons_per_forward_segment", lt.light_rays ? double(stored) / double(lt.light_rays) : 0.0},
         {"rays_per_second", light_s > 0 ? double(lt.light_rays) / light_s : 0.0}}},
       {"maps",
        {{"peak_photon_bytes", peak_map_bytes},
