@@ -90,9 +90,8 @@ def guides(variant):
     s = header("# Light Guides (%s): transparent acrylic bars (eta 1.49) keep light in by total\n"
                "# internal reflection and let it out where white extraction dots scatter it.\n"
                "# Written by scenes/tools/make_scenes.py.\n" % what, lookat, fov, (320, 240), 64, names[variant])
-    s += "# A dark floor and back wall\nMaterial \"diffuse\" \"rgb reflectance\" [ 0.2 0.2 0.22 ]\n"
-    s += quad((-3, 0, -3), (-3, 0, 3), (3, 0, 3), (3, 0, -3))
-    s += quad((-3, 0, 2), (3, 0, 2), (3, 3, 2), (-3, 3, 2)) + "\n"
+    s += "# A closed light grey test room around the guides\nMaterial \"diffuse\" \"rgb reflectance\" [ 0.7 0.7 0.72 ]\n"
+    s += box(-3, 0, -3, 3, 3, 2) + "\n"
     for i, (y, z) in enumerate(((0.3, 0.0), (0.55, 0.35), (0.8, 0.7))):
         x0, x1, h, d = -1.0, 1.0, 0.08, 0.25
         s += "# Guide %d\nAttributeBegin\n" % (i + 1)
