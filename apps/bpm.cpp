@@ -43,6 +43,10 @@ struct RenderArgs {
   int photons_per_batch = 0, max_batches = 0;
   bool final_gather = false;
   int knn = -1;
+  double accuracy = 0, write_every = 0;
+  bool adaptive = false;
+  float adaptive_floor = 0.1f;
+  int m_images = 4;
 };
 
 // The bpm statistics a user wants to see at the end of a run (all of them are in the JSON).
@@ -135,8 +139,22 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n", a.scene.c_str(),
                  ls.scene.objects.size(), ls.scene.triangle_count(), ls.scene.lights.size(), ls.film.width,
                  ls.film.height, opt.integrator.c_str());
+  opt.accuracy = a.accuracy;
+  if (a.accuracy > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // delta decides
+  opt.adaptive = a.adaptive;
+  opt.adaptive_floor = a.adaptive_floor;
+  opt.write_every_s = a.write_every;
   install_interrupt_handlers();
-  Film film(ls.film.width, ls.film.height);
+  Film film(ls.film.width, ls.film.height, a.m_images);
+  // Intermediate outputs: the images so far and a JSON record that says the render is running.
+  opt.checkpoint = [&](int passes) {
+    write_images(paths, film, ls.film.imaging_ratio);
+    nlohmann::json rec;
+    rec["scene"] = a.scene;
+    rec["settings"] = {{"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
+    rec["result"] = {{"passes", passes}, {"stop_reason", "running"}, {"relative_error_delta", film.relative_error()}};
+    write_text_atomic(paths.json, rec.dump(2) + "\n");
+  };
   RenderStats st = render(ls, opt, &film);
 
   auto t3 = Clock::now();
@@ -151,6 +169,10 @@ int run_render(const RenderArgs& a) {
                      {"integrator_in_file", ls.render.integrator_as_written},
                      {"spp_requested", opt.spp == std::numeric_limits<int>::max() ? -1 : opt.spp},
                      {"time_limit_s", opt.time_limit_s},
+                     {"accuracy", opt.accuracy},
+                     {"adaptive", opt.adaptive},
+                     {"adaptive_floor", opt.adaptive_floor},
+                     {"write_every_s", opt.write_every_s},
                      {"threads", threads},
                      {"seed", opt.seed},
                      {"max_depth", opt.max_depth},
@@ -164,7 +186,10 @@ int run_render(const RenderArgs& a) {
                    {"iterations", st.passes},
                    {"samples_per_pixel", st.passes},
                    {"stop_reason", st.stop_reason},
-                   {"relative_error_delta", st.relative_error}};
+                   {"mean_sampling_probability", st.mean_sampling_probability},
+                   {"relative_error_delta", st.relative_error},
+                   {"m_images", film.m_images()},
+                   {"relative_error_delta_m_images", film.relative_error_m_images()}};
   rec["rays"] = {{"camera", st.rays.camera_rays},
                  {"bounce", st.rays.bounce_rays},
                  {"shadow", st.rays.shadow_rays},
@@ -235,6 +260,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100000));
   render->add_option("-o,--output", ra.output, "Output EXR; PNG, .error.png and .json are written beside it");
   render->add_flag("-q,--quiet", ra.quiet, "No progress output");
+  render->add_option("--accuracy", ra.accuracy,
+                     "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
+      ->check(CLI::Range(1e-6, 1.0));
+  render->add_flag("--adaptive", ra.adaptive, "Adaptive sampling: pixels with a larger relative error get more passes");
+  render->add_option("--adaptive-floor", ra.adaptive_floor,
+                     "Lowest probability of sampling a pixel in a pass with --adaptive (default 0.1)")
+      ->check(CLI::Range(0.01, 1.0));
+  render->add_option("--m-images", ra.m_images,
+                     "Also estimate the error from M intermediate images (pass j to image j mod M; 0: off; default 4)")
+      ->check(CLI::Range(0, 64));
+  render->add_option("--write-every", ra.write_every, "Write the outputs so far every SECONDS (atomically)")
+      ->check(CLI::Range(0.1, 1e9));
   render->add_option("--iterations", ra.iterations,
                      "Iterations (each one eye sample per pixel and a photon pass); same as --spp")
       ->check(CLI::Range(1, 1 << 24));

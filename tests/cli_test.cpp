@@ -225,6 +225,43 @@ TEST_F(Cli, SigtermStillWritesTheImageSoFar) {
   }
 }
 
+TEST_F(Cli, WriteEveryLeavesIntermediateOutputs) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  std::string out = (dir_ / "out.exr").string();
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    int devnull = ::open("/dev/null", 1);
+    dup2(devnull, 2);
+    execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", "bpm", "--spp", "10000000",
+          "--photons-per-batch", "5000", "--write-every", "0.2", "--adaptive", "-o", out.c_str(), nullptr);
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  ASSERT_TRUE(fs::exists(out));
+  auto mid = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(mid["result"]["stop_reason"], "running");
+  EXPECT_EQ(read_exr(out).width, 32);
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["result"]["stop_reason"], "interrupted");
+  EXPECT_EQ(rec["settings"]["adaptive"], true);
+}
+
+TEST_F(Cli, AccuracyFlagStopsAtTheRequestedDelta) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  CliRun r = run("render " + scene + " -q --accuracy 0.05 -o " + (dir_ / "out.exr").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["result"]["stop_reason"], "accuracy");
+  EXPECT_LE(rec["result"]["relative_error_delta"].get<double>(), 0.05);
+  EXPECT_GT(rec["result"]["relative_error_delta_m_images"].get<double>(), 0.0);
+  EXPECT_EQ(rec["result"]["m_images"], 4);
+}
+
 TEST_F(Cli, CompareReportsMeans) {
   std::string scene = write("s.pbrt", kTinyScene);
   std::string out = (dir_ / "out.exr").string();

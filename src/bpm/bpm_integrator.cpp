@@ -16,6 +16,7 @@
 #include "bpm/light_pass.h"
 #include "bpm/masks.h"
 #include "camera/camera.h"
+#include "render/control.h"
 
 namespace bpm {
 
@@ -141,24 +142,15 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   BackwardMaps maps;
   BpmTotals tot;
   RenderStats stats;
-  stats.stop_reason = "samples";
-  auto t0 = Clock::now();
-  double last_progress = -1;
   const uint64_t photons_per_batch = uint64_t(s.photons_per_batch);
   const int chunks_per_batch = int((photons_per_batch + kPhotonChunk - 1) / kPhotonChunk);
   std::vector<Chunk> chunks(chunks_per_batch);
   LightPassParams lp{opt.max_depth, s.normal_cos};
 
-  for (int iter = 0; iter < opt.spp; ++iter) {
+  RenderControl control(opt, *film, "iteration");
+  std::vector<uint8_t> sampled(n_pixels, 0);
+  for (int iter = 0; control.keep_going(iter); ++iter) {
     const int it = opt.first_iteration + iter;  // the index random streams and radii follow
-    if (interrupt_flag().load()) {
-      stats.stop_reason = "interrupted";
-      break;
-    }
-    if (opt.time_limit_s > 0 && iter > 0 && since(t0) >= opt.time_limit_s) {
-      stats.stop_reason = "time";
-      break;
-    }
     // ---- 1. eye pass, block by block, each slot over its mask ----
     auto t_stage = Clock::now();
     float scale = radius_scale(s, it);
@@ -170,6 +162,11 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
       for (int task = r.begin(); task < r.end(); ++task) {
         if (interrupt_flag().load(std::memory_order_relaxed)) return;
         for (uint32_t pixel : masks.pixels(task / slots, task % slots)) {
+          sampled[pixel] = control.sample_pixel(iter, pixel);
+          if (!sampled[pixel]) {
+            cost[pixel] = 0;
+            continue;
+          }
           auto tp = Clock::now();
           int x = int(pixel % w), y = int(pixel / w);
           Rng rng(stream_key(opt.seed, uint64_t(it), pixel));
@@ -188,7 +185,6 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
       // An iteration without its light pass would be a wrong image: drop it.
       for (ObjectPhotonLists& l : thread_lists)
         for (auto& v : l) v.clear();
-      stats.stop_reason = "interrupted";
       break;
     }
 
@@ -279,6 +275,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
       for (int y = r.begin(); y < r.end(); ++y)
         for (int x = 0; x < w; ++x) {
           size_t p = size_t(y) * w + x;
+          if (!sampled[p]) continue;
           Spectrum L = eye_L[p] + photon_L[p];
           if (!L.is_finite() || L.has_negative()) L = Spectrum();
           float m = L.max_component();
@@ -291,18 +288,18 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     masks.rebuild(cost);
     stats.passes = iter + 1;
 
-    if (opt.progress && (since(t0) - last_progress >= 0.5 || iter + 1 == opt.spp)) {
-      double t = since(t0);
-      last_progress = t;
-      std::fprintf(stderr, "\rbpm: iteration %d%s  %.1f s  %zu backward photons  %d batches  coverage %.2f   ",
-                   iter + 1, opt.spp == std::numeric_limits<int>::max() ? "" : ("/" + std::to_string(opt.spp)).c_str(),
-                   t, n_bp, int(emitted / photons_per_batch), coverage);
-      std::fflush(stderr);
-    }
+    uint64_t rays = 0;
+    for (const EyeCounters& c : eye_counters) rays += c.rays.total();
+    for (const LightCounters& c : light_counters) rays += c.light_rays;
+    char extra[128];
+    std::snprintf(extra, sizeof extra, "  %zu backward photons  %d batches  coverage %.2f", n_bp,
+                  int(emitted / photons_per_batch), coverage);
+    control.after_pass(iter, rays, extra);
   }
-  if (opt.progress) std::fprintf(stderr, "\n");
-  if (interrupt_flag().load()) stats.stop_reason = "interrupted";
-  stats.render_seconds = since(t0);
+  control.finish();
+  stats.stop_reason = control.stop_reason();
+  stats.mean_sampling_probability = control.mean_sampling_probability();
+  stats.render_seconds = control.elapsed();
   for (const EyeCounters& c : eye_counters) tot.eye.add(c);
   for (const LightCounters& c : light_counters) tot.light.add(c);
   stats.rays = tot.eye.rays;

@@ -4,7 +4,44 @@
 
 namespace bpm {
 
-Film::Film(int width, int height) : width_(width), height_(height), pixels_(size_t(width) * height) {}
+Film::Film(int width, int height, int m_images)
+    : width_(width), height_(height), pixels_(size_t(width) * height), m_(m_images > 1 ? m_images : 0) {
+  m_sum_.assign(pixels_.size() * size_t(m_), 0.0);
+  m_count_.assign(pixels_.size() * size_t(m_), 0);
+}
+
+std::vector<float> Film::rms_m_images() const {
+  std::vector<float> out(pixels_.size(), 0.0f);
+  if (m_ == 0) return out;
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const double* s = &m_sum_[i * m_];
+    const int* c = &m_count_[i * m_];
+    double mean = 0, var = 0;
+    bool full = true;
+    for (int k = 0; k < m_; ++k) full = full && c[k] > 0;
+    if (!full) continue;
+    for (int k = 0; k < m_; ++k) mean += s[k] / c[k];
+    mean /= m_;
+    for (int k = 0; k < m_; ++k) var += (s[k] / c[k] - mean) * (s[k] / c[k] - mean);
+    // The standard deviation between the M images, over sqrt(M): the error of their average.
+    out[i] = float(std::sqrt(var / (m_ - 1) / m_));
+  }
+  return out;
+}
+
+double Film::relative_error_m_images() const {
+  if (m_ == 0) return 0;
+  std::vector<float> r = rms_m_images();
+  double num = 0, den = 0;
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    if (p.passes == 0) continue;
+    double mean = p.sum_e / p.passes;
+    num += double(r[i]) * r[i];
+    den += mean * mean;
+  }
+  return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
+}
 
 Image Film::image(float scale) const {
   Image img;

@@ -20,7 +20,9 @@ struct Image {
 
 class Film {
  public:
-  Film(int width, int height);
+  // m_images > 0 also keeps the paper's M intermediate images (section 4): pass j of a pixel goes
+  // to image j mod M, and the spread between the M images is a second error estimate.
+  Film(int width, int height, int m_images = 0);
   int width() const { return width_; }
   int height() const { return height_; }
 
@@ -38,6 +40,11 @@ class Film {
       double e = p.pass_wl / p.pass_w;
       p.sum_e += e;
       p.sum_e2 += e * e;
+      if (m_ > 0) {
+        size_t k = size_t(y) * width_ * m_ + x * size_t(m_) + size_t(p.passes % m_);
+        m_sum_[k] += e;
+        ++m_count_[k];
+      }
       ++p.passes;
     }
     p.pass_wl = p.pass_w = 0;
@@ -48,6 +55,11 @@ class Film {
   std::vector<float> rms() const;
   double relative_error() const;
   std::vector<float> pass_counts() const;
+  // The M-images estimates: per-pixel standard error of the mean from the spread of the M image
+  // means, and the image error delta from them (eq. 4). Zero until every image has a pass.
+  int m_images() const { return m_; }
+  std::vector<float> rms_m_images() const;
+  double relative_error_m_images() const;
 
  private:
   struct Pixel {
@@ -59,6 +71,9 @@ class Film {
   };
   int width_, height_;
   std::vector<Pixel> pixels_;
+  int m_ = 0;
+  std::vector<double> m_sum_;
+  std::vector<int> m_count_;
 };
 
 }  // namespace bpm

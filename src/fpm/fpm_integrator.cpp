@@ -15,6 +15,7 @@
 #include "base/error.h"
 #include "bpm/sphere_kdtree.h"
 #include "camera/camera.h"
+#include "render/control.h"
 #include "photons/density.h"
 #include "photons/light_path.h"
 
@@ -69,7 +70,7 @@ struct EyeCounters {
 // sum f dPhi / (pi r^2 N). With knn > 0 the radius is the distance to the knn-th nearest
 // photon within `radius` (Jensen's estimate), else `radius`.
 template <class Accept>
-Spectrum estimate(const RenderScene& scene, const PhotonMap& map, const Material& m, const SurfacePoint& sp, Vec3 wo,
+Spectrum estimate(const PhotonMap& map, const Material& m, const SurfacePoint& sp, Vec3 wo,
                   float radius, int eye_depth, const EyeParams& prm, Accept&& accept, EyeCounters& c) {
   ++c.lookups;
   auto usable = [&](const ForwardPhoton& ph) {
@@ -132,16 +133,16 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
       float r1 = length * prm.radius_per_length1;
       if (gathering) {
         // x2: everything the global map holds, direct photons included.
-        L += beta * estimate(scene, global, m, sp, wo, r1, depth, prm, [](PhotonClass) { return true; }, c);
+        L += beta * estimate(global, m, sp, wo, r1, depth, prm, [](PhotonClass) { return true; }, c);
         break;
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
       L += beta * sample_direct_light(scene, sp, m, frame, wo_local, false, rng, c.rays);
-      L += beta * estimate(scene, caustic, m, sp, wo, length * prm.radius_per_length0, depth, prm,
+      L += beta * estimate(caustic, m, sp, wo, length * prm.radius_per_length0, depth, prm,
                            [](PhotonClass k) { return k == PhotonClass::kCaustic; }, c);
       if (!prm.fpm->final_gather) {
-        L += beta * estimate(scene, global, m, sp, wo, r1, depth, prm,
+        L += beta * estimate(global, m, sp, wo, r1, depth, prm,
                              [](PhotonClass k) { return k == PhotonClass::kIndirect; }, c);
         break;
       }
@@ -186,23 +187,13 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   tbb::enumerable_thread_specific<LightCounters> light_counters;
   tbb::enumerable_thread_specific<EyeCounters> eye_counters;
   RenderStats stats;
-  stats.stop_reason = "samples";
   double light_s = 0, build_s = 0, eye_s = 0;
   uint64_t stored = 0, stored_caustic = 0;
   size_t peak_map_bytes = 0, peak_tree_bytes = 0;
-  auto t0 = Clock::now();
-  double last_progress = -1;
 
-  for (int iter = 0; iter < opt.spp; ++iter) {
+  RenderControl control(opt, *film, "iteration");
+  for (int iter = 0; control.keep_going(iter); ++iter) {
     const int it = opt.first_iteration + iter;  // the index random streams and radii follow
-    if (interrupt_flag().load()) {
-      stats.stop_reason = "interrupted";
-      break;
-    }
-    if (opt.time_limit_s > 0 && iter > 0 && since(t0) >= opt.time_limit_s) {
-      stats.stop_reason = "time";
-      break;
-    }
     // ---- 1. light pass: a forward photon at every diffuse hit ----
     auto t_stage = Clock::now();
     tbb::parallel_for(tbb::blocked_range<int>(0, n_chunks, 1), [&](const tbb::blocked_range<int>& r) {
@@ -250,6 +241,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
       EyeCounters& ec = eye_counters.local();
       for (int y = r.rows().begin(); y < r.rows().end(); ++y)
         for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+          if (!control.sample_pixel(iter, uint32_t(y) * w + x)) continue;
           Rng rng(stream_key(opt.seed, uint64_t(it), uint64_t(y) * w + x));
           FilterSample fsm = filter.sample({rng.uniform(), rng.uniform()});
           Ray ray = camera.generate_ray({x + 0.5f + fsm.offset.x, y + 0.5f + fsm.offset.y}, {rng.uniform(), rng.uniform()});
@@ -263,16 +255,17 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     });
     eye_s += since(t_stage);
     stats.passes = iter + 1;
-    if (opt.progress && (since(t0) - last_progress >= 0.5 || iter + 1 == opt.spp)) {
-      last_progress = since(t0);
-      std::fprintf(stderr, "\rbpm: fpm iteration %d  %.1f s  %zu photons stored   ", iter + 1, last_progress,
-                   global.photons.size() + caustic.photons.size());
-      std::fflush(stderr);
-    }
+    uint64_t rays = 0;
+    for (const EyeCounters& c : eye_counters) rays += c.rays.total();
+    for (const LightCounters& c : light_counters) rays += c.light_rays;
+    char extra[64];
+    std::snprintf(extra, sizeof extra, "  %zu photons stored", global.photons.size());
+    control.after_pass(iter, rays, extra);
   }
-  if (opt.progress) std::fprintf(stderr, "\n");
-  if (interrupt_flag().load()) stats.stop_reason = "interrupted";
-  stats.render_seconds = since(t0);
+  control.finish();
+  stats.stop_reason = control.stop_reason();
+  stats.mean_sampling_probability = control.mean_sampling_probability();
+  stats.render_seconds = control.elapsed();
   LightCounters lt;
   for (const LightCounters& c : light_counters) lt.add(c);
   EyeCounters et;

@@ -14,6 +14,7 @@
 #include "bpm/bpm_integrator.h"
 #include "fpm/fpm_integrator.h"
 #include "camera/camera.h"
+#include "render/control.h"
 
 namespace bpm {
 
@@ -47,26 +48,21 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
   const float max_value = ls.film.max_component_value;
   tbb::enumerable_thread_specific<PathCounters> counters;
   RenderStats stats;
-  auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-  stats.stop_reason = "samples";
-  double last_progress = -1;
-
-  for (int pass = 0; pass < opt.spp; ++pass) {
-    if (interrupt_flag().load()) {
-      stats.stop_reason = "interrupted";
-      break;
-    }
-    if (opt.time_limit_s > 0 && pass > 0 && elapsed() >= opt.time_limit_s) {
-      stats.stop_reason = "time";
-      break;
-    }
+  RenderControl control(opt, *film, "pass");
+  auto total_rays = [&] {
+    uint64_t n = 0;
+    for (const PathCounters& c : counters) n += c.total();
+    return n;
+  };
+  for (int pass = 0; control.keep_going(pass); ++pass) {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 16, 0, w, 16), [&](const tbb::blocked_range2d<int>& r) {
       if (interrupt_flag().load(std::memory_order_relaxed)) return;
       PathCounters& c = counters.local();
       for (int y = r.rows().begin(); y < r.rows().end(); ++y)
         for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-          Rng rng(stream_key(opt.seed, uint64_t(opt.first_iteration + pass), uint64_t(y) * w + x));
+          uint32_t pixel = uint32_t(y) * w + x;
+          if (!control.sample_pixel(pass, pixel)) continue;
+          Rng rng(stream_key(opt.seed, uint64_t(opt.first_iteration + pass), pixel));
           FilterSample fs = filter.sample({rng.uniform(), rng.uniform()});
           Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
           Vec2 u_lens{rng.uniform(), rng.uniform()};
@@ -80,19 +76,12 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
         }
     });
     stats.passes = pass + 1;
-    if (opt.progress && (elapsed() - last_progress >= 0.5 || pass + 1 == opt.spp)) {
-      double t = elapsed();
-      last_progress = t;
-      if (opt.spp == std::numeric_limits<int>::max())
-        std::fprintf(stderr, "\rbpm: pass %d  %.1f s of %.1f s   ", pass + 1, t, opt.time_limit_s);
-      else
-        std::fprintf(stderr, "\rbpm: pass %d/%d  %.1f s  (%.2f s/pass)   ", pass + 1, opt.spp, t, t / (pass + 1));
-      std::fflush(stderr);
-    }
+    control.after_pass(pass, total_rays());
   }
-  if (opt.progress) std::fprintf(stderr, "\n");
-  if (interrupt_flag().load()) stats.stop_reason = "interrupted";
-  stats.render_seconds = elapsed();
+  control.finish();
+  stats.stop_reason = control.stop_reason();
+  stats.render_seconds = control.elapsed();
+  stats.mean_sampling_probability = control.mean_sampling_probability();
   for (const PathCounters& c : counters) stats.rays.add(c);
   stats.relative_error = film->relative_error();
   return stats;

@@ -25,6 +25,11 @@ struct RenderOptions {
   uint64_t seed = 0;
   int max_depth = 5;
   bool progress = true;
+  double accuracy = 0;        // stop when the image error delta (eq. 4) is at most this; 0: off
+  bool adaptive = false;      // adaptive sampling (render/control.h)
+  float adaptive_floor = 0.1f;  // lowest probability of sampling a pixel in a pass
+  double write_every_s = 0;   // call checkpoint this often (between passes); 0: never
+  std::function<void(int passes)> checkpoint;
   BpmSettings bpm;  // used by the bpm integrator, and by fpm for radii and photon counts
   FpmSettings fpm;
 };
@@ -36,7 +41,8 @@ struct StageTime {
 
 struct RenderStats {
   int passes = 0;
-  std::string stop_reason;  // "samples", "time", "interrupted"
+  std::string stop_reason;  // "samples", "time", "accuracy", "interrupted"
+  double mean_sampling_probability = 1;  // adaptive sampling: the last pass's mean
   PathCounters rays;       // eye rays (camera, bounce, shadow)
   uint64_t light_rays = 0;  // photon rays (bpm)
   double render_seconds = 0;

@@ -1,0 +1,109 @@
+// Section 4 of the paper, measured: (1) does the predicted error delta (eq. 4 from the per-pixel
+// RMS of eq. 5, and from M intermediate images) agree with the error actually made, and (2) how
+// many rays does adaptive sampling save to reach a given delta. Prints figures; never fails.
+//   accuracy [--res WxH] [--passes N] [--reference-passes N] [--target DELTA]
+//
+// The measured noise part comes from two renders with different seeds, a and b:
+// sum (a - b)^2 / 2 estimates sum Var, whatever the bias, so noise = sqrt(sum (a-b)^2 / 2 / sum ref^2).
+// The total error is measured against a path-traced reference with its own seed; the bias part is
+// what the total has beyond the noise of the render and of the reference.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "render/renderer.h"
+#include "scene/flatten.h"
+
+using namespace bpm;
+
+namespace {
+
+std::vector<double> luminance(const Image& img) {
+  std::vector<double> l(size_t(img.width) * img.height);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) l[size_t(y) * img.width + x] = img.at(x, y).luminance();
+  return l;
+}
+
+struct Rendered {
+  Film film;
+  RenderStats stats;
+};
+
+Rendered run(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed, double accuracy = 0,
+             bool adaptive = false) {
+  Rendered r{Film(ls.film.width, ls.film.height, 4), {}};
+  RenderOptions opt;
+  opt.integrator = integrator;
+  opt.spp = passes;
+  opt.seed = seed;
+  opt.max_depth = ls.render.max_depth;
+  opt.progress = false;
+  opt.accuracy = accuracy;
+  opt.adaptive = adaptive;
+  opt.bpm.photons_per_batch = 30000;
+  r.stats = render(ls, opt, &r.film);
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  int w = 128, h = 96, passes = 32, ref_passes = 2048;
+  double target = 0.05;
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
+    if (!std::strcmp(argv[i], "--res")) std::sscanf(next().c_str(), "%dx%d", &w, &h);
+    else if (!std::strcmp(argv[i], "--passes")) passes = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--reference-passes")) ref_passes = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--target")) target = std::atof(next().c_str());
+  }
+  std::printf("== predicted against measured error, %dx%d, %d passes, reference: path %d spp ==\n", w, h, passes,
+              ref_passes);
+  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5", "delta M=4", "noise", "ratio",
+              "total", "bias");
+  for (const char* name : {"cornell-box", "caustic-sphere"}) {
+    LoadedScene ls = flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/" + name + ".pbrt"));
+    ls.film.width = w;
+    ls.film.height = h;
+    Rendered ref = run(ls, "path", ref_passes, 0x5eed);
+    std::vector<double> lr = luminance(ref.film.image());
+    double ref_sum2 = 0;
+    for (double v : lr) ref_sum2 += v * v;
+    double ref_delta = ref.film.relative_error();
+    for (const char* integrator : {"path", "bpm", "fpm"}) {
+      int n = std::string(integrator) == "path" ? passes * 8 : passes;
+      Rendered a = run(ls, integrator, n, 1), b = run(ls, integrator, n, 2);
+      std::vector<double> la = luminance(a.film.image()), lb = luminance(b.film.image());
+      double d_ab = 0, d_ar = 0;
+      for (size_t i = 0; i < la.size(); ++i) {
+        d_ab += (la[i] - lb[i]) * (la[i] - lb[i]);
+        d_ar += (la[i] - lr[i]) * (la[i] - lr[i]);
+      }
+      double noise = std::sqrt(d_ab / 2 / ref_sum2), total = std::sqrt(d_ar / ref_sum2);
+      double bias = std::sqrt(std::fmax(0.0, total * total - noise * noise - ref_delta * ref_delta));
+      double pred = a.film.relative_error();
+      std::printf("%-16s %-5s %10.4f %10.4f %10.4f %10.2f %10.4f %10.4f\n", name, integrator, pred,
+                  a.film.relative_error_m_images(), noise, pred / noise, total, bias);
+    }
+  }
+  std::printf("(ratio: predicted delta over measured noise; total: against the reference; bias: total beyond\n"
+              " the noise of the render and of the reference, %s)\n\n",
+              "whose own delta is subtracted");
+
+  std::printf("== rays to reach delta %.3g on the caustic scene, %dx%d ==\n", target, w, h);
+  LoadedScene ls = flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/caustic-sphere.pbrt"));
+  ls.film.width = w;
+  ls.film.height = h;
+  std::printf("%-6s %-9s %12s %10s %10s %10s\n", "", "adaptive", "rays", "passes", "seconds", "delta");
+  for (const char* integrator : {"path", "bpm"})
+    for (bool adaptive : {false, true}) {
+      Rendered r = run(ls, integrator, std::numeric_limits<int>::max(), 3, target, adaptive);
+      std::printf("%-6s %-9s %12.4g %10d %10.2f %10.4f\n", integrator, adaptive ? "yes" : "no",
+                  double(r.stats.total_rays()), r.stats.passes, r.stats.render_seconds, r.stats.relative_error);
+    }
+  return 0;
+}

@@ -1,0 +1,115 @@
+#include "render/control.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "base/rng.h"
+#include "render/renderer.h"
+
+namespace bpm {
+namespace {
+constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
+// Passes before the error estimate is trusted (for the accuracy budget and adaptive sampling).
+constexpr int kWarmupPasses = 4;
+}  // namespace
+
+RenderControl::RenderControl(const RenderOptions& opt, const Film& film, const char* unit)
+    : opt_(opt), film_(film), unit_(unit), t0_(std::chrono::steady_clock::now()) {}
+
+double RenderControl::elapsed() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+bool RenderControl::keep_going(int done) {
+  if (interrupt_flag().load()) {
+    stop_reason_ = "interrupted";
+    return false;
+  }
+  if (done >= opt_.spp) {
+    stop_reason_ = "samples";
+    return false;
+  }
+  if (opt_.time_limit_s > 0 && done > 0 && elapsed() >= opt_.time_limit_s) {
+    stop_reason_ = "time";
+    return false;
+  }
+  if (opt_.accuracy > 0 && done >= kWarmupPasses && delta_ > 0 && delta_ <= opt_.accuracy) {
+    stop_reason_ = "accuracy";
+    return false;
+  }
+  return true;
+}
+
+void RenderControl::update_probabilities() {
+  std::vector<float> rms = film_.rms();
+  Image img = film_.image();
+  size_t n = rms.size();
+  // Relative RMS, with a small share of the image's mean added to the denominator so that black
+  // pixels (rms 0 / mean 0) are not declared infinitely noisy.
+  double image_mean = 0;
+  for (size_t i = 0; i < n; ++i) image_mean += img.rgb[3 * i] * 0.2126 + img.rgb[3 * i + 1] * 0.7152 + img.rgb[3 * i + 2] * 0.0722;
+  image_mean /= double(std::max<size_t>(n, 1));
+  std::vector<float> rel(n);
+  for (size_t i = 0; i < n; ++i) {
+    double L = img.rgb[3 * i] * 0.2126 + img.rgb[3 * i + 1] * 0.7152 + img.rgb[3 * i + 2] * 0.0722;
+    rel[i] = float(rms[i] / (std::fabs(L) + 0.01 * image_mean + 1e-12));
+  }
+  // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
+  std::vector<float> sorted = rel;
+  size_t k = std::min(n - 1, size_t(0.9 * double(n)));
+  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+  float ref = sorted[k];
+  probability_.resize(n);
+  for (size_t i = 0; i < n; ++i)
+    probability_[i] = ref > 0 ? std::clamp(rel[i] / ref, opt_.adaptive_floor, 1.0f) : 1.0f;
+}
+
+void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra) {
+  int passes = done + 1;
+  if (opt_.accuracy > 0 || opt_.progress || (opt_.adaptive && passes >= kWarmupPasses)) delta_ = film_.relative_error();
+  if (opt_.adaptive && passes >= kWarmupPasses) update_probabilities();
+  double t = elapsed();
+  if (opt_.checkpoint && opt_.write_every_s > 0 && t - last_checkpoint_ >= opt_.write_every_s) {
+    opt_.checkpoint(passes);
+    last_checkpoint_ = t;
+  }
+  if (!opt_.progress || (t - last_progress_ < 0.5 && passes != opt_.spp)) return;
+  last_progress_ = t;
+  char budget[32] = "";
+  if (opt_.spp != std::numeric_limits<int>::max()) std::snprintf(budget, sizeof budget, "/%d", opt_.spp);
+  std::string eta;
+  if (opt_.accuracy > 0 && delta_ > opt_.accuracy && passes >= kWarmupPasses) {
+    // delta falls as 1/sqrt(passes): the passes still needed, at the rate so far.
+    double more = double(passes) * (delta_ * delta_ / (opt_.accuracy * opt_.accuracy) - 1);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "  %.0f s to delta %.3g", more * t / passes, opt_.accuracy);
+    eta = buf;
+  }
+  std::fprintf(stderr, "\rbpm: %s %d%s  %.1f s  delta %.4f  %.2f Mrays/s%s%s   ", unit_, passes, budget, t,
+               delta_, t > 0 ? double(rays) / t * 1e-6 : 0.0, extra.c_str(), eta.c_str());
+  std::fflush(stderr);
+}
+
+bool RenderControl::sample_pixel(int pass, uint32_t pixel) const {
+  if (probability_.empty()) return true;
+  float p = probability_[pixel];
+  if (p >= 1) return true;
+  Rng rng(stream_key(opt_.seed ^ kAdaptiveStream, uint64_t(opt_.first_iteration + pass), pixel));
+  return rng.uniform() < p;
+}
+
+double RenderControl::mean_sampling_probability() const {
+  if (probability_.empty()) return 1;
+  double s = 0;
+  for (float p : probability_) s += p;
+  return s / double(probability_.size());
+}
+
+void RenderControl::finish() {
+  if (opt_.progress) std::fprintf(stderr, "\n");
+  if (interrupt_flag().load()) stop_reason_ = "interrupted";
+}
+
+}  // namespace bpm

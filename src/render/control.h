@@ -1,0 +1,55 @@
+// What every integrator's outer loop shares (section 4 of the paper): the budgets that end a
+// render (passes, time, the requested accuracy delta of eq. 4, an interrupt), the progress line
+// with delta, rays per second and the time left to the requested accuracy, intermediate outputs
+// every so many seconds, and adaptive sampling: which pixels the next pass samples.
+//
+// Adaptive sampling keeps every pixel's estimate unbiased: a pixel is either sampled in a pass or
+// not, with a probability decided from the passes before (never from the pass itself), and its
+// value is the mean of the passes that sampled it. The probability follows the pixel's relative
+// RMS (eq. 5 over its mean), is 1 for the noisiest pixels and never below a floor, so that no
+// pixel starves and the error estimate of every pixel stays alive.
+#pragma once
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "film/film.h"
+
+namespace bpm {
+
+struct RenderOptions;
+
+class RenderControl {
+ public:
+  // `unit` names a pass in the progress line ("pass" or "iteration").
+  RenderControl(const RenderOptions& opt, const Film& film, const char* unit);
+
+  // Before pass `done` (0-based): false when the render must stop; stop_reason() says why.
+  bool keep_going(int done);
+  // After a pass: updates the sampling probabilities, prints progress, writes a checkpoint.
+  // `rays` is the total traced so far; `extra` is appended to the progress line.
+  void after_pass(int done, uint64_t rays, const std::string& extra = "");
+  // Whether the pass samples the pixel (always, without adaptive sampling).
+  bool sample_pixel(int pass, uint32_t pixel) const;
+  // Call once at the end: finishes the progress line.
+  void finish();
+
+  const std::string& stop_reason() const { return stop_reason_; }
+  double elapsed() const;
+  double delta() const { return delta_; }
+  double mean_sampling_probability() const;
+
+ private:
+  void update_probabilities();
+  const RenderOptions& opt_;
+  const Film& film_;
+  const char* unit_;
+  std::chrono::steady_clock::time_point t0_;
+  std::string stop_reason_ = "samples";
+  double delta_ = 0;
+  double last_progress_ = -1, last_checkpoint_ = 0;
+  std::vector<float> probability_;  // empty: every pixel every pass
+};
+
+}  // namespace bpm
