@@ -29,19 +29,7 @@ std::vector<float> Film::rms_m_images() const {
   return out;
 }
 
-double Film::relative_error_m_images() const {
-  if (m_ == 0) return 0;
-  std::vector<float> r = rms_m_images();
-  double num = 0, den = 0;
-  for (size_t i = 0; i < pixels_.size(); ++i) {
-    const Pixel& p = pixels_[i];
-    if (p.passes == 0) continue;
-    double mean = p.sum_e / p.passes;
-    num += double(r[i]) * r[i];
-    den += mean * mean;
-  }
-  return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
-}
+double Film::relative_error_m_images() const { return m_ == 0 ? 0 : delta_from(rms_m_images()); }
 
 Image Film::image(float scale) const {
   Image img;
@@ -68,8 +56,9 @@ std::vector<float> Film::rms() const {
   return out;
 }
 
-double Film::relative_error() const {
-  std::vector<float> r = rms();
+double Film::relative_error() const { return delta_from(rms()); }
+
+double Film::delta_from(const std::vector<float>& r) const {
   double num = 0, den = 0;
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const Pixel& p = pixels_[i];

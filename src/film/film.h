@@ -62,6 +62,8 @@ class Film {
   double relative_error_m_images() const;
 
  private:
+  // eq. (4) from per-pixel standard errors.
+  double delta_from(const std::vector<float>& rms) const;
   struct Pixel {
     double sum_wl[3] = {0, 0, 0};
     double sum_w = 0;
