@@ -44,7 +44,7 @@ struct RenderArgs {
   bool final_gather = false;
   int knn = -1;
   double accuracy = 0, write_every = 0;
-  bool adaptive = false;
+  bool no_adaptive = false;
   float adaptive_floor = 0.1f;
   int m_images = 4;
 };
@@ -141,7 +141,7 @@ int run_render(const RenderArgs& a) {
                  ls.film.height, opt.integrator.c_str());
   opt.accuracy = a.accuracy;
   if (a.accuracy > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // delta decides
-  opt.adaptive = a.adaptive;
+  opt.adaptive = !a.no_adaptive;
   opt.adaptive_floor = a.adaptive_floor;
   opt.write_every_s = a.write_every;
   install_interrupt_handlers();
@@ -263,9 +263,10 @@ int main(int argc, char** argv) {
   render->add_option("--accuracy", ra.accuracy,
                      "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
       ->check(CLI::Range(1e-6, 1.0));
-  render->add_flag("--adaptive", ra.adaptive, "Adaptive sampling: pixels with a larger relative error get more passes");
+  render->add_flag("--no-adaptive", ra.no_adaptive,
+                   "Sample every pixel in every pass (by default pixels with a larger relative error get more passes)");
   render->add_option("--adaptive-floor", ra.adaptive_floor,
-                     "Lowest probability of sampling a pixel in a pass with --adaptive (default 0.1)")
+                     "Lowest probability of sampling a pixel in a pass under adaptive sampling (default 0.1)")
       ->check(CLI::Range(0.01, 1.0));
   render->add_option("--m-images", ra.m_images,
                      "Also estimate the error from M intermediate images (pass j to image j mod M; 0: off; default 4)")
