@@ -182,9 +182,12 @@ int run_render(const RenderArgs& a) {
                      {"filter_radius", {ls.filter.radius.x, ls.filter.radius.y}},
                      {"imaging_ratio", ls.film.imaging_ratio}};
   if (!st.details.is_null()) rec[opt.integrator] = st.details;
+  double mean_samples = 0;
+  for (float c : film.pass_counts()) mean_samples += c;
+  mean_samples /= double(std::max<size_t>(1, size_t(film.width()) * film.height()));
   rec["result"] = {{"passes", st.passes},
                    {"iterations", st.passes},
-                   {"samples_per_pixel", st.passes},
+                   {"samples_per_pixel_mean", mean_samples},
                    {"stop_reason", st.stop_reason},
                    {"mean_sampling_probability", st.mean_sampling_probability},
                    {"relative_error_delta", st.relative_error},
