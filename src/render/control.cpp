@@ -68,14 +68,18 @@ void RenderControl::update_probabilities() {
 
 void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra) {
   int passes = done + 1;
-  if (opt_.accuracy > 0 || opt_.progress || (opt_.adaptive && passes >= kWarmupPasses)) delta_ = film_.relative_error();
-  if (opt_.adaptive && passes >= kWarmupPasses) update_probabilities();
   double t = elapsed();
+  bool print = opt_.progress && (t - last_progress_ >= 0.5 || passes == opt_.spp);
+  // Each of these reads the whole film: the accuracy budget needs delta after every pass, the rest
+  // only now and then (sampling probabilities every pass at first, then every fourth).
+  bool adapt = opt_.adaptive && passes >= kWarmupPasses && (passes < 16 || passes % 4 == 0);
+  if (opt_.accuracy > 0 || print) delta_ = film_.relative_error();
+  if (adapt) update_probabilities();
   if (opt_.checkpoint && opt_.write_every_s > 0 && t - last_checkpoint_ >= opt_.write_every_s) {
     opt_.checkpoint(passes);
     last_checkpoint_ = t;
   }
-  if (!opt_.progress || (t - last_progress_ < 0.5 && passes != opt_.spp)) return;
+  if (!print) return;
   last_progress_ = t;
   char budget[32] = "";
   if (opt_.spp != std::numeric_limits<int>::max()) std::snprintf(budget, sizeof budget, "/%d", opt_.spp);
