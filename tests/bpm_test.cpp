@@ -38,18 +38,25 @@ struct RenderRun {
   RenderStats stats;
 };
 
-RenderRun render_with(const LoadedScene& ls, const std::string& integrator, int passes, int threads = 0, uint64_t seed = 1,
-                      BpmSettings bpm = {}, FpmSettings fpm = {}) {
-  RenderRun r{Film(ls.film.width, ls.film.height), {}};
+// Options for a quiet render of `ls` with the file's maxdepth.
+RenderOptions test_options(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed = 1,
+                           const BpmSettings& bpm = {}, const FpmSettings& fpm = {}) {
   RenderOptions opt;
   opt.integrator = integrator;
   opt.spp = passes;
-  opt.threads = threads;
   opt.seed = seed;
   opt.max_depth = ls.render.max_depth;
   opt.progress = false;
   opt.bpm = bpm;
   opt.fpm = fpm;
+  return opt;
+}
+
+RenderRun render_with(const LoadedScene& ls, const std::string& integrator, int passes, int threads = 0, uint64_t seed = 1,
+                      BpmSettings bpm = {}, FpmSettings fpm = {}) {
+  RenderRun r{Film(ls.film.width, ls.film.height), {}};
+  RenderOptions opt = test_options(ls, integrator, passes, seed, bpm, fpm);
+  opt.threads = threads;
   r.stats = render(ls, opt, &r.film);
   return r;
 }
@@ -132,15 +139,8 @@ Iterations render_iterations(const LoadedScene& ls, const std::string& integrato
   Iterations out;
   for (int i = 0; i < n; ++i) {
     Film film(ls.film.width, ls.film.height);
-    RenderOptions opt;
-    opt.integrator = integrator;
-    opt.spp = 1;
+    RenderOptions opt = test_options(ls, integrator, 1, seed, bpm, fpm);
     opt.first_iteration = i;
-    opt.seed = seed;
-    opt.max_depth = ls.render.max_depth;
-    opt.progress = false;
-    opt.bpm = bpm;
-    opt.fpm = fpm;
     out.last = render(ls, opt, &film);
     out.images.push_back(film.image());
   }
@@ -239,16 +239,32 @@ std::string caustic_scene() {
 // over the disc that is at most beta_max^2 / 8 ~ (r / R)^2 / 8. The radius is k * pixel angle *
 // eye path length, and the path to the last vertex is at most R + 2 R D long from the centre,
 // which bounds the bias used below; a narrow field of view keeps it well under one percent.
-TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
-  const int max_depth = 8;
-  const float rho = 0.8f;
-  std::string scene = header(16, max_depth, "0 0 0  0 0 1  0 1 0", 10) +
-                      "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
-                      "Material \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
-                      "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n";
-  LoadedScene ls = load(scene);
+// The furnace scene and its exact radiance, sum_{k=0}^{maxdepth} 0.8^k.
+LoadedScene sphere_furnace() {
+  return load(header(16, 8, "0 0 0  0 0 1  0 1 0", 10) +
+              "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+              "Material \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
+              "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+}
+
+// The image mean of 24 iterations equals the exact radiance within 4.5 sigma (spread over
+// iterations) plus the tilt bias bound (r / R)^2 / 8, where the last gathering vertex is at most
+// `path_radii` sphere radii from the camera along the eye path.
+void expect_furnace(const std::string& integrator, const BpmSettings& s, const FpmSettings& f, int path_radii,
+                    const std::string& what) {
+  LoadedScene ls = sphere_furnace();
   double expected = 0;
-  for (int k = 0; k <= max_depth; ++k) expected += std::pow(double(rho), k);
+  for (int k = 0; k <= ls.render.max_depth; ++k) expected += std::pow(0.8, k);
+  BlockStats m = image_mean(render_iterations(ls, integrator, 24, 11, s, f));
+  double sigma = std::sqrt(m.var);
+  float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
+  double r_over_R = s.k1 * pixel_angle * path_radii;
+  double bias = expected * r_over_R * r_over_R / 8;
+  EXPECT_NEAR(m.mean, expected, 4.5 * sigma + bias) << what << " sigma " << sigma << " bias bound " << bias;
+  EXPECT_LT(sigma, 0.01 * expected) << what;  // the test has power
+}
+
+TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
   for (int d : {0, 1, 2, 3})
     for (RadiusPolicy policy : {RadiusPolicy::kFixed, RadiusPolicy::kProgressive}) {
       BpmSettings s = small_batches(d);
@@ -256,14 +272,7 @@ TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
       // At D = 0 every pixel reads the photons directly: their noise is shared by all pixels
       // and needs more photons for the test to have power.
       if (d == 0) s.photons_per_batch = 32768;
-      BlockStats m = image_mean(render_iterations(ls, "bpm", 24, 11, s));
-      double mean = m.mean, sigma = std::sqrt(m.var);
-      float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
-      double r_over_R = s.k1 * pixel_angle * (1 + 2 * d);
-      double bias = expected * r_over_R * r_over_R / 8;
-      EXPECT_NEAR(mean, expected, 4.5 * sigma + bias)
-          << "D=" << d << " " << to_string(policy) << " sigma " << sigma << " bias bound " << bias;
-      EXPECT_LT(sigma, 0.01 * expected) << "D=" << d;  // the test has power
+      expect_furnace("bpm", s, {}, 1 + 2 * d, "D=" + std::to_string(d) + " " + to_string(policy));
     }
 }
 
@@ -453,26 +462,12 @@ TEST(Bpm, CentreTreeGivesTheSameImageAsSphereTree) {
 // The sphere furnace again: caustic map, global map and final gathering account for every
 // bounce exactly once and keep pbrt-v4's depth rule.
 TEST(Fpm, SphereFurnaceMatchesAnalyticRadiance) {
-  const int max_depth = 8;
-  std::string scene = header(16, max_depth, "0 0 0  0 0 1  0 1 0", 10) +
-                      "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
-                      "Material \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
-                      "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n";
-  LoadedScene ls = load(scene);
-  double expected = 0;
-  for (int k = 0; k <= max_depth; ++k) expected += std::pow(0.8, k);
   for (bool gather : {false, true}) {
     BpmSettings s = small_batches(0);
     s.photons_per_batch = 32768;
     FpmSettings f;
     f.final_gather = gather;
-    BlockStats m = image_mean(render_iterations(ls, "fpm", 24, 11, s, f));
-    double mean = m.mean, sigma = std::sqrt(m.var);
-    // Bias bound as in the bpm furnace: the radius is at most k1 * pixel angle * (R + 2R) / R.
-    float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
-    double r_over_R = s.k1 * pixel_angle * (gather ? 3 : 1);
-    EXPECT_NEAR(mean, expected, 4.5 * sigma + expected * r_over_R * r_over_R / 8) << (gather ? "final gather" : "direct");
-    EXPECT_LT(sigma, 0.01 * expected);
+    expect_furnace("fpm", s, f, gather ? 3 : 1, gather ? "final gather" : "direct");
   }
 }
 
@@ -515,14 +510,7 @@ TEST(Accuracy, PredictedDeltaMatchesMeasuredNoise) {
     BpmSettings s = small_batches(1);
     auto run = [&](uint64_t seed) {
       Film film(ls.film.width, ls.film.height, 4);
-      RenderOptions opt;
-      opt.integrator = integrator;
-      opt.spp = passes;
-      opt.seed = seed;
-      opt.max_depth = ls.render.max_depth;
-      opt.progress = false;
-      opt.bpm = s;
-      render(ls, opt, &film);
+      render(ls, test_options(ls, integrator, passes, seed, s), &film);
       return film;
     };
     Film a = run(1), b = run(2);
@@ -546,13 +534,8 @@ TEST(Accuracy, RequestedAccuracyEndsTheRender) {
   LoadedScene ls = load(cornell());
   for (const char* integrator : {"path", "bpm"}) {
     Film film(ls.film.width, ls.film.height);
-    RenderOptions opt;
-    opt.integrator = integrator;
-    opt.spp = std::numeric_limits<int>::max();
+    RenderOptions opt = test_options(ls, integrator, std::numeric_limits<int>::max(), 1, small_batches(1));
     opt.accuracy = 0.08;
-    opt.max_depth = ls.render.max_depth;
-    opt.progress = false;
-    opt.bpm = small_batches(1);
     RenderStats st = render(ls, opt, &film);
     EXPECT_EQ(st.stop_reason, "accuracy") << integrator;
     EXPECT_LE(st.relative_error, 0.08) << integrator;
@@ -566,13 +549,8 @@ TEST(Accuracy, AdaptiveSamplingKeepsPixelsUnbiased) {
   LoadedScene ls = load(caustic_scene());
   RenderRun ref = render_with(ls, "path", 2048);
   Film film(ls.film.width, ls.film.height);
-  RenderOptions opt;
-  opt.integrator = "path";
-  opt.spp = 1024;
-  opt.seed = 4;
+  RenderOptions opt = test_options(ls, "path", 1024, 4);
   opt.adaptive = true;
-  opt.max_depth = ls.render.max_depth;
-  opt.progress = false;
   RenderStats st = render(ls, opt, &film);
   EXPECT_LT(st.mean_sampling_probability, 0.9);
   std::vector<float> counts = film.pass_counts();

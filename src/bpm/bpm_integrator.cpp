@@ -33,9 +33,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Photons per chunk: the unit of work of the light pass, and the unit whose entries phase two
-// applies in a fixed order (so that sums do not depend on the thread count).
-constexpr int kPhotonChunk = 1024;
 // Domain separation of photon streams from pixel streams.
 constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
 
@@ -143,7 +140,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   BpmTotals tot;
   RenderStats stats;
   const uint64_t photons_per_batch = uint64_t(s.photons_per_batch);
-  const int chunks_per_batch = int((photons_per_batch + kPhotonChunk - 1) / kPhotonChunk);
+  const int chunks_per_batch = int((photons_per_batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   std::vector<Chunk> chunks(chunks_per_batch);
   LightPassParams lp{opt.max_depth, s.normal_cos};
 
@@ -201,7 +198,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
       for (size_t o = 0; o < scene.objects.size(); ++o) {
         size_t n = maps.object_begin[o + 1] - maps.object_begin[o];
         in += n;
-        stored += size_t(maps.sphere_trees[o].duplication() * double(n) + 0.5);
+        stored += maps.sphere_trees[o].reference_count();
       }
       if (in) {
         tot.duplication_sum += double(stored) / double(in);
@@ -225,8 +222,8 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
           Chunk& ch = chunks[c];
           ch.by_slot.resize(slots);
           for (auto& v : ch.by_slot) v.clear();
-          uint64_t first = uint64_t(c) * kPhotonChunk;
-          uint64_t last = std::min(first + kPhotonChunk, photons_per_batch);
+          uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+          uint64_t last = std::min(first + kPhotonsPerChunk, photons_per_batch);
           for (uint64_t k = first; k < last; ++k) {
             uint64_t index = uint64_t(batch) * photons_per_batch + k;
             Rng rng(stream_key(opt.seed ^ kPhotonStream, uint64_t(it), index, 1));

@@ -34,8 +34,8 @@ class SphereKdTree {
     }
   }
   size_t bytes() const;
-  size_t node_count() const { return nodes_.size(); }
-  // Sphere references stored in leaves over spheres given (1 means no duplication).
+  // Sphere references stored in leaves, and that over the spheres given (1: no duplication).
+  size_t reference_count() const { return items_.size(); }
   double duplication() const;
 
  private:

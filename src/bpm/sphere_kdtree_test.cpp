@@ -42,7 +42,9 @@ void check_against_brute_force(const char* name, int n) {
     ASSERT_EQ(got, expected) << name << " n=" << n << " query " << q;
     total += got.size();
   }
-  if (n >= 1000) EXPECT_GT(total, 3000u) << name;  // the queries do find spheres
+  if (n >= 1000) {
+    EXPECT_GT(total, 3000u) << name;  // the queries do find spheres
+  }
 }
 
 TEST(SphereKdTree, MatchesBruteForce) {

@@ -25,7 +25,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-constexpr int kPhotonChunk = 1024;
 constexpr uint64_t kPhotonStream = 0x66706d70686f74ull;
 
 struct ForwardPhoton {
@@ -176,7 +175,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   const float pixel_angle = std::sqrt(camera.pixel_solid_angle());
   const float max_value = ls.film.max_component_value;
   const uint64_t n_photons = uint64_t(s.photons_per_batch);
-  const int n_chunks = int((n_photons + kPhotonChunk - 1) / kPhotonChunk);
+  const int n_chunks = int((n_photons + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   const int min_eye_vertices = fs_.final_gather ? 2 : 1;
 
   struct Chunk {
@@ -202,7 +201,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
         Chunk& ch = chunks[c];
         ch.global.clear();
         ch.caustic.clear();
-        uint64_t first = uint64_t(c) * kPhotonChunk, last = std::min(first + kPhotonChunk, n_photons);
+        uint64_t first = uint64_t(c) * kPhotonsPerChunk, last = std::min(first + kPhotonsPerChunk, n_photons);
         for (uint64_t k = first; k < last; ++k) {
           Rng rng(stream_key(opt.seed ^ kPhotonStream, uint64_t(it), k, 2));
           trace_light_path(scene, opt.max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {

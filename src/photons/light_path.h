@@ -13,6 +13,10 @@
 
 namespace bpm {
 
+// Photons per chunk: the unit of work of a light pass, and the unit whose results are combined in
+// a fixed order, so that sums do not depend on the thread count.
+constexpr int kPhotonsPerChunk = 1024;
+
 // How a photon arrived: straight from the light, through specular vertices only, or after at
 // least one diffuse vertex.
 enum class PhotonClass : uint8_t { kDirect, kCaustic, kIndirect };

@@ -48,14 +48,14 @@ void RenderControl::update_probabilities() {
   size_t n = rms.size();
   // Relative RMS, with a small share of the image's mean added to the denominator so that black
   // pixels (rms 0 / mean 0) are not declared infinitely noisy.
+  std::vector<double> lum(n);
   double image_mean = 0;
-  for (size_t i = 0; i < n; ++i) image_mean += img.rgb[3 * i] * 0.2126 + img.rgb[3 * i + 1] * 0.7152 + img.rgb[3 * i + 2] * 0.0722;
-  image_mean /= double(std::max<size_t>(n, 1));
-  std::vector<float> rel(n);
   for (size_t i = 0; i < n; ++i) {
-    double L = img.rgb[3 * i] * 0.2126 + img.rgb[3 * i + 1] * 0.7152 + img.rgb[3 * i + 2] * 0.0722;
-    rel[i] = float(rms[i] / (std::fabs(L) + 0.01 * image_mean + 1e-12));
+    lum[i] = Spectrum(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]).luminance();
+    image_mean += lum[i] / double(n);
   }
+  std::vector<float> rel(n);
+  for (size_t i = 0; i < n; ++i) rel[i] = float(rms[i] / (std::fabs(lum[i]) + 0.01 * image_mean + 1e-12));
   // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
   std::vector<float> sorted = rel;
   size_t k = std::min(n - 1, size_t(0.9 * double(n)));
