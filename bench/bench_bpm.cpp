@@ -97,7 +97,8 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
   RayLog eye_log, light_log;
   {
     PerspectiveCamera cam(ls.camera, w, h);
-    EyePassParams ep{bs.diffuse_depth, ls.render.max_depth, 1e-3f, 3e-3f};
+    const WavelengthMaterials wm(ls.scene, sample_wavelengths(0.5f));
+    EyePassParams ep{&wm, bs.diffuse_depth, ls.render.max_depth, 1e-3f, 3e-3f};
     ObjectPhotonLists lists(ls.scene.objects.size());
     EyeCounters c;
     c.rays.log = &eye_log;
@@ -115,7 +116,7 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     lc.log = &light_log;
     for (int k = 0; k < bs.photons_per_batch; ++k) {
       Rng rng(stream_key(98, 0, k));
-      trace_photon(ls.scene, empty, LightPassParams{ls.render.max_depth, bs.normal_cos}, owner, rng, out, lc);
+      trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos}, owner, rng, out, lc);
     }
   }
   std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n", eye_log.closest_hit.size(),

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
         for (int s = 0; s < 4; ++s) {
           Rng rng(stream_key(99, s, uint64_t(y) * res + x));
           Ray r = cam.generate_ray({x + rng.uniform(), y + rng.uniform()}, {0.5f, 0.5f});
-          path_radiance(ls.scene, r, PathSettings{ls.render.max_depth}, rng, c);
+          path_radiance(ls.scene, r, PathSettings{ls.render.max_depth}, sample_wavelengths(rng.uniform()), rng, c);
         }
   }
   std::printf("recorded %zu closest-hit and %zu shadow rays\n", log.closest_hit.size(), log.shadow.size());

@@ -1,54 +1,92 @@
-// Radiometric quantities. bpm transports three sRGB-primaries channels; every integrator uses
-// Spectrum only through these operations, so a spectral (sampled wavelengths) type with the same
-// interface can replace it without touching integrator code.
+// Radiometric quantities. Light is transported spectrally, as in pbrt-v4: every camera or light
+// path carries its values at a handful of sampled wavelengths (Spectrum), and only the film turns
+// them into colour (Rgb, linear sRGB primaries). Both are small fixed-size vectors with the same
+// element-wise operations.
 #pragma once
 #include <array>
 #include <cmath>
 
 namespace bpm {
 
-struct Spectrum {
-  static constexpr int kChannels = 3;
-  std::array<float, kChannels> c{0, 0, 0};
+template <int N>
+struct Channels {
+  static constexpr int kChannels = N;
+  std::array<float, N> c{};
 
-  constexpr Spectrum() = default;
-  constexpr explicit Spectrum(float v) : c{v, v, v} {}
-  constexpr Spectrum(float r, float g, float b) : c{r, g, b} {}
+  constexpr Channels() = default;
+  constexpr explicit Channels(float v) { c.fill(v); }
+  constexpr Channels(float r, float g, float b)
+    requires(N == 3)
+      : c{r, g, b} {}
 
   float operator[](int i) const { return c[i]; }
   float& operator[](int i) { return c[i]; }
 
-  Spectrum& operator+=(const Spectrum& o) { for (int i = 0; i < kChannels; ++i) c[i] += o.c[i]; return *this; }
-  Spectrum& operator*=(const Spectrum& o) { for (int i = 0; i < kChannels; ++i) c[i] *= o.c[i]; return *this; }
-  Spectrum& operator*=(float s) { for (float& v : c) v *= s; return *this; }
-  Spectrum& operator/=(float s) { return *this *= 1.0f / s; }
+  Channels& operator+=(const Channels& o) { for (int i = 0; i < N; ++i) c[i] += o.c[i]; return *this; }
+  Channels& operator-=(const Channels& o) { for (int i = 0; i < N; ++i) c[i] -= o.c[i]; return *this; }
+  Channels& operator*=(const Channels& o) { for (int i = 0; i < N; ++i) c[i] *= o.c[i]; return *this; }
+  Channels& operator*=(float s) { for (float& v : c) v *= s; return *this; }
+  Channels& operator/=(float s) { return *this *= 1.0f / s; }
 
-  bool is_black() const { return c[0] == 0 && c[1] == 0 && c[2] == 0; }
-  float max_component() const { return std::fmax(c[0], std::fmax(c[1], c[2])); }
-  float min_component() const { return std::fmin(c[0], std::fmin(c[1], c[2])); }
-  float average() const { return (c[0] + c[1] + c[2]) / 3.0f; }
+  bool is_black() const {
+    for (float v : c)
+      if (v != 0) return false;
+    return true;
+  }
+  float max_component() const {
+    float m = c[0];
+    for (float v : c) m = std::fmax(m, v);
+    return m;
+  }
+  float min_component() const {
+    float m = c[0];
+    for (float v : c) m = std::fmin(m, v);
+    return m;
+  }
+  float average() const {
+    float s = 0;
+    for (float v : c) s += v;
+    return s / N;
+  }
   // Luminance Y of linear sRGB (Rec. 709 primaries, D65).
-  float luminance() const { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
-  bool is_finite() const { return std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]); }
-  bool has_negative() const { return c[0] < 0 || c[1] < 0 || c[2] < 0; }
+  float luminance() const
+    requires(N == 3)
+  {
+    return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+  }
+  bool is_finite() const {
+    for (float v : c)
+      if (!std::isfinite(v)) return false;
+    return true;
+  }
+  bool has_negative() const {
+    for (float v : c)
+      if (v < 0) return true;
+    return false;
+  }
 };
 
-inline Spectrum operator+(Spectrum a, const Spectrum& b) { return a += b; }
-inline Spectrum operator-(Spectrum a, const Spectrum& b) {
-  for (int i = 0; i < Spectrum::kChannels; ++i) a[i] -= b[i];
+template <int N> Channels<N> operator+(Channels<N> a, const Channels<N>& b) { return a += b; }
+template <int N> Channels<N> operator-(Channels<N> a, const Channels<N>& b) { return a -= b; }
+template <int N> Channels<N> operator*(Channels<N> a, const Channels<N>& b) { return a *= b; }
+template <int N> Channels<N> operator*(Channels<N> a, float s) { return a *= s; }
+template <int N> Channels<N> operator*(float s, Channels<N> a) { return a *= s; }
+template <int N> Channels<N> operator/(Channels<N> a, float s) { return a /= s; }
+// Element-wise quotient; 0 where the divisor is 0.
+template <int N>
+Channels<N> operator/(Channels<N> a, const Channels<N>& b) {
+  for (int i = 0; i < N; ++i) a[i] = b[i] != 0 ? a[i] / b[i] : 0;
   return a;
 }
-inline Spectrum operator*(Spectrum a, const Spectrum& b) { return a *= b; }
-inline Spectrum operator*(Spectrum a, float s) { return a *= s; }
-inline Spectrum operator*(float s, Spectrum a) { return a *= s; }
-inline Spectrum operator/(Spectrum a, float s) { return a /= s; }
-inline Spectrum operator/(Spectrum a, const Spectrum& b) {
-  for (int i = 0; i < Spectrum::kChannels; ++i) a[i] = b[i] != 0 ? a[i] / b[i] : 0;
-  return a;
-}
-inline Spectrum sqrt(Spectrum a) {
+template <int N>
+Channels<N> sqrt(Channels<N> a) {
   for (float& v : a.c) v = std::sqrt(v);
   return a;
 }
+
+// Linear sRGB: images, and the colours a scene file states.
+using Rgb = Channels<3>;
+// Values at the wavelengths a path samples (Wavelengths in base/color.h); four, as pbrt-v4.
+using Spectrum = Channels<4>;
 
 }  // namespace bpm

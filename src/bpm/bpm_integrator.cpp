@@ -142,7 +142,6 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
   const uint64_t photons_per_batch = uint64_t(s.photons_per_batch);
   const int chunks_per_batch = int((photons_per_batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   std::vector<Chunk> chunks(chunks_per_batch);
-  LightPassParams lp{opt.max_depth, s.normal_cos};
 
   RenderControl control(opt, *film, "iteration");
   std::vector<uint8_t> sampled(n_pixels, 0);
@@ -151,7 +150,10 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     // ---- 1. eye pass, block by block, each slot over its mask ----
     auto t_stage = Clock::now();
     float scale = radius_scale(s, it);
-    EyePassParams ep{s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale};
+    // One set of wavelengths for every eye and light path of the iteration.
+    const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
+    EyePassParams ep{&wm, s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale};
+    LightPassParams lp{&wm, opt.max_depth, s.normal_cos};
     const int slots = masks.slots();
     tbb::parallel_for(tbb::blocked_range<int>(0, masks.block_count() * slots, 1), [&](const tbb::blocked_range<int>& r) {
       ObjectPhotonLists& lists = thread_lists.local();
@@ -273,11 +275,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
         for (int x = 0; x < w; ++x) {
           size_t p = size_t(y) * w + x;
           if (!sampled[p]) continue;
-          Spectrum L = eye_L[p] + photon_L[p];
-          if (!L.is_finite() || L.has_negative()) L = Spectrum();
-          float m = L.max_component();
-          if (m > max_value) L *= max_value / m;
-          film->add_sample(x, y, L, weight[p]);
+          film->add_sample(x, y, film_rgb(eye_L[p] + photon_L[p], wm.wl, max_value), weight[p]);
           film->end_pass(x, y);
         }
     });

@@ -9,6 +9,7 @@ namespace bpm {
 
 Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray, uint32_t pixel, Rng& rng,
                         ObjectPhotonLists& out, EyeCounters& counters) {
+  const Wavelengths& wl = prm.materials->wl;
   Spectrum L, beta(1.0f);
   int diffuse = 0;      // diffuse vertices so far (j of DESIGN.md)
   int depth = 0;        // scattering events so far, as the path integrator counts them
@@ -27,10 +28,10 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
         if (!inf) continue;
         if (diffuse == 0) {
-          L += beta * inf->radiance;
+          L += beta * inf->radiance.sample(wl);
         } else if (after_diffuse_sample) {
           float p_l = scene.light_distribution.pmf(li) * kUniformSpherePdfSolidAngle;
-          L += beta * inf->radiance * power_heuristic(prev_pdf_bsdf, p_l);
+          L += beta * inf->radiance.sample(wl) * power_heuristic(prev_pdf_bsdf, p_l);
         }
       }
       break;
@@ -41,7 +42,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0 && (diffuse == 0 || after_diffuse_sample)) {
       const AreaLight& al = std::get<AreaLight>(scene.lights[light_index]);
-      Spectrum Le = area_light_radiance(al, sp.ng, wo);
+      Spectrum Le = area_light_radiance(al, sp.ng, wo, wl);
       if (!Le.is_black()) {
         if (diffuse == 0) {
           L += beta * Le;  // seen from the camera through specular vertices only
@@ -54,7 +55,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       }
     }
     int material_index = scene.objects[hit.object].material;
-    const Material& m = scene.materials[material_index];
+    const Material& m = prm.materials->materials[material_index];
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       ray = spawn_ray(sp, ray.d);
       ++counters.rays.bounce_rays;
@@ -70,7 +71,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       bool last = diffuse == prm.diffuse_depth + 1;
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
-      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, !last, rng, counters.rays);
+      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, !last, wl, rng, counters.rays);
       BackwardPhoton bp;
       bp.p = sp.p;
       bp.radius = length * (last ? prm.radius_per_length1 : prm.radius_per_length0);

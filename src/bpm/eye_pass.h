@@ -15,6 +15,7 @@
 namespace bpm {
 
 struct EyePassParams {
+  const WavelengthMaterials* materials = nullptr;  // this iteration's wavelengths
   int diffuse_depth = 1;
   int max_depth = 5;
   // Radius per unit of eye path length: k * sqrt(pixel solid angle) * radius_scale(iteration).

@@ -17,7 +17,7 @@ void gather_at_hit(const RenderScene& scene, const BackwardMaps& maps, const Lig
     const BackwardPhoton& bp = maps.photons[g];
     if (!bp.accepts_class(cls) || int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
-    Spectrum value = photon_contribution(scene.materials[bp.material], bp.ng, bp.ns, bp.wo, wi, flux);
+    Spectrum value = photon_contribution(prm.materials->materials[bp.material], bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     out[owner[bp.pixel]].push_back({g, value});
     ++counters.entries;
@@ -31,7 +31,7 @@ void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Ligh
                   LightCounters& counters) {
   // A backward photon adds at least one eye vertex; direct photons are never used (next-event
   // estimation counts direct light).
-  trace_light_path(scene, prm.max_depth, 1, rng, counters, [&](const PhotonHit& h) {
+  trace_light_path(scene, *prm.materials, prm.max_depth, 1, rng, counters, [&](const PhotonHit& h) {
     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
       gather_at_hit(scene, maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out, counters);
   });

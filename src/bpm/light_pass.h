@@ -20,6 +20,7 @@ struct PhotonEntry {
 };
 
 struct LightPassParams {
+  const WavelengthMaterials* materials = nullptr;  // this iteration's wavelengths
   int max_depth = 5;
   float normal_cos = 0.5f;
 };

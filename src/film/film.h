@@ -5,6 +5,7 @@
 #pragma once
 #include <vector>
 
+#include "base/color.h"
 #include "base/spectrum.h"
 
 namespace bpm {
@@ -12,11 +13,23 @@ namespace bpm {
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgb;  // width * height * 3, row-major from the top
-  Spectrum at(int x, int y) const {
+  Rgb at(int x, int y) const {
     size_t i = 3 * (size_t(y) * width + x);
-    return Spectrum(rgb[i], rgb[i + 1], rgb[i + 2]);
+    return Rgb(rgb[i], rgb[i + 1], rgb[i + 2]);
   }
 };
+
+// The colour a film records for a sample with radiance L at wavelengths wl: linear sRGB, with the
+// largest channel clamped to max_value (pbrt-v4's maxcomponentvalue). A non-finite or negative
+// spectral value (a numerical accident) gives black rather than poisoning the pixel. Colours may
+// have negative channels: a single sample's few wavelengths can lie outside the sRGB gamut.
+inline Rgb film_rgb(const Spectrum& L, const Wavelengths& wl, float max_value) {
+  if (!L.is_finite() || L.has_negative()) return Rgb();
+  Rgb c = spectrum_to_rgb(L, wl);
+  float m = c.max_component();
+  if (m > max_value) c *= max_value / m;
+  return c;
+}
 
 class Film {
  public:
@@ -26,7 +39,7 @@ class Film {
   int width() const { return width_; }
   int height() const { return height_; }
 
-  void add_sample(int x, int y, const Spectrum& L, float weight) {
+  void add_sample(int x, int y, const Rgb& L, float weight) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
     for (int c = 0; c < 3; ++c) p.sum_wl[c] += double(weight) * L[c];
     p.sum_w += weight;

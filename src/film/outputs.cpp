@@ -24,7 +24,7 @@ Image error_false_colour(const Film& film) {
   out.height = img.height;
   out.rgb.resize(img.rgb.size());
   for (size_t i = 0; i < rms.size(); ++i) {
-    Spectrum c(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]);
+    Rgb c(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]);
     float lum = c.luminance();
     float rel = lum > 1e-6f ? rms[i] / lum : (rms[i] > 0 ? 1.0f : 0.0f);
     float t = std::clamp(rel / 0.1f, 0.0f, 1.0f);

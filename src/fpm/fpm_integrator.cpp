@@ -48,6 +48,7 @@ struct PhotonMap {
 };
 
 struct EyeParams {
+  const WavelengthMaterials* materials;
   const FpmSettings* fpm;
   int max_depth;
   float normal_cos;
@@ -99,6 +100,7 @@ Spectrum estimate(const PhotonMap& map, const Material& m, const SurfacePoint& s
 // One eye path to its first diffuse vertex (and, with final gathering, one more).
 Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const PhotonMap& caustic,
                       const EyeParams& prm, Ray ray, Rng& rng, EyeCounters& c) {
+  const Wavelengths& wl = prm.materials->wl;
   Spectrum L, beta(1.0f);
   int depth = 0;
   float length = 0;
@@ -109,7 +111,7 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
     if (!scene.intersect(ray, &hit)) {
       if (!gathering)
         for (int li : scene.infinite_lights)
-          if (auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li])) L += beta * inf->radiance;
+          if (auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li])) L += beta * inf->radiance.sample(wl);
       break;
     }
     length += hit.t * bpm::length(ray.d);
@@ -117,8 +119,8 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0 && !gathering)
-      L += beta * area_light_radiance(std::get<AreaLight>(scene.lights[light_index]), sp.ng, wo);
-    const Material& m = scene.materials[scene.objects[hit.object].material];
+      L += beta * area_light_radiance(std::get<AreaLight>(scene.lights[light_index]), sp.ng, wo, wl);
+    const Material& m = prm.materials->of_object(scene, hit.object);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       ray = spawn_ray(sp, ray.d);
       ++c.rays.bounce_rays;
@@ -137,7 +139,7 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
-      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, false, rng, c.rays);
+      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, false, wl, rng, c.rays);
       L += beta * estimate(caustic, m, sp, wo, length * prm.radius_per_length0, depth, prm,
                            [](PhotonClass k) { return k == PhotonClass::kCaustic; }, c);
       if (!prm.fpm->final_gather) {
@@ -195,6 +197,8 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     const int it = opt.first_iteration + iter;  // the index random streams and radii follow
     // ---- 1. light pass: a forward photon at every diffuse hit ----
     auto t_stage = Clock::now();
+    // One set of wavelengths for every eye and light path of the iteration.
+    const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
     tbb::parallel_for(tbb::blocked_range<int>(0, n_chunks, 1), [&](const tbb::blocked_range<int>& r) {
       LightCounters& lc = light_counters.local();
       for (int c = r.begin(); c < r.end(); ++c) {
@@ -204,7 +208,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
         uint64_t first = uint64_t(c) * kPhotonsPerChunk, last = std::min(first + kPhotonsPerChunk, n_photons);
         for (uint64_t k = first; k < last; ++k) {
           Rng rng(stream_key(opt.seed ^ kPhotonStream, uint64_t(it), k, 2));
-          trace_light_path(scene, opt.max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
+          trace_light_path(scene, wm, opt.max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
             if (hit.bounces + min_eye_vertices > opt.max_depth) return;
             ForwardPhoton ph{hit.sp.p, hit.wi, hit.sp.ng, hit.flux, uint16_t(hit.bounces), hit.cls};
             ch.global.push_back(ph);
@@ -234,7 +238,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     // ---- 3. eye pass ----
     t_stage = Clock::now();
     float scale = radius_scale(s, it);
-    EyeParams ep{&fs_, opt.max_depth, s.normal_cos, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale,
+    EyeParams ep{&wm, &fs_, opt.max_depth, s.normal_cos, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale,
                  double(n_photons)};
     tbb::parallel_for(tbb::blocked_range2d<int>(0, h, 16, 0, w, 16), [&](const tbb::blocked_range2d<int>& r) {
       EyeCounters& ec = eye_counters.local();
@@ -245,10 +249,7 @@ RenderStats render_fpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
           FilterSample fsm = filter.sample({rng.uniform(), rng.uniform()});
           Ray ray = camera.generate_ray({x + 0.5f + fsm.offset.x, y + 0.5f + fsm.offset.y}, {rng.uniform(), rng.uniform()});
           Spectrum L = eye_radiance(scene, global, caustic, ep, ray, rng, ec);
-          if (!L.is_finite() || L.has_negative()) L = Spectrum();
-          float mx = L.max_component();
-          if (mx > max_value) L *= max_value / mx;
-          film->add_sample(x, y, L, fsm.weight);
+          film->add_sample(x, y, film_rgb(L, wm.wl, max_value), fsm.weight);
           film->end_pass(x, y);
         }
     });

@@ -80,14 +80,14 @@ SphereWorld sphere_world(const Sphere& s) {
 }  // namespace
 
 std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec2 u,
-                                             const SceneBoundsInfo& bounds) {
+                                             const SceneBoundsInfo& bounds, const Wavelengths& wl) {
   LightLiSample ls;
   if (auto* l = std::get_if<PointLight>(&light)) {
     Vec3 d = l->position - p_ref;
     float d2 = length_squared(d);
     if (d2 == 0) return std::nullopt;
     ls.wi = d / std::sqrt(d2);
-    ls.radiance = l->intensity / d2;
+    ls.radiance = l->intensity.sample(wl) / d2;
     ls.p_light = l->position;
     ls.pdf_solid_angle = 1;
     ls.is_delta = true;
@@ -100,7 +100,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
     ls.wi = d / std::sqrt(d2);
     float fall = spot_falloff(*l, l->frame.to_local(-ls.wi));
     if (fall == 0) return std::nullopt;
-    ls.radiance = l->intensity * (fall / d2);
+    ls.radiance = l->intensity.sample(wl) * (fall / d2);
     ls.p_light = l->position;
     ls.pdf_solid_angle = 1;
     ls.is_delta = true;
@@ -108,7 +108,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
   }
   if (auto* l = std::get_if<DistantLight>(&light)) {
     ls.wi = l->direction_to_light;
-    ls.radiance = l->radiance;
+    ls.radiance = l->radiance.sample(wl);
     ls.p_light = p_ref + ls.wi * (2 * bounds.radius);
     ls.pdf_solid_angle = 1;
     ls.is_delta = true;
@@ -117,7 +117,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
   }
   if (auto* l = std::get_if<UniformInfiniteLight>(&light)) {
     ls.wi = sample_uniform_sphere(u);
-    ls.radiance = l->radiance;
+    ls.radiance = l->radiance.sample(wl);
     ls.p_light = p_ref + ls.wi * (2 * bounds.radius);
     ls.pdf_solid_angle = kUniformSpherePdfSolidAngle;
     ls.is_infinite = true;
@@ -144,7 +144,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
       ls.wi = w;
       ls.p_light = sp.p;
       ls.n_light = sp.ng;
-      ls.radiance = area_light_radiance(l, sp.ng, -w);
+      ls.radiance = area_light_radiance(l, sp.ng, -w, wl);
       ls.pdf_solid_angle = uniform_cone_pdf_solid_angle(cos_max);
       if (ls.radiance.is_black()) return std::nullopt;
       return ls;
@@ -159,7 +159,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
   if (cos_l == 0) return std::nullopt;
   ls.p_light = as.p;
   ls.n_light = as.n;
-  ls.radiance = area_light_radiance(l, as.n, -ls.wi);
+  ls.radiance = area_light_radiance(l, as.n, -ls.wi, wl);
   ls.pdf_solid_angle = as.pdf_area * d2 / cos_l;
   if (ls.radiance.is_black()) return std::nullopt;
   return ls;
@@ -184,12 +184,12 @@ float light_pdf_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec3 wi, 
 }
 
 std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
-                                             const SceneBoundsInfo& bounds) {
+                                             const SceneBoundsInfo& bounds, const Wavelengths& wl) {
   LightLeSample s;
   if (auto* l = std::get_if<PointLight>(&light)) {
     s.origin = l->position;
     s.direction = sample_uniform_sphere(u_dir);
-    s.flux = l->intensity / kUniformSpherePdfSolidAngle;
+    s.flux = l->intensity.sample(wl) / kUniformSpherePdfSolidAngle;
     return s;
   }
   if (auto* l = std::get_if<SpotLight>(&light)) {
@@ -198,7 +198,7 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
     if (fall == 0) return std::nullopt;
     s.origin = l->position;
     s.direction = l->frame.to_world(w);
-    s.flux = l->intensity * (fall / uniform_cone_pdf_solid_angle(l->cos_falloff_end));
+    s.flux = l->intensity.sample(wl) * (fall / uniform_cone_pdf_solid_angle(l->cos_falloff_end));
     return s;
   }
   // Infinite lights emit through a disk of the scene's bounding radius, facing the direction of
@@ -212,13 +212,13 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
   if (auto* l = std::get_if<DistantLight>(&light)) {
     s.direction = -l->direction_to_light;
     s.origin = disk_origin(s.direction);
-    s.flux = l->radiance * disk_area;
+    s.flux = l->radiance.sample(wl) * disk_area;
     return s;
   }
   if (auto* l = std::get_if<UniformInfiniteLight>(&light)) {
     s.direction = sample_uniform_sphere(u_dir);
     s.origin = disk_origin(s.direction);
-    s.flux = l->radiance * (disk_area / kUniformSpherePdfSolidAngle);
+    s.flux = l->radiance.sample(wl) * (disk_area / kUniformSpherePdfSolidAngle);
     return s;
   }
   const AreaLight& l = std::get<AreaLight>(light);
@@ -241,19 +241,19 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
   s.direction = Frame::from_z(n).to_world(w_local);
   s.origin = as.p;
   s.n_light = as.n;
-  s.flux = l.radiance * (w_local.z / (as.pdf_area * pdf_dir));
+  s.flux = l.radiance.sample(wl) * (w_local.z / (as.pdf_area * pdf_dir));
   return s;
 }
 
-Spectrum light_power(const Light& light, const SceneBoundsInfo& bounds) {
-  if (auto* l = std::get_if<PointLight>(&light)) return l->intensity * (4 * kPi);
+Rgb light_power(const Light& light, const SceneBoundsInfo& bounds) {
+  if (auto* l = std::get_if<PointLight>(&light)) return l->intensity.rgb() * (4 * kPi);
   if (auto* l = std::get_if<SpotLight>(&light))
-    return l->intensity * (2 * kPi * ((1 - l->cos_falloff_start) + (l->cos_falloff_start - l->cos_falloff_end) / 2));
-  if (auto* l = std::get_if<DistantLight>(&light)) return l->radiance * (kPi * bounds.radius * bounds.radius);
+    return l->intensity.rgb() * (2 * kPi * ((1 - l->cos_falloff_start) + (l->cos_falloff_start - l->cos_falloff_end) / 2));
+  if (auto* l = std::get_if<DistantLight>(&light)) return l->radiance.rgb() * (kPi * bounds.radius * bounds.radius);
   if (auto* l = std::get_if<UniformInfiniteLight>(&light))
-    return l->radiance * (4 * kPi * kPi * bounds.radius * bounds.radius);
+    return l->radiance.rgb() * (4 * kPi * kPi * bounds.radius * bounds.radius);
   const AreaLight& l = std::get<AreaLight>(light);
-  return l.radiance * (kPi * (l.two_sided ? 2 : 1) * l.area);
+  return l.radiance.rgb() * (kPi * (l.two_sided ? 2 : 1) * l.area);
 }
 
 }  // namespace bpm

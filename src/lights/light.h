@@ -5,6 +5,7 @@
 #include <optional>
 #include <variant>
 
+#include "base/color.h"
 #include "base/spectrum.h"
 #include "base/vec.h"
 #include "scene/shapes.h"
@@ -13,7 +14,7 @@ namespace bpm {
 
 struct PointLight {
   Vec3 position;
-  Spectrum intensity;  // W/sr per channel
+  SpectrumCurve intensity;  // W/sr per nm
 };
 
 // pbrt-v4 spot light: full intensity inside cos_falloff_start, smoothstep to zero at
@@ -21,24 +22,24 @@ struct PointLight {
 struct SpotLight {
   Vec3 position;
   Frame frame;  // frame.n is the axis of the cone
-  Spectrum intensity;
+  SpectrumCurve intensity;
   float cos_falloff_start = 1, cos_falloff_end = 1;
 };
 
 struct DistantLight {
   Vec3 direction_to_light;  // unit
-  Spectrum radiance;        // irradiance on a surface facing the light
+  SpectrumCurve radiance;   // irradiance on a surface facing the light
 };
 
 struct UniformInfiniteLight {
-  Spectrum radiance;
+  SpectrumCurve radiance;
 };
 
 // Diffuse emission from one primitive of an object (a triangle, a full sphere or a disk).
 struct AreaLight {
   int object = 0;
   int primitive = 0;
-  Spectrum radiance;
+  SpectrumCurve radiance;
   bool two_sided = false;
   float area = 0;
 };
@@ -74,20 +75,21 @@ bool light_is_infinite(const Light& l);
 
 // The shape is needed only for area lights (pass the object's shape).
 std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec2 u,
-                                             const SceneBoundsInfo& bounds);
+                                             const SceneBoundsInfo& bounds, const Wavelengths& wl);
 // Solid-angle density of light_sample_li choosing direction wi that reaches the light at
 // p_light (area lights) or escapes (infinite lights).
 float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light);
 // Radiance leaving an area light with geometric normal n toward w.
-inline Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec3 w) {
+inline Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec3 w, const Wavelengths& wl) {
   if (!l.two_sided && dot(n, w) <= 0) return {};
-  return l.radiance;
+  return l.radiance.sample(wl);
 }
 // Samples an emitted photon; u_pos picks the point, u_dir the direction.
 std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
-                                             const SceneBoundsInfo& bounds);
-// Total emitted power (W per channel), used by the power light sampler.
-Spectrum light_power(const Light& l, const SceneBoundsInfo& bounds);
+                                             const SceneBoundsInfo& bounds, const Wavelengths& wl);
+// Total emitted power as a colour (the light's RGB times its geometric factor), used by the
+// power light sampler.
+Rgb light_power(const Light& l, const SceneBoundsInfo& bounds);
 
 // pbrt-v4's smoothstep falloff of spot lights.
 float spot_falloff(const SpotLight& l, Vec3 w_light_local);

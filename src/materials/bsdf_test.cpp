@@ -35,11 +35,21 @@ bool near_rel(double a, double b, double rel, double abs_tol = 0) {
   return std::fabs(a - b) <= rel * std::fmax(std::fabs(a), std::fabs(b)) + abs_tol;
 }
 
+// A spectrum at four wavelengths, for materials whose values differ per wavelength.
+Spectrum spec4(float a, float b, float c, float d) {
+  Spectrum s;
+  s[0] = a;
+  s[1] = b;
+  s[2] = c;
+  s[3] = d;
+  return s;
+}
+
 Material diffuse() { return DiffuseMaterial{Spectrum(0.5f)}; }
 Material rough_conductor(float ax, float ay) {
   ConductorMaterial c;
-  c.eta = Spectrum(0.2f, 0.45f, 1.5f);  // roughly gold
-  c.k = Spectrum(3.6f, 2.5f, 1.9f);
+  c.eta = spec4(0.2f, 0.45f, 0.9f, 1.5f);  // roughly gold
+  c.k = spec4(3.6f, 2.5f, 2.2f, 1.9f);
   c.roughness = Roughness{ax, ay};
   return c;
 }
@@ -61,7 +71,7 @@ Material diffuse_transmission() {
   return m;
 }
 
-Material phong() { return PhongMaterial{Spectrum(0.8f, 0.6f, 0.4f), 12}; }
+Material phong() { return PhongMaterial{spec4(0.8f, 0.6f, 0.5f, 0.4f), 12}; }
 bool is_phong(const Material& m) { return std::holds_alternative<PhongMaterial>(m); }
 bool is_dielectric(const Material& m) { return std::holds_alternative<DielectricMaterial>(m); }
 
@@ -523,7 +533,7 @@ TEST(Fresnel, ComplexWithZeroAbsorptionIsDielectric) {
 }
 
 TEST(Fresnel, ComplexNormalIncidence) {
-  Spectrum eta(0.2f, 0.45f, 1.5f), k(3.6f, 2.5f, 1.9f);
+  Spectrum eta = spec4(0.2f, 0.45f, 0.9f, 1.5f), k = spec4(3.6f, 2.5f, 2.2f, 1.9f);
   Spectrum f = fresnel_complex(1, eta, k);
   for (int ch = 0; ch < Spectrum::kChannels; ++ch) {
     double n = eta[ch], kk = k[ch];
@@ -607,8 +617,8 @@ TEST(SmoothDielectric, LobeProbabilitiesAreFresnel) {
 
 TEST(SmoothConductor, MirrorReflection) {
   ConductorMaterial c;
-  c.eta = Spectrum(0.2f, 0.45f, 1.5f);
-  c.k = Spectrum(3.6f, 2.5f, 1.9f);
+  c.eta = spec4(0.2f, 0.45f, 0.9f, 1.5f);
+  c.k = spec4(3.6f, 2.5f, 2.2f, 1.9f);
   Material m = c;
   EXPECT_TRUE(bsdf_is_specular(m));
   EXPECT_FALSE(bsdf_is_specular(rough_conductor(0.3f, 0.3f)));

@@ -8,6 +8,7 @@
 #include <optional>
 #include <variant>
 
+#include "base/color.h"
 #include "base/spectrum.h"
 #include "base/vec.h"
 
@@ -63,6 +64,30 @@ struct InterfaceMaterial {};
 using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMaterial,
                               ThinDielectricMaterial, DiffuseTransmissionMaterial, PhongMaterial,
                               InterfaceMaterial>;
+
+// The scene's description of a material, with its colours as spectral curves. resolve_material
+// evaluates it at a path's wavelengths into the Material the BSDF functions take. The alternatives
+// are in the same order as Material's.
+struct DiffuseDesc {
+  SpectrumCurve reflectance{0.5f};
+};
+struct ConductorDesc {
+  SpectrumCurve eta, k;
+  // pbrt-v4's "reflectance" form: eta = 1 and k from the reflectance at each wavelength.
+  std::optional<SpectrumCurve> reflectance;
+  Roughness roughness;
+};
+struct DiffuseTransmissionDesc {
+  SpectrumCurve reflectance{0.25f}, transmittance{0.25f};
+};
+struct PhongDesc {
+  SpectrumCurve reflectance{0.5f};
+  float exponent = 20;
+};
+using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
+                                  DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial>;
+
+Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl);
 
 enum BsdfFlags : unsigned {
   kReflection = 1,

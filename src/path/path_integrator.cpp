@@ -7,14 +7,14 @@
 namespace bpm {
 
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, const Material& m, const Frame& frame,
-                             Vec3 wo_local, bool use_mis, Rng& rng, PathCounters& counters) {
+                             Vec3 wo_local, bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters) {
   if (scene.lights.empty()) return {};
   float pmf;
   float ul = rng.uniform();
   int li = scene.light_distribution.sample(ul, &pmf);
   const Light& light = scene.lights[li];
   Vec2 u{rng.uniform(), rng.uniform()};
-  auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info);
+  auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info, wl);
   if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
   Vec3 wi_local = frame.to_local(ls->wi);
   Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
@@ -36,8 +36,8 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, c
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
 }
 
-Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, Rng& rng,
-                       PathCounters& counters) {
+Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, const Wavelengths& wl,
+                       Rng& rng, PathCounters& counters) {
   Spectrum L, beta(1.0f);
   bool specular_bounce = false;
   float eta_scale = 1;
@@ -53,10 +53,10 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
         if (!inf) continue;
         if (depth == 0 || specular_bounce) {
-          L += beta * inf->radiance;
+          L += beta * inf->radiance.sample(wl);
         } else {
           float p_l = scene.light_distribution.pmf(li) * kUniformSpherePdfSolidAngle;
-          L += beta * inf->radiance * power_heuristic(prev_pdf_bsdf, p_l);
+          L += beta * inf->radiance.sample(wl) * power_heuristic(prev_pdf_bsdf, p_l);
         }
       }
       break;
@@ -66,7 +66,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0) {
       const AreaLight& al = std::get<AreaLight>(scene.lights[light_index]);
-      Spectrum Le = area_light_radiance(al, sp.ng, wo);
+      Spectrum Le = area_light_radiance(al, sp.ng, wo, wl);
       if (!Le.is_black()) {
         if (depth == 0 || specular_bounce) {
           L += beta * Le;
@@ -78,7 +78,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
         }
       }
     }
-    const Material& m = scene.materials[scene.objects[hit.object].material];
+    const Material m = resolve_material(scene.materials[scene.objects[hit.object].material], wl);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       // A boundary that does not scatter: continue the same ray past it.
       ray = spawn_ray(sp, ray.d);
@@ -89,7 +89,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     Frame frame = Frame::from_z(sp.ns);
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
-    if (!bsdf_is_specular(m)) L += beta * sample_direct_light(scene, sp, m, frame, wo_local, true, rng, counters);
+    if (!bsdf_is_specular(m)) L += beta * sample_direct_light(scene, sp, m, frame, wo_local, true, wl, rng, counters);
 
     float uc = rng.uniform();
     Vec2 u{rng.uniform(), rng.uniform()};

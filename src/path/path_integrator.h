@@ -35,10 +35,10 @@ struct PathSettings {
 // 9.2.4), with the power heuristic against BSDF sampling when use_mis (the caller then weights
 // the emitters its BSDF samples hit), else with full weight.
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, const Material& m, const Frame& frame,
-                             Vec3 wo_local, bool use_mis, Rng& rng, PathCounters& counters);
+                             Vec3 wo_local, bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters);
 
-// Radiance arriving along -ray.d at the ray's origin.
-Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, Rng& rng,
-                       PathCounters& counters);
+// Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl.
+Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, const Wavelengths& wl,
+                       Rng& rng, PathCounters& counters);
 
 }  // namespace bpm

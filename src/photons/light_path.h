@@ -17,6 +17,13 @@ namespace bpm {
 // a fixed order, so that sums do not depend on the thread count.
 constexpr int kPhotonsPerChunk = 1024;
 
+// The wavelengths of iteration `it` of a photon method: drawn afresh each iteration, independently
+// of everything else, so that iterations stay independent estimates (the error estimate needs it).
+inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
+  Rng rng(stream_key(seed ^ 0x7761766573ull, uint64_t(it), 0, 3));
+  return sample_wavelengths(rng.uniform());
+}
+
 // How a photon arrived: straight from the light, through specular vertices only, or after at
 // least one diffuse vertex.
 enum class PhotonClass : uint8_t { kDirect, kCaustic, kIndirect };
@@ -48,19 +55,19 @@ struct PhotonHit {
   int bounces;
 };
 
-// Traces one photon; calls on_hit(const PhotonHit&) at each diffuse surface. The path stops
+// Traces one photon at the wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface. The path stops
 // once a further bounce could not make a path of at most max_depth scattering events with the
 // `min_eye_vertices` the estimator adds on the camera side.
 template <class OnHit>
-void trace_light_path(const RenderScene& scene, int max_depth, int min_eye_vertices, Rng& rng,
-                      LightCounters& counters, OnHit&& on_hit) {
+void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth, int min_eye_vertices,
+                      Rng& rng, LightCounters& counters, OnHit&& on_hit) {
   ++counters.photons;
   if (scene.lights.empty() || max_depth < min_eye_vertices) return;
   float pmf;
   int li = scene.light_distribution.sample(rng.uniform(), &pmf);
   const Light& light = scene.lights[li];
   Vec2 u_pos{rng.uniform(), rng.uniform()}, u_dir{rng.uniform(), rng.uniform()};
-  auto le = light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info);
+  auto le = light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info, wm.wl);
   if (!le || le->flux.is_black() || pmf == 0) return;
   Spectrum beta = le->flux / pmf;
   bool has_surface = length_squared(le->n_light) > 0;
@@ -73,7 +80,7 @@ void trace_light_path(const RenderScene& scene, int max_depth, int min_eye_verti
     if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) break;
     SurfacePoint sp = scene.surface(ray, hit);
-    const Material& m = scene.materials[scene.objects[hit.object].material];
+    const Material& m = wm.of_object(scene, hit.object);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       ray = spawn_ray(sp, ray.d);
       ++counters.light_rays;

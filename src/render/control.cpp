@@ -51,7 +51,7 @@ void RenderControl::update_probabilities() {
   std::vector<double> lum(n);
   double image_mean = 0;
   for (size_t i = 0; i < n; ++i) {
-    lum[i] = Spectrum(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]).luminance();
+    lum[i] = Rgb(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]).luminance();
     image_mean += lum[i] / double(n);
   }
   std::vector<float> rel(n);

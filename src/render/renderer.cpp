@@ -67,11 +67,9 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
           Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
           Vec2 u_lens{rng.uniform(), rng.uniform()};
           Ray ray = camera.generate_ray(p_film, u_lens);
-          Spectrum L = path_radiance(ls.scene, ray, ps, rng, c);
-          if (!L.is_finite() || L.has_negative()) L = Spectrum();  // never let one sample poison a pixel
-          float m = L.max_component();
-          if (m > max_value) L *= max_value / m;
-          film->add_sample(x, y, L, fs.weight);
+          Wavelengths wl = sample_wavelengths(rng.uniform());
+          Spectrum L = path_radiance(ls.scene, ray, ps, wl, rng, c);
+          film->add_sample(x, y, film_rgb(L, wl, max_value), fs.weight);
           film->end_pass(x, y);
         }
     });

@@ -28,7 +28,7 @@ class Flattener {
     read_filter(&out);
     read_sampler_and_integrator(&out);
     // Default material (pbrt-v4: diffuse, reflectance 0.5) is material 0.
-    scene().materials.push_back(DiffuseMaterial{});
+    scene().materials.push_back(DiffuseDesc{});
     for (const ShapeEntity& s : parsed_.shapes) add_shape(s, &out.scene);
     for (const LightEntity& l : parsed_.lights) add_light(l, &out.scene);
     out.scene.commit();
@@ -185,7 +185,7 @@ class Flattener {
   }
 
   // ---- materials ----
-  std::optional<Spectrum> spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
+  std::optional<SpectrumCurve> spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
     const Param* p = ps.find_any(name);
     if (p && p->type == "texture") {
       p->used = true;
@@ -198,10 +198,10 @@ class Flattener {
         float v = t.params.get_float("value", 1);
         if (v < 0 || (kind == SpectrumKind::kAlbedo && v > 1))
           throw Error(t.loc, "constant texture \"" + t.texture_name + "\" used as a reflectance must lie in [0, 1]");
-        return Spectrum(v);
+        return SpectrumCurve(v);
       }
       auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
-      return v ? *v : Spectrum(1.0f);
+      return v ? *v : SpectrumCurve(1.0f);
     }
     return get_spectrum(ps, name, kind, parsed_.base_directory);
   }
@@ -230,28 +230,23 @@ class Flattener {
     return Roughness{u, v};
   }
 
-  Material make_material(const SceneEntity& e) {
+  MaterialDesc make_material(const SceneEntity& e) {
     const ParamSet& ps = e.params;
     for (const char* unsupported : {"displacement", "normalmap"})
       if (auto* p = ps.find_any(unsupported)) throw Error(p->loc, std::string(unsupported) + " is not supported");
-    Material m;
+    MaterialDesc m;
     if (e.name == "diffuse") {
-      DiffuseMaterial d;
+      DiffuseDesc d;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
       m = d;
     } else if (e.name == "conductor") {
-      ConductorMaterial c;
+      ConductorDesc c;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) {
-        // pbrt-v4: a reflectance is turned into k with eta = 1.
-        c.eta = Spectrum(1.0f);
-        for (int i = 0; i < 3; ++i) {
-          float rr = std::clamp((*r)[i], 0.0f, 0.9999f);
-          c.k[i] = 2 * std::sqrt(rr) / std::sqrt(1 - rr);
-        }
+        c.reflectance = *r;
         if (ps.find_any("eta") || ps.find_any("k")) throw Error(e.loc, "conductor has both reflectance and eta/k");
       } else {
-        c.eta = spectrum_param(ps, "eta", SpectrumKind::kUnbounded).value_or(*named_spectrum_rgb("metal-Cu-eta", SpectrumKind::kUnbounded));
-        c.k = spectrum_param(ps, "k", SpectrumKind::kUnbounded).value_or(*named_spectrum_rgb("metal-Cu-k", SpectrumKind::kUnbounded));
+        c.eta = spectrum_param(ps, "eta", SpectrumKind::kUnbounded).value_or(*named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
+        c.k = spectrum_param(ps, "k", SpectrumKind::kUnbounded).value_or(*named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
       }
       c.roughness = roughness(ps, e.loc);
       m = c;
@@ -261,27 +256,27 @@ class Flattener {
       if (p && p->type == "float") {
         eta = ps.get_float("eta", 1.5f);
       } else if (p) {
-        Spectrum s = *spectrum_param(ps, "eta", SpectrumKind::kUnbounded);
-        if (s.max_component() - s.min_component() > 1e-4f)
-          warning(p->loc, "a wavelength-dependent eta is reduced to its green value (no dispersion)");
-        eta = s[1];
+        SpectrumCurve s = *spectrum_param(ps, "eta", SpectrumKind::kUnbounded);
+        if (s.max_value() - s.min_value() > 1e-4f)
+          warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
+        eta = s.value(550);
       }
       if (!(eta > 0)) throw Error(p ? p->loc : e.loc, "eta must be positive");
       if (e.name == "dielectric") m = DielectricMaterial{eta, roughness(ps, e.loc)};
       else m = ThinDielectricMaterial{eta};
     } else if (e.name == "diffusetransmission") {
-      DiffuseTransmissionMaterial d;
+      DiffuseTransmissionDesc d;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
       if (auto t = spectrum_param(ps, "transmittance", SpectrumKind::kAlbedo)) d.transmittance = *t;
       float s = ps.get_float("scale", 1);
-      d.reflectance *= s;
-      d.transmittance *= s;
-      if ((d.reflectance + d.transmittance).max_component() > 1.0001f)
+      d.reflectance = d.reflectance.scaled(s);
+      d.transmittance = d.transmittance.scaled(s);
+      if ((d.reflectance.rgb() + d.transmittance.rgb()).max_component() > 1.0001f)
         throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
       m = d;
     } else if (e.name == "phong") {
       // bpm's own non-reciprocal glossy lobe (material.h); pbrt-v4 does not know it.
-      PhongMaterial ph;
+      PhongDesc ph;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) ph.reflectance = *r;
       if (const Param* p = ps.find_any("exponent")) {
         ph.exponent = ps.get_float("exponent", 20);
@@ -431,7 +426,7 @@ class Flattener {
     if (a.name != "diffuse") throw Error(a.loc, "area light \"" + a.name + "\" is not supported");
     const ParamSet& ps = a.params;
     if (auto* f = ps.find_any("filename")) throw Error(f->loc, "image area lights are not supported");
-    Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+    SpectrumCurve L = light_spectrum(ps, "L");
     float scale = ps.get_float("scale", 1);
     if (scale < 0) throw Error(ps.find_any("scale")->loc, "area light scale must not be negative");
     bool two_sided = ps.get_bool("twosided", false);
@@ -455,23 +450,29 @@ class Flattener {
       float s = scale;
       // pbrt-v4 applies "power" to each shape it creates, i.e. to each triangle of a mesh.
       if (power > 0 && l.area > 0) s *= power / (kPi * (two_sided ? 2 : 1) * l.area);
-      l.radiance = L * s;
+      l.radiance = L.scaled(s);
       rs->lights.push_back(l);
     }
   }
 
   // ---- light sources ----
+  // A light's spectrum; D65 at unit luminance when absent (pbrt-v4's colour-space illuminant).
+  SpectrumCurve light_spectrum(const ParamSet& ps, const std::string& name) {
+    return get_spectrum(ps, name, SpectrumKind::kIlluminant, parsed_.base_directory)
+        .value_or(SpectrumCurve::from_rgb(Rgb(1.0f), SpectrumKind::kIlluminant));
+  }
+
   void add_light(const LightEntity& e, RenderScene* rs) {
     const ParamSet& ps = e.params;
     const Transform& xf = e.world_from_light;
     float scale = ps.get_float("scale", 1);
     if (e.name == "point") {
-      Spectrum I = get_spectrum(ps, "I", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      SpectrumCurve I = light_spectrum(ps, "I");
       float power = ps.get_float("power", -1);
       if (power > 0) scale *= power / (4 * kPi);
-      rs->lights.push_back(PointLight{xf.point(ps.get_point3("from", Vec3(0, 0, 0))), I * scale});
+      rs->lights.push_back(PointLight{xf.point(ps.get_point3("from", Vec3(0, 0, 0))), I.scaled(scale)});
     } else if (e.name == "spot") {
-      Spectrum I = get_spectrum(ps, "I", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      SpectrumCurve I = light_spectrum(ps, "I");
       Vec3 from = ps.get_point3("from", Vec3(0, 0, 0)), to = ps.get_point3("to", Vec3(0, 0, 1));
       if (length(to - from) == 0) throw Error(e.loc, "spot light with from == to");
       float cone = ps.get_float("coneangle", 30), delta = ps.get_float("conedelta", 5);
@@ -483,22 +484,22 @@ class Flattener {
       float power = ps.get_float("power", -1);
       if (power > 0)
         scale *= power / (2 * kPi * ((1 - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2));
-      l.intensity = I * scale;
+      l.intensity = I.scaled(scale);
       rs->lights.push_back(l);
     } else if (e.name == "distant") {
-      Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      SpectrumCurve L = light_spectrum(ps, "L");
       Vec3 from = ps.get_point3("from", Vec3(0, 0, 0)), to = ps.get_point3("to", Vec3(0, 0, 1));
       if (length(to - from) == 0) throw Error(e.loc, "distant light with from == to");
       float E = ps.get_float("illuminance", -1);
       if (E > 0) scale *= E;
-      rs->lights.push_back(DistantLight{normalize(xf.vector(from - to)), L * scale});
+      rs->lights.push_back(DistantLight{normalize(xf.vector(from - to)), L.scaled(scale)});
     } else if (e.name == "infinite") {
       if (auto* f = ps.find_any("filename")) throw Error(f->loc, "environment map lights are not supported");
       if (auto* p = ps.find_any("portal")) throw Error(p->loc, "light portals are not supported");
-      Spectrum L = get_spectrum(ps, "L", SpectrumKind::kIlluminant, parsed_.base_directory).value_or(Spectrum(1.0f));
+      SpectrumCurve L = light_spectrum(ps, "L");
       float E = ps.get_float("illuminance", -1);
       if (E > 0) scale *= E / kPi;
-      rs->lights.push_back(UniformInfiniteLight{L * scale});
+      rs->lights.push_back(UniformInfiniteLight{L.scaled(scale)});
     } else {
       throw Error(e.loc, "light \"" + e.name + "\" is not supported");
     }

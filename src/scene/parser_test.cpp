@@ -83,8 +83,13 @@ void expect_vec_near(Vec3 a, Vec3 b, float eps = 1e-5f) {
   EXPECT_NEAR(a.z, b.z, eps);
 }
 
-void expect_spectrum_near(const Spectrum& a, const Spectrum& b, float eps = 1e-5f) {
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(a[i], b[i], eps) << "channel " << i;
+// A spectral curve's colour against the colour the file gave (the sigmoid fit reproduces it).
+void expect_spectrum_near(const SpectrumCurve& a, const Rgb& b, float eps = 1e-4f) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(a.rgb()[i], b[i], eps) << "channel " << i;
+}
+// Two curves, wavelength by wavelength.
+void expect_spectrum_near(const SpectrumCurve& a, const SpectrumCurve& b, float eps = 1e-5f) {
+  for (float l = kLambdaMin; l <= kLambdaMax; l += 10) EXPECT_NEAR(a.value(l), b.value(l), eps) << l << " nm";
 }
 
 Vec3 origin_of(const Transform& t) { return t.point(Vec3(0, 0, 0)); }
@@ -171,8 +176,8 @@ TEST(SceneParse, MinimalSceneFlattens) {
   LoadedScene ls = flatten_scene(p);
   EXPECT_TRUE(ls.scene.objects.empty());
   ASSERT_EQ(ls.scene.materials.size(), 1u);  // the default material
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(ls.scene.materials[0]));
-  expect_spectrum_near(std::get<DiffuseMaterial>(ls.scene.materials[0]).reflectance, Spectrum(0.5f));
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(ls.scene.materials[0]));
+  expect_spectrum_near(std::get<DiffuseDesc>(ls.scene.materials[0]).reflectance, Rgb(0.5f));
   EXPECT_EQ(ls.render.integrator, "path");
   EXPECT_EQ(ls.film.width, 1280);
   EXPECT_EQ(ls.film.height, 720);
@@ -322,7 +327,7 @@ TEST(SceneParse, AttributeBeginEndRestoresTransformAndMaterial) {
   EXPECT_EQ(p.shapes[1].material.index, -1);
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 2u);
-  EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(ls.scene.materials[ls.scene.objects[0].material]));
+  EXPECT_TRUE(std::holds_alternative<ConductorDesc>(ls.scene.materials[ls.scene.objects[0].material]));
   EXPECT_EQ(ls.scene.objects[1].material, 0);  // the default diffuse material
 }
 
@@ -466,10 +471,10 @@ TEST(SceneParse, MaterialAppliesToFollowingShapes) {
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 3u);
   EXPECT_EQ(ls.scene.objects[0].material, ls.scene.objects[1].material);  // shared, not duplicated
-  const Material& m0 = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m0));
-  expect_spectrum_near(std::get<DiffuseMaterial>(m0).reflectance, Spectrum(0.1f, 0.2f, 0.3f));
-  const Material& m2 = ls.scene.materials[ls.scene.objects[2].material];
+  const MaterialDesc& m0 = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m0));
+  expect_spectrum_near(std::get<DiffuseDesc>(m0).reflectance, Rgb(0.1f, 0.2f, 0.3f));
+  const MaterialDesc& m2 = ls.scene.materials[ls.scene.objects[2].material];
   ASSERT_TRUE(std::holds_alternative<DielectricMaterial>(m2));
   EXPECT_FLOAT_EQ(std::get<DielectricMaterial>(m2).eta, 1.33f);
 }
@@ -487,11 +492,11 @@ TEST(SceneParse, NamedMaterialResolvesAtFlatten) {
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 2u);
   EXPECT_EQ(ls.scene.objects[0].material, ls.scene.objects[1].material);
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m));
-  const ConductorMaterial& c = std::get<ConductorMaterial>(m);
-  expect_spectrum_near(c.eta, *named_spectrum_rgb("metal-Au-eta", SpectrumKind::kUnbounded));
-  expect_spectrum_near(c.k, *named_spectrum_rgb("metal-Au-k", SpectrumKind::kUnbounded));
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m));
+  const ConductorDesc& c = std::get<ConductorDesc>(m);
+  expect_spectrum_near(c.eta, *named_spectrum("metal-Au-eta", SpectrumKind::kUnbounded));
+  expect_spectrum_near(c.k, *named_spectrum("metal-Au-k", SpectrumKind::kUnbounded));
   EXPECT_NEAR(c.roughness.alpha_x, 0.2f, 1e-6f);  // remapped: sqrt(0.04)
   EXPECT_NEAR(c.roughness.alpha_y, 0.2f, 1e-6f);
 }
@@ -501,17 +506,17 @@ TEST(SceneParse, NamedMaterialMayBeDefinedAfterUse) {
       "WorldBegin\nNamedMaterial \"glass\"\nShape \"sphere\"\n"
       "MakeNamedMaterial \"glass\" \"string type\" \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n"));
   ASSERT_EQ(ls.scene.objects.size(), 1u);
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<DielectricMaterial>(m));
   EXPECT_NEAR(std::get<DielectricMaterial>(m).eta, 1.5168f, 1e-5f);
 }
 
 TEST(SceneParse, ConductorDefaultsToCopper) {
   LoadedScene ls = flatten_scene(parse_scene_string("WorldBegin\nMaterial \"conductor\"\nShape \"sphere\"\n"));
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m));
-  expect_spectrum_near(std::get<ConductorMaterial>(m).eta, *named_spectrum_rgb("metal-Cu-eta", SpectrumKind::kUnbounded));
-  expect_spectrum_near(std::get<ConductorMaterial>(m).k, *named_spectrum_rgb("metal-Cu-k", SpectrumKind::kUnbounded));
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m));
+  expect_spectrum_near(std::get<ConductorDesc>(m).eta, *named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
+  expect_spectrum_near(std::get<ConductorDesc>(m).k, *named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
 }
 
 TEST(SceneParse, ConstantTextures) {
@@ -532,16 +537,16 @@ TEST(SceneParse, ConstantTextures) {
   EXPECT_EQ(p.textures[3].value_type, "spectrum");  // "color" is the old name
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 3u);
-  const Material& m0 = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m0));
-  expect_spectrum_near(std::get<DiffuseMaterial>(m0).reflectance, Spectrum(0.2f, 0.3f, 0.4f));
-  const Material& m1 = ls.scene.materials[ls.scene.objects[1].material];
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m1));
-  expect_spectrum_near(std::get<DiffuseMaterial>(m1).reflectance, Spectrum(0.7f));
-  const Material& m2 = ls.scene.materials[ls.scene.objects[2].material];
-  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m2));
-  EXPECT_FLOAT_EQ(std::get<ConductorMaterial>(m2).roughness.alpha_x, 0.25f);
-  EXPECT_FLOAT_EQ(std::get<ConductorMaterial>(m2).roughness.alpha_y, 0.25f);
+  const MaterialDesc& m0 = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m0));
+  expect_spectrum_near(std::get<DiffuseDesc>(m0).reflectance, Rgb(0.2f, 0.3f, 0.4f));
+  const MaterialDesc& m1 = ls.scene.materials[ls.scene.objects[1].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m1));
+  expect_spectrum_near(std::get<DiffuseDesc>(m1).reflectance, Rgb(0.7f));
+  const MaterialDesc& m2 = ls.scene.materials[ls.scene.objects[2].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m2));
+  EXPECT_FLOAT_EQ(std::get<ConductorDesc>(m2).roughness.alpha_x, 0.25f);
+  EXPECT_FLOAT_EQ(std::get<ConductorDesc>(m2).roughness.alpha_y, 0.25f);
 }
 
 TEST(SceneParse, PointLight) {
@@ -555,7 +560,7 @@ TEST(SceneParse, PointLight) {
   ASSERT_TRUE(std::holds_alternative<PointLight>(ls.scene.lights[0]));
   const PointLight& l = std::get<PointLight>(ls.scene.lights[0]);
   expect_vec_near(l.position, Vec3(2, 2, 3));
-  expect_spectrum_near(l.intensity, Spectrum(1, 2, 3));
+  expect_spectrum_near(l.intensity, Rgb(1, 2, 3));
 }
 
 TEST(SceneParse, DistantAndInfiniteLights) {
@@ -566,7 +571,7 @@ TEST(SceneParse, DistantAndInfiniteLights) {
   ASSERT_TRUE(std::holds_alternative<DistantLight>(ls.scene.lights[0]));
   expect_vec_near(std::get<DistantLight>(ls.scene.lights[0]).direction_to_light, Vec3(0, 1, 0));
   ASSERT_TRUE(std::holds_alternative<UniformInfiniteLight>(ls.scene.lights[1]));
-  expect_spectrum_near(std::get<UniformInfiniteLight>(ls.scene.lights[1]).radiance, Spectrum(0.2f, 0.4f, 0.6f));
+  expect_spectrum_near(std::get<UniformInfiniteLight>(ls.scene.lights[1]).radiance, Rgb(0.2f, 0.4f, 0.6f));
   ASSERT_EQ(ls.scene.infinite_lights.size(), 1u);
   EXPECT_EQ(ls.scene.infinite_lights[0], 1);
 }
@@ -605,7 +610,7 @@ TEST(SceneParse, AreaLightOnMesh) {
     EXPECT_EQ(a.primitive, i);
     EXPECT_TRUE(a.two_sided);
     EXPECT_NEAR(a.area, 0.5f, 1e-6f);
-    expect_spectrum_near(a.radiance, Spectrum(1, 2, 3));
+    expect_spectrum_near(a.radiance, Rgb(1, 2, 3));
   }
 }
 
@@ -615,7 +620,7 @@ TEST(SceneParse, AreaLightOnWholeSphere) {
   ASSERT_EQ(ls.scene.lights.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<AreaLight>(ls.scene.lights[0]));
   const AreaLight& a = std::get<AreaLight>(ls.scene.lights[0]);
-  expect_spectrum_near(a.radiance, Spectrum(2.0f));
+  expect_spectrum_near(a.radiance, Rgb(2.0f));
   EXPECT_FALSE(a.two_sided);
   EXPECT_NEAR(a.area, 4 * kPi * 4, 1e-3f);
 }
@@ -907,18 +912,18 @@ TEST(SceneParams, GetterMarksUsed) {
 TEST(SceneParams, RgbReflectance) {
   LoadedScene ls = flatten_scene(parse_scene_string(
       "WorldBegin\nMaterial \"diffuse\" \"color reflectance\" [0.25 0.5 0.75]\nShape \"sphere\"\n"));
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m));
-  expect_spectrum_near(std::get<DiffuseMaterial>(m).reflectance, Spectrum(0.25f, 0.5f, 0.75f));
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m));
+  expect_spectrum_near(std::get<DiffuseDesc>(m).reflectance, Rgb(0.25f, 0.5f, 0.75f));
 }
 
 TEST(SceneParams, InlineSpectrumReflectance) {
   // Constant over the whole visible range: a grey reflectance of that value.
   LoadedScene ls = flatten_scene(parse_scene_string(
       "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" [360 0.5 830 0.5]\nShape \"sphere\"\n"));
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m));
-  expect_spectrum_near(std::get<DiffuseMaterial>(m).reflectance, Spectrum(0.5f), 1e-4f);
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m));
+  expect_spectrum_near(std::get<DiffuseDesc>(m).reflectance, Rgb(0.5f), 1e-4f);
 }
 
 TEST(SceneParams, SpectrumFile) {
@@ -926,19 +931,25 @@ TEST(SceneParams, SpectrumFile) {
   dir.write("grey.spd", "# wavelength value\n360 0.25\n600 0.25 # middle\n830 0.25\n");
   LoadedScene ls = flatten_scene(parse_scene_string(
       "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"grey.spd\"\nShape \"sphere\"\n", dir.str()));
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<DiffuseMaterial>(m));
-  expect_spectrum_near(std::get<DiffuseMaterial>(m).reflectance, Spectrum(0.25f), 1e-4f);
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m));
+  expect_spectrum_near(std::get<DiffuseDesc>(m).reflectance, Rgb(0.25f), 1e-4f);
 }
 
 TEST(SceneParams, NamedSpectrumEta) {
   LoadedScene ls = flatten_scene(parse_scene_string(
       "WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-Ag-eta\" \"spectrum k\" \"metal-Ag-k\"\n"
       "Shape \"sphere\"\n"));
-  const Material& m = ls.scene.materials[ls.scene.objects[0].material];
-  ASSERT_TRUE(std::holds_alternative<ConductorMaterial>(m));
-  expect_spectrum_near(std::get<ConductorMaterial>(m).eta, Spectrum(0.155265f, 0.116723f, 0.138342f));
-  expect_spectrum_near(std::get<ConductorMaterial>(m).k, Spectrum(4.828181f, 3.122249f, 2.146961f));
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m));
+  // Through the measured values at 650, 550 and 450 nm.
+  const ConductorDesc& c = std::get<ConductorDesc>(m);
+  EXPECT_NEAR(c.eta.value(650), 0.155265f, 1e-5f);
+  EXPECT_NEAR(c.eta.value(550), 0.116723f, 1e-5f);
+  EXPECT_NEAR(c.eta.value(450), 0.138342f, 1e-5f);
+  EXPECT_NEAR(c.k.value(650), 4.828181f, 1e-5f);
+  EXPECT_NEAR(c.k.value(450), 2.146961f, 1e-5f);
+  EXPECT_NEAR(c.eta.value(600), 0.5f * (0.155265f + 0.116723f), 1e-5f);  // linear between
 }
 
 TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
@@ -947,11 +958,12 @@ TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
       "\"float scale\" 2\n"));
   ASSERT_EQ(ls.scene.lights.size(), 2u);
   const PointLight& a = std::get<PointLight>(ls.scene.lights[0]);
-  expect_spectrum_near(a.intensity, blackbody_rgb(6500));
-  EXPECT_NEAR(a.intensity.luminance(), 1.0f, 2e-3f);
+  SpectrumCurve bb = SpectrumCurve::blackbody(6500);
+  expect_spectrum_near(a.intensity, bb.scaled(1 / bb.luminance()));
+  EXPECT_NEAR(a.intensity.luminance(), 1.0f, 1e-4f);
   const PointLight& b = std::get<PointLight>(ls.scene.lights[1]);
-  EXPECT_NEAR(b.intensity.luminance(), 2.0f, 4e-3f);
-  EXPECT_GT(b.intensity[0], b.intensity[2]);  // 3000 K is reddish
+  EXPECT_NEAR(b.intensity.luminance(), 2.0f, 2e-4f);
+  EXPECT_GT(b.intensity.rgb()[0], b.intensity.rgb()[2]);  // 3000 K is reddish
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -43,7 +43,7 @@ class RenderScene {
   RenderScene& operator=(RenderScene&&) noexcept;
 
   std::vector<Object> objects;
-  std::vector<Material> materials;
+  std::vector<MaterialDesc> materials;
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
   Distribution1D light_distribution;  // in proportion to power
@@ -74,6 +74,20 @@ class RenderScene {
 
  private:
   std::unique_ptr<Accel> accel_;
+};
+
+// The scene's materials evaluated at one set of wavelengths. The photon methods use one set for
+// every path of an iteration, so that eye and light paths meet at the same wavelengths.
+struct WavelengthMaterials {
+  Wavelengths wl;
+  std::vector<Material> materials;
+  WavelengthMaterials(const RenderScene& scene, const Wavelengths& wavelengths) : wl(wavelengths) {
+    materials.reserve(scene.materials.size());
+    for (const MaterialDesc& d : scene.materials) materials.push_back(resolve_material(d, wl));
+  }
+  const Material& of_object(const RenderScene& scene, int object) const {
+    return materials[scene.objects[object].material];
+  }
 };
 
 // Offsets a ray origin off the surface at p (normal n) toward direction w, to avoid

@@ -7,139 +7,65 @@
 #include <sstream>
 
 namespace bpm {
-namespace {
 
-// CIE 1931 colour matching functions, multi-lobe Gaussian fit of Wyman, Sloan and Shirley,
-// "Simple Analytic Approximations to the CIE XYZ Color Matching Functions", JCGT 2013.
-double lobe(double l, double mu, double s1, double s2) {
-  double t = (l - mu) / (l < mu ? s1 : s2);
-  return std::exp(-0.5 * t * t);
-}
-double cie_x(double l) {
-  return 1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) -
-         0.065 * lobe(l, 501.1, 20.4, 26.2);
-}
-double cie_y(double l) { return 0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1); }
-double cie_z(double l) { return 1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8); }
-
-// XYZ to linear sRGB (D65 white).
-Spectrum xyz_to_srgb(double x, double y, double z) {
-  return Spectrum(float(3.2404542 * x - 1.5371385 * y - 0.4985314 * z),
-                  float(-0.9692660 * x + 1.8760108 * y + 0.0415560 * z),
-                  float(0.0556434 * x - 0.2040259 * y + 1.0572252 * z));
-}
-
-template <typename F>
-void integrate_xyz(F&& spd, double* X, double* Y, double* Z) {
-  *X = *Y = *Z = 0;
-  for (double l = 360; l <= 830; l += 1) {
-    double v = spd(l);
-    *X += v * cie_x(l);
-    *Y += v * cie_y(l);
-    *Z += v * cie_z(l);
-  }
-}
-
-// RGB of a spectrum, read according to its kind. Illuminants are normalised to luminance 1;
-// reflectance-like spectra are balanced so that a constant spectrum c gives (c, c, c).
-template <typename F>
-Spectrum spd_to_rgb(F&& spd, SpectrumKind kind) {
-  double X, Y, Z;
-  integrate_xyz(spd, &X, &Y, &Z);
-  if (kind == SpectrumKind::kIlluminant) {
-    if (Y <= 0) return Spectrum(0.0f);
-    return xyz_to_srgb(X / Y, 1.0, Z / Y);
-  }
-  double Xe, Ye, Ze;
-  integrate_xyz([](double) { return 1.0; }, &Xe, &Ye, &Ze);
-  Spectrum rgb = xyz_to_srgb(X / Ye, Y / Ye, Z / Ye);
-  Spectrum white = xyz_to_srgb(Xe / Ye, 1.0, Ze / Ye);
-  Spectrum out = rgb / white;
-  for (int i = 0; i < 3; ++i) out[i] = std::fmax(out[i], 0.0f);
-  return out;
-}
-
-double planck(double lambda_nm, double T) {
-  const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
-  double l = lambda_nm * 1e-9;
-  return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1));
-}
-
-}  // namespace
-
-Spectrum blackbody_rgb(float T) {
-  return spd_to_rgb([T](double l) { return planck(l, T); }, SpectrumKind::kIlluminant);
-}
-
-Spectrum sampled_spectrum_rgb(const std::vector<double>& pairs, SpectrumKind kind) {
-  auto spd = [&pairs](double l) {
-    size_t n = pairs.size() / 2;
-    if (n == 0 || l < pairs[0] || l > pairs[2 * (n - 1)]) return 0.0;
-    for (size_t i = 0; i + 1 < n; ++i) {
-      double l0 = pairs[2 * i], l1 = pairs[2 * i + 2];
-      if (l >= l0 && l <= l1) {
-        double t = l1 > l0 ? (l - l0) / (l1 - l0) : 0;
-        return pairs[2 * i + 1] * (1 - t) + pairs[2 * i + 3] * t;
-      }
-    }
-    return pairs[2 * n - 1];
+std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKind kind) {
+  // Metals: the complex index of refraction at 450, 550 and 650 nm of the measured data pbrt-v4
+  // tabulates, joined linearly (bpm does not ship the full tables). Glasses: index at the d line.
+  struct Metal {
+    const char* name;
+    double v450, v550, v650;
   };
-  return spd_to_rgb(spd, kind);
-}
-
-std::optional<Spectrum> named_spectrum_rgb(const std::string& name, SpectrumKind kind) {
-  // Metals: complex index of refraction reduced to the R, G, B channels (values at about 650,
-  // 550 and 450 nm of the measured data pbrt-v4 tabulates). Glasses: index at the d line.
-  static const std::map<std::string, Spectrum> table = {
-      {"metal-Cu-eta", {0.200438f, 0.924033f, 1.102212f}},
-      {"metal-Cu-k", {3.912949f, 2.452848f, 2.142188f}},
-      {"metal-Au-eta", {0.143119f, 0.374957f, 1.442479f}},
-      {"metal-Au-k", {3.983160f, 2.385721f, 1.603215f}},
-      {"metal-Ag-eta", {0.155265f, 0.116723f, 0.138342f}},
-      {"metal-Ag-k", {4.828181f, 3.122249f, 2.146961f}},
-      {"metal-Al-eta", {1.657460f, 0.880369f, 0.521229f}},
-      {"metal-Al-k", {9.223869f, 6.269523f, 4.837001f}},
-      {"metal-CuZn-eta", {0.444f, 0.527f, 1.094f}},
-      {"metal-CuZn-k", {3.695f, 2.765f, 1.829f}},
-      {"metal-MgO-eta", {1.7357f, 1.7373f, 1.7497f}},
-      {"metal-MgO-k", {0.0f, 0.0f, 0.0f}},
-      {"metal-TiO2-eta", {2.8717f, 2.9568f, 3.1520f}},
-      {"metal-TiO2-k", {0.0f, 0.0f, 0.0f}},
-      {"glass-BK7", Spectrum(1.5168f)},
-      {"glass-BAF10", Spectrum(1.6700f)},
-      {"glass-FK51A", Spectrum(1.4866f)},
-      {"glass-LASF9", Spectrum(1.8503f)},
-      {"glass-F5", Spectrum(1.6034f)},
-      {"glass-F10", Spectrum(1.6200f)},
-      {"glass-F11", Spectrum(1.6209f)},
+  static const Metal metals[] = {
+      {"metal-Cu-eta", 1.102212, 0.924033, 0.200438}, {"metal-Cu-k", 2.142188, 2.452848, 3.912949},
+      {"metal-Au-eta", 1.442479, 0.374957, 0.143119}, {"metal-Au-k", 1.603215, 2.385721, 3.983160},
+      {"metal-Ag-eta", 0.138342, 0.116723, 0.155265}, {"metal-Ag-k", 2.146961, 3.122249, 4.828181},
+      {"metal-Al-eta", 0.521229, 0.880369, 1.657460}, {"metal-Al-k", 4.837001, 6.269523, 9.223869},
+      {"metal-CuZn-eta", 1.094, 0.527, 0.444},        {"metal-CuZn-k", 1.829, 2.765, 3.695},
+      {"metal-MgO-eta", 1.7497, 1.7373, 1.7357},      {"metal-MgO-k", 0, 0, 0},
+      {"metal-TiO2-eta", 3.1520, 2.9568, 2.8717},     {"metal-TiO2-k", 0, 0, 0},
   };
-  auto it = table.find(name);
-  if (it != table.end()) return it->second;
+  for (const Metal& m : metals)
+    if (name == m.name) return SpectrumCurve::from_pairs({450, m.v450, 550, m.v550, 650, m.v650}, kind);
+  static const std::map<std::string, float> glasses = {
+      {"glass-BK7", 1.5168f}, {"glass-BAF10", 1.6700f}, {"glass-FK51A", 1.4866f}, {"glass-LASF9", 1.8503f},
+      {"glass-F5", 1.6034f},  {"glass-F10", 1.6200f},   {"glass-F11", 1.6209f},
+  };
+  if (auto it = glasses.find(name); it != glasses.end()) return SpectrumCurve(it->second);
   if (kind == SpectrumKind::kIlluminant) {
-    if (name == "stdillum-D65") return Spectrum(1.0f);
-    if (name == "stdillum-A") return blackbody_rgb(2856);
-    if (name == "stdillum-D50") return blackbody_rgb(5003);
+    if (name == "stdillum-D65") return SpectrumCurve::from_rgb(Rgb(1.0f), kind);
+    if (name == "stdillum-A") return SpectrumCurve::blackbody(2856);
+    if (name == "stdillum-D50") return SpectrumCurve::blackbody(5003);  // its CCT; not the daylight curve
   }
   return std::nullopt;
 }
 
-std::optional<Spectrum> get_spectrum(const ParamSet& ps, const std::string& name, SpectrumKind kind,
+std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string& name, SpectrumKind kind,
                                      const std::string& directory) {
   const Param* p = ps.find_any(name);
   if (!p) return std::nullopt;
   p->used = true;
-  Spectrum s;
+  SpectrumCurve s;
+  // pbrt-v4 normalises every light spectrum except an RGB one to unit luminance.
+  auto unit_luminance = [kind](SpectrumCurve c) {
+    float y = c.luminance();
+    return kind == SpectrumKind::kIlluminant && y > 0 ? c.scaled(1 / y) : c;
+  };
   if (p->type == "rgb") {
-    s = Spectrum(float(p->numbers[0]), float(p->numbers[1]), float(p->numbers[2]));
+    Rgb rgb(float(p->numbers[0]), float(p->numbers[1]), float(p->numbers[2]));
+    if (!rgb.is_finite() || rgb.has_negative())
+      throw Error(p->loc, "parameter \"" + name + "\" has a negative or non-finite value");
+    if (kind == SpectrumKind::kAlbedo && rgb.max_component() > 1)
+      throw Error(p->loc, "parameter \"" + name + "\" is a reflectance and must not exceed 1");
+    s = SpectrumCurve::from_rgb(rgb, kind);
   } else if (p->type == "blackbody") {
     float T = float(p->numbers[0]);
     if (!(T > 0)) throw Error(p->loc, "blackbody temperature must be positive");
-    s = blackbody_rgb(T);
-    if (p->numbers.size() == 2) s *= float(p->numbers[1]);
+    s = unit_luminance(SpectrumCurve::blackbody(T));
+    if (p->numbers.size() == 2) s = s.scaled(float(p->numbers[1]));
   } else if (p->type == "spectrum" && !p->strings.empty()) {
     const std::string& str = p->strings[0];
-    if (auto named = named_spectrum_rgb(str, kind)) {
-      s = *named;
+    if (auto named = named_spectrum(str, kind)) {
+      s = unit_luminance(*named);
     } else {
       std::filesystem::path path = std::filesystem::path(str).is_absolute()
                                        ? std::filesystem::path(str)
@@ -158,20 +84,20 @@ std::optional<Spectrum> get_spectrum(const ParamSet& ps, const std::string& name
       }
       if (pairs.size() < 2 || pairs.size() % 2)
         throw Error(p->loc, "spectrum file \"" + str + "\" must hold wavelength/value pairs");
-      s = sampled_spectrum_rgb(pairs, kind);
+      s = unit_luminance(SpectrumCurve::from_pairs(pairs, kind));
     }
   } else if (p->type == "spectrum") {
     for (size_t i = 2; i < p->numbers.size(); i += 2)
       if (p->numbers[i] <= p->numbers[i - 2])
         throw Error(p->loc, "spectrum wavelengths must increase");
-    s = sampled_spectrum_rgb(p->numbers, kind);
+    s = unit_luminance(SpectrumCurve::from_pairs(p->numbers, kind));
   } else {
     throw Error(p->loc, "parameter \"" + name + "\" has type \"" + p->type +
                             "\"; expected rgb, spectrum or blackbody");
   }
-  if (!s.is_finite() || s.has_negative())
+  if (!s.rgb().is_finite() || !(s.min_value() >= 0) || !std::isfinite(s.max_value()))
     throw Error(p->loc, "parameter \"" + name + "\" has a negative or non-finite value");
-  if (kind == SpectrumKind::kAlbedo && s.max_component() > 1)
+  if (kind == SpectrumKind::kAlbedo && s.max_value() > 1.0001f)
     throw Error(p->loc, "parameter \"" + name + "\" is a reflectance and must not exceed 1");
   return s;
 }

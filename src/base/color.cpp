@@ -1,0 +1,369 @@
+#include "base/color.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "base/vec.h"
+
+namespace bpm {
+namespace {
+
+constexpr int kTableSize = int(kLambdaMax - kLambdaMin) + 1;  // 1 nm steps, both ends included
+
+double lobe(double l, double mu, double s1, double s2) {
+  double t = (l - mu) / (l < mu ? s1 : s2);
+  return std::exp(-0.5 * t * t);
+}
+
+// CIE standard illuminant D65 (ISO 11664-2), 300 to 830 nm in 10 nm steps, 100 at 560 nm.
+constexpr float kD65[] = {
+    0.0341f,  3.2945f,  20.236f,  37.0535f, 39.9488f, 44.9117f, 46.6383f, 52.0891f, 49.9755f, 54.6482f,
+    82.7549f, 91.486f,  93.4318f, 86.6823f, 104.865f, 117.008f, 117.812f, 114.861f, 115.923f, 108.811f,
+    109.354f, 107.802f, 104.79f,  107.689f, 104.405f, 104.046f, 100.0f,   96.3342f, 95.788f,  88.6856f,
+    90.0062f, 89.5991f, 87.6987f, 83.2886f, 83.6992f, 80.0268f, 80.2146f, 82.2778f, 78.2842f, 69.7213f,
+    71.6091f, 74.349f,  61.604f,  69.8856f, 75.087f,  63.5927f, 46.4182f, 66.8054f, 63.3828f, 64.304f,
+    59.4519f, 51.959f,  57.4406f, 60.3125f};
+
+double d65_raw(double l) {
+  double x = (l - 300) / 10;
+  int i = std::clamp(int(x), 0, int(std::size(kD65)) - 2);
+  double t = std::clamp(x - i, 0.0, 1.0);
+  return kD65[i] * (1 - t) + kD65[i + 1] * t;
+}
+
+// XYZ to linear sRGB (IEC 61966-2-1).
+void xyz_to_srgb(const double xyz[3], double rgb[3]) {
+  rgb[0] = 3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2];
+  rgb[1] = -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2];
+  rgb[2] = 0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2];
+}
+
+// Everything the conversions need, tabulated once at 1 nm.
+struct Tables {
+  double y_integral = 0;           // integral of ybar
+  double d65_scale = 0;            // D65 raw -> unit luminance
+  std::vector<float> d65;          // unit-luminance D65
+  std::vector<std::array<float, 3>> rgb_weight;      // sRGB of a unit spike at lambda, white balanced
+  std::vector<std::array<float, 3>> rgb_weight_d65;  // the same times D65: a reflectance's colour
+
+  Tables() {
+    d65.resize(kTableSize);
+    rgb_weight.resize(kTableSize);
+    rgb_weight_d65.resize(kTableSize);
+    double d65_y = 0, white_xyz[3] = {0, 0, 0};
+    for (int i = 0; i < kTableSize; ++i) {
+      double l = kLambdaMin + i;
+      y_integral += cie_y(float(l));
+      d65_y += d65_raw(l) * cie_y(float(l));
+    }
+    d65_scale = y_integral / d65_y;
+    for (int i = 0; i < kTableSize; ++i) {
+      double l = kLambdaMin + i;
+      d65[i] = float(d65_raw(l) * d65_scale);
+      white_xyz[0] += d65[i] * cie_x(float(l)) / y_integral;
+      white_xyz[1] += d65[i] * cie_y(float(l)) / y_integral;
+      white_xyz[2] += d65[i] * cie_z(float(l)) / y_integral;
+    }
+    double white[3];
+    xyz_to_srgb(white_xyz, white);
+    for (int i = 0; i < kTableSize; ++i) {
+      double l = kLambdaMin + i;
+      double xyz[3] = {cie_x(float(l)) / y_integral, cie_y(float(l)) / y_integral, cie_z(float(l)) / y_integral};
+      double rgb[3];
+      xyz_to_srgb(xyz, rgb);
+      for (int c = 0; c < 3; ++c) {
+        rgb_weight[i][c] = float(rgb[c] / white[c]);
+        rgb_weight_d65[i][c] = rgb_weight[i][c] * d65[i];
+      }
+    }
+  }
+};
+
+const Tables& tables() {
+  static const Tables t;
+  return t;
+}
+
+template <typename T>
+T lerp_table(const std::vector<T>& table, float lambda, T (*mix)(const T&, const T&, float)) {
+  float x = std::clamp(lambda - kLambdaMin, 0.0f, float(kTableSize - 1));
+  int i = std::min(int(x), kTableSize - 2);
+  return mix(table[i], table[i + 1], x - float(i));
+}
+float mix_float(const float& a, const float& b, float t) { return a + (b - a) * t; }
+std::array<float, 3> mix_rgb(const std::array<float, 3>& a, const std::array<float, 3>& b, float t) {
+  return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
+}
+
+// Visible-wavelength density: sech^2(a (lambda - mu)) normalised over the range.
+constexpr double kPdfA = 0.0072, kPdfMu = 540;
+double tanh_lo() { return std::tanh(kPdfA * (kLambdaMin - kPdfMu)); }
+double tanh_hi() { return std::tanh(kPdfA * (kLambdaMax - kPdfMu)); }
+
+float normalised_lambda(float lambda) { return (lambda - kLambdaMin) / (kLambdaMax - kLambdaMin); }
+
+float sigmoid(float x) { return 0.5f + x / (2 * std::sqrt(1 + x * x)); }
+
+// Colour (under D65) of the sigmoid spectrum with coefficients c, and its Jacobian.
+void sigmoid_rgb(const std::array<double, 3>& c, double rgb[3], double jac[3][3]) {
+  const Tables& t = tables();
+  for (int i = 0; i < 3; ++i) {
+    rgb[i] = 0;
+    for (int k = 0; k < 3; ++k) jac[i][k] = 0;
+  }
+  for (int i = 0; i < kTableSize; ++i) {
+    double u = normalised_lambda(kLambdaMin + i);
+    double x = (c[0] * u + c[1]) * u + c[2];
+    double s = 0.5 + x / (2 * std::sqrt(1 + x * x));
+    double ds = 0.5 / std::pow(1 + x * x, 1.5);
+    double basis[3] = {u * u, u, 1};
+    for (int ch = 0; ch < 3; ++ch) {
+      double w = t.rgb_weight_d65[i][ch];
+      rgb[ch] += w * s;
+      for (int k = 0; k < 3; ++k) jac[ch][k] += w * ds * basis[k];
+    }
+  }
+}
+
+bool solve3(double a[3][3], const double b[3], double x[3]) {
+  double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+               a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  if (!(std::fabs(det) > 1e-300)) return false;
+  for (int col = 0; col < 3; ++col) {
+    double m[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m[r][c] = c == col ? b[r] : a[r][c];
+    x[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+              m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) /
+             det;
+  }
+  return true;
+}
+
+double max_abs_residual(const double rgb[3], const double target[3]) {
+  return std::max({std::fabs(rgb[0] - target[0]), std::fabs(rgb[1] - target[1]), std::fabs(rgb[2] - target[2])});
+}
+
+}  // namespace
+
+float cie_x(float l) {
+  return float(1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) - 0.065 * lobe(l, 501.1, 20.4, 26.2));
+}
+float cie_y(float l) { return float(0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1)); }
+float cie_z(float l) { return float(1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8)); }
+
+float d65_unit(float lambda) { return lerp_table(tables().d65, lambda, mix_float); }
+
+Wavelengths sample_wavelengths(float u) {
+  Wavelengths wl;
+  const double lo = tanh_lo(), hi = tanh_hi();
+  for (int i = 0; i < Spectrum::kChannels; ++i) {
+    double ui = u + double(i) / Spectrum::kChannels;
+    if (ui >= 1) ui -= 1;
+    double l = kPdfMu + std::atanh(lo + ui * (hi - lo)) / kPdfA;
+    wl.lambda[i] = std::clamp(float(l), kLambdaMin, kLambdaMax);
+    wl.pdf[i] = wavelength_pdf(wl.lambda[i]);
+  }
+  return wl;
+}
+
+float wavelength_pdf(float lambda) {
+  if (lambda < kLambdaMin || lambda > kLambdaMax) return 0;
+  double c = std::cosh(kPdfA * (lambda - kPdfMu));
+  return float(kPdfA / (c * c) / (tanh_hi() - tanh_lo()));
+}
+
+Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl) {
+  const Tables& t = tables();
+  Rgb out;
+  for (int i = 0; i < Spectrum::kChannels; ++i) {
+    if (L[i] == 0 || wl.pdf[i] == 0) continue;
+    std::array<float, 3> w = lerp_table(t.rgb_weight, wl.lambda[i], mix_rgb);
+    float s = L[i] / (wl.pdf[i] * Spectrum::kChannels);
+    for (int c = 0; c < 3; ++c) out[c] += w[c] * s;
+  }
+  return out;
+}
+
+float sigmoid_spectrum(const std::array<float, 3>& c, float lambda) {
+  float u = normalised_lambda(lambda);
+  return sigmoid((c[0] * u + c[1]) * u + c[2]);
+}
+
+float fit_sigmoid(Rgb rgb, std::array<float, 3>* coeff) {
+  // Gauss-Newton from the grey of the same mean, moving the target toward rgb in steps so that
+  // each solve starts close to its answer (saturated colours need large coefficients).
+  double target_end[3] = {rgb[0], rgb[1], rgb[2]};
+  double grey = std::clamp((rgb[0] + rgb[1] + rgb[2]) / 3.0, 0.02, 0.98);
+  std::array<double, 3> c = {0, 0, (2 * grey - 1) / (2 * std::sqrt(grey * (1 - grey)))};
+  double rgb_now[3], jac[3][3], residual = 0;
+  constexpr int kSteps = 8;
+  for (int step = 1; step <= kSteps; ++step) {
+    double f = double(step) / kSteps, target[3];
+    for (int i = 0; i < 3; ++i) target[i] = grey + (target_end[i] - grey) * f;
+    for (int iter = 0; iter < 40; ++iter) {
+      sigmoid_rgb(c, rgb_now, jac);
+      residual = max_abs_residual(rgb_now, target);
+      if (residual < 1e-6) break;
+      double r[3] = {target[0] - rgb_now[0], target[1] - rgb_now[1], target[2] - rgb_now[2]}, d[3];
+      if (!solve3(jac, r, d)) break;
+      // Backtrack until the step reduces the residual.
+      double scale = 1;
+      bool improved = false;
+      for (int tries = 0; tries < 12 && !improved; ++tries, scale *= 0.5) {
+        std::array<double, 3> trial = {c[0] + scale * d[0], c[1] + scale * d[1], c[2] + scale * d[2]};
+        double trial_rgb[3], trial_jac[3][3];
+        sigmoid_rgb(trial, trial_rgb, trial_jac);
+        if (max_abs_residual(trial_rgb, target) < residual) {
+          c = trial;
+          improved = true;
+        }
+      }
+      if (!improved) break;
+    }
+  }
+  sigmoid_rgb(c, rgb_now, jac);
+  *coeff = {float(c[0]), float(c[1]), float(c[2])};
+  return float(max_abs_residual(rgb_now, target_end));
+}
+
+SpectrumCurve::SpectrumCurve(float constant) : kind_(Kind::kConstant), scale_(constant), rgb_(constant) {}
+
+SpectrumCurve SpectrumCurve::from_rgb(Rgb rgb, SpectrumKind kind) {
+  SpectrumCurve s;
+  float m = rgb.max_component();
+  if (m <= 0) {
+    s.times_d65_ = kind == SpectrumKind::kIlluminant;
+    return s;
+  }
+  if (rgb.min_component() == m) {
+    s.kind_ = Kind::kConstant;
+    s.scale_ = m;
+  } else {
+    // A reflectance is fitted as it is; other colours are scaled so that their largest channel
+    // is 0.5, the middle of the sigmoid's range (pbrt-v4's RGBUnboundedSpectrum).
+    float scale = kind == SpectrumKind::kAlbedo ? 1.0f : 2 * m;
+    s.kind_ = Kind::kSigmoid;
+    s.scale_ = scale;
+    fit_sigmoid(rgb / scale, &s.coeff_);
+  }
+  s.times_d65_ = kind == SpectrumKind::kIlluminant;
+  s.finish(kind);
+  return s;
+}
+
+SpectrumCurve SpectrumCurve::from_table(std::vector<float> values, SpectrumKind kind) {
+  SpectrumCurve s;
+  values.resize(kTableSize, values.empty() ? 0.0f : values.back());
+  s.kind_ = Kind::kTable;
+  s.scale_ = 1;
+  s.table_ = std::make_shared<const std::vector<float>>(std::move(values));
+  s.finish(kind);
+  return s;
+}
+
+SpectrumCurve SpectrumCurve::from_pairs(const std::vector<double>& pairs, SpectrumKind kind) {
+  size_t n = pairs.size() / 2;
+  std::vector<float> values(kTableSize, 0.0f);
+  for (int i = 0; i < kTableSize && n > 0; ++i) {
+    double l = kLambdaMin + i;
+    if (l <= pairs[0]) {
+      values[i] = float(pairs[1]);
+    } else if (l >= pairs[2 * (n - 1)]) {
+      values[i] = float(pairs[2 * n - 1]);
+    } else {
+      size_t j = 0;
+      while (j + 2 < n && pairs[2 * (j + 1)] < l) ++j;
+      double l0 = pairs[2 * j], l1 = pairs[2 * j + 2];
+      double t = l1 > l0 ? (l - l0) / (l1 - l0) : 0;
+      values[i] = float(pairs[2 * j + 1] * (1 - t) + pairs[2 * j + 3] * t);
+    }
+  }
+  return from_table(std::move(values), kind);
+}
+
+SpectrumCurve SpectrumCurve::blackbody(float T) {
+  const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
+  std::vector<float> values(kTableSize);
+  double peak = 0;
+  std::vector<double> planck(kTableSize);
+  for (int i = 0; i < kTableSize; ++i) {
+    double l = (kLambdaMin + i) * 1e-9;
+    planck[i] = (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1));
+    peak = std::max(peak, planck[i]);
+  }
+  // Normalised to 1 at the peak of the curve (Wien's law), as pbrt-v4.
+  double l_max = 2.8977721e-3 / T;
+  double peak_value = (2 * h * c * c) / (std::pow(l_max, 5) * (std::exp((h * c) / (l_max * kb * T)) - 1));
+  for (int i = 0; i < kTableSize; ++i) values[i] = float(planck[i] / peak_value);
+  return from_table(std::move(values), SpectrumKind::kIlluminant);
+}
+
+float SpectrumCurve::raw(float lambda) const {
+  switch (kind_) {
+    case Kind::kZero: return 0;
+    case Kind::kConstant: return 1;
+    case Kind::kSigmoid: return sigmoid_spectrum(coeff_, lambda);
+    case Kind::kTable: return lerp_table(*table_, lambda, mix_float);
+  }
+  return 0;
+}
+
+float SpectrumCurve::value(float lambda) const {
+  float v = scale_ * raw(lambda);
+  return times_d65_ ? v * d65_unit(lambda) : v;
+}
+
+Spectrum SpectrumCurve::sample(const Wavelengths& wl) const {
+  Spectrum s;
+  if (kind_ == Kind::kZero) return s;
+  for (int i = 0; i < Spectrum::kChannels; ++i) s[i] = value(wl.lambda[i]);
+  return s;
+}
+
+float SpectrumCurve::luminance() const {
+  double y = 0;
+  for (int i = 0; i < kTableSize; ++i) y += value(kLambdaMin + i) * cie_y(kLambdaMin + i);
+  return float(y / tables().y_integral);
+}
+
+float SpectrumCurve::min_value() const {
+  float m = kInf;
+  for (int i = 0; i < kTableSize; ++i) {
+    float v = value(kLambdaMin + i);
+    if (std::isnan(v)) return v;
+    m = std::min(m, v);
+  }
+  return m;
+}
+
+float SpectrumCurve::max_value() const {
+  float m = -kInf;
+  for (int i = 0; i < kTableSize; ++i) {
+    float v = value(kLambdaMin + i);
+    if (std::isnan(v)) return v;
+    m = std::max(m, v);
+  }
+  return m;
+}
+
+SpectrumCurve SpectrumCurve::scaled(float s) const {
+  SpectrumCurve out = *this;
+  out.scale_ *= s;
+  out.rgb_ *= s;
+  return out;
+}
+
+void SpectrumCurve::finish(SpectrumKind kind) {
+  // An illuminant's colour is its own; anything else is seen under D65.
+  const Tables& t = tables();
+  double rgb[3] = {0, 0, 0};
+  for (int i = 0; i < kTableSize; ++i) {
+    float v = value(kLambdaMin + i);
+    const auto& w = kind == SpectrumKind::kIlluminant ? t.rgb_weight[i] : t.rgb_weight_d65[i];
+    for (int c = 0; c < 3; ++c) rgb[c] += v * w[c];
+  }
+  rgb_ = Rgb(float(rgb[0]), float(rgb[1]), float(rgb[2]));
+}
+
+}  // namespace bpm

@@ -1,0 +1,95 @@
+// Spectral rendering support, following pbrt-v4's model (Pharr, Jakob, Humphreys, 4th ed., ch. 4):
+// - a path samples four wavelengths (Wavelengths) and carries its values there (Spectrum);
+// - scene colours become smooth spectra (SpectrumCurve): an RGB reflectance is the sigmoid of a
+//   quadratic (Jakob and Hanika 2019, "A Low-Dimensional Function Space for Efficient Spectral
+//   Upsampling") fitted so that it reproduces the RGB under the sRGB white (D65); an RGB light is
+//   such a curve times the D65 illuminant;
+// - the film projects the sampled values onto the CIE 1931 matching functions and converts to
+//   linear sRGB.
+// bpm's colour matching functions are the multi-lobe fit of Wyman, Sloan and Shirley (JCGT 2013);
+// every conversion uses the same functions, so an RGB round trip is exact and a constant spectrum
+// of 1 under D65 is white (1, 1, 1).
+#pragma once
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "base/spectrum.h"
+
+namespace bpm {
+
+constexpr float kLambdaMin = 360, kLambdaMax = 830;
+
+struct Wavelengths {
+  std::array<float, Spectrum::kChannels> lambda{};
+  std::array<float, Spectrum::kChannels> pdf{};  // density of each wavelength (per nm)
+};
+
+// Four wavelengths stratified over [kLambdaMin, kLambdaMax] from one uniform number, each drawn
+// with a density that follows the eye's sensitivity (a sech^2 lobe about 540 nm).
+Wavelengths sample_wavelengths(float u);
+float wavelength_pdf(float lambda);
+
+// Linear sRGB of the Monte Carlo estimate L at the wavelengths wl (the film's sensor, pbrt-v4's
+// "cie1931").
+Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl);
+
+// How a stated colour is read (as pbrt-v4's SpectrumType): reflectances are bounded by 1,
+// unbounded values (eta, k) may be anything non-negative, illuminants are emission spectra.
+enum class SpectrumKind { kAlbedo, kUnbounded, kIlluminant };
+
+// A spectral distribution from the scene description, evaluated at a path's wavelengths.
+class SpectrumCurve {
+ public:
+  SpectrumCurve() = default;  // zero everywhere
+  explicit SpectrumCurve(float constant);
+
+  // The smooth spectrum whose colour is rgb (see the top of this file). An albedo must lie in
+  // [0, 1]; an illuminant rgb is the colour of the light, D65 for (1, 1, 1).
+  static SpectrumCurve from_rgb(Rgb rgb, SpectrumKind kind);
+  // Values at 1 nm steps over [kLambdaMin, kLambdaMax], linearly interpolated.
+  static SpectrumCurve from_table(std::vector<float> values_per_nm, SpectrumKind kind);
+  // Piecewise linear through (wavelength nm, value) pairs, constant beyond the ends.
+  static SpectrumCurve from_pairs(const std::vector<double>& lambda_value_pairs, SpectrumKind kind);
+  // Planck's law at the temperature, 1 at its peak.
+  static SpectrumCurve blackbody(float temperature_kelvin);
+
+  float value(float lambda) const;
+  Spectrum sample(const Wavelengths& wl) const;
+  // Linear sRGB: the colour of a reflectance lit by D65 (albedo and unbounded), or of the light
+  // (illuminant). Cached at construction.
+  Rgb rgb() const { return rgb_; }
+  // Luminance relative to the matching functions, integral of s * ybar over integral of ybar.
+  float luminance() const;
+  // Extremes over [kLambdaMin, kLambdaMax] at 1 nm (NaN if a value is NaN); for checking input.
+  float min_value() const;
+  float max_value() const;
+  SpectrumCurve scaled(float s) const;
+  bool is_black() const { return kind_ == Kind::kZero || scale_ == 0; }
+  bool is_constant() const { return kind_ == Kind::kZero || kind_ == Kind::kConstant; }
+
+ private:
+  enum class Kind { kZero, kConstant, kSigmoid, kTable };
+  float raw(float lambda) const;
+  void finish(SpectrumKind kind);
+
+  Kind kind_ = Kind::kZero;
+  float scale_ = 0;
+  std::array<float, 3> coeff_{};  // sigmoid polynomial in normalised wavelength
+  bool times_d65_ = false;        // multiplied by the D65 illuminant (unit luminance)
+  std::shared_ptr<const std::vector<float>> table_;
+  Rgb rgb_;
+};
+
+// Sigmoid-polynomial coefficients of a reflectance with colour rgb in [0, 1]^3 (exposed for tests);
+// returns the largest remaining channel error.
+float fit_sigmoid(Rgb rgb, std::array<float, 3>* coeff);
+float sigmoid_spectrum(const std::array<float, 3>& coeff, float lambda);
+
+// The CIE standard illuminant D65 scaled to unit luminance, and the matching functions.
+float d65_unit(float lambda);
+float cie_x(float lambda);
+float cie_y(float lambda);
+float cie_z(float lambda);
+
+}  // namespace bpm
