@@ -100,7 +100,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (beta.is_black()) break;
     after_diffuse_sample = is_diffuse;
-    prev_pdf_bsdf = bs->pdf_solid_angle;
+    prev_pdf_bsdf = bs->mis_pdf;
     prev_p = sp.p;
     ray = spawn_ray(sp, frame.to_world(bs->wi));
     ++counters.rays.bounce_rays;

@@ -8,7 +8,7 @@ namespace bpm {
 namespace {
 
 // Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`.
-void gather_at_hit(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                    const std::vector<uint16_t>& owner, int object, const SurfacePoint& sp, Vec3 wi,
                    const Spectrum& flux, PhotonClass cls, int bounces, std::vector<std::vector<PhotonEntry>>& out,
                    LightCounters& counters) {
@@ -33,7 +33,7 @@ void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Ligh
   // estimation counts direct light).
   trace_light_path(scene, *prm.materials, prm.max_depth, 1, rng, counters, [&](const PhotonHit& h) {
     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
-      gather_at_hit(scene, maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out, counters);
+      gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out, counters);
   });
 }
 

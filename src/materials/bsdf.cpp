@@ -1,6 +1,8 @@
 #include <complex>
 
 #include "base/sampling.h"
+#include "materials/dielectric.h"
+#include "materials/layered.h"
 #include "materials/material.h"
 #include "materials/microfacet.h"
 
@@ -149,42 +151,56 @@ Spectrum f_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode)
   if (mode == TransportMode::kRadiance) ft /= h->etap * h->etap;
   return Spectrum(ft);
 }
-float pdf_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+}  // namespace
+
+Spectrum dielectric_f(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) { return f_of(m, wo, wi, mode); }
+
+// With `lobes` restricting the choice, reflection and transmission are picked in proportion to
+// the Fresnel terms of the lobes allowed (pbrt-v4's BxDFReflTransFlags).
+float dielectric_pdf(const DielectricMaterial& m, Vec3 wo, Vec3 wi, unsigned lobes) {
   if (m.eta == 1 || m.roughness.effectively_smooth()) return 0;
   auto h = dielectric_half_vector(m.eta, wo, wi);
   if (!h) return 0;
   TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
   float R = fresnel_dielectric(dot(wo, h->wm), m.eta), T = 1 - R;
+  float pr = (lobes & kReflection) ? R : 0, pt = (lobes & kTransmission) ? T : 0;
+  if (pr + pt == 0) return 0;
   float dvis = d.d_visible(wo, h->wm);  // symmetric in the sign of wo
-  if (h->reflect) return dvis / (4 * absdot(wo, h->wm)) * R / (R + T);
+  if (h->reflect) return dvis / (4 * absdot(wo, h->wm)) * pr / (pr + pt);
   float denom = dot(wi, h->wm) + dot(wo, h->wm) / h->etap;
   float dwm_dwi = absdot(wi, h->wm) / (denom * denom);
-  return dvis * dwm_dwi * T / (R + T);
+  return dvis * dwm_dwi * pt / (pr + pt);
 }
-std::optional<BsdfSample> sample_of(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+
+std::optional<BsdfSample> dielectric_sample(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode,
+                                            unsigned lobes) {
   if (m.eta == 1 || m.roughness.effectively_smooth()) {
     float R = fresnel_dielectric(wo.z, m.eta), T = 1 - R;
-    if (uc < R / (R + T)) {
+    float pr = (lobes & kReflection) ? R : 0, pt = (lobes & kTransmission) ? T : 0;
+    if (pr + pt == 0) return std::nullopt;
+    if (uc < pr / (pr + pt)) {
       Vec3 wi(-wo.x, -wo.y, wo.z);
-      return BsdfSample{Spectrum(R / std::fabs(wi.z)), wi, R / (R + T), kReflection | kSpecular};
+      return BsdfSample{Spectrum(R / std::fabs(wi.z)), wi, pr / (pr + pt), kReflection | kSpecular};
     }
     Vec3 wi;
     float etap;
     if (!refract(wo, Vec3(0, 0, 1), m.eta, &etap, &wi) || wi.z == 0) return std::nullopt;
     float ft = T / std::fabs(wi.z);
     if (mode == TransportMode::kRadiance) ft /= etap * etap;
-    return BsdfSample{Spectrum(ft), wi, T / (R + T), kTransmission | kSpecular, etap};
+    return BsdfSample{Spectrum(ft), wi, pt / (pr + pt), kTransmission | kSpecular, etap};
   }
   TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
   // wm lies in the upper hemisphere whichever side wo is on, so that dot(wo, wm) < 0 tells the
   // Fresnel term and refract() that the ray comes from inside.
   Vec3 wm = d.sample_wm(wo, u);
   float R = fresnel_dielectric(dot(wo, wm), m.eta), T = 1 - R;
+  float pr = (lobes & kReflection) ? R : 0, pt = (lobes & kTransmission) ? T : 0;
+  if (pr + pt == 0) return std::nullopt;
   float dvis = d.d_visible(wo, wm);
-  if (uc < R / (R + T)) {
+  if (uc < pr / (pr + pt)) {
     Vec3 wi = reflect(wo, wm);
     if (!same_hemisphere(wo, wi)) return std::nullopt;
-    float pdf = dvis / (4 * absdot(wo, wm)) * R / (R + T);
+    float pdf = dvis / (4 * absdot(wo, wm)) * pr / (pr + pt);
     Spectrum f(d.d(wm) * d.g(wo, wi) * R / std::fabs(4 * wi.z * wo.z));
     return BsdfSample{f, wi, pdf, kReflection | kGlossy};
   }
@@ -194,10 +210,19 @@ std::optional<BsdfSample> sample_of(const DielectricMaterial& m, Vec3 wo, float 
   float denom = dot(wi, wm) + dot(wo, wm) / etap;
   denom *= denom;
   float dwm_dwi = absdot(wi, wm) / denom;
-  float pdf = dvis * dwm_dwi * T / (R + T);
+  float pdf = dvis * dwm_dwi * pt / (pr + pt);
   float ft = T * d.d(wm) * d.g(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
   if (mode == TransportMode::kRadiance) ft /= etap * etap;
   return BsdfSample{Spectrum(ft), wi, pdf, kTransmission | kGlossy, etap};
+}
+
+namespace {
+
+float pdf_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  return dielectric_pdf(m, wo, wi, kReflection | kTransmission);
+}
+std::optional<BsdfSample> sample_of(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+  return dielectric_sample(m, wo, uc, u, mode, kReflection | kTransmission);
 }
 
 // ---- thin dielectric ----
@@ -274,6 +299,16 @@ std::optional<BsdfSample> sample_of(const PhongMaterial& m, Vec3 wo, float, Vec2
 }
 
 // ---- interface: no scattering; the integrators skip such surfaces ----
+Spectrum f_of(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return coated_diffuse_f(m, wo, wi, mode);
+}
+float pdf_of(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return coated_diffuse_pdf(m, wo, wi, mode);
+}
+std::optional<BsdfSample> sample_of(const CoatedDiffuseMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+  return coated_diffuse_sample(m, wo, uc, u, mode);
+}
+
 Spectrum f_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return {}; }
 float pdf_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return 0; }
 std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2, TransportMode) { return std::nullopt; }
@@ -289,6 +324,11 @@ float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
 std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
   auto s = std::visit([&](const auto& x) { return sample_of(x, wo, uc, u, mode); }, m);
   if (s && (s->pdf_solid_angle <= 0 || !s->f.is_finite() || !std::isfinite(s->pdf_solid_angle))) return std::nullopt;
+  if (s) {
+    // A layered material's walk gives an exact weight but no density; MIS takes its estimate.
+    bool estimated = std::holds_alternative<CoatedDiffuseMaterial>(m) && !s->is_specular();
+    s->mis_pdf = estimated ? bsdf_pdf(m, wo, s->wi, mode) : s->pdf_solid_angle;
+  }
   return s;
 }
 bool bsdf_is_specular(const Material& m) {
@@ -300,6 +340,7 @@ bool bsdf_is_specular(const Material& m) {
     bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
     bool operator()(const PhongMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return true; }
+    bool operator()(const CoatedDiffuseMaterial&) const { return false; }
   };
   return std::visit(V{}, m);
 }

@@ -58,12 +58,24 @@ struct PhongMaterial {
   float exponent = 20;
 };
 
+// pbrt-v4's "coateddiffuse": a dielectric coating (index eta, GGX roughness) over a Lambertian base
+// of the given reflectance, with a non-scattering layer of the given thickness between them that
+// attenuates as exp(-thickness / |cos|). Light bounces inside the layer; the BSDF is the expected
+// value of those random walks (pbrt-v4's stochastic LayeredBxDF, two-sided, at most max_depth
+// bounces): f and pdf are unbiased estimates seeded by the directions (materials/layered.h).
+struct CoatedDiffuseMaterial {
+  Spectrum reflectance{0.5f};
+  Roughness roughness;
+  float eta = 1.5f, thickness = 0.01f;
+  int max_depth = 10, samples = 1;
+};
+
 // Marks a boundary that does not scatter (pbrt-v4 "interface"): rays pass straight through.
 struct InterfaceMaterial {};
 
 using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMaterial,
                               ThinDielectricMaterial, DiffuseTransmissionMaterial, PhongMaterial,
-                              InterfaceMaterial>;
+                              InterfaceMaterial, CoatedDiffuseMaterial>;
 
 // The scene's description of a material, with its colours as spectral curves. resolve_material
 // evaluates it at a path's wavelengths into the Material the BSDF functions take. The alternatives
@@ -84,8 +96,12 @@ struct PhongDesc {
   SpectrumCurve reflectance{0.5f};
   float exponent = 20;
 };
+struct CoatedDiffuseDesc {
+  SpectrumCurve reflectance{0.5f};
+  CoatedDiffuseMaterial rest;  // everything but the reflectance
+};
 using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
-                                  DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial>;
+                                  DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc>;
 
 Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl);
 
@@ -103,6 +119,10 @@ struct BsdfSample {
   float pdf_solid_angle = 0;
   unsigned flags = 0;
   float eta = 1;  // relative index of refraction across the boundary, 1 for reflection
+  // The density to use in multiple importance sampling. It equals pdf_solid_angle except for
+  // layered materials, whose sample weight f / pdf is exact while their density is only
+  // estimated (pbrt-v4's pdfIsProportional): bsdf_sample fills it.
+  float mis_pdf = 0;
   bool is_specular() const { return flags & kSpecular; }
   bool is_transmission() const { return flags & kTransmission; }
 };

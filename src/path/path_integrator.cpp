@@ -97,7 +97,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     if (!bs) break;
     beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     specular_bounce = bs->is_specular();
-    prev_pdf_bsdf = bs->pdf_solid_angle;
+    prev_pdf_bsdf = bs->mis_pdf;
     if (bs->is_transmission()) eta_scale *= bs->eta * bs->eta;
     prev_p = sp.p;
     Vec3 wi = frame.to_world(bs->wi);

@@ -230,6 +230,22 @@ class Flattener {
     return Roughness{u, v};
   }
 
+  // A dielectric's index of refraction: a float, or a spectrum reduced to its value at 550 nm.
+  float dielectric_eta(const ParamSet& ps, const FileLoc& loc) {
+    float eta = 1.5f;
+    const Param* p = ps.find_any("eta");
+    if (p && p->type == "float") {
+      eta = ps.get_float("eta", 1.5f);
+    } else if (p) {
+      SpectrumCurve s = *spectrum_param(ps, "eta", SpectrumKind::kUnbounded);
+      if (s.max_value() - s.min_value() > 1e-4f)
+        warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
+      eta = s.value(550);
+    }
+    if (!(eta > 0)) throw Error(p ? p->loc : loc, "eta must be positive");
+    return eta;
+  }
+
   MaterialDesc make_material(const SceneEntity& e) {
     const ParamSet& ps = e.params;
     for (const char* unsupported : {"displacement", "normalmap"})
@@ -251,17 +267,7 @@ class Flattener {
       c.roughness = roughness(ps, e.loc);
       m = c;
     } else if (e.name == "dielectric" || e.name == "thindielectric") {
-      float eta = 1.5f;
-      const Param* p = ps.find_any("eta");
-      if (p && p->type == "float") {
-        eta = ps.get_float("eta", 1.5f);
-      } else if (p) {
-        SpectrumCurve s = *spectrum_param(ps, "eta", SpectrumKind::kUnbounded);
-        if (s.max_value() - s.min_value() > 1e-4f)
-          warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
-        eta = s.value(550);
-      }
-      if (!(eta > 0)) throw Error(p ? p->loc : e.loc, "eta must be positive");
+      float eta = dielectric_eta(ps, e.loc);
       if (e.name == "dielectric") m = DielectricMaterial{eta, roughness(ps, e.loc)};
       else m = ThinDielectricMaterial{eta};
     } else if (e.name == "diffusetransmission") {
@@ -274,6 +280,29 @@ class Flattener {
       if ((d.reflectance.rgb() + d.transmittance.rgb()).max_component() > 1.0001f)
         throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
       m = d;
+    } else if (e.name == "coateddiffuse") {
+      CoatedDiffuseDesc c;
+      if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
+      c.rest.roughness = roughness(ps, e.loc);
+      auto positive = [&](const char* name, float def) {
+        float v = float_param(ps, name, def);
+        if (!(v > 0) || !std::isfinite(v)) throw Error(ps.find_any(name)->loc, std::string(name) + " must be positive");
+        return v;
+      };
+      c.rest.thickness = positive("thickness", 0.01f);
+      c.rest.eta = dielectric_eta(ps, e.loc);
+      auto count = [&](const char* name, int def) {
+        int v = ps.get_int(name, def);
+        if (v < 1 || v > 1000) throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
+        return v;
+      };
+      c.rest.max_depth = count("maxdepth", 10);
+      c.rest.samples = count("nsamples", 1);
+      // A scattering medium inside the layer (albedo > 0) is not modelled.
+      if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && !a->is_black())
+        throw Error(ps.find_any("albedo")->loc, "coateddiffuse with a scattering layer (albedo > 0) is not supported");
+      if (ps.find_any("g")) float_param(ps, "g", 0);  // the phase function of that medium: irrelevant without it
+      m = c;
     } else if (e.name == "phong") {
       // bpm's own non-reciprocal glossy lobe (material.h); pbrt-v4 does not know it.
       PhongDesc ph;

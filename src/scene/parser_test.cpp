@@ -1479,6 +1479,42 @@ TEST(SceneFlattenError, ParameterTakesOneValue) {
                       "parameter \"radius\" takes one value; got 2"));
 }
 
+TEST(SceneParams, CoatedDiffuse) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"coateddiffuse\" \"rgb reflectance\" [0.2 0.4 0.6] \"float roughness\" 0.04 "
+      "\"float thickness\" 0.05 \"float eta\" 1.33 \"integer maxdepth\" 5 \"integer nsamples\" 2\n"
+      "Shape \"sphere\"\nMaterial \"coateddiffuse\"\nShape \"sphere\"\n"));
+  const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
+  ASSERT_TRUE(std::holds_alternative<CoatedDiffuseDesc>(m));
+  const CoatedDiffuseDesc& c = std::get<CoatedDiffuseDesc>(m);
+  expect_spectrum_near(c.reflectance, Rgb(0.2f, 0.4f, 0.6f));
+  EXPECT_NEAR(c.rest.roughness.alpha_x, 0.2f, 1e-6f);  // remapped
+  EXPECT_FLOAT_EQ(c.rest.thickness, 0.05f);
+  EXPECT_FLOAT_EQ(c.rest.eta, 1.33f);
+  EXPECT_EQ(c.rest.max_depth, 5);
+  EXPECT_EQ(c.rest.samples, 2);
+  // pbrt-v4's defaults.
+  const CoatedDiffuseDesc& d = std::get<CoatedDiffuseDesc>(ls.scene.materials[ls.scene.objects[1].material]);
+  expect_spectrum_near(d.reflectance, Rgb(0.5f));
+  EXPECT_FLOAT_EQ(d.rest.thickness, 0.01f);
+  EXPECT_FLOAT_EQ(d.rest.eta, 1.5f);
+  EXPECT_EQ(d.rest.max_depth, 10);
+  EXPECT_EQ(d.rest.samples, 1);
+  EXPECT_TRUE(d.rest.roughness.effectively_smooth());
+}
+
+TEST(SceneFlattenError, CoatedDiffuseBadValues) {
+  const std::string l1 = R"(Material "coateddiffuse" "float thickness" -1)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\nShape \"sphere\"\n"), at(2, col(l1, "\"float thickness")),
+                      "thickness must be positive"));
+  const std::string l2 = R"(Material "coateddiffuse" "rgb albedo" [0.5 0.5 0.5])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"rgb albedo")),
+                      "coateddiffuse with a scattering layer (albedo > 0) is not supported"));
+  const std::string l3 = R"(Material "coateddiffuse" "integer maxdepth" 0)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l3 + "\nShape \"sphere\"\n"), at(2, col(l3, "\"integer maxdepth")),
+                      "maxdepth must be in [1, 1000]"));
+}
+
 TEST(SceneFlattenError, UnknownNamedSpectrum) {
   TempDir dir;
   const std::string l2 = R"(Material "conductor" "spectrum eta" "metal-Unobtainium")";
