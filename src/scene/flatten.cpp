@@ -1,4 +1,5 @@
 #include "scene/flatten.h"
+#include "scene/loop_subdivision.h"
 
 #include <algorithm>
 #include <cmath>
@@ -396,6 +397,23 @@ class Flattener {
       }
       if (bilinear) idx = bilinear_to_triangles(P, idx, s.loc);
       obj.shape = mesh_from(s.world_from_object, flip, P, N, uv, idx);
+    } else if (s.name == "loopsubdiv") {
+      auto P = ps.get_point3s("P");
+      auto idx = ps.get_ints("indices");
+      if (P.empty() || idx.empty()) throw Error(s.loc, "loopsubdiv needs \"point3 P\" and \"integer indices\"");
+      const FileLoc& iloc = ps.find_any("indices")->loc;
+      if (idx.size() % 3 != 0)
+        throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of 3");
+      check_indices(idx, P.size(), iloc);
+      int levels = ps.get_int("levels", 3);
+      if (levels < 0 || levels > 8) throw Error(ps.find_any("levels")->loc, "loopsubdiv levels must be in [0, 8]");
+      SubdividedMesh sub;
+      try {
+        sub = loop_subdivide(P, idx, levels);
+      } catch (const std::invalid_argument& e) {
+        throw Error(s.loc, std::string("loopsubdiv: ") + e.what());
+      }
+      obj.shape = mesh_from(s.world_from_object, flip, std::move(sub.positions), std::move(sub.normals), {}, sub.indices);
     } else if (s.name == "plymesh") {
       std::string file = ps.get_string("filename", "");
       if (file.empty()) throw Error(s.loc, "plymesh has no \"string filename\"");

@@ -1515,6 +1515,30 @@ TEST(SceneFlattenError, CoatedDiffuseBadValues) {
                       "maxdepth must be in [1, 1000]"));
 }
 
+TEST(SceneParams, LoopSubdivisionMesh) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nShape \"loopsubdiv\" \"integer levels\" 2 \"point3 P\" [1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1] "
+      "\"integer indices\" [0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5]\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 1u);
+  const auto& m = std::get<TriangleMesh>(ls.scene.objects[0].shape);
+  EXPECT_EQ(m.indices.size(), 24u * 16);
+  EXPECT_EQ(m.positions.size(), 66u);
+  EXPECT_EQ(m.normals.size(), m.positions.size());  // shading normals
+}
+
+TEST(SceneFlattenError, LoopSubdivisionBadInput) {
+  const std::string l1 = R"(Shape "loopsubdiv" "integer levels" -1 "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 2])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\n"), at(2, col(l1, "\"integer levels")),
+                      "loopsubdiv levels must be in [0, 8]"));
+  const std::string l2 =
+      R"(Shape "loopsubdiv" "point3 P" [0 0 0 1 0 0 0 1 0 0 -1 0 0 0 1] "integer indices" [0 1 2 1 0 3 0 1 4])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, 1),
+                      "loopsubdiv: an edge is shared by more than two triangles"));
+  const std::string l3 = R"(Shape "loopsubdiv" "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 5])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l3 + "\n"), at(2, col(l3, "\"integer indices")),
+                      "vertex index 5 out of range (3 vertices)"));
+}
+
 TEST(SceneFlattenError, UnknownNamedSpectrum) {
   TempDir dir;
   const std::string l2 = R"(Material "conductor" "spectrum eta" "metal-Unobtainium")";
