@@ -1,0 +1,134 @@
+// Scene conformance: renders every scene file of ../shared/scenes with the path integrator at a
+// small resolution and prints, per scene, the mean of each channel and, where ../shared/references
+// holds a pbrt-v4 render of that scene, the ratio of our channel means to pbrt-v4's and the
+// relative MSE (mean over pixels and channels of (a - b)^2 / (b^2 + 0.01)) against it. A scene bpm
+// cannot render prints the error it reports. Prints figures; never fails.
+//   conformance [--shared DIR] [--spp N] [--width W]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/error.h"
+#include "film/image_io.h"
+#include "render/renderer.h"
+#include "scene/flatten.h"
+
+using namespace bpm;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Reference {
+  fs::path path;
+  int width = 0, height = 0, spp = 0;
+};
+
+// The pbrt-v4 reference of a scene folder with the most samples: <scene>-path-<W>x<H>-<N>spp.exr.
+std::optional<Reference> find_reference(const fs::path& dir, const std::string& scene) {
+  std::optional<Reference> best;
+  if (!fs::is_directory(dir)) return best;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    std::string name = e.path().filename().string();
+    Reference r;
+    r.path = e.path();
+    std::string prefix = scene + "-path-";
+    if (name.rfind(prefix, 0) != 0 || e.path().extension() != ".exr") continue;
+    if (std::sscanf(name.c_str() + prefix.size(), "%dx%d-%dspp", &r.width, &r.height, &r.spp) != 3) continue;
+    if (!best || r.spp > best->spp) best = r;
+  }
+  return best;
+}
+
+std::array<double, 3> channel_means(const Image& img) {
+  std::array<double, 3> m{0, 0, 0};
+  size_t n = size_t(img.width) * img.height;
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) m[c] += img.rgb[3 * i + c];
+  for (double& v : m) v /= double(n);
+  return m;
+}
+
+double rel_mse(const Image& a, const Image& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    double d = a.rgb[i] - b.rgb[i];
+    s += d * d / (double(b.rgb[i]) * b.rgb[i] + 0.01);
+  }
+  return s / double(a.rgb.size());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string shared = std::string(BPM_SOURCE_DIR) + "/../shared";
+  int spp = 64, max_width = 200;
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
+    if (!std::strcmp(argv[i], "--shared")) shared = next();
+    else if (!std::strcmp(argv[i], "--spp")) spp = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--width")) max_width = std::atoi(next().c_str());
+  }
+  fs::path scenes = fs::path(shared) / "scenes";
+  if (!fs::is_directory(scenes)) {
+    std::printf("no scenes at %s\n", scenes.string().c_str());
+    return 0;
+  }
+  std::vector<fs::path> files;
+  for (const auto& d : fs::directory_iterator(scenes))
+    if (d.is_directory())
+      for (const auto& f : fs::directory_iterator(d.path()))
+        if (f.path().extension() == ".pbrt") files.push_back(f.path());
+  std::sort(files.begin(), files.end());
+
+  std::printf("path integrator, %d spp; references: pbrt-v4 renders in %s/references\n\n", spp, shared.c_str());
+  std::printf("| scene file | resolution | seconds | mean R G B | bpm / pbrt-v4 per channel | relMSE to pbrt-v4 |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- |\n");
+  for (const fs::path& file : files) {
+    std::string scene = file.parent_path().filename().string();
+    std::string label = scene + "/" + file.filename().string();
+    try {
+      LoadedScene ls = flatten_scene(parse_scene_file(file.string()));
+      auto ref = find_reference(fs::path(shared) / "references", scene);
+      int w = ls.film.width, h = ls.film.height;
+      if (ref) {
+        w = ref->width;
+        h = ref->height;
+      } else if (w > max_width) {
+        h = std::max(1, h * max_width / w);
+        w = max_width;
+      }
+      ls.film.width = w;
+      ls.film.height = h;
+      RenderOptions opt;
+      opt.spp = spp;
+      opt.max_depth = ls.render.max_depth;
+      opt.progress = false;
+      Film film(w, h);
+      auto t0 = std::chrono::steady_clock::now();
+      render(ls, opt, &film);
+      double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      Image img = film.image(ls.film.imaging_ratio);
+      auto m = channel_means(img);
+      std::printf("| %s | %dx%d | %.1f | %.4f %.4f %.4f |", label.c_str(), w, h, secs, m[0], m[1], m[2]);
+      if (ref) {
+        Image r = read_exr(ref->path.string());
+        auto mr = channel_means(r);
+        std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2], rel_mse(img, r));
+      } else {
+        std::printf(" no reference | |\n");
+      }
+    } catch (const std::exception& e) {
+      std::string msg = e.what();
+      std::replace(msg.begin(), msg.end(), '|', '/');
+      std::printf("| %s | | | not rendered: %s | | |\n", label.c_str(), msg.c_str());
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}
