@@ -299,34 +299,41 @@ std::optional<BsdfSample> sample_of(const PhongMaterial& m, Vec3 wo, float, Vec2
 }
 
 // ---- interface: no scattering; the integrators skip such surfaces ----
-Spectrum f_of(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
-  return coated_diffuse_f(m, wo, wi, mode);
-}
-float pdf_of(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
-  return coated_diffuse_pdf(m, wo, wi, mode);
-}
-std::optional<BsdfSample> sample_of(const CoatedDiffuseMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
-  return coated_diffuse_sample(m, wo, uc, u, mode);
-}
-
 Spectrum f_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return {}; }
 float pdf_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return 0; }
 std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2, TransportMode) { return std::nullopt; }
 
 }  // namespace
 
+// Layered materials take the whole Material (materials/layered.h); the others their own struct.
 Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
-  return std::visit([&](const auto& x) { return f_of(x, wo, wi, mode); }, m);
+  return std::visit(
+      [&](const auto& x) {
+        if constexpr (kLayered<std::decay_t<decltype(x)>>) return layered_f(m, wo, wi, mode);
+        else return f_of(x, wo, wi, mode);
+      },
+      m);
 }
 float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
-  return std::visit([&](const auto& x) { return pdf_of(x, wo, wi, mode); }, m);
+  return std::visit(
+      [&](const auto& x) {
+        if constexpr (kLayered<std::decay_t<decltype(x)>>) return layered_pdf(m, wo, wi, mode);
+        else return pdf_of(x, wo, wi, mode);
+      },
+      m);
 }
 std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
-  auto s = std::visit([&](const auto& x) { return sample_of(x, wo, uc, u, mode); }, m);
+  auto s = std::visit(
+      [&](const auto& x) {
+        if constexpr (kLayered<std::decay_t<decltype(x)>>) return layered_sample(m, wo, uc, u, mode);
+        else return sample_of(x, wo, uc, u, mode);
+      },
+      m);
   if (s && (s->pdf_solid_angle <= 0 || !s->f.is_finite() || !std::isfinite(s->pdf_solid_angle))) return std::nullopt;
   if (s) {
     // A layered material's walk gives an exact weight but no density; MIS takes its estimate.
-    bool estimated = std::holds_alternative<CoatedDiffuseMaterial>(m) && !s->is_specular();
+    bool layered = std::visit([](const auto& x) { return kLayered<std::decay_t<decltype(x)>>; }, m);
+    bool estimated = layered && !s->is_specular();
     s->mis_pdf = estimated ? bsdf_pdf(m, wo, s->wi, mode) : s->pdf_solid_angle;
   }
   return s;
@@ -341,6 +348,10 @@ bool bsdf_is_specular(const Material& m) {
     bool operator()(const PhongMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return true; }
     bool operator()(const CoatedDiffuseMaterial&) const { return false; }
+    // A smooth coat over a mirror is all delta lobes; otherwise the walk has glossy exits.
+    bool operator()(const CoatedConductorMaterial& c) const {
+      return c.roughness.effectively_smooth() && c.conductor.roughness.effectively_smooth();
+    }
   };
   return std::visit(V{}, m);
 }

@@ -11,7 +11,6 @@
 namespace bpm {
 namespace {
 
-DielectricMaterial coating(const CoatedDiffuseMaterial& m) { return DielectricMaterial{m.eta, m.roughness}; }
 
 TransportMode adjoint(TransportMode mode) {
   return mode == TransportMode::kRadiance ? TransportMode::kImportance : TransportMode::kRadiance;
@@ -32,12 +31,36 @@ bool usable(const std::optional<BsdfSample>& s) {
   return s && !s->f.is_black() && s->pdf_solid_angle > 0 && s->wi.z != 0;
 }
 
-// The Lambertian base, seen from inside the layer (directions above it, z > 0).
-float base_pdf(Vec3 wo, Vec3 wi) { return wo.z * wi.z > 0 ? std::fabs(wi.z) * kInvPi : 0; }
+// The reflector under the coating, seen from inside the layer: a Lambertian or a conductor
+// (any non-transmitting Material would do).
+struct Base {
+  Material m;
+  bool specular;
+  explicit Base(Material mat) : m(std::move(mat)), specular(bsdf_is_specular(m)) {}
+  Spectrum f(Vec3 wo, Vec3 wi, TransportMode mode) const { return bsdf_f(m, wo, wi, mode); }
+  float pdf(Vec3 wo, Vec3 wi, TransportMode mode) const { return bsdf_pdf(m, wo, wi, mode); }
+  std::optional<BsdfSample> sample(Vec3 wo, Rng& rng, TransportMode mode) const {
+    float uc = rng.uniform();
+    return bsdf_sample(m, wo, uc, {rng.uniform(), rng.uniform()}, mode);
+  }
+};
 
-}  // namespace
+struct Layer {
+  DielectricMaterial top;
+  Base base;
+  float thickness;
+  int max_depth, samples;
+};
 
-Spectrum coated_diffuse_f(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+Layer layer_of(const CoatedDiffuseMaterial& m) {
+  return Layer{DielectricMaterial{m.eta, m.roughness}, Base(DiffuseMaterial{m.reflectance}), m.thickness, m.max_depth,
+               m.samples};
+}
+Layer layer_of(const CoatedConductorMaterial& m) {
+  return Layer{DielectricMaterial{m.eta, m.roughness}, Base(m.conductor), m.thickness, m.max_depth, m.samples};
+}
+
+Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   // Two-sided: seen from below, the material is the same as from above.
   if (wo.z < 0) {
     wo = -wo;
@@ -45,12 +68,12 @@ Spectrum coated_diffuse_f(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, Tran
   }
   // The base does not transmit, so light leaves on the side it arrived from.
   if (wo.z == 0 || wi.z <= 0) return {};
-  const DielectricMaterial top = coating(m);
-  const bool top_smooth = m.roughness.effectively_smooth();
+  const DielectricMaterial& top = L.top;
+  const bool top_smooth = top.roughness.effectively_smooth();
   // Reflection off the coating itself (zero for a smooth coating: its mirror lobe is a delta).
-  Spectrum f = dielectric_f(top, wo, wi, mode) * float(m.samples);
+  Spectrum f = dielectric_f(top, wo, wi, mode) * float(L.samples);
   Rng rng(key_of(wo, wi));
-  for (int s = 0; s < m.samples; ++s) {
+  for (int s = 0; s < L.samples; ++s) {
     // Into the layer along wo, and the way out toward wi traced backwards (adjoint transport).
     auto in = dielectric_sample(top, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, mode, kTransmission);
     if (!usable(in)) continue;
@@ -59,13 +82,13 @@ Spectrum coated_diffuse_f(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, Tran
     Spectrum beta = in->f * (std::fabs(in->wi.z) / in->pdf_solid_angle);
     Vec3 w = in->wi;  // direction of travel inside the layer
     bool at_top = true;
-    for (int depth = 0; depth < m.max_depth; ++depth) {
+    for (int depth = 0; depth < L.max_depth; ++depth) {
       if (depth > 3 && beta.max_component() < 0.25f) {
         float q = std::fmax(0.0f, 1 - beta.max_component());
         if (rng.uniform() < q) break;
         beta /= 1 - q;
       }
-      beta *= layer_transmittance(m.thickness, w);
+      beta *= layer_transmittance(L.thickness, w);
       at_top = !at_top;
       if (at_top) {
         // Reflected back into the layer by the coating, from inside.
@@ -75,73 +98,72 @@ Spectrum coated_diffuse_f(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, Tran
         w = r->wi;
         continue;
       }
-      // At the base. Next-event estimation through the coating along the presampled way out,
-      // weighted against reaching it by sampling the base (power heuristic) unless the coating
-      // is smooth, where only this strategy can find it.
+      // At the base. Next-event estimation through the coating along the presampled way out
+      // (impossible for a mirror base), weighted against reaching it by sampling the base (power
+      // heuristic) unless the coating is smooth, where only this strategy can find it.
       Vec3 wb = -w, to_exit = -out->wi;
-      Spectrum base = wb.z * to_exit.z > 0 ? m.reflectance * kInvPi : Spectrum();
-      float wt = top_smooth ? 1 : power_heuristic(out->pdf_solid_angle, base_pdf(wb, to_exit));
-      f += beta * base * (std::fabs(out->wi.z) * wt * layer_transmittance(m.thickness, out->wi) / out->pdf_solid_angle) *
-           out->f;
-      // Sample the base: f cos / pdf = reflectance for a cosine-distributed direction.
-      Vec3 nw = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
-      if (nw.z == 0) break;
-      float pdf_b = cosine_hemisphere_pdf_solid_angle(nw.z);
-      beta *= m.reflectance;
-      w = nw;
+      if (!L.base.specular) {
+        float wt = top_smooth ? 1 : power_heuristic(out->pdf_solid_angle, L.base.pdf(wb, to_exit, mode));
+        f += beta * L.base.f(wb, to_exit, mode) *
+             (std::fabs(out->wi.z) * wt * layer_transmittance(L.thickness, out->wi) / out->pdf_solid_angle) * out->f;
+      }
+      auto b = L.base.sample(wb, rng, mode);
+      if (!usable(b)) break;
+      beta *= b->f * (std::fabs(b->wi.z) / b->pdf_solid_angle);
+      w = b->wi;
       if (!top_smooth) {
         Spectrum f_exit = dielectric_f(top, -w, wi, mode);
         if (!f_exit.is_black()) {
           // Both strategies' densities over the same variable, the direction leaving the base:
           // the other strategy would have drawn it by refracting wi into the layer.
-          float wt_exit = power_heuristic(pdf_b, dielectric_pdf(top, wi, -w, kTransmission));
-          f += beta * f_exit * (layer_transmittance(m.thickness, w) * wt_exit);
+          float wt_exit = L.base.specular ? 1 : power_heuristic(b->pdf_solid_angle, dielectric_pdf(top, wi, -w, kTransmission));
+          f += beta * f_exit * (layer_transmittance(L.thickness, w) * wt_exit);
         }
       }
     }
   }
-  return f / float(m.samples);
+  return f / float(L.samples);
 }
 
-float coated_diffuse_pdf(const CoatedDiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   if (wo.z < 0) {
     wo = -wo;
     wi = -wi;
   }
   float sum = 0;
   if (wi.z > 0 && wo.z > 0) {
-    const DielectricMaterial top = coating(m);
-    const bool top_smooth = m.roughness.effectively_smooth();
-    sum = float(m.samples) * dielectric_pdf(top, wo, wi, kReflection);
+    const DielectricMaterial& top = L.top;
+    const bool top_smooth = top.roughness.effectively_smooth();
+    sum = float(L.samples) * dielectric_pdf(top, wo, wi, kReflection);
     Rng rng(key_of(wi, wo));
-    for (int s = 0; s < m.samples; ++s) {
+    for (int s = 0; s < L.samples; ++s) {
       // Transmission, base reflection, transmission: the dominant path.
       auto in = dielectric_sample(top, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, mode, kTransmission);
       auto out = dielectric_sample(top, wi, rng.uniform(), {rng.uniform(), rng.uniform()}, adjoint(mode), kTransmission);
       if (!usable(in) || !usable(out)) continue;
       if (top_smooth) {
-        sum += base_pdf(-in->wi, -out->wi);
+        sum += L.base.pdf(-in->wi, -out->wi, mode);
         continue;
       }
-      float p_base = base_pdf(-in->wi, -out->wi);
-      sum += power_heuristic(out->pdf_solid_angle, p_base) * p_base;
-      Vec3 nw = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
-      float pdf_b = cosine_hemisphere_pdf_solid_angle(nw.z);
-      if (pdf_b == 0) continue;
-      float p_top = dielectric_pdf(top, -nw, wi, kTransmission);
-      sum += power_heuristic(pdf_b, p_top) * p_top;
+      auto b = L.base.sample(-in->wi, rng, mode);
+      if (!usable(b)) continue;
+      if (!L.base.specular) {
+        float p_base = L.base.pdf(-in->wi, -out->wi, mode);
+        sum += power_heuristic(out->pdf_solid_angle, p_base) * p_base;
+      }
+      float p_top = dielectric_pdf(top, -b->wi, wi, kTransmission);
+      sum += (L.base.specular ? 1 : power_heuristic(b->pdf_solid_angle, p_top)) * p_top;
     }
   }
   // Mixed with a uniform density (pbrt-v4 does the same), so that no direction the walk can
   // produce gets a zero MIS density.
-  return 0.1f / (4 * kPi) + 0.9f * sum / float(m.samples);
+  return 0.1f / (4 * kPi) + 0.9f * sum / float(L.samples);
 }
 
-std::optional<BsdfSample> coated_diffuse_sample(const CoatedDiffuseMaterial& m, Vec3 wo, float uc, Vec2 u,
-                                                TransportMode mode) {
+std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
   const bool flip = wo.z < 0;
   if (flip) wo = -wo;
-  const DielectricMaterial top = coating(m);
+  const DielectricMaterial& top = L.top;
   auto bs = dielectric_sample(top, wo, uc, u, mode, kReflection | kTransmission);
   if (!usable(bs)) return std::nullopt;
   if (!bs->is_transmission()) {  // reflected by the coating
@@ -152,8 +174,8 @@ std::optional<BsdfSample> coated_diffuse_sample(const CoatedDiffuseMaterial& m, 
   Spectrum f = bs->f * std::fabs(bs->wi.z);
   float pdf = bs->pdf_solid_angle;
   Vec3 w = bs->wi;
-  bool at_top = true;
-  for (int depth = 0; depth < m.max_depth; ++depth) {
+  bool at_top = true, specular_path = bs->is_specular();
+  for (int depth = 0; depth < L.max_depth; ++depth) {
     float rr = f.max_component() / pdf;
     if (depth > 3 && rr < 0.25f) {
       float q = std::fmax(0.0f, 1 - rr);
@@ -161,31 +183,47 @@ std::optional<BsdfSample> coated_diffuse_sample(const CoatedDiffuseMaterial& m, 
       pdf *= 1 - q;
     }
     if (w.z == 0) return std::nullopt;
-    f *= layer_transmittance(m.thickness, w);
+    f *= layer_transmittance(L.thickness, w);
     at_top = !at_top;
+    std::optional<BsdfSample> t;
     if (!at_top) {
-      Vec3 nw = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
-      float pdf_b = cosine_hemisphere_pdf_solid_angle(nw.z);
-      if (pdf_b == 0) return std::nullopt;
-      f *= m.reflectance * (kInvPi * nw.z);
-      pdf *= pdf_b;
-      w = nw;
-      continue;
+      t = L.base.sample(-w, rng, mode);
+    } else {
+      float uc2 = rng.uniform();
+      t = dielectric_sample(top, -w, uc2, {rng.uniform(), rng.uniform()}, mode, kReflection | kTransmission);
     }
-    auto t = dielectric_sample(top, -w, rng.uniform(), {rng.uniform(), rng.uniform()}, mode, kReflection | kTransmission);
     if (!usable(t)) return std::nullopt;
     f *= t->f;
     pdf *= t->pdf_solid_angle;
+    specular_path = specular_path && t->is_specular();
     w = t->wi;
     if (t->is_transmission()) {
-      // Out through the coating: a reflection of the whole material, never a delta (the base is
-      // diffuse).
+      // Out through the coating: a reflection of the whole material.
       if (flip) w = -w;
-      return BsdfSample{f, w, pdf, kReflection | kGlossy, 1};
+      return BsdfSample{f, w, pdf, kReflection | (specular_path ? kSpecular : kGlossy), 1};
     }
     f *= std::fabs(w.z);
   }
   return std::nullopt;
 }
 
+
+Layer layer_of(const Material& m) {
+  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) return layer_of(*d);
+  return layer_of(std::get<CoatedConductorMaterial>(m));
+}
+
+}  // namespace
+
+Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return layered_f(layer_of(m), wo, wi, mode);
+}
+float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return layered_pdf(layer_of(m), wo, wi, mode);
+}
+std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+  return layered_sample(layer_of(m), wo, uc, u, mode);
+}
+
 }  // namespace bpm
+

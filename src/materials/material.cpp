@@ -34,6 +34,11 @@ Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl) {
     }
     Material operator()(const PhongDesc& d) const { return PhongMaterial{d.reflectance.sample(wl), d.exponent}; }
     Material operator()(const InterfaceMaterial& d) const { return d; }
+    Material operator()(const CoatedConductorDesc& d) const {
+      CoatedConductorMaterial m = d.rest;
+      m.conductor = std::get<ConductorMaterial>((*this)(d.conductor));
+      return m;
+    }
     Material operator()(const CoatedDiffuseDesc& d) const {
       CoatedDiffuseMaterial m = d.rest;
       m.reflectance = d.reflectance.sample(wl);

@@ -70,12 +70,20 @@ struct CoatedDiffuseMaterial {
   int max_depth = 10, samples = 1;
 };
 
+// pbrt-v4's "coatedconductor": the same layered model over a conductor base (smooth or rough).
+struct CoatedConductorMaterial {
+  ConductorMaterial conductor;
+  Roughness roughness;  // of the coating
+  float eta = 1.5f, thickness = 0.01f;
+  int max_depth = 10, samples = 1;
+};
+
 // Marks a boundary that does not scatter (pbrt-v4 "interface"): rays pass straight through.
 struct InterfaceMaterial {};
 
 using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMaterial,
                               ThinDielectricMaterial, DiffuseTransmissionMaterial, PhongMaterial,
-                              InterfaceMaterial, CoatedDiffuseMaterial>;
+                              InterfaceMaterial, CoatedDiffuseMaterial, CoatedConductorMaterial>;
 
 // The scene's description of a material, with its colours as spectral curves. resolve_material
 // evaluates it at a path's wavelengths into the Material the BSDF functions take. The alternatives
@@ -100,8 +108,13 @@ struct CoatedDiffuseDesc {
   SpectrumCurve reflectance{0.5f};
   CoatedDiffuseMaterial rest;  // everything but the reflectance
 };
+struct CoatedConductorDesc {
+  ConductorDesc conductor;
+  CoatedConductorMaterial rest;  // everything but the conductor's eta and k
+};
 using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
-                                  DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc>;
+                                  DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc,
+                                  CoatedConductorDesc>;
 
 Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl);
 

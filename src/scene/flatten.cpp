@@ -219,10 +219,11 @@ class Flattener {
     return ps.get_float(name, def);
   }
 
-  Roughness roughness(const ParamSet& ps, const FileLoc& loc) {
-    float r = float_param(ps, "roughness", 0);
-    float u = ps.find_any("uroughness") ? float_param(ps, "uroughness", r) : r;
-    float v = ps.find_any("vroughness") ? float_param(ps, "vroughness", r) : r;
+  // prefix: "" for most materials, "interface." or "conductor." for coatedconductor's two layers.
+  Roughness roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix = "") {
+    float r = float_param(ps, prefix + "roughness", 0);
+    float u = ps.find_any(prefix + "uroughness") ? float_param(ps, prefix + "uroughness", r) : r;
+    float v = ps.find_any(prefix + "vroughness") ? float_param(ps, prefix + "vroughness", r) : r;
     if (u < 0 || v < 0) throw Error(loc, "roughness must not be negative");
     if (ps.get_bool("remaproughness", true)) {
       u = std::sqrt(u);  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha
@@ -232,19 +233,56 @@ class Flattener {
   }
 
   // A dielectric's index of refraction: a float, or a spectrum reduced to its value at 550 nm.
-  float dielectric_eta(const ParamSet& ps, const FileLoc& loc) {
+  float dielectric_eta(const ParamSet& ps, const FileLoc& loc, const std::string& name = "eta") {
     float eta = 1.5f;
-    const Param* p = ps.find_any("eta");
+    const Param* p = ps.find_any(name);
     if (p && p->type == "float") {
-      eta = ps.get_float("eta", 1.5f);
+      eta = ps.get_float(name, 1.5f);
     } else if (p) {
-      SpectrumCurve s = *spectrum_param(ps, "eta", SpectrumKind::kUnbounded);
+      SpectrumCurve s = *spectrum_param(ps, name, SpectrumKind::kUnbounded);
       if (s.max_value() - s.min_value() > 1e-4f)
         warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
       eta = s.value(550);
     }
     if (!(eta > 0)) throw Error(p ? p->loc : loc, "eta must be positive");
     return eta;
+  }
+
+  // A conductor from eta and k (copper by default) or from a reflectance; prefix names the
+  // parameters ("conductor." inside coatedconductor).
+  ConductorDesc conductor_desc(const ParamSet& ps, const FileLoc& loc, const std::string& prefix) {
+    ConductorDesc c;
+    // pbrt-v4's coatedconductor calls the base's reflectance plain "reflectance".
+    if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) {
+      c.reflectance = *r;
+      if (ps.find_any(prefix + "eta") || ps.find_any(prefix + "k"))
+        throw Error(loc, "conductor has both reflectance and eta/k");
+    } else {
+      c.eta = spectrum_param(ps, prefix + "eta", SpectrumKind::kUnbounded)
+                  .value_or(*named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
+      c.k = spectrum_param(ps, prefix + "k", SpectrumKind::kUnbounded)
+                .value_or(*named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
+    }
+    c.roughness = roughness(ps, loc, prefix);
+    return c;
+  }
+
+  // The layer of pbrt-v4's coated materials: thickness, bounce limit, walks per evaluation. A
+  // scattering medium inside the layer (albedo > 0) is not modelled.
+  void layer_params(const ParamSet& ps, const std::string& material, float* thickness, int* max_depth, int* samples) {
+    float t = float_param(ps, "thickness", 0.01f);
+    if (!(t > 0) || !std::isfinite(t)) throw Error(ps.find_any("thickness")->loc, "thickness must be positive");
+    *thickness = t;
+    auto count = [&](const char* name, int def) {
+      int v = ps.get_int(name, def);
+      if (v < 1 || v > 1000) throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
+      return v;
+    };
+    *max_depth = count("maxdepth", 10);
+    *samples = count("nsamples", 1);
+    if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && !a->is_black())
+      throw Error(ps.find_any("albedo")->loc, material + " with a scattering layer (albedo > 0) is not supported");
+    if (ps.find_any("g")) float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
   }
 
   MaterialDesc make_material(const SceneEntity& e) {
@@ -257,16 +295,7 @@ class Flattener {
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
       m = d;
     } else if (e.name == "conductor") {
-      ConductorDesc c;
-      if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) {
-        c.reflectance = *r;
-        if (ps.find_any("eta") || ps.find_any("k")) throw Error(e.loc, "conductor has both reflectance and eta/k");
-      } else {
-        c.eta = spectrum_param(ps, "eta", SpectrumKind::kUnbounded).value_or(*named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
-        c.k = spectrum_param(ps, "k", SpectrumKind::kUnbounded).value_or(*named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
-      }
-      c.roughness = roughness(ps, e.loc);
-      m = c;
+      m = conductor_desc(ps, e.loc, "");
     } else if (e.name == "dielectric" || e.name == "thindielectric") {
       float eta = dielectric_eta(ps, e.loc);
       if (e.name == "dielectric") m = DielectricMaterial{eta, roughness(ps, e.loc)};
@@ -285,24 +314,15 @@ class Flattener {
       CoatedDiffuseDesc c;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
       c.rest.roughness = roughness(ps, e.loc);
-      auto positive = [&](const char* name, float def) {
-        float v = float_param(ps, name, def);
-        if (!(v > 0) || !std::isfinite(v)) throw Error(ps.find_any(name)->loc, std::string(name) + " must be positive");
-        return v;
-      };
-      c.rest.thickness = positive("thickness", 0.01f);
       c.rest.eta = dielectric_eta(ps, e.loc);
-      auto count = [&](const char* name, int def) {
-        int v = ps.get_int(name, def);
-        if (v < 1 || v > 1000) throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
-        return v;
-      };
-      c.rest.max_depth = count("maxdepth", 10);
-      c.rest.samples = count("nsamples", 1);
-      // A scattering medium inside the layer (albedo > 0) is not modelled.
-      if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && !a->is_black())
-        throw Error(ps.find_any("albedo")->loc, "coateddiffuse with a scattering layer (albedo > 0) is not supported");
-      if (ps.find_any("g")) float_param(ps, "g", 0);  // the phase function of that medium: irrelevant without it
+      layer_params(ps, e.name, &c.rest.thickness, &c.rest.max_depth, &c.rest.samples);
+      m = c;
+    } else if (e.name == "coatedconductor") {
+      CoatedConductorDesc c;
+      c.rest.roughness = roughness(ps, e.loc, "interface.");
+      c.rest.eta = dielectric_eta(ps, e.loc, "interface.eta");
+      c.conductor = conductor_desc(ps, e.loc, "conductor.");
+      layer_params(ps, e.name, &c.rest.thickness, &c.rest.max_depth, &c.rest.samples);
       m = c;
     } else if (e.name == "phong") {
       // bpm's own non-reciprocal glossy lobe (material.h); pbrt-v4 does not know it.

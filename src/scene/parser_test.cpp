@@ -1503,6 +1503,25 @@ TEST(SceneParams, CoatedDiffuse) {
   EXPECT_TRUE(d.rest.roughness.effectively_smooth());
 }
 
+TEST(SceneParams, CoatedConductor) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"coatedconductor\" \"float interface.roughness\" 0.09 \"float interface.eta\" 1.4 "
+      "\"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\" "
+      "\"float conductor.roughness\" 0.16 \"float thickness\" 0.02\nShape \"sphere\"\n"
+      "Material \"coatedconductor\" \"rgb reflectance\" [0.9 0.5 0.2]\nShape \"sphere\"\n"));
+  const auto& c = std::get<CoatedConductorDesc>(ls.scene.materials[ls.scene.objects[0].material]);
+  EXPECT_NEAR(c.rest.roughness.alpha_x, 0.3f, 1e-6f);
+  EXPECT_FLOAT_EQ(c.rest.eta, 1.4f);
+  EXPECT_FLOAT_EQ(c.rest.thickness, 0.02f);
+  EXPECT_NEAR(c.conductor.roughness.alpha_x, 0.4f, 1e-6f);
+  expect_spectrum_near(c.conductor.eta, *named_spectrum("metal-Au-eta", SpectrumKind::kUnbounded));
+  const auto& d = std::get<CoatedConductorDesc>(ls.scene.materials[ls.scene.objects[1].material]);
+  ASSERT_TRUE(d.conductor.reflectance.has_value());
+  expect_spectrum_near(*d.conductor.reflectance, Rgb(0.9f, 0.5f, 0.2f));
+  EXPECT_FLOAT_EQ(d.rest.eta, 1.5f);
+  EXPECT_TRUE(d.rest.roughness.effectively_smooth());
+}
+
 TEST(SceneFlattenError, CoatedDiffuseBadValues) {
   const std::string l1 = R"(Material "coateddiffuse" "float thickness" -1)";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\nShape \"sphere\"\n"), at(2, col(l1, "\"float thickness")),
