@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "base/error.h"
+#include "film/image_compare.h"
 #include "film/image_io.h"
 #include "film/outputs.h"
 #include "render/renderer.h"
@@ -224,20 +225,12 @@ int run_compare(const std::string& a_path, const std::string& b_path) {
   if (a.width != b.width || a.height != b.height)
     throw Error("images differ in size: " + std::to_string(a.width) + "x" + std::to_string(a.height) + " vs " +
                 std::to_string(b.width) + "x" + std::to_string(b.height));
-  double ma[3] = {0, 0, 0}, mb[3] = {0, 0, 0}, rel_mse = 0;
-  size_t n = size_t(a.width) * a.height;
-  for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      double x = a.rgb[3 * i + c], y = b.rgb[3 * i + c];
-      ma[c] += x;
-      mb[c] += y;
-      rel_mse += (x - y) * (x - y) / (y * y + 0.01);
-    }
-  rel_mse /= 3.0 * n;
-  std::printf("mean A      %.6f %.6f %.6f\n", ma[0] / n, ma[1] / n, ma[2] / n);
-  std::printf("mean B      %.6f %.6f %.6f\n", mb[0] / n, mb[1] / n, mb[2] / n);
+  ImageComparison c = compare_images(a, b);
+  const auto &ma = c.mean_a, &mb = c.mean_b;
+  std::printf("mean A      %.6f %.6f %.6f\n", ma[0], ma[1], ma[2]);
+  std::printf("mean B      %.6f %.6f %.6f\n", mb[0], mb[1], mb[2]);
   std::printf("mean A/B-1  %+.4f %+.4f %+.4f\n", ma[0] / mb[0] - 1, ma[1] / mb[1] - 1, ma[2] / mb[2] - 1);
-  std::printf("relMSE      %.6f   (mean over pixels and channels of (a-b)^2/(b^2+0.01))\n", rel_mse);
+  std::printf("relMSE      %.6f   (mean over pixels and channels of (a-b)^2/(b^2+0.01))\n", c.rel_mse);
   return 0;
 }
 

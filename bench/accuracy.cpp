@@ -35,12 +35,7 @@ struct Rendered {
 Rendered run(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed, double accuracy = 0,
              bool adaptive = false) {
   Rendered r{Film(ls.film.width, ls.film.height, 4), {}};
-  RenderOptions opt;
-  opt.integrator = integrator;
-  opt.spp = passes;
-  opt.seed = seed;
-  opt.max_depth = ls.render.max_depth;
-  opt.progress = false;
+  RenderOptions opt = quiet_options(ls, integrator, passes, seed);
   opt.accuracy = accuracy;
   opt.adaptive = adaptive;
   opt.bpm.photons_per_batch = 30000;

@@ -35,14 +35,9 @@ namespace {
 
 RenderStats run(const LoadedScene& ls, const std::string& integrator, int iterations, double time_s, int threads,
                 const BpmSettings& bs, Film* film, uint64_t seed = 1) {
-  RenderOptions opt;
-  opt.integrator = integrator;
-  opt.spp = iterations;
+  RenderOptions opt = quiet_options(ls, integrator, iterations, seed);
   opt.time_limit_s = time_s;
   opt.threads = threads;
-  opt.seed = seed;
-  opt.max_depth = ls.render.max_depth;
-  opt.progress = false;
   opt.bpm = bs;
   return render(ls, opt, film);
 }

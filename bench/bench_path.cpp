@@ -55,11 +55,8 @@ int main(int argc, char** argv) {
   std::printf("recorded %zu closest-hit and %zu shadow rays\n", log.closest_hit.size(), log.shadow.size());
 
   for (int threads : {1, hw}) {
-    RenderOptions opt;
-    opt.spp = spp;
+    RenderOptions opt = quiet_options(ls, "path", spp);
     opt.threads = threads;
-    opt.max_depth = ls.render.max_depth;
-    opt.progress = false;
     Film film(res, res);
     RenderStats st = render(ls, opt, &film);
     double path_rate = st.rays.total() / st.render_seconds;

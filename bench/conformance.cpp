@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "film/image_compare.h"
 #include "film/image_io.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
@@ -43,24 +44,6 @@ std::optional<Reference> find_reference(const fs::path& dir, const std::string& 
     if (!best || r.spp > best->spp) best = r;
   }
   return best;
-}
-
-std::array<double, 3> channel_means(const Image& img) {
-  std::array<double, 3> m{0, 0, 0};
-  size_t n = size_t(img.width) * img.height;
-  for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) m[c] += img.rgb[3 * i + c];
-  for (double& v : m) v /= double(n);
-  return m;
-}
-
-double rel_mse(const Image& a, const Image& b) {
-  double s = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i) {
-    double d = a.rgb[i] - b.rgb[i];
-    s += d * d / (double(b.rgb[i]) * b.rgb[i] + 0.01);
-  }
-  return s / double(a.rgb.size());
 }
 
 }  // namespace
@@ -105,10 +88,7 @@ int main(int argc, char** argv) {
       }
       ls.film.width = w;
       ls.film.height = h;
-      RenderOptions opt;
-      opt.spp = spp;
-      opt.max_depth = ls.render.max_depth;
-      opt.progress = false;
+      RenderOptions opt = quiet_options(ls, "path", spp);
       Film film(w, h);
       auto t0 = std::chrono::steady_clock::now();
       render(ls, opt, &film);
@@ -117,9 +97,9 @@ int main(int argc, char** argv) {
       auto m = channel_means(img);
       std::printf("| %s | %dx%d | %.1f | %.4f %.4f %.4f |", label.c_str(), w, h, secs, m[0], m[1], m[2]);
       if (ref) {
-        Image r = read_exr(ref->path.string());
-        auto mr = channel_means(r);
-        std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2], rel_mse(img, r));
+        ImageComparison c = compare_images(img, read_exr(ref->path.string()));
+        const auto& mr = c.mean_b;
+        std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2], c.rel_mse);
       } else {
         std::printf(" no reference | |\n");
       }

@@ -68,10 +68,7 @@ int main(int argc, char** argv) {
     LoadedScene ls = flatten_scene(parse_scene_file(path));
     ls.film.width = w;
     ls.film.height = h;
-    RenderOptions opt;
-    opt.max_depth = ls.render.max_depth;
-    opt.progress = false;
-    opt.seed = 1;
+    RenderOptions opt = quiet_options(ls, "path", 16, 1);
     opt.bpm.photons_per_batch = photons;
 
     Run f;

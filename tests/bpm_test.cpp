@@ -41,12 +41,7 @@ struct RenderRun {
 // Options for a quiet render of `ls` with the file's maxdepth.
 RenderOptions test_options(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed = 1,
                            const BpmSettings& bpm = {}, const FpmSettings& fpm = {}) {
-  RenderOptions opt;
-  opt.integrator = integrator;
-  opt.spp = passes;
-  opt.seed = seed;
-  opt.max_depth = ls.render.max_depth;
-  opt.progress = false;
+  RenderOptions opt = quiet_options(ls, integrator, passes, seed);
   opt.bpm = bpm;
   opt.fpm = fpm;
   return opt;

@@ -2,34 +2,12 @@
 // Skipped when ../shared is absent (a user's clone has none).
 #include <cmath>
 
+#include "film/image_compare.h"
 #include "film/image_io.h"
 #include "test_util.h"
 
 namespace bpm {
 namespace {
-
-struct Moments {
-  double mean[3] = {0, 0, 0};
-};
-
-Moments channel_means(const Image& img) {
-  Moments m;
-  size_t n = size_t(img.width) * img.height;
-  for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) m.mean[c] += img.rgb[3 * i + c];
-  for (double& v : m.mean) v /= n;
-  return m;
-}
-
-// The metric of ../shared/references/README.md.
-double rel_mse(const Image& a, const Image& b) {
-  double s = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i) {
-    double d = a.rgb[i] - b.rgb[i];
-    s += d * d / (double(b.rgb[i]) * b.rgb[i] + 0.01);
-  }
-  return s / a.rgb.size();
-}
 
 struct Case {
   const char* scene;
@@ -55,21 +33,21 @@ TEST_P(Reference, MatchesPbrtV4) {
   ASSERT_EQ(ref.width, c.width);
   ASSERT_EQ(ref.height, c.height);
 
-  Moments ma = channel_means(a), mb = channel_means(b), mr = channel_means(ref);
+  auto ma = channel_means(a), mb = channel_means(b), mr = channel_means(ref);
   for (int ch = 0; ch < 3; ++ch) {
     // The spread of our two independent means bounds the noise in the comparison.
-    double noise = std::fabs(ma.mean[ch] - mb.mean[ch]);
-    double diff = std::fabs(0.5 * (ma.mean[ch] + mb.mean[ch]) / mr.mean[ch] - 1);
+    double noise = std::fabs(ma[ch] - mb[ch]);
+    double diff = std::fabs(0.5 * (ma[ch] + mb[ch]) / mr[ch] - 1);
     std::printf("%s channel %d: bpm/pbrt-v4 - 1 = %+.4f (noise %.4f)\n", c.scene, ch,
-                0.5 * (ma.mean[ch] + mb.mean[ch]) / mr.mean[ch] - 1, noise / mr.mean[ch]);
+                0.5 * (ma[ch] + mb[ch]) / mr[ch] - 1, noise / mr[ch]);
     // Every channel within 3% (both renderers transport spectra, so saturated interreflections
     // agree too).
-    EXPECT_LT(diff, 0.03 + 3 * noise / mr.mean[ch]) << "channel " << ch;
+    EXPECT_LT(diff, 0.03 + 3 * noise / mr[ch]) << "channel " << ch;
   }
   // What remains per pixel is noise: our render differs from pbrt-v4's (whose own noise is
   // negligible at 2048 spp) no more than from another render of ours. E[relMSE(a, ref)] is
   // sigma^2 + bias^2 and E[relMSE(a, b)] is 2 sigma^2, so this fails once bias^2 ~ sigma^2.
-  double to_ref = rel_mse(a, ref), to_ours = rel_mse(a, b);
+  double to_ref = compare_images(a, ref).rel_mse, to_ours = compare_images(a, b).rel_mse;
   std::printf("%s relMSE to pbrt-v4 %.5f, to an independent bpm render %.5f\n", c.scene, to_ref, to_ours);
   EXPECT_LT(to_ref, to_ours);
 }

@@ -17,13 +17,8 @@ inline LoadedScene load(const std::string& text) { return flatten_scene(parse_sc
 
 inline Film render_film(const LoadedScene& ls, int spp, int threads = 0, uint64_t seed = 1) {
   Film film(ls.film.width, ls.film.height);
-  RenderOptions opt;
-  opt.integrator = ls.render.integrator;
-  opt.spp = spp;
+  RenderOptions opt = quiet_options(ls, ls.render.integrator, spp, seed);
   opt.threads = threads;
-  opt.seed = seed;
-  opt.max_depth = ls.render.max_depth;
-  opt.progress = false;
   render(ls, opt, &film);
   return film;
 }

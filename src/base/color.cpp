@@ -284,18 +284,11 @@ SpectrumCurve SpectrumCurve::from_pairs(const std::vector<double>& pairs, Spectr
 
 SpectrumCurve SpectrumCurve::blackbody(float T) {
   const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
-  std::vector<float> values(kTableSize);
-  double peak = 0;
-  std::vector<double> planck(kTableSize);
-  for (int i = 0; i < kTableSize; ++i) {
-    double l = (kLambdaMin + i) * 1e-9;
-    planck[i] = (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1));
-    peak = std::max(peak, planck[i]);
-  }
+  auto planck = [&](double l) { return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1)); };
   // Normalised to 1 at the peak of the curve (Wien's law), as pbrt-v4.
-  double l_max = 2.8977721e-3 / T;
-  double peak_value = (2 * h * c * c) / (std::pow(l_max, 5) * (std::exp((h * c) / (l_max * kb * T)) - 1));
-  for (int i = 0; i < kTableSize; ++i) values[i] = float(planck[i] / peak_value);
+  const double peak = planck(2.8977721e-3 / T);
+  std::vector<float> values(kTableSize);
+  for (int i = 0; i < kTableSize; ++i) values[i] = float(planck((kLambdaMin + i) * 1e-9) / peak);
   return from_table(std::move(values), SpectrumKind::kIlluminant);
 }
 

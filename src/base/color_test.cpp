@@ -139,8 +139,8 @@ TEST(Color, BlackbodyPeaksAtOneAndReddensWhenCooler) {
 TEST(Color, TwoBouncesDifferFromTheRgbProduct) {
   Rgb wall(0.14f, 0.45f, 0.091f);
   SpectrumCurve s = SpectrumCurve::from_rgb(wall, SpectrumKind::kAlbedo);
-  std::vector<float> squared(471);
-  for (int i = 0; i < 471; ++i) squared[i] = s.value(kLambdaMin + i) * s.value(kLambdaMin + i);
+  std::vector<float> squared;  // at 1 nm steps, as from_table takes them
+  for (float l = kLambdaMin; l <= kLambdaMax; l += 1) squared.push_back(s.value(l) * s.value(l));
   Rgb spectral = SpectrumCurve::from_table(squared, SpectrumKind::kAlbedo).rgb();
   Rgb product = wall * wall;
   EXPECT_GT(std::fabs(spectral[2] / product[2] - 1), 0.05f) << "blue " << spectral[2] << " vs " << product[2];

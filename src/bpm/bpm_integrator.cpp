@@ -30,8 +30,6 @@ float radius_scale(const BpmSettings& s, int iteration) {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 // Domain separation of photon streams from pixel streams.
 constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;

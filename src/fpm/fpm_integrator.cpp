@@ -22,8 +22,6 @@
 namespace bpm {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 constexpr uint64_t kPhotonStream = 0x66706d70686f74ull;
 

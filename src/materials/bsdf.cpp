@@ -350,7 +350,7 @@ bool bsdf_is_specular(const Material& m) {
     bool operator()(const CoatedDiffuseMaterial&) const { return false; }
     // A smooth coat over a mirror is all delta lobes; otherwise the walk has glossy exits.
     bool operator()(const CoatedConductorMaterial& c) const {
-      return c.roughness.effectively_smooth() && c.conductor.roughness.effectively_smooth();
+      return c.layer.roughness.effectively_smooth() && c.conductor.roughness.effectively_smooth();
     }
   };
   return std::visit(V{}, m);

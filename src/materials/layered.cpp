@@ -50,15 +50,10 @@ struct Layer {
   Base base;
   float thickness;
   int max_depth, samples;
+  Layer(const CoatLayer& c, Material base_material)
+      : top{c.eta, c.roughness}, base(std::move(base_material)), thickness(c.thickness), max_depth(c.max_depth),
+        samples(c.samples) {}
 };
-
-Layer layer_of(const CoatedDiffuseMaterial& m) {
-  return Layer{DielectricMaterial{m.eta, m.roughness}, Base(DiffuseMaterial{m.reflectance}), m.thickness, m.max_depth,
-               m.samples};
-}
-Layer layer_of(const CoatedConductorMaterial& m) {
-  return Layer{DielectricMaterial{m.eta, m.roughness}, Base(m.conductor), m.thickness, m.max_depth, m.samples};
-}
 
 Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   // Two-sided: seen from below, the material is the same as from above.
@@ -209,8 +204,9 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
 
 
 Layer layer_of(const Material& m) {
-  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) return layer_of(*d);
-  return layer_of(std::get<CoatedConductorMaterial>(m));
+  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) return Layer(d->layer, DiffuseMaterial{d->reflectance});
+  const auto& c = std::get<CoatedConductorMaterial>(m);
+  return Layer(c.layer, c.conductor);
 }
 
 }  // namespace

@@ -22,8 +22,8 @@ namespace {
 CoatedDiffuseMaterial coated(float reflectance, float alpha, float thickness = 0.01f) {
   CoatedDiffuseMaterial m;
   m.reflectance = Spectrum(reflectance);
-  m.roughness = Roughness{alpha, alpha};
-  m.thickness = thickness;
+  m.layer.roughness = Roughness{alpha, alpha};
+  m.layer.thickness = thickness;
   return m;
 }
 
@@ -58,7 +58,7 @@ TEST(CoatedDiffuse, WhiteBaseUnderSmoothCoatingConservesEnergy) {
   // Thin layer (no attenuation), many bounces allowed, a smooth boundary (which loses nothing):
   // all light comes back out.
   CoatedDiffuseMaterial c = coated(1.0f, 0.0f, 1e-6f);
-  c.max_depth = 200;
+  c.layer.max_depth = 200;
   Material m = c;
   for (float cos_o : {0.9f, 0.4f, -0.7f}) {
     MeanAccumulator s = sampled_albedo(m, direction(cos_o, 0.7f), 100000, 3);
@@ -72,7 +72,7 @@ TEST(CoatedDiffuse, WhiteBaseUnderSmoothCoatingConservesEnergy) {
 // cent above its own sampling on rough coatings; bpm uses the competing strategy's density.)
 TEST(CoatedDiffuse, RoughCoatingSampledAndEvaluatedAlbedosAgree) {
   CoatedDiffuseMaterial c = coated(1.0f, 0.3f, 1e-6f);
-  c.max_depth = 200;
+  c.layer.max_depth = 200;
   Material m = c;
   for (float cos_o : {0.9f, 0.4f, -0.7f}) {
     Vec3 wo = direction(cos_o, 0.7f);
@@ -133,7 +133,7 @@ TEST(CoatedDiffuse, SampledWeightsMatchEvaluatedBsdfPerBin) {
 
 CoatedConductorMaterial coated_gold(float coat_alpha, float base_alpha) {
   CoatedConductorMaterial m;
-  m.roughness = Roughness{coat_alpha, coat_alpha};
+  m.layer.roughness = Roughness{coat_alpha, coat_alpha};
   m.conductor.eta = Spectrum(0.3f);
   m.conductor.eta[2] = 1.2f;
   m.conductor.k = Spectrum(2.8f);
@@ -151,8 +151,8 @@ TEST(CoatedConductor, SmoothCoatOverMirrorConservesEnergyAndIsSpecular) {
   CoatedConductorMaterial c = coated_gold(0.0f, 0.0f);
   c.conductor.eta = Spectrum(1.0f);
   c.conductor.k = Spectrum(1e4f);  // reflectance 1 at every angle
-  c.thickness = 1e-6f;
-  c.max_depth = 200;
+  c.layer.thickness = 1e-6f;
+  c.layer.max_depth = 200;
   Material m = c;
   EXPECT_TRUE(bsdf_is_specular(m));
   for (float cos_o : {0.9f, 0.3f}) {
@@ -164,7 +164,7 @@ TEST(CoatedConductor, SmoothCoatOverMirrorConservesEnergyAndIsSpecular) {
 
 TEST(CoatedDiffuse, ReciprocalInExpectation) {
   CoatedDiffuseMaterial c = coated(0.6f, 0.3f);
-  c.samples = 4000;  // many walks per value, so that one evaluation is close to the expectation
+  c.layer.samples = 4000;  // many walks per value, so that one evaluation is close to the expectation
   Material m = c;
   for (auto [a, b] : {std::pair{direction(0.9f, 0.3f), direction(0.3f, 2.0f)}, {direction(0.5f, 1.0f), direction(0.7f, 4.0f)}}) {
     float fab = bsdf_f(m, a, b, TransportMode::kRadiance)[0], fba = bsdf_f(m, b, a, TransportMode::kRadiance)[0];

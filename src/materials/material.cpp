@@ -35,14 +35,10 @@ Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl) {
     Material operator()(const PhongDesc& d) const { return PhongMaterial{d.reflectance.sample(wl), d.exponent}; }
     Material operator()(const InterfaceMaterial& d) const { return d; }
     Material operator()(const CoatedConductorDesc& d) const {
-      CoatedConductorMaterial m = d.rest;
-      m.conductor = std::get<ConductorMaterial>((*this)(d.conductor));
-      return m;
+      return CoatedConductorMaterial{std::get<ConductorMaterial>((*this)(d.conductor)), d.layer};
     }
     Material operator()(const CoatedDiffuseDesc& d) const {
-      CoatedDiffuseMaterial m = d.rest;
-      m.reflectance = d.reflectance.sample(wl);
-      return m;
+      return CoatedDiffuseMaterial{d.reflectance.sample(wl), d.layer};
     }
   };
   return std::visit(V{wl}, desc);

@@ -58,24 +58,27 @@ struct PhongMaterial {
   float exponent = 20;
 };
 
-// pbrt-v4's "coateddiffuse": a dielectric coating (index eta, GGX roughness) over a Lambertian base
-// of the given reflectance, with a non-scattering layer of the given thickness between them that
-// attenuates as exp(-thickness / |cos|). Light bounces inside the layer; the BSDF is the expected
-// value of those random walks (pbrt-v4's stochastic LayeredBxDF, two-sided, at most max_depth
-// bounces): f and pdf are unbiased estimates seeded by the directions (materials/layered.h).
-struct CoatedDiffuseMaterial {
-  Spectrum reflectance{0.5f};
+// The coat of pbrt-v4's layered materials: a dielectric boundary (index eta, GGX roughness) over a
+// base, with a non-scattering layer of the given thickness between them that attenuates as
+// exp(-thickness / |cos|). Light bounces inside the layer; the BSDF is the expected value of those
+// random walks (pbrt-v4's stochastic LayeredBxDF, two-sided, at most max_depth bounces, `samples`
+// walks per value): f and pdf are estimates seeded by the directions (materials/layered.h).
+struct CoatLayer {
   Roughness roughness;
   float eta = 1.5f, thickness = 0.01f;
   int max_depth = 10, samples = 1;
 };
 
-// pbrt-v4's "coatedconductor": the same layered model over a conductor base (smooth or rough).
+// pbrt-v4's "coateddiffuse": the coat over a Lambertian base.
+struct CoatedDiffuseMaterial {
+  Spectrum reflectance{0.5f};
+  CoatLayer layer;
+};
+
+// pbrt-v4's "coatedconductor": the coat over a conductor base (smooth or rough).
 struct CoatedConductorMaterial {
   ConductorMaterial conductor;
-  Roughness roughness;  // of the coating
-  float eta = 1.5f, thickness = 0.01f;
-  int max_depth = 10, samples = 1;
+  CoatLayer layer;
 };
 
 // Marks a boundary that does not scatter (pbrt-v4 "interface"): rays pass straight through.
@@ -106,11 +109,11 @@ struct PhongDesc {
 };
 struct CoatedDiffuseDesc {
   SpectrumCurve reflectance{0.5f};
-  CoatedDiffuseMaterial rest;  // everything but the reflectance
+  CoatLayer layer;
 };
 struct CoatedConductorDesc {
   ConductorDesc conductor;
-  CoatedConductorMaterial rest;  // everything but the conductor's eta and k
+  CoatLayer layer;
 };
 using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
                                   DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc,

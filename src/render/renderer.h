@@ -34,6 +34,18 @@ struct RenderOptions {
   FpmSettings fpm;
 };
 
+// Options for a render of `ls` without a progress line, with the file's maxdepth: what tests and
+// benchmarks start from.
+inline RenderOptions quiet_options(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed = 0) {
+  RenderOptions opt;
+  opt.integrator = integrator;
+  opt.spp = passes;
+  opt.seed = seed;
+  opt.max_depth = ls.render.max_depth;
+  opt.progress = false;
+  return opt;
+}
+
 struct StageTime {
   std::string name;
   double seconds = 0;

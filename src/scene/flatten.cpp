@@ -267,22 +267,27 @@ class Flattener {
     return c;
   }
 
-  // The layer of pbrt-v4's coated materials: thickness, bounce limit, walks per evaluation. A
-  // scattering medium inside the layer (albedo > 0) is not modelled.
-  void layer_params(const ParamSet& ps, const std::string& material, float* thickness, int* max_depth, int* samples) {
-    float t = float_param(ps, "thickness", 0.01f);
-    if (!(t > 0) || !std::isfinite(t)) throw Error(ps.find_any("thickness")->loc, "thickness must be positive");
-    *thickness = t;
+  // The coat of pbrt-v4's coated materials; prefix names the coat's roughness and eta
+  // ("interface." in coatedconductor). A scattering medium inside the layer (albedo > 0) is not
+  // modelled.
+  CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix) {
+    CoatLayer c;
+    c.roughness = roughness(ps, e.loc, prefix);
+    c.eta = dielectric_eta(ps, e.loc, prefix + "eta");
+    c.thickness = float_param(ps, "thickness", 0.01f);
+    if (!(c.thickness > 0) || !std::isfinite(c.thickness))
+      throw Error(ps.find_any("thickness")->loc, "thickness must be positive");
     auto count = [&](const char* name, int def) {
       int v = ps.get_int(name, def);
       if (v < 1 || v > 1000) throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
       return v;
     };
-    *max_depth = count("maxdepth", 10);
-    *samples = count("nsamples", 1);
+    c.max_depth = count("maxdepth", 10);
+    c.samples = count("nsamples", 1);
     if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && !a->is_black())
-      throw Error(ps.find_any("albedo")->loc, material + " with a scattering layer (albedo > 0) is not supported");
+      throw Error(ps.find_any("albedo")->loc, e.name + " with a scattering layer (albedo > 0) is not supported");
     if (ps.find_any("g")) float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
+    return c;
   }
 
   MaterialDesc make_material(const SceneEntity& e) {
@@ -313,16 +318,12 @@ class Flattener {
     } else if (e.name == "coateddiffuse") {
       CoatedDiffuseDesc c;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
-      c.rest.roughness = roughness(ps, e.loc);
-      c.rest.eta = dielectric_eta(ps, e.loc);
-      layer_params(ps, e.name, &c.rest.thickness, &c.rest.max_depth, &c.rest.samples);
+      c.layer = coat_layer(ps, e, "");
       m = c;
     } else if (e.name == "coatedconductor") {
       CoatedConductorDesc c;
-      c.rest.roughness = roughness(ps, e.loc, "interface.");
-      c.rest.eta = dielectric_eta(ps, e.loc, "interface.eta");
+      c.layer = coat_layer(ps, e, "interface.");
       c.conductor = conductor_desc(ps, e.loc, "conductor.");
-      layer_params(ps, e.name, &c.rest.thickness, &c.rest.max_depth, &c.rest.samples);
       m = c;
     } else if (e.name == "phong") {
       // bpm's own non-reciprocal glossy lobe (material.h); pbrt-v4 does not know it.

@@ -1488,19 +1488,19 @@ TEST(SceneParams, CoatedDiffuse) {
   ASSERT_TRUE(std::holds_alternative<CoatedDiffuseDesc>(m));
   const CoatedDiffuseDesc& c = std::get<CoatedDiffuseDesc>(m);
   expect_spectrum_near(c.reflectance, Rgb(0.2f, 0.4f, 0.6f));
-  EXPECT_NEAR(c.rest.roughness.alpha_x, 0.2f, 1e-6f);  // remapped
-  EXPECT_FLOAT_EQ(c.rest.thickness, 0.05f);
-  EXPECT_FLOAT_EQ(c.rest.eta, 1.33f);
-  EXPECT_EQ(c.rest.max_depth, 5);
-  EXPECT_EQ(c.rest.samples, 2);
+  EXPECT_NEAR(c.layer.roughness.alpha_x, 0.2f, 1e-6f);  // remapped
+  EXPECT_FLOAT_EQ(c.layer.thickness, 0.05f);
+  EXPECT_FLOAT_EQ(c.layer.eta, 1.33f);
+  EXPECT_EQ(c.layer.max_depth, 5);
+  EXPECT_EQ(c.layer.samples, 2);
   // pbrt-v4's defaults.
   const CoatedDiffuseDesc& d = std::get<CoatedDiffuseDesc>(ls.scene.materials[ls.scene.objects[1].material]);
   expect_spectrum_near(d.reflectance, Rgb(0.5f));
-  EXPECT_FLOAT_EQ(d.rest.thickness, 0.01f);
-  EXPECT_FLOAT_EQ(d.rest.eta, 1.5f);
-  EXPECT_EQ(d.rest.max_depth, 10);
-  EXPECT_EQ(d.rest.samples, 1);
-  EXPECT_TRUE(d.rest.roughness.effectively_smooth());
+  EXPECT_FLOAT_EQ(d.layer.thickness, 0.01f);
+  EXPECT_FLOAT_EQ(d.layer.eta, 1.5f);
+  EXPECT_EQ(d.layer.max_depth, 10);
+  EXPECT_EQ(d.layer.samples, 1);
+  EXPECT_TRUE(d.layer.roughness.effectively_smooth());
 }
 
 TEST(SceneParams, CoatedConductor) {
@@ -1510,16 +1510,16 @@ TEST(SceneParams, CoatedConductor) {
       "\"float conductor.roughness\" 0.16 \"float thickness\" 0.02\nShape \"sphere\"\n"
       "Material \"coatedconductor\" \"rgb reflectance\" [0.9 0.5 0.2]\nShape \"sphere\"\n"));
   const auto& c = std::get<CoatedConductorDesc>(ls.scene.materials[ls.scene.objects[0].material]);
-  EXPECT_NEAR(c.rest.roughness.alpha_x, 0.3f, 1e-6f);
-  EXPECT_FLOAT_EQ(c.rest.eta, 1.4f);
-  EXPECT_FLOAT_EQ(c.rest.thickness, 0.02f);
+  EXPECT_NEAR(c.layer.roughness.alpha_x, 0.3f, 1e-6f);
+  EXPECT_FLOAT_EQ(c.layer.eta, 1.4f);
+  EXPECT_FLOAT_EQ(c.layer.thickness, 0.02f);
   EXPECT_NEAR(c.conductor.roughness.alpha_x, 0.4f, 1e-6f);
   expect_spectrum_near(c.conductor.eta, *named_spectrum("metal-Au-eta", SpectrumKind::kUnbounded));
   const auto& d = std::get<CoatedConductorDesc>(ls.scene.materials[ls.scene.objects[1].material]);
   ASSERT_TRUE(d.conductor.reflectance.has_value());
   expect_spectrum_near(*d.conductor.reflectance, Rgb(0.9f, 0.5f, 0.2f));
-  EXPECT_FLOAT_EQ(d.rest.eta, 1.5f);
-  EXPECT_TRUE(d.rest.roughness.effectively_smooth());
+  EXPECT_FLOAT_EQ(d.layer.eta, 1.5f);
+  EXPECT_TRUE(d.layer.roughness.effectively_smooth());
 }
 
 TEST(SceneFlattenError, CoatedDiffuseBadValues) {
