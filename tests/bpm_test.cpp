@@ -271,6 +271,93 @@ TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
     }
 }
 
+// A furnace whose albedo is a checkerboard texture over the sphere's (u, v) (0.3 and 0.7, 8 x 4
+// cells: u follows the azimuth, v runs from the south pole to the north, as pbrt-v4). Inside a
+// sphere every point sees every other with the same form factor, so the radiance after at most D
+// scattering events is L(x) = Le + rho(x) A_{D-1}, with A_0 = Le, A_k = Le + rhobar A_{k-1} and
+// rhobar the area mean of the albedo. Textured materials are resolved on eye and light paths.
+struct CheckerFurnace {
+  static constexpr int kRes = 16, kDepth = 6;
+  LoadedScene ls = load(header(kRes, kDepth, "0 0 0  0 0 1  0 1 0") +
+                        "Texture \"checks\" \"spectrum\" \"checkerboard\" \"float uscale\" 8 \"float vscale\" 4\n"
+                        "  \"rgb tex1\" [0.3 0.3 0.3] \"rgb tex2\" [0.7 0.7 0.7]\n"
+                        "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+                        "Material \"diffuse\" \"texture reflectance\" \"checks\"\n"
+                        "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+  static float rho(Vec3 p) {
+    double phi = std::atan2(double(p.y), double(p.x));
+    if (phi < 0) phi += 2 * M_PI;
+    double u = phi / (2 * M_PI), v = 1 - std::acos(std::clamp(p.z / 2.0, -1.0, 1.0)) / M_PI;
+    long s = long(std::floor(8 * u)) + long(std::floor(4 * v));
+    return s % 2 == 0 ? 0.3f : 0.7f;
+  }
+  // Expected luminance per pixel (box filter: the mean over 8 x 8 positions in the pixel).
+  std::vector<double> expected() const {
+    double rho_bar = 0;
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) {  // a Fibonacci lattice: nearly uniform over the sphere
+      double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z), phi = 2.399963229728653 * i;
+      rho_bar += rho(Vec3(float(2 * r * std::cos(phi)), float(2 * r * std::sin(phi)), float(2 * z)));
+    }
+    rho_bar /= n;
+    double a = 1;  // A_0 = Le = 1 (unit luminance)
+    for (int k = 1; k < kDepth; ++k) a = 1 + rho_bar * a;
+    PerspectiveCamera cam(ls.camera, kRes, kRes);
+    std::vector<double> out(kRes * kRes, 0.0);
+    for (int y = 0; y < kRes; ++y)
+      for (int x = 0; x < kRes; ++x)
+        for (int j = 0; j < 64; ++j) {
+          Ray r = cam.generate_ray({x + (j % 8 + 0.5f) / 8, y + (j / 8 + 0.5f) / 8}, {0.5f, 0.5f});
+          Vec3 p = r.o + normalize(r.d) * 2.0f;
+          out[size_t(y) * kRes + x] += (1 + rho(p) * a) / 64;
+        }
+    return out;
+  }
+};
+
+TEST(Textures, CheckerboardFurnaceMatchesAnalyticRadianceWithPath) {
+  CheckerFurnace f;
+  std::vector<double> want = f.expected();
+  RenderRun run = render_with(f.ls, "path", 1024);
+  Image img = run.film.image();
+  std::vector<float> rms = run.film.rms();
+  double lo = 1e9, hi = 0, sum_diff = 0, sum_var = 0;
+  const int n = CheckerFurnace::kRes * CheckerFurnace::kRes;
+  for (int i = 0; i < n; ++i) {
+    float v = img.at(i % CheckerFurnace::kRes, i / CheckerFurnace::kRes).luminance();
+    EXPECT_NEAR(v, want[size_t(i)], 4.5 * rms[size_t(i)] + 1e-3) << "pixel " << i;
+    EXPECT_LT(rms[size_t(i)], 0.04 * want[size_t(i)]);
+    lo = std::min(lo, want[size_t(i)]), hi = std::max(hi, want[size_t(i)]);
+    sum_diff += v - want[size_t(i)];
+    sum_var += double(rms[size_t(i)]) * rms[size_t(i)];
+  }
+  EXPECT_GT(hi - lo, 0.5);  // the image shows the checks
+  // All pixels together: within 4.5 sigma of the mean (about 0.8% here).
+  EXPECT_NEAR(sum_diff / n, 0.0, 4.5 * std::sqrt(sum_var) / n);
+}
+
+TEST(Textures, CheckerboardFurnaceMatchesAnalyticRadianceWithBpm) {
+  CheckerFurnace f;
+  std::vector<double> want = f.expected();
+  BpmSettings s = small_batches(1);
+  Iterations its = render_iterations(f.ls, "bpm", 40, 13, s);
+  const int block = CheckerFurnace::kRes / 2;
+  std::vector<BlockStats> got = its.blocks(block);
+  float pixel_angle = std::sqrt(PerspectiveCamera(f.ls.camera, CheckerFurnace::kRes, CheckerFurnace::kRes).pixel_solid_angle());
+  double r_over_R = s.k1 * pixel_angle * 3;
+  ASSERT_EQ(got.size(), 4u);
+  for (int b = 0; b < 4; ++b) {
+    double e = 0;
+    for (int y = 0; y < block; ++y)
+      for (int x = 0; x < block; ++x) e += want[size_t((b / 2 * block + y) * CheckerFurnace::kRes + b % 2 * block + x)];
+    e /= block * block;
+    double sigma = std::sqrt(got[size_t(b)].var), bias = e * r_over_R * r_over_R / 8;
+    EXPECT_NEAR(got[size_t(b)].mean, e, 4.5 * sigma + bias) << "block " << b << " sigma " << sigma;
+    EXPECT_LT(sigma, 0.01 * e);
+  }
+  EXPECT_GT(its.last.details["light"]["entries"].get<uint64_t>(), 0u);
+}
+
 // bpm with D = 0, 1, 2 and progressive radii against the path tracer: block-wise within the
 // error bound, and the error falls with the iterations.
 void expect_bpm_converges(const LoadedScene& ls, const Film& ref, uint64_t seed) {

@@ -1,7 +1,12 @@
 // Analytic checks of the path integrator and of the render loop.
 #include <cmath>
 
+#include <unistd.h>
+
+#include <filesystem>
+
 #include "camera/camera.h"
+#include "film/image_io.h"
 #include "test_util.h"
 
 namespace bpm {
@@ -111,6 +116,62 @@ TEST(PathIntegrator, PlaneUnderPointLight) {
   EXPECT_GT(checked, 200);
   // All pixels together: the mean ratio is 1 within 4 sigma (about 0.1%).
   EXPECT_NEAR(sum_ratio / checked, 1.0, 4 * std::sqrt(sum_var) / checked);
+}
+
+// The plane under the point light again, its reflectance now an image texture (a 2 x 2 PNG read
+// with linear encoding and the point filter, repeated 25 times over the plane's uv): each pixel
+// shows its texel's reflectance, which checks the image's orientation (t runs up the image).
+TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
+  const float I = 3.0f, h = 2.0f;
+  std::filesystem::path png = std::filesystem::temp_directory_path() / ("bpm_plane_texture_" + std::to_string(::getpid()) + ".png");
+  Image tex;
+  tex.width = tex.height = 2;
+  tex.rgb = {0.2f, 0.2f, 0.2f, 0.9f, 0.9f, 0.9f,   // top row
+             0.5f, 0.5f, 0.5f, 0.7f, 0.7f, 0.7f};  // bottom row
+  write_png_display(png.string(), tex);
+  LoadedScene ls = load(R"(
+    LookAt 0 5 -3  0 0 0  0 1 0
+    Camera "perspective" "float fov" 50
+    Film "rgb" "integer xresolution" 24 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+    Integrator "path" "integer maxdepth" 1
+    WorldBegin
+    LightSource "point" "rgb I" [3 3 3] "point3 from" [0.5 2 0.3]
+    Texture "t" "spectrum" "imagemap" "string filename" ")" + png.string() + R"("
+      "string encoding" "linear" "string filter" "point" "float uscale" 25 "float vscale" 25
+    Material "diffuse" "texture reflectance" "t"
+    Shape "trianglemesh" "point3 P" [-50 0 -50  50 0 -50  50 0 50  -50 0 50]
+      "point2 uv" [0 0 1 0 1 1 0 1] "integer indices" [0 1 2 0 2 3]
+  )");
+  std::filesystem::remove(png);
+  Film film = render_film(ls, 64);
+  Image img = film.image();
+  std::vector<float> rms = film.rms();
+  PerspectiveCamera cam(ls.camera, 24, 16);
+  Vec3 light(0.5f, h, 0.3f);
+  auto byte = [](float v) { return std::round(v * 255) / 255; };
+  int checked = 0, seen[4] = {0, 0, 0, 0};
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 24; ++x) {
+      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+      if (r.d.y >= 0) continue;
+      Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
+      float fx = 2 * 25 * (p.x + 50) / 100, fy = 2 * (1 - 25 * (p.z + 50) / 100);
+      auto near_edge = [](float f) { return std::fabs(f - std::round(f)) < 0.1f; };
+      if (near_edge(fx) || near_edge(fy)) continue;
+      int ix = int(std::floor(fx)) & 1, iy = int(std::floor(fy)) & 1;
+      float rho = byte(tex.rgb[size_t(iy * 2 + ix) * 3]);
+      ++seen[iy * 2 + ix];
+      Vec3 to_light = light - p;
+      float d2 = length_squared(to_light);
+      float expected = rho / kPi * I * (to_light.y / std::sqrt(d2)) / d2;
+      float sigma = rms[y * 24 + x];
+      // The grey texels become near-constant spectra through the coefficient table (within 0.002).
+      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 4e-3f * expected) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+  for (int k = 0; k < 4; ++k) EXPECT_GT(seen[k], 5) << "texel " << k;
 }
 
 // Same seed and budget give the same image whatever the number of threads.

@@ -85,6 +85,12 @@ class SpectrumCurve {
 // returns the largest remaining channel error.
 float fit_sigmoid(Rgb rgb, std::array<float, 3>* coeff);
 float sigmoid_spectrum(const std::array<float, 3>& coeff, float lambda);
+// The same coefficients interpolated in a table of fits over the colour cube, built on the first
+// call (about half a second on two cores): what per-texel colours use.
+std::array<float, 3> sigmoid_coefficients_lookup(Rgb rgb);
+// A colour read at render time (an image texel) as a spectrum at the wavelengths wl, through the
+// table: an albedo is clamped to [0, 1]; see SpectrumCurve::from_rgb for the other kinds.
+Spectrum rgb_texel_spectrum(Rgb rgb, SpectrumKind kind, const Wavelengths& wl);
 
 // The CIE standard illuminant D65 scaled to unit luminance, and the matching functions.
 float d65_unit(float lambda);

@@ -18,6 +18,7 @@ struct BackwardPhoton {
   float radius;  // world units
   Vec3 ng, ns;   // geometric and shading normals
   Vec3 wo;       // toward the previous eye vertex
+  Vec2 uv;       // surface coordinates, for textured materials
   Spectrum tau;  // throughput from the camera (the paper's transmittance)
   uint32_t pixel;
   uint32_t material;

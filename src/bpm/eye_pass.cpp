@@ -55,7 +55,8 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       }
     }
     int material_index = scene.objects[hit.object].material;
-    const Material& m = prm.materials->materials[material_index];
+    Material storage;
+    const Material& m = prm.materials->at(material_index, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       ray = spawn_ray(sp, ray.d);
       ++counters.rays.bounce_rays;
@@ -77,6 +78,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       bp.radius = length * (last ? prm.radius_per_length1 : prm.radius_per_length0);
       bp.ng = sp.ng;
       bp.ns = sp.ns;
+      bp.uv = sp.uv;
       bp.wo = wo;
       bp.tau = beta;
       bp.pixel = pixel;

@@ -17,7 +17,9 @@ void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     const BackwardPhoton& bp = maps.photons[g];
     if (!bp.accepts_class(cls) || int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
-    Spectrum value = photon_contribution(prm.materials->materials[bp.material], bp.ng, bp.ns, bp.wo, wi, flux);
+    Material storage;
+    const Material& m = prm.materials->at(int(bp.material), TextureContext{bp.p, bp.uv}, storage);
+    Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     out[owner[bp.pixel]].push_back({g, value});
     ++counters.entries;

@@ -118,7 +118,8 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0 && !gathering)
       L += beta * area_light_radiance(std::get<AreaLight>(scene.lights[light_index]), sp.ng, wo, wl);
-    const Material& m = prm.materials->of_object(scene, hit.object);
+    Material storage;
+    const Material& m = prm.materials->at(scene.objects[hit.object].material, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       ray = spawn_ray(sp, ray.d);
       ++c.rays.bounce_rays;

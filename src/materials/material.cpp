@@ -5,43 +5,92 @@
 
 namespace bpm {
 
-Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl) {
-  struct V {
-    const Wavelengths& wl;
-    Material operator()(const DiffuseDesc& d) const { return DiffuseMaterial{d.reflectance.sample(wl)}; }
-    Material operator()(const ConductorDesc& d) const {
-      ConductorMaterial c;
-      c.roughness = d.roughness;
-      if (d.reflectance) {
-        // pbrt-v4's ConductorMaterial: k = 2 sqrt(r) / sqrt(1 - r) with eta = 1 gives reflectance r
-        // at normal incidence.
-        Spectrum r = d.reflectance->sample(wl);
-        c.eta = Spectrum(1.0f);
-        for (int i = 0; i < Spectrum::kChannels; ++i) {
-          float rr = std::clamp(r[i], 0.0f, 0.9999f);
-          c.k[i] = 2 * std::sqrt(rr) / std::sqrt(1 - rr);
-        }
-      } else {
-        c.eta = d.eta.sample(wl);
-        c.k = d.k.sample(wl);
+namespace {
+
+struct Resolver {
+  const Wavelengths& wl;
+  const TextureSet* ts;  // null when the material has no textures
+  const TextureContext* ctx;
+
+  Spectrum eval(const SpectrumParam& p) const {
+    return p.textured() ? ts->spectrum(p.texture, *ctx, wl) : p.curve.sample(wl);
+  }
+  Roughness rough(const Roughness& r, const RoughnessTextures& t) const {
+    return t.any() ? t.eval(r, *ts, *ctx) : r;
+  }
+  Material operator()(const DiffuseDesc& d) const { return DiffuseMaterial{eval(d.reflectance)}; }
+  Material operator()(const ConductorDesc& d) const {
+    ConductorMaterial c;
+    c.roughness = rough(d.roughness, d.roughness_tex);
+    if (d.reflectance) {
+      // pbrt-v4's ConductorMaterial: k = 2 sqrt(r) / sqrt(1 - r) with eta = 1 gives reflectance r
+      // at normal incidence.
+      Spectrum r = eval(*d.reflectance);
+      c.eta = Spectrum(1.0f);
+      for (int i = 0; i < Spectrum::kChannels; ++i) {
+        float rr = std::clamp(r[i], 0.0f, 0.9999f);
+        c.k[i] = 2 * std::sqrt(rr) / std::sqrt(1 - rr);
       }
-      return c;
+    } else {
+      c.eta = eval(d.eta);
+      c.k = eval(d.k);
     }
-    Material operator()(const DielectricMaterial& d) const { return d; }
-    Material operator()(const ThinDielectricMaterial& d) const { return d; }
-    Material operator()(const DiffuseTransmissionDesc& d) const {
-      return DiffuseTransmissionMaterial{d.reflectance.sample(wl), d.transmittance.sample(wl)};
-    }
-    Material operator()(const PhongDesc& d) const { return PhongMaterial{d.reflectance.sample(wl), d.exponent}; }
-    Material operator()(const InterfaceMaterial& d) const { return d; }
-    Material operator()(const CoatedConductorDesc& d) const {
-      return CoatedConductorMaterial{std::get<ConductorMaterial>((*this)(d.conductor)), d.layer};
-    }
-    Material operator()(const CoatedDiffuseDesc& d) const {
-      return CoatedDiffuseMaterial{d.reflectance.sample(wl), d.layer};
-    }
+    return c;
+  }
+  Material operator()(const DielectricMaterial& d) const { return d; }
+  Material operator()(const ThinDielectricMaterial& d) const { return d; }
+  Material operator()(const DiffuseTransmissionDesc& d) const {
+    return DiffuseTransmissionMaterial{eval(d.reflectance), eval(d.transmittance)};
+  }
+  Material operator()(const PhongDesc& d) const { return PhongMaterial{eval(d.reflectance), d.exponent}; }
+  Material operator()(const InterfaceMaterial& d) const { return d; }
+  Material operator()(const CoatedConductorDesc& d) const {
+    CoatLayer layer = d.layer;
+    layer.roughness = rough(d.layer.roughness, d.roughness_tex);
+    return CoatedConductorMaterial{std::get<ConductorMaterial>((*this)(d.conductor)), layer};
+  }
+  Material operator()(const CoatedDiffuseDesc& d) const {
+    CoatLayer layer = d.layer;
+    layer.roughness = rough(d.layer.roughness, d.roughness_tex);
+    return CoatedDiffuseMaterial{eval(d.reflectance), layer};
+  }
+};
+
+}  // namespace
+
+Roughness RoughnessTextures::eval(const Roughness& constant, const TextureSet& ts, const TextureContext& ctx) const {
+  auto alpha = [&](int tex, float fallback) {
+    if (tex < 0) return fallback;
+    float r = std::max(0.0f, ts.value(tex, ctx));
+    return remap ? std::sqrt(r) : r;
   };
-  return std::visit(V{wl}, desc);
+  return Roughness{alpha(u, constant.alpha_x), alpha(v, constant.alpha_y)};
+}
+
+Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl) {
+  return std::visit(Resolver{wl, nullptr, nullptr}, desc);
+}
+
+Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl, const TextureSet& textures,
+                          const TextureContext& ctx) {
+  return std::visit(Resolver{wl, &textures, &ctx}, desc);
+}
+
+bool material_is_textured(const MaterialDesc& desc) {
+  struct V {
+    bool operator()(const DiffuseDesc& d) const { return d.reflectance.textured(); }
+    bool operator()(const ConductorDesc& d) const {
+      return d.eta.textured() || d.k.textured() || (d.reflectance && d.reflectance->textured()) || d.roughness_tex.any();
+    }
+    bool operator()(const DiffuseTransmissionDesc& d) const { return d.reflectance.textured() || d.transmittance.textured(); }
+    bool operator()(const PhongDesc& d) const { return d.reflectance.textured(); }
+    bool operator()(const CoatedDiffuseDesc& d) const { return d.reflectance.textured() || d.roughness_tex.any(); }
+    bool operator()(const CoatedConductorDesc& d) const { return (*this)(d.conductor) || d.roughness_tex.any(); }
+    bool operator()(const DielectricMaterial&) const { return false; }
+    bool operator()(const ThinDielectricMaterial&) const { return false; }
+    bool operator()(const InterfaceMaterial&) const { return false; }
+  };
+  return std::visit(V{}, desc);
 }
 
 }  // namespace bpm

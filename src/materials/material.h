@@ -11,6 +11,7 @@
 #include "base/color.h"
 #include "base/spectrum.h"
 #include "base/vec.h"
+#include "textures/texture.h"
 
 namespace bpm {
 
@@ -88,38 +89,57 @@ using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMate
                               ThinDielectricMaterial, DiffuseTransmissionMaterial, PhongMaterial,
                               InterfaceMaterial, CoatedDiffuseMaterial, CoatedConductorMaterial>;
 
-// The scene's description of a material, with its colours as spectral curves. resolve_material
-// evaluates it at a path's wavelengths into the Material the BSDF functions take. The alternatives
-// are in the same order as Material's.
+// The scene's description of a material, with its colours as spectral curves or textures.
+// resolve_material evaluates it at a path's wavelengths (and, when textured, at the surface point)
+// into the Material the BSDF functions take. The alternatives are in the same order as Material's.
+
+// Textured roughness: float textures for u and v (-1: the constant), remapped as pbrt-v4's
+// RoughnessToAlpha when remap is set.
+struct RoughnessTextures {
+  int u = -1, v = -1;
+  bool remap = true;
+  bool any() const { return u >= 0 || v >= 0; }
+  Roughness eval(const Roughness& constant, const TextureSet& ts, const TextureContext& ctx) const;
+};
+
 struct DiffuseDesc {
-  SpectrumCurve reflectance{0.5f};
+  SpectrumParam reflectance{SpectrumCurve(0.5f)};
 };
 struct ConductorDesc {
-  SpectrumCurve eta, k;
+  SpectrumParam eta, k;
   // pbrt-v4's "reflectance" form: eta = 1 and k from the reflectance at each wavelength.
-  std::optional<SpectrumCurve> reflectance;
+  std::optional<SpectrumParam> reflectance;
   Roughness roughness;
+  RoughnessTextures roughness_tex;
 };
 struct DiffuseTransmissionDesc {
-  SpectrumCurve reflectance{0.25f}, transmittance{0.25f};
+  SpectrumParam reflectance{SpectrumCurve(0.25f)}, transmittance{SpectrumCurve(0.25f)};
 };
 struct PhongDesc {
-  SpectrumCurve reflectance{0.5f};
+  SpectrumParam reflectance{SpectrumCurve(0.5f)};
   float exponent = 20;
 };
 struct CoatedDiffuseDesc {
-  SpectrumCurve reflectance{0.5f};
+  SpectrumParam reflectance{SpectrumCurve(0.5f)};
   CoatLayer layer;
+  RoughnessTextures roughness_tex;  // the coat's
 };
 struct CoatedConductorDesc {
   ConductorDesc conductor;
   CoatLayer layer;
+  RoughnessTextures roughness_tex;  // the coat's
 };
 using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
                                   DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc,
                                   CoatedConductorDesc>;
 
+// A material without textures at the wavelengths.
 Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl);
+// Any material, at the wavelengths and the surface point.
+Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl, const TextureSet& textures,
+                          const TextureContext& ctx);
+// True when a parameter of the material is a texture (it must be resolved per surface point).
+bool material_is_textured(const MaterialDesc& desc);
 
 enum BsdfFlags : unsigned {
   kReflection = 1,

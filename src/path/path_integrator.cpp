@@ -78,7 +78,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
         }
       }
     }
-    const Material m = resolve_material(scene.materials[scene.objects[hit.object].material], wl);
+    const Material m = material_at(scene, scene.objects[hit.object].material, wl, texture_context(sp));
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       // A boundary that does not scatter: continue the same ray past it.
       ray = spawn_ray(sp, ray.d);

@@ -80,7 +80,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) break;
     SurfacePoint sp = scene.surface(ray, hit);
-    const Material& m = wm.of_object(scene, hit.object);
+    Material storage;
+    const Material& m = wm.at(scene.objects[hit.object].material, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       ray = spawn_ray(sp, ray.d);
       ++counters.light_rays;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
+#include <tuple>
 
 #include "scene/ply.h"
 #include "scene/spectra.h"
@@ -40,6 +42,8 @@ class Flattener {
  private:
   const ParsedScene& parsed_;
   std::map<std::string, const TextureEntity*> textures_;
+  std::map<std::tuple<std::string, bool, int>, int> texture_nodes_;
+  std::set<std::string> building_;
   std::map<int, int> anonymous_material_ids_;
   std::map<std::string, int> named_material_ids_;
   RenderScene* scene_ = nullptr;
@@ -185,51 +189,221 @@ class Flattener {
     check("tree", b->centre_tree || ps.get_string("tree", "spheres") == "spheres", "must be \"spheres\" or \"centres\"");
   }
 
+  // ---- textures ----
+  const TextureEntity& texture_entity(const Param& ref) {
+    ref.used = true;
+    if (ref.strings.size() != 1) throw Error(ref.loc, "a texture parameter names one texture");
+    auto it = textures_.find(ref.strings[0]);
+    if (it == textures_.end()) throw Error(ref.loc, "unknown texture \"" + ref.strings[0] + "\"");
+    return *it->second;
+  }
+
+  // The node of a texture, built on first use. Spectrum textures are built once per kind (how
+  // their image texels are read); float textures once.
+  int texture_node(const TextureEntity& t, bool as_float, SpectrumKind kind) {
+    auto key = std::make_tuple(t.texture_name, as_float, as_float ? 0 : int(kind));
+    if (auto it = texture_nodes_.find(key); it != texture_nodes_.end()) return it->second;
+    if (!building_.insert(t.texture_name).second)
+      throw Error(t.loc, "texture \"" + t.texture_name + "\" refers to itself");
+    int node = build_texture(t, as_float, kind);
+    building_.erase(t.texture_name);
+    texture_nodes_[key] = node;
+    return node;
+  }
+
+  // A texture's parameter that may itself be a texture: its node, or a constant node.
+  int spectrum_node(const ParamSet& ps, const std::string& name, SpectrumKind kind, float def) {
+    const Param* p = ps.find_any(name);
+    if (p && p->type == "texture") return texture_node(texture_entity(*p), false, kind);
+    if (p && p->type == "float") return scene().textures.add(ConstantTexture{SpectrumCurve(ps.get_float(name, def)), 0});
+    auto v = get_spectrum(ps, name, kind, parsed_.base_directory);
+    return scene().textures.add(ConstantTexture{v.value_or(SpectrumCurve(def)), 0});
+  }
+  int float_node(const ParamSet& ps, const std::string& name, float def) {
+    const Param* p = ps.find_any(name);
+    if (p && p->type == "texture") return texture_node(texture_entity(*p), true, SpectrumKind::kAlbedo);
+    return scene().textures.add(ConstantTexture{SpectrumCurve(), ps.get_float(name, def)});
+  }
+
+  static TexMapping texture_mapping(const TextureEntity& t) {
+    const ParamSet& ps = t.params;
+    TexMapping m;
+    std::string kind = ps.get_string("mapping", "uv");
+    m.texture_from_world = t.world_from_texture.inverse();
+    if (kind == "uv") {
+      m.kind = TexMapping::Kind::kUV;
+      m.su = ps.get_float("uscale", 1);
+      m.sv = ps.get_float("vscale", 1);
+      m.du = ps.get_float("udelta", 0);
+      m.dv = ps.get_float("vdelta", 0);
+    } else if (kind == "spherical") {
+      m.kind = TexMapping::Kind::kSpherical;
+    } else if (kind == "cylindrical") {
+      m.kind = TexMapping::Kind::kCylindrical;
+    } else if (kind == "planar") {
+      m.kind = TexMapping::Kind::kPlanar;
+      auto v1 = ps.get_vector3s("v1"), v2 = ps.get_vector3s("v2");
+      if (!v1.empty()) m.vs = v1[0];
+      if (!v2.empty()) m.vt = v2[0];
+      m.ds = ps.get_float("udelta", 0);
+      m.dt = ps.get_float("vdelta", 0);
+    } else {
+      throw Error(ps.find_any("mapping")->loc, "texture mapping \"" + kind + "\" is unknown (uv, spherical, cylindrical, planar)");
+    }
+    return m;
+  }
+
+  int build_texture(const TextureEntity& t, bool as_float, SpectrumKind kind) {
+    const ParamSet& ps = t.params;
+    if (as_float != (t.value_type == "float"))
+      throw Error(t.loc, "texture \"" + t.texture_name + "\" is a " + t.value_type + " texture; a " +
+                             (as_float ? "float" : "spectrum") + " texture is needed here");
+    TextureNode node;
+    if (t.name == "constant") {
+      ConstantTexture c;
+      if (as_float) c.value = ps.get_float("value", 1);
+      else c.spectrum = get_spectrum(ps, "value", kind, parsed_.base_directory).value_or(SpectrumCurve(1.0f));
+      node = c;
+    } else if (t.name == "imagemap") {
+      ImageTexture im;
+      std::string file = ps.get_string("filename", "");
+      if (file.empty()) throw Error(t.loc, "imagemap texture \"" + t.texture_name + "\" has no \"string filename\"");
+      fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+      TexEncoding enc;
+      std::string encoding = ps.get_string("encoding", "sRGB");
+      if (encoding == "sRGB") {
+        enc.kind = TexEncoding::Kind::kSrgb;
+      } else if (encoding == "linear") {
+        enc.kind = TexEncoding::Kind::kLinear;
+      } else if (encoding.rfind("gamma ", 0) == 0) {
+        enc.kind = TexEncoding::Kind::kGamma;
+        try {
+          enc.gamma = std::stof(encoding.substr(6));
+        } catch (const std::exception&) {
+          enc.gamma = -1;
+        }
+        if (!(enc.gamma > 0)) throw Error(ps.find_any("encoding")->loc, "bad gamma in encoding \"" + encoding + "\"");
+      } else {
+        throw Error(ps.find_any("encoding")->loc, "encoding \"" + encoding + "\" is unknown (sRGB, linear, \"gamma g\")");
+      }
+      try {
+        im.image = load_texture_image(path.string(), enc);
+      } catch (const Error& e) {
+        throw Error(ps.find_any("filename")->loc, e.what());
+      }
+      std::string filter = ps.get_string("filter", "bilinear");
+      if (filter == "point") {
+        im.filter = TexFilter::kPoint;
+      } else if (filter == "bilinear" || filter == "trilinear" || filter == "ewa" || filter == "EWA") {
+        im.filter = TexFilter::kBilinear;  // without ray differentials, the finest level (texture.h)
+      } else {
+        throw Error(ps.find_any("filter")->loc, "texture filter \"" + filter + "\" is unknown (point, bilinear, trilinear, ewa)");
+      }
+      ps.get_float("maxanisotropy", 8);
+      std::string wrap = ps.get_string("wrap", "repeat");
+      if (wrap == "repeat") im.wrap = TexWrap::kRepeat;
+      else if (wrap == "clamp") im.wrap = TexWrap::kClamp;
+      else if (wrap == "black") im.wrap = TexWrap::kBlack;
+      else if (wrap == "octahedralsphere") im.wrap = TexWrap::kOctahedralSphere;
+      else throw Error(ps.find_any("wrap")->loc, "wrap mode \"" + wrap + "\" is unknown (repeat, clamp, black, octahedralsphere)");
+      im.scale = ps.get_float("scale", 1);
+      im.invert = ps.get_bool("invert", false);
+      im.kind = kind;
+      im.mapping = texture_mapping(t);
+      node = im;
+    } else if (t.name == "checkerboard") {
+      CheckerboardTexture c;
+      c.dimension = ps.get_int("dimension", 2);
+      if (c.dimension != 2 && c.dimension != 3)
+        throw Error(ps.find_any("dimension")->loc, "checkerboard dimension must be 2 or 3");
+      ps.get_string("aamode", "closedform");
+      if (c.dimension == 2) c.mapping = texture_mapping(t);
+      c.texture_from_world = t.world_from_texture.inverse();
+      c.tex1 = as_float ? float_node(ps, "tex1", 1) : spectrum_node(ps, "tex1", kind, 1);
+      c.tex2 = as_float ? float_node(ps, "tex2", 0) : spectrum_node(ps, "tex2", kind, 0);
+      node = c;
+    } else if (t.name == "scale") {
+      ScaleTexture sc;
+      sc.tex = as_float ? float_node(ps, "tex", 1) : spectrum_node(ps, "tex", kind, 1);
+      sc.scale = float_node(ps, "scale", 1);
+      node = sc;
+    } else if (t.name == "mix") {
+      MixTexture m;
+      m.tex1 = as_float ? float_node(ps, "tex1", 0) : spectrum_node(ps, "tex1", kind, 0);
+      m.tex2 = as_float ? float_node(ps, "tex2", 1) : spectrum_node(ps, "tex2", kind, 1);
+      m.amount = float_node(ps, "amount", 0.5f);
+      node = m;
+    } else {
+      throw Error(t.loc, "texture class \"" + t.name + "\" is not supported (constant, imagemap, checkerboard, scale, mix)");
+    }
+    ps.warn_unused("texture \"" + t.texture_name + "\"");
+    return scene().textures.add(std::move(node));
+  }
+
   // ---- materials ----
-  std::optional<SpectrumCurve> spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
+  // A spectral material parameter: a constant (a constant texture included) or a texture node.
+  std::optional<SpectrumParam> spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
     const Param* p = ps.find_any(name);
     if (p && p->type == "texture") {
-      p->used = true;
-      auto it = textures_.find(p->strings[0]);
-      if (it == textures_.end()) throw Error(p->loc, "unknown texture \"" + p->strings[0] + "\"");
-      const TextureEntity& t = *it->second;
-      if (t.name != "constant")
-        throw Error(p->loc, "texture \"" + p->strings[0] + "\" of class \"" + t.name + "\" is not supported (only constant textures)");
-      if (t.value_type == "float") {
+      const TextureEntity& t = texture_entity(*p);
+      if (t.name == "constant" && t.value_type == "float") {
         float v = t.params.get_float("value", 1);
         if (v < 0 || (kind == SpectrumKind::kAlbedo && v > 1))
           throw Error(t.loc, "constant texture \"" + t.texture_name + "\" used as a reflectance must lie in [0, 1]");
-        return SpectrumCurve(v);
+        return SpectrumParam(SpectrumCurve(v));
       }
-      auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
-      return v ? *v : SpectrumCurve(1.0f);
+      if (t.name == "constant") {
+        auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
+        return SpectrumParam(v ? *v : SpectrumCurve(1.0f));
+      }
+      SpectrumParam sp;
+      sp.texture = texture_node(t, false, kind);
+      return sp;
     }
-    return get_spectrum(ps, name, kind, parsed_.base_directory);
+    if (auto c = get_spectrum(ps, name, kind, parsed_.base_directory)) return SpectrumParam(*c);
+    return std::nullopt;
   }
+  // A float material parameter that must not vary over the surface (a constant texture is fine).
   float float_param(const ParamSet& ps, const std::string& name, float def) {
     const Param* p = ps.find_any(name);
     if (p && p->type == "texture") {
-      p->used = true;
-      auto it = textures_.find(p->strings[0]);
-      if (it == textures_.end()) throw Error(p->loc, "unknown texture \"" + p->strings[0] + "\"");
-      if (it->second->name != "constant" || it->second->value_type != "float")
-        throw Error(p->loc, "texture \"" + p->strings[0] + "\" is not a constant float texture");
-      return it->second->params.get_float("value", 1);
+      const TextureEntity& t = texture_entity(*p);
+      if (t.name != "constant" || t.value_type != "float")
+        throw Error(p->loc, "\"" + name + "\" must be a float or a constant float texture; \"" + p->strings[0] + "\" is not");
+      return t.params.get_float("value", 1);
     }
     return ps.get_float(name, def);
   }
+  // A float parameter that may vary: its constant, or the node of a non-constant float texture.
+  FloatParam float_or_texture(const ParamSet& ps, const std::string& name, float def) {
+    const Param* p = ps.find_any(name);
+    if (p && p->type == "texture") {
+      const TextureEntity& t = texture_entity(*p);
+      if (!(t.name == "constant" && t.value_type == "float")) return FloatParam{0, texture_node(t, true, SpectrumKind::kAlbedo)};
+    }
+    return FloatParam{float_param(ps, name, def), -1};
+  }
 
   // prefix: "" for most materials, "interface." or "conductor." for coatedconductor's two layers.
-  Roughness roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix = "") {
-    float r = float_param(ps, prefix + "roughness", 0);
-    float u = ps.find_any(prefix + "uroughness") ? float_param(ps, prefix + "uroughness", r) : r;
-    float v = ps.find_any(prefix + "vroughness") ? float_param(ps, prefix + "vroughness", r) : r;
-    if (u < 0 || v < 0) throw Error(loc, "roughness must not be negative");
-    if (ps.get_bool("remaproughness", true)) {
-      u = std::sqrt(u);  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha
-      v = std::sqrt(v);
+  // Textured roughness goes to tex; a material that takes none passes null.
+  Roughness roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix = "",
+                      RoughnessTextures* tex = nullptr) {
+    FloatParam r = float_or_texture(ps, prefix + "roughness", 0);
+    FloatParam u = ps.find_any(prefix + "uroughness") ? float_or_texture(ps, prefix + "uroughness", 0) : r;
+    FloatParam v = ps.find_any(prefix + "vroughness") ? float_or_texture(ps, prefix + "vroughness", 0) : r;
+    bool remap = ps.get_bool("remaproughness", true);
+    if (u.textured() || v.textured()) {
+      if (!tex) throw Error(loc, "textured roughness is not supported for this material");
+      tex->u = u.texture;
+      tex->v = v.texture;
+      tex->remap = remap;
     }
-    return Roughness{u, v};
+    if (u.value < 0 || v.value < 0) throw Error(loc, "roughness must not be negative");
+    if (remap) {
+      u.value = std::sqrt(u.value);  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha
+      v.value = std::sqrt(v.value);
+    }
+    return Roughness{u.value, v.value};
   }
 
   // A dielectric's index of refraction: a float, or a spectrum reduced to its value at 550 nm.
@@ -239,7 +413,9 @@ class Flattener {
     if (p && p->type == "float") {
       eta = ps.get_float(name, 1.5f);
     } else if (p) {
-      SpectrumCurve s = *spectrum_param(ps, name, SpectrumKind::kUnbounded);
+      SpectrumParam sp = *spectrum_param(ps, name, SpectrumKind::kUnbounded);
+      if (sp.textured()) throw Error(p->loc, "a textured eta is not supported");
+      const SpectrumCurve& s = sp.curve;
       if (s.max_value() - s.min_value() > 1e-4f)
         warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
       eta = s.value(550);
@@ -259,20 +435,20 @@ class Flattener {
         throw Error(loc, "conductor has both reflectance and eta/k");
     } else {
       c.eta = spectrum_param(ps, prefix + "eta", SpectrumKind::kUnbounded)
-                  .value_or(*named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
+                  .value_or(SpectrumParam(*named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded)));
       c.k = spectrum_param(ps, prefix + "k", SpectrumKind::kUnbounded)
-                .value_or(*named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
+                .value_or(SpectrumParam(*named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded)));
     }
-    c.roughness = roughness(ps, loc, prefix);
+    c.roughness = roughness(ps, loc, prefix, &c.roughness_tex);
     return c;
   }
 
   // The coat of pbrt-v4's coated materials; prefix names the coat's roughness and eta
   // ("interface." in coatedconductor). A scattering medium inside the layer (albedo > 0) is not
   // modelled.
-  CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix) {
+  CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix, RoughnessTextures* tex) {
     CoatLayer c;
-    c.roughness = roughness(ps, e.loc, prefix);
+    c.roughness = roughness(ps, e.loc, prefix, tex);
     c.eta = dielectric_eta(ps, e.loc, prefix + "eta");
     c.thickness = float_param(ps, "thickness", 0.01f);
     if (!(c.thickness > 0) || !std::isfinite(c.thickness))
@@ -284,7 +460,7 @@ class Flattener {
     };
     c.max_depth = count("maxdepth", 10);
     c.samples = count("nsamples", 1);
-    if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && !a->is_black())
+    if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && (a->textured() || !a->curve.is_black()))
       throw Error(ps.find_any("albedo")->loc, e.name + " with a scattering layer (albedo > 0) is not supported");
     if (ps.find_any("g")) float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
     return c;
@@ -310,19 +486,23 @@ class Flattener {
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
       if (auto t = spectrum_param(ps, "transmittance", SpectrumKind::kAlbedo)) d.transmittance = *t;
       float s = ps.get_float("scale", 1);
-      d.reflectance = d.reflectance.scaled(s);
-      d.transmittance = d.transmittance.scaled(s);
-      if ((d.reflectance.rgb() + d.transmittance.rgb()).max_component() > 1.0001f)
-        throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
+      if (d.reflectance.textured() || d.transmittance.textured()) {
+        if (s != 1) throw Error(ps.find_any("scale")->loc, "diffusetransmission scale with textures is not supported");
+      } else {
+        d.reflectance.curve = d.reflectance.curve.scaled(s);
+        d.transmittance.curve = d.transmittance.curve.scaled(s);
+        if ((d.reflectance.curve.rgb() + d.transmittance.curve.rgb()).max_component() > 1.0001f)
+          throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
+      }
       m = d;
     } else if (e.name == "coateddiffuse") {
       CoatedDiffuseDesc c;
       if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
-      c.layer = coat_layer(ps, e, "");
+      c.layer = coat_layer(ps, e, "", &c.roughness_tex);
       m = c;
     } else if (e.name == "coatedconductor") {
       CoatedConductorDesc c;
-      c.layer = coat_layer(ps, e, "interface.");
+      c.layer = coat_layer(ps, e, "interface.", &c.roughness_tex);
       c.conductor = conductor_desc(ps, e.loc, "conductor.");
       m = c;
     } else if (e.name == "phong") {

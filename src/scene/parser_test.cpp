@@ -92,6 +92,16 @@ void expect_spectrum_near(const SpectrumCurve& a, const SpectrumCurve& b, float 
   for (float l = kLambdaMin; l <= kLambdaMax; l += 10) EXPECT_NEAR(a.value(l), b.value(l), eps) << l << " nm";
 }
 
+// A material parameter that must be a constant curve.
+void expect_spectrum_near(const SpectrumParam& a, const Rgb& b, float eps = 1e-4f) {
+  EXPECT_FALSE(a.textured());
+  expect_spectrum_near(a.curve, b, eps);
+}
+void expect_spectrum_near(const SpectrumParam& a, const SpectrumCurve& b, float eps = 1e-5f) {
+  EXPECT_FALSE(a.textured());
+  expect_spectrum_near(a.curve, b, eps);
+}
+
 Vec3 origin_of(const Transform& t) { return t.point(Vec3(0, 0, 0)); }
 
 // A fresh folder under the system temp directory, removed with its contents at the end.
@@ -944,12 +954,12 @@ TEST(SceneParams, NamedSpectrumEta) {
   ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m));
   // Through the measured values at 650, 550 and 450 nm.
   const ConductorDesc& c = std::get<ConductorDesc>(m);
-  EXPECT_NEAR(c.eta.value(650), 0.155265f, 1e-5f);
-  EXPECT_NEAR(c.eta.value(550), 0.116723f, 1e-5f);
-  EXPECT_NEAR(c.eta.value(450), 0.138342f, 1e-5f);
-  EXPECT_NEAR(c.k.value(650), 4.828181f, 1e-5f);
-  EXPECT_NEAR(c.k.value(450), 2.146961f, 1e-5f);
-  EXPECT_NEAR(c.eta.value(600), 0.5f * (0.155265f + 0.116723f), 1e-5f);  // linear between
+  EXPECT_NEAR(c.eta.curve.value(650), 0.155265f, 1e-5f);
+  EXPECT_NEAR(c.eta.curve.value(550), 0.116723f, 1e-5f);
+  EXPECT_NEAR(c.eta.curve.value(450), 0.138342f, 1e-5f);
+  EXPECT_NEAR(c.k.curve.value(650), 4.828181f, 1e-5f);
+  EXPECT_NEAR(c.k.curve.value(450), 2.146961f, 1e-5f);
+  EXPECT_NEAR(c.eta.curve.value(600), 0.5f * (0.155265f + 0.116723f), 1e-5f);  // linear between
 }
 
 TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
@@ -1591,11 +1601,34 @@ TEST(SceneFlattenError, UnknownTexture) {
                       "unknown texture \"nope\""));
 }
 
-TEST(SceneFlattenError, NonConstantTexture) {
-  const std::string l3 = R"(Material "diffuse" "texture reflectance" "img")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"a.png\"\n" +
-                               l3 + "\nShape \"sphere\"\n"),
-                      at(3, col(l3, "\"texture")), "of class \"imagemap\" is not supported (only constant textures)"));
+TEST(SceneFlattenError, TextureErrorsNameTheDirective) {
+  const std::string tex = "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"missing.png\"";
+  const std::string use = R"(Material "diffuse" "texture reflectance" "img")";
+  // A missing image: at its filename, naming the file.
+  std::string e = error_of("WorldBegin\n" + tex + "\n" + use + "\nShape \"sphere\"\n");
+  EXPECT_TRUE(IsError(e, at(2, col(tex, "\"string filename")), "missing.png"));
+  // Unknown class, a float texture where a spectrum is needed, and the reverse.
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"n\" \"spectrum\" \"fbm\"\n" + use.substr(0, use.size() - 5) +
+                               "\"n\"\nShape \"sphere\"\n"),
+                      at(2, 1), "texture class \"fbm\" is not supported"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"c\" \"float\" \"checkerboard\"\n"
+                               "Material \"diffuse\" \"texture reflectance\" \"c\"\nShape \"sphere\"\n"),
+                      at(2, 1), "is a float texture; a spectrum texture is needed here"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\n"
+                               "Material \"conductor\" \"texture roughness\" \"c\"\nShape \"sphere\"\n"),
+                      at(2, 1), "is a spectrum texture; a float texture is needed here"));
+  // Unknown names and modes.
+  const std::string l3 = R"(Material "diffuse" "texture reflectance" "nope")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n\n" + l3 + "\nShape \"sphere\"\n"), at(3, col(l3, "\"texture")),
+                      "unknown texture \"nope\""));
+  const std::string wrap = R"(Texture "c" "spectrum" "checkerboard" "string mapping" "cubic")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + wrap + "\nMaterial \"diffuse\" \"texture reflectance\" \"c\"\n"
+                               "Shape \"sphere\"\n"),
+                      at(2, col(wrap, "\"string mapping")), "texture mapping \"cubic\" is unknown"));
+  // A textured roughness where bpm takes none.
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"r\" \"float\" \"checkerboard\"\n"
+                               "Material \"dielectric\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"),
+                      at(3, 1), "textured roughness is not supported"));
 }
 
 TEST(SceneFlattenError, ConductorWithReflectanceAndEta) {

@@ -44,6 +44,7 @@ class RenderScene {
 
   std::vector<Object> objects;
   std::vector<MaterialDesc> materials;
+  TextureSet textures;  // the nodes textured materials read
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
   Distribution1D light_distribution;  // in proportion to power
@@ -76,17 +77,34 @@ class RenderScene {
   std::unique_ptr<Accel> accel_;
 };
 
+inline TextureContext texture_context(const SurfacePoint& sp) { return {sp.p, sp.uv}; }
+
+// The material of a surface point at the wavelengths (resolved there, textures included).
+inline Material material_at(const RenderScene& scene, int material, const Wavelengths& wl, const TextureContext& ctx) {
+  return resolve_material(scene.materials[size_t(material)], wl, scene.textures, ctx);
+}
+
 // The scene's materials evaluated at one set of wavelengths. The photon methods use one set for
-// every path of an iteration, so that eye and light paths meet at the same wavelengths.
+// every path of an iteration, so that eye and light paths meet at the same wavelengths. Textured
+// materials are resolved per surface point instead.
 struct WavelengthMaterials {
   Wavelengths wl;
   std::vector<Material> materials;
-  WavelengthMaterials(const RenderScene& scene, const Wavelengths& wavelengths) : wl(wavelengths) {
-    materials.reserve(scene.materials.size());
-    for (const MaterialDesc& d : scene.materials) materials.push_back(resolve_material(d, wl));
+  std::vector<char> textured;
+  const RenderScene* scene;
+  WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths) : wl(wavelengths), scene(&s) {
+    materials.reserve(s.materials.size());
+    for (const MaterialDesc& d : s.materials) {
+      textured.push_back(material_is_textured(d));
+      materials.push_back(textured.back() ? Material{} : resolve_material(d, wl));
+    }
   }
-  const Material& of_object(const RenderScene& scene, int object) const {
-    return materials[scene.objects[object].material];
+  // The material at a point: the iteration's copy, or for a textured one its resolution at ctx,
+  // made in storage.
+  const Material& at(int material, const TextureContext& ctx, Material& storage) const {
+    if (!textured[size_t(material)]) return materials[size_t(material)];
+    storage = material_at(*scene, material, wl, ctx);
+    return storage;
   }
 };
 

@@ -107,8 +107,11 @@ SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) 
     Vec3 n = normalize(s->world_from_object.normal(po));
     sp.ng = sp.ns = s->flip_normal ? -n : n;
     float phi = float(phi_of(po.x, po.y));
+    // pbrt-v4: v runs from the z_min cap (0) to the z_max cap (1).
     float theta = std::acos(std::clamp(po.z / s->radius, -1.0f, 1.0f));
-    sp.uv = {phi / s->phi_max, theta / kPi};
+    float theta_min = std::acos(std::clamp(s->z_min / s->radius, -1.0f, 1.0f));
+    float theta_max = std::acos(std::clamp(s->z_max / s->radius, -1.0f, 1.0f));
+    sp.uv = {phi / s->phi_max, theta_max != theta_min ? (theta - theta_min) / (theta_max - theta_min) : 0.0f};
     return sp;
   }
   const Disk& k = std::get<Disk>(shape);
