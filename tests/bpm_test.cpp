@@ -212,14 +212,20 @@ std::string cornell(const std::string& floor_material = "Material \"diffuse\" \"
 }
 
 // A glass sphere on a floor under a small light: the caustic is the test's subject.
-std::string caustic_scene() {
-  std::string s = header(32, 8, "0 2.0 -1.6  0 0 0.2  0 1 0");
-  s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [60 60 60]\n" + quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true) +
-       "AttributeEnd\n";
+// absorbing: the glass is filled with a green absorbing medium (pbrt-v4 MediumInterface).
+std::string caustic_scene(bool absorbing = false) {
+  std::string s = absorbing ? "MakeNamedMedium \"green\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1.5 1.5 1.5] "
+                              "\"rgb sigma_s\" [0 0 0]\n"
+                            : "";
+  s += header(32, 8, "0 2.0 -1.6  0 0 0.2  0 1 0");
+  // The absorbing variant moves the light aside, so that its caustic falls where the camera sees it.
+  s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [60 60 60]\n" +
+       (absorbing ? quad(1.3f, 0.1f, 1.7f, 0.5f, 2.0f, true) : quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true)) + "AttributeEnd\n";
   s += "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]\n" + quad(-1.5f, -1.5f, 1.5f, 2, 0, false);
   s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.5 0 2  1.5 0 2  1.5 2 2  -1.5 2 2]\n";
-  s += "AttributeBegin\nMaterial \"dielectric\" \"float eta\" 1.5\nTranslate 0 0.45 0.3\n"
-       "Shape \"sphere\" \"float radius\" 0.45\nAttributeEnd\n";
+  s += "AttributeBegin\nMaterial \"dielectric\" \"float eta\" 1.5\nTranslate 0 0.45 0.3\n";
+  if (absorbing) s += "MediumInterface \"green\" \"\"\n";
+  s += "Shape \"sphere\" \"float radius\" 0.45\nAttributeEnd\n";
   return s;
 }
 
@@ -379,6 +385,19 @@ TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
 TEST(Bpm, GlassSphereCausticConvergesToPath) {
   LoadedScene ls = load(caustic_scene());
   expect_bpm_converges(ls, render_with(ls, "path", 4096).film, 5);
+}
+
+// The caustic of a glass sphere filled with a grey absorbing medium (grey, so that the comparison of
+// luminance sees it): photons lose exp(-sigma_a d) inside
+// as eye paths do, so bpm (D = 1) converges to the path tracer block by block.
+TEST(Bpm, AbsorbingGlassCausticConvergesToPath) {
+  LoadedScene ls = load(caustic_scene(true));
+  ASSERT_EQ(ls.scene.media.size(), 1u);
+  Film ref = render_with(ls, "path", 4096, 0, 7).film;
+  Iterations its = render_iterations(ls, "bpm", 160, 9, small_batches(1));
+  expect_blocks_agree(its, ref, 8, edge_bias(small_batches(1), 160, 8), "D=1");
+  EXPECT_GT(its.last.details["light"]["entries"].get<uint64_t>(), 0u);
+
 }
 
 // Light that reaches every visible point only directly: the photons add nothing (no entry is

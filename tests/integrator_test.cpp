@@ -174,6 +174,55 @@ TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
   for (int k = 0; k < 4; ++k) EXPECT_GT(seen[k], 5) << "texel " << k;
 }
 
+// An absorbing medium (sigma_a = 0.7, grey) fills a sphere of radius 1 whose surface does not
+// scatter; behind it an emitter of radiance 1 fills the view. Each pixel sees exp(-sigma_a c),
+// c the chord its ray cuts through the sphere (Beer-Lambert), with every integrator.
+TEST(Integrators, AbsorbingMediumAttenuatesByBeerLambert) {
+  const float sigma = 0.7f, R = 1;
+  LoadedScene ls = load(R"(
+    LookAt 0 0 -4  0 0 0  0 1 0
+    Camera "perspective" "float fov" 30
+    Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+    Integrator "path" "integer maxdepth" 5
+    MakeNamedMedium "ink" "string type" "homogeneous" "rgb sigma_a" [0.7 0.7 0.7] "rgb sigma_s" [0 0 0]
+    WorldBegin
+    AttributeBegin
+      MediumInterface "ink" ""
+      Material "interface"
+      Shape "sphere" "float radius" 1
+    AttributeEnd
+    AttributeBegin
+      AreaLightSource "diffuse" "rgb L" [1 1 1]
+      Material "diffuse" "rgb reflectance" [0 0 0]
+      Shape "trianglemesh" "point3 P" [-9 -9 3  9 -9 3  9 9 3  -9 9 3] "integer indices" [0 2 1 0 3 2]
+    AttributeEnd
+  )");
+  PerspectiveCamera cam(ls.camera, 16, 16);
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    Film film(16, 16);
+    render(ls, quiet_options(ls, integrator, 64, 1), &film);
+    Image img = film.image();
+    std::vector<float> rms = film.rms();
+    int inside = 0;
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+        Vec3 d = normalize(r.d);
+        float b = dot(r.o, d), c = length_squared(r.o) - R * R, disc = b * b - c;
+        float chord = disc > 0 ? 2 * std::sqrt(disc) : 0;
+        if (disc > 0 && disc < 0.05f) continue;  // grazing: the chord changes fast across the pixel
+        inside += chord > 0;
+        // The only noise is that of the sampled wavelengths.
+        EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-sigma * chord), 5 * rms[size_t(y) * 16 + x] + 1e-3f)
+            << integrator << " " << x << "," << y;
+        EXPECT_LT(rms[size_t(y) * 16 + x], 0.01f);
+      }
+    EXPECT_GT(inside, 40) << integrator;
+    EXPECT_LT(img.at(8, 8).luminance(), 0.3f) << integrator;  // exp(-1.4) through the middle
+  }
+}
+
 // Same seed and budget give the same image whatever the number of threads.
 TEST(Renderer, SameImageWithOneAndTwoThreads) {
   LoadedScene ls = load(R"(

@@ -19,11 +19,13 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
   bool after_diffuse_sample = false;
   float prev_pdf_bsdf = 0;
   Vec3 prev_p;
+  int medium = -1;  // the camera is in vacuum (flatten.cpp)
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
     if (counters.rays.log) counters.rays.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) {
+      if (medium >= 0) beta *= medium_transmittance(scene, medium, kInf, wl);
       for (int li : scene.infinite_lights) {
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
         if (!inf) continue;
@@ -37,6 +39,10 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       break;
     }
     length += hit.t * bpm::length(ray.d);
+    if (medium >= 0) {
+      beta *= medium_transmittance(scene, medium, hit.t * bpm::length(ray.d), wl);
+      if (beta.is_black()) break;
+    }
     SurfacePoint sp = scene.surface(ray, hit);
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);
@@ -58,6 +64,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     Material storage;
     const Material& m = prm.materials->at(material_index, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
+      medium = medium_toward(scene, hit.object, sp.ng, ray.d, medium);
       ray = spawn_ray(sp, ray.d);
       ++counters.rays.bounce_rays;
       continue;
@@ -72,7 +79,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       bool last = diffuse == prm.diffuse_depth + 1;
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
-      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, !last, wl, rng, counters.rays);
+      L += beta * sample_direct_light(scene, sp, hit.object, medium, m, frame, wo_local, !last, wl, rng, counters.rays);
       BackwardPhoton bp;
       bp.p = sp.p;
       bp.radius = length * (last ? prm.radius_per_length1 : prm.radius_per_length0);
@@ -104,7 +111,9 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     after_diffuse_sample = is_diffuse;
     prev_pdf_bsdf = bs->mis_pdf;
     prev_p = sp.p;
-    ray = spawn_ray(sp, frame.to_world(bs->wi));
+    Vec3 wi = frame.to_world(bs->wi);
+    medium = medium_toward(scene, hit.object, sp.ng, wi, medium);
+    ray = spawn_ray(sp, wi);
     ++counters.rays.bounce_rays;
   }
   return L;

@@ -103,16 +103,22 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
   int depth = 0;
   float length = 0;
   bool gathering = false;  // between x1 and x2 on a final-gather ray
+  int medium = -1;         // the camera is in vacuum (flatten.cpp)
   ++c.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
     if (!scene.intersect(ray, &hit)) {
+      if (medium >= 0) beta *= medium_transmittance(scene, medium, kInf, wl);
       if (!gathering)
         for (int li : scene.infinite_lights)
           if (auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li])) L += beta * inf->radiance.sample(wl);
       break;
     }
     length += hit.t * bpm::length(ray.d);
+    if (medium >= 0) {
+      beta *= medium_transmittance(scene, medium, hit.t * bpm::length(ray.d), wl);
+      if (beta.is_black()) break;
+    }
     SurfacePoint sp = scene.surface(ray, hit);
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);
@@ -121,6 +127,7 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
     Material storage;
     const Material& m = prm.materials->at(scene.objects[hit.object].material, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
+      medium = medium_toward(scene, hit.object, sp.ng, ray.d, medium);
       ray = spawn_ray(sp, ray.d);
       ++c.rays.bounce_rays;
       continue;
@@ -138,7 +145,7 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
-      L += beta * sample_direct_light(scene, sp, m, frame, wo_local, false, wl, rng, c.rays);
+      L += beta * sample_direct_light(scene, sp, hit.object, medium, m, frame, wo_local, false, wl, rng, c.rays);
       L += beta * estimate(caustic, m, sp, wo, length * prm.radius_per_length0, depth, prm,
                            [](PhotonClass k) { return k == PhotonClass::kCaustic; }, c);
       if (!prm.fpm->final_gather) {
@@ -152,7 +159,9 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
     if (!bs) break;
     beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (beta.is_black()) break;
-    ray = spawn_ray(sp, frame.to_world(bs->wi));
+    Vec3 wi = frame.to_world(bs->wi);
+    medium = medium_toward(scene, hit.object, sp.ng, wi, medium);
+    ray = spawn_ray(sp, wi);
     ++c.rays.bounce_rays;
   }
   return L;

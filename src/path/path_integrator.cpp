@@ -6,8 +6,9 @@
 
 namespace bpm {
 
-Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, const Material& m, const Frame& frame,
-                             Vec3 wo_local, bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters) {
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object, int medium, const Material& m,
+                             const Frame& frame, Vec3 wo_local, bool use_mis, const Wavelengths& wl, Rng& rng,
+                             PathCounters& counters) {
   if (scene.lights.empty()) return {};
   float pmf;
   float ul = rng.uniform();
@@ -30,6 +31,10 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, c
     counters.log->shadow.push_back(Ray{origin, d / len, len * (1 - 1e-4f)});
   }
   if (scene.occluded(origin, target)) return {};
+  if (int toward = medium_toward(scene, object, sp.ng, ls->wi, medium); toward >= 0) {
+    f *= medium_transmittance(scene, toward, ls->is_infinite ? kInf : length(ls->p_light - sp.p), wl);
+    if (f.is_black()) return {};
+  }
   float p_light = pmf * ls->pdf_solid_angle;
   if (ls->is_delta || !use_mis) return ls->radiance * f / p_light;
   float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance);
@@ -44,11 +49,13 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
   float prev_pdf_bsdf = 0;
   Vec3 prev_p;
   int depth = 0;
+  int medium = -1;  // the camera is in vacuum (flatten.cpp)
   ++counters.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
     if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) {
+      if (medium >= 0) beta *= medium_transmittance(scene, medium, kInf, wl);
       for (int li : scene.infinite_lights) {
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
         if (!inf) continue;
@@ -60,6 +67,10 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
         }
       }
       break;
+    }
+    if (medium >= 0) {
+      beta *= medium_transmittance(scene, medium, hit.t * length(ray.d), wl);
+      if (beta.is_black()) break;
     }
     SurfacePoint sp = scene.surface(ray, hit);
     Vec3 wo = -ray.d;
@@ -81,6 +92,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     const Material m = material_at(scene, scene.objects[hit.object].material, wl, texture_context(sp));
     if (std::holds_alternative<InterfaceMaterial>(m)) {
       // A boundary that does not scatter: continue the same ray past it.
+      medium = medium_toward(scene, hit.object, sp.ng, ray.d, medium);
       ray = spawn_ray(sp, ray.d);
       ++counters.bounce_rays;
       continue;
@@ -89,7 +101,8 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     Frame frame = Frame::from_z(sp.ns);
     Vec3 wo_local = frame.to_local(wo);
     if (wo_local.z == 0) break;
-    if (!bsdf_is_specular(m)) L += beta * sample_direct_light(scene, sp, m, frame, wo_local, true, wl, rng, counters);
+    if (!bsdf_is_specular(m))
+      L += beta * sample_direct_light(scene, sp, hit.object, medium, m, frame, wo_local, true, wl, rng, counters);
 
     float uc = rng.uniform();
     Vec2 u{rng.uniform(), rng.uniform()};
@@ -101,6 +114,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     if (bs->is_transmission()) eta_scale *= bs->eta * bs->eta;
     prev_p = sp.p;
     Vec3 wi = frame.to_world(bs->wi);
+    medium = medium_toward(scene, hit.object, sp.ng, wi, medium);
     ray = spawn_ray(sp, wi);
     ++counters.bounce_rays;
     if (beta.is_black()) break;

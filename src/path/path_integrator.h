@@ -33,9 +33,11 @@ struct PathSettings {
 
 // Direct light at a non-specular vertex by sampling one light chosen by power (Veach 1997,
 // 9.2.4), with the power heuristic against BSDF sampling when use_mis (the caller then weights
-// the emitters its BSDF samples hit), else with full weight.
-Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, const Material& m, const Frame& frame,
-                             Vec3 wo_local, bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters);
+// the emitters its BSDF samples hit), else with full weight. sp lies on `object`, reached by a ray
+// in `medium`: the shadow ray's absorption is that of the medium on the light's side.
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object, int medium, const Material& m,
+                             const Frame& frame, Vec3 wo_local, bool use_mis, const Wavelengths& wl, Rng& rng,
+                             PathCounters& counters);
 
 // Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl.
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings, const Wavelengths& wl,

@@ -74,15 +74,24 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
   Ray ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin, le->direction, kInf};
   int bounces = 0;
   bool all_specular = true;
+  // Only area lights may touch a medium (flatten.cpp): the one on the side the photon leaves to.
+  int medium = -1;
+  if (const auto* area = std::get_if<AreaLight>(&light))
+    medium = medium_toward(scene, area->object, le->n_light, le->direction, scene.objects[size_t(area->object)].medium_outside);
   ++counters.light_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
     if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) break;
+    if (medium >= 0) {
+      beta *= medium_transmittance(scene, medium, hit.t * length(ray.d), wm.wl);
+      if (beta.is_black()) break;
+    }
     SurfacePoint sp = scene.surface(ray, hit);
     Material storage;
     const Material& m = wm.at(scene.objects[hit.object].material, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {
+      medium = medium_toward(scene, hit.object, sp.ng, ray.d, medium);
       ray = spawn_ray(sp, ray.d);
       ++counters.light_rays;
       continue;
@@ -114,6 +123,7 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     if (beta.is_black() || !beta.is_finite()) break;
     ++bounces;
     all_specular = all_specular && bs->is_specular();
+    medium = medium_toward(scene, hit.object, sp.ng, wi, medium);
     ray = spawn_ray(sp, wi);
     ++counters.light_rays;
   }

@@ -46,6 +46,7 @@ class Flattener {
   std::set<std::string> building_;
   std::map<int, int> anonymous_material_ids_;
   std::map<std::string, int> named_material_ids_;
+  std::map<std::string, int> medium_ids_;
   RenderScene* scene_ = nullptr;
   RenderScene& scene() { return *scene_; }
 
@@ -57,6 +58,8 @@ class Flattener {
       return;
     }
     const CameraEntity& c = *parsed_.camera;
+    if (!c.medium.outside.empty())
+      throw Error(c.medium.loc, "a camera inside a medium (\"" + c.medium.outside + "\") is not supported");
     if (c.name != "perspective")
       throw Error(c.loc, "camera \"" + c.name + "\" is not supported (only perspective)");
     out->camera.world_from_camera = c.camera_from_world.inverse();
@@ -524,6 +527,42 @@ class Flattener {
     return m;
   }
 
+  // ---- media ----
+  // The index of a named medium, -1 for "" (vacuum). Only media that absorb without scattering
+  // or emitting are supported (pbrt-v4 "homogeneous" with sigma_s = 0 and no Le).
+  int medium_id(const std::string& name, const FileLoc& loc) {
+    if (name.empty()) return -1;
+    if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
+    auto e = parsed_.media.find(name);
+    if (e == parsed_.media.end()) throw Error(loc, "unknown medium \"" + name + "\"");
+    const SceneEntity& m = e->second;
+    const ParamSet& ps = m.params;
+    auto unsupported = [&](const std::string& why) {
+      return Error(loc, "participating media are not supported (medium \"" + name + "\" defined at " + m.loc.str() +
+                            ": " + why + "); only absorbing homogeneous media (sigma_s = 0) are");
+    };
+    if (m.name != "homogeneous") throw unsupported("type \"" + m.name + "\"");
+    if (const Param* p = ps.find_any("preset")) {
+      p->used = true;
+      throw unsupported("preset \"" + (p->strings.empty() ? std::string() : p->strings[0]) + "\" scatters");
+    }
+    float scale = ps.get_float("scale", 1);
+    if (!(scale >= 0) || !std::isfinite(scale)) throw Error(m.loc, "medium scale must be a non-negative number");
+    // pbrt-v4's defaults scatter: sigma_s must be stated, and zero.
+    auto sigma_s = get_spectrum(ps, "sigma_s", SpectrumKind::kUnbounded, parsed_.base_directory);
+    if (!sigma_s || sigma_s->max_value() * scale > 0) throw unsupported("it scatters (sigma_s > 0)");
+    auto Le = get_spectrum(ps, "Le", SpectrumKind::kIlluminant, parsed_.base_directory);
+    float le_scale = ps.get_float("Lescale", 1);
+    if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
+    ps.get_float("g", 0);
+    auto sigma_a = get_spectrum(ps, "sigma_a", SpectrumKind::kUnbounded, parsed_.base_directory)
+                       .value_or(SpectrumCurve::from_rgb(Rgb(0.0011f, 0.0024f, 0.014f), SpectrumKind::kUnbounded));
+    if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
+    ps.warn_unused("medium \"" + name + "\"");
+    scene().media.push_back(AbsorbingMedium{name, sigma_a.scaled(scale)});
+    return medium_ids_[name] = int(scene().media.size()) - 1;
+  }
+
   int material_id(const MaterialRef& ref) {
     if (!ref.named.empty()) {
       auto it = named_material_ids_.find(ref.named);
@@ -650,6 +689,8 @@ class Flattener {
     }
     ps.warn_unused("shape \"" + s.name + "\"");
     obj.material = material_id(s.material);
+    obj.medium_inside = medium_id(s.medium.inside, s.medium.loc);
+    obj.medium_outside = medium_id(s.medium.outside, s.medium.loc);
     int id = int(rs->objects.size());
     if (s.area_light) add_area_light(*s.area_light, &obj, id, rs);
     rs->objects.push_back(std::move(obj));
@@ -712,6 +753,8 @@ class Flattener {
 
   void add_light(const LightEntity& e, RenderScene* rs) {
     const ParamSet& ps = e.params;
+    if (!e.medium.outside.empty() && medium_id(e.medium.outside, e.medium.loc) >= 0)
+      throw Error(e.loc, "light \"" + e.name + "\" inside a medium (\"" + e.medium.outside + "\") is not supported");
     const Transform& xf = e.world_from_light;
     float scale = ps.get_float("scale", 1);
     if (e.name == "point") {

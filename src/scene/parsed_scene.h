@@ -17,8 +17,17 @@ struct SceneEntity {
   FileLoc loc;
 };
 
+// The media on the two sides of a surface (pbrt-v4's MediumInterface; "" is vacuum), or the
+// medium a camera or light sits in (outside).
+struct MediumRef {
+  std::string inside, outside;
+  FileLoc loc;  // of the MediumInterface directive
+  bool any() const { return !inside.empty() || !outside.empty(); }
+};
+
 struct CameraEntity : SceneEntity {
   Transform camera_from_world;
+  MediumRef medium;
 };
 
 struct MaterialRef {
@@ -33,10 +42,12 @@ struct ShapeEntity : SceneEntity {
   MaterialRef material;
   std::optional<SceneEntity> area_light;
   std::string directory;  // of the file that named the shape, for relative paths
+  MediumRef medium;
 };
 
 struct LightEntity : SceneEntity {
   Transform world_from_light;
+  MediumRef medium;
 };
 
 struct TextureEntity : SceneEntity {
@@ -55,6 +66,7 @@ struct ParsedScene {
   std::vector<SceneEntity> materials;                // anonymous Material directives
   std::map<std::string, SceneEntity> named_materials;  // MakeNamedMaterial
   std::vector<TextureEntity> textures;
+  std::map<std::string, SceneEntity> media;  // MakeNamedMedium; name is the "type" parameter
   std::vector<ShapeEntity> shapes;
   std::vector<LightEntity> lights;
   std::string base_directory;  // of the main scene file

@@ -20,6 +20,7 @@ struct GraphicsState {
   MaterialRef material;
   std::optional<SceneEntity> area_light;
   bool in_object = false;
+  MediumRef medium;
 };
 
 class Parser {
@@ -286,6 +287,7 @@ class Parser {
       c.loc = d.loc;
       c.params = params();
       c.camera_from_world = gs_.ctm;
+      c.medium = gs_.medium;
       coord_systems_["camera"] = gs_.ctm.inverse();
       scene_->camera = std::move(c);
     } else if (k == "Film" || k == "Sampler" || k == "PixelFilter" || k == "Integrator" || k == "Accelerator") {
@@ -352,6 +354,7 @@ class Parser {
       l.loc = d.loc;
       l.params = params();
       l.world_from_light = gs_.ctm;
+      l.medium = gs_.medium;
       scene_->lights.push_back(std::move(l));
     } else if (k == "AreaLightSource") {
       require_world(d, true);
@@ -369,6 +372,7 @@ class Parser {
       s.material = gs_.material;
       s.area_light = gs_.area_light;
       s.directory = current_directory();
+      s.medium = gs_.medium;
       if (object_name_) objects_[*object_name_].push_back(std::move(s));
       else scene_->shapes.push_back(std::move(s));
     } else if (k == "ObjectBegin") {
@@ -405,15 +409,17 @@ class Parser {
       include_chain_.insert(ps);
       push_file(Tokenizer::from_file(ps, d.loc));
     } else if (k == "MakeNamedMedium") {
-      expect_string(d, "a medium name");
-      params();
-      warning(d.loc, "participating media are not supported; the medium is ignored unless a shape or camera uses it");
+      std::string name = expect_string(d, "a medium name");
+      ParamSet ps = params();
+      const Param* type = ps.find("type", "string");
+      if (!type || type->strings.size() != 1) throw Error(d.loc, "medium \"" + name + "\" has no \"string type\"");
+      type->used = true;
+      scene_->media[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
     } else if (k == "MediumInterface") {
       std::string inside = expect_string(d, "a medium name");
       std::string outside = inside;
       if (auto t = peek_token(); t && t->is_string()) outside = next_token()->unquoted();
-      if (!inside.empty() || !outside.empty())
-        throw Error(d.loc, "participating media are not supported (MediumInterface \"" + inside + "\" \"" + outside + "\")");
+      gs_.medium = MediumRef{inside, outside, d.loc};
     } else {
       throw Error(d.loc, "unknown directive '" + std::string(k) + "'");
     }

@@ -787,13 +787,31 @@ TEST(SceneParse, ParseSceneFileResolvesRelativeToItsDirectory) {
   expect_vec_near(m.positions[2], Vec3(1, 1, 2));
 }
 
-TEST(SceneParse, MakeNamedMediumOnlyWarns) {
+TEST(SceneParse, MediaAreReadAndAbsorbingOnesAttachToShapes) {
   int before = warning_count();
   ParsedScene p = parse_scene_string(
-      "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 1 1]\nWorldBegin\n"
-      "Shape \"sphere\"\n");
-  EXPECT_EQ(warning_count() - before, 1);
-  EXPECT_EQ(p.shapes.size(), 1u);
+      "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [1 1 1]\n"
+      "MakeNamedMedium \"ink\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.2 0.4]\n"
+      "  \"rgb sigma_s\" [0 0 0] \"float scale\" 2\nWorldBegin\n"
+      "AttributeBegin\nMediumInterface \"ink\" \"\"\nShape \"sphere\"\nAttributeEnd\n"
+      "MediumInterface \"\" \"ink\"\nShape \"sphere\"\nMediumInterface \"ink\"\nShape \"sphere\"\n");
+  ASSERT_EQ(p.media.size(), 2u);
+  EXPECT_EQ(p.media.at("fog").name, "homogeneous");
+  ASSERT_EQ(p.shapes.size(), 3u);
+  EXPECT_EQ(p.shapes[0].medium.inside, "ink");
+  EXPECT_EQ(p.shapes[0].medium.outside, "");
+  EXPECT_EQ(p.shapes[2].medium.outside, "ink");  // one name: both sides
+  // The unused scattering medium is no error; the used one is absorbing, scaled.
+  LoadedScene ls = flatten_scene(p);
+  EXPECT_EQ(warning_count(), before);
+  ASSERT_EQ(ls.scene.media.size(), 1u);
+  expect_spectrum_near(ls.scene.media[0].sigma_a, Rgb(1.0f, 0.4f, 0.8f), 2e-3f);
+  EXPECT_EQ(ls.scene.objects[0].medium_inside, 0);
+  EXPECT_EQ(ls.scene.objects[0].medium_outside, -1);
+  EXPECT_EQ(ls.scene.objects[1].medium_inside, -1);
+  EXPECT_EQ(ls.scene.objects[1].medium_outside, 0);
+  EXPECT_EQ(ls.scene.objects[2].medium_inside, 0);
+  EXPECT_EQ(ls.scene.objects[2].medium_outside, 0);
 }
 
 TEST(SceneParse, EmptyMediumInterfaceIsAccepted) {
@@ -1258,9 +1276,29 @@ TEST(SceneParseError, NamedMaterialDefinedTwice) {
                       at(3, 1), "named material \"m\" defined twice"));
 }
 
-TEST(SceneParseError, MediumInterfaceWithMedium) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nMediumInterface \"fog\" \"\"\nShape \"sphere\"\n"), at(2, 1),
-                      "participating media are not supported"));
+TEST(SceneParseError, MediaThatScatterOrAreUnknownAreErrors) {
+  auto scene = [](const std::string& medium_params, const std::string& interface = "MediumInterface \"m\" \"\"") {
+    return "MakeNamedMedium \"m\" " + medium_params + "\nWorldBegin\n" + interface + "\nShape \"sphere\"\n";
+  };
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\"", "MediumInterface \"nope\" \"\"")), at(3, 1),
+                      "unknown medium \"nope\""));
+  // pbrt-v4's default sigma_s scatters; so does a stated one.
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\"")), at(3, 1),
+                      "participating media are not supported (medium \"m\" defined at <string>:1:1: it scatters"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0.1 0]")), at(3, 1),
+                      "it scatters (sigma_s > 0)"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"rgb sigma_s\" [0 0 0]")), at(3, 1),
+                      "type \"uniformgrid\""));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] \"rgb Le\" [1 1 1]")),
+                      at(3, 1), "it emits (Le)"));
+  EXPECT_TRUE(IsError(error_of("MakeNamedMedium \"m\" \"float scale\" 1\nWorldBegin\n"), at(1, 1),
+                      "medium \"m\" has no \"string type\""));
+  // The camera or a light inside a medium.
+  const std::string absorbing = "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0]\n";
+  EXPECT_TRUE(IsError(error_of(absorbing + "MediumInterface \"\" \"m\"\nCamera \"perspective\"\nWorldBegin\n"), at(2, 1),
+                      "a camera inside a medium (\"m\") is not supported"));
+  EXPECT_TRUE(IsError(error_of(absorbing + "WorldBegin\nMediumInterface \"m\"\nLightSource \"point\"\n"), at(4, 1),
+                      "light \"point\" inside a medium (\"m\") is not supported"));
 }
 
 TEST(SceneParseError, ColorSpaceOtherThanSrgb) {

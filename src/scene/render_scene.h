@@ -14,9 +14,19 @@
 
 namespace bpm {
 
+// A homogeneous medium that absorbs and does not scatter or emit (pbrt-v4 "homogeneous" with
+// sigma_s = 0): light crossing a distance d in it keeps exp(-sigma_a d), wavelength by wavelength.
+struct AbsorbingMedium {
+  std::string name;
+  SpectrumCurve sigma_a;  // per unit distance
+};
+
 struct Object {
   Shape shape;
   int material = 0;
+  // Media inside and outside (the side the geometric normal points to); -1 is vacuum. A surface
+  // with the same medium on both sides leaves a ray in the medium it travels in.
+  int medium_inside = -1, medium_outside = -1;
   int first_light = -1;  // index of the area light of primitive 0; primitive i is first_light + i
   std::string source;    // file:line of the Shape directive, for statistics and messages
 };
@@ -45,6 +55,7 @@ class RenderScene {
   std::vector<Object> objects;
   std::vector<MaterialDesc> materials;
   TextureSet textures;  // the nodes textured materials read
+  std::vector<AbsorbingMedium> media;
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
   Distribution1D light_distribution;  // in proportion to power
@@ -78,6 +89,24 @@ class RenderScene {
 };
 
 inline TextureContext texture_context(const SurfacePoint& sp) { return {sp.p, sp.uv}; }
+
+// The medium a ray leaving a surface of `object` (geometric normal ng) toward w travels in, when
+// the ray that arrived was in `current`.
+inline int medium_toward(const RenderScene& scene, int object, Vec3 ng, Vec3 w, int current) {
+  const Object& o = scene.objects[size_t(object)];
+  if (o.medium_inside == o.medium_outside) return current;
+  return dot(w, ng) > 0 ? o.medium_outside : o.medium_inside;
+}
+
+// The fraction of light that crosses `distance` in `medium` (-1: vacuum) at each wavelength.
+inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float distance, const Wavelengths& wl) {
+  Spectrum t(1.0f);
+  if (medium < 0) return t;
+  Spectrum sigma = scene.media[size_t(medium)].sigma_a.sample(wl);
+  for (int i = 0; i < Spectrum::kChannels; ++i)
+    if (sigma[i] > 0) t[i] = std::exp(-sigma[i] * distance);
+  return t;
+}
 
 // The material of a surface point at the wavelengths (resolved there, textures included).
 inline Material material_at(const RenderScene& scene, int material, const Wavelengths& wl, const TextureContext& ctx) {
