@@ -387,6 +387,40 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
   expect_bpm_converges(ls, render_with(ls, "path", 4096).film, 5);
 }
 
+// A furnace whose material is pbrt-v4's mix of two diffuse materials (0.2 and 0.8, amount 0.25),
+// chosen per point: its mean albedo is 0.35, and every pixel sees Le + 0.35 A_{D-1} with
+// A_k = Le + 0.35 A_{k-1}, for path (per pixel) and bpm (image mean over iterations).
+TEST(Materials, MixFurnaceMatchesAnalyticRadiance) {
+  const int depth = 6;
+  LoadedScene ls = load(header(16, depth, "0 0 0  0 0 1  0 1 0") +
+                        "MakeNamedMaterial \"dark\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.2 0.2 0.2]\n"
+                        "MakeNamedMaterial \"light\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
+                        "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+                        "Material \"mix\" \"string materials\" [\"dark\" \"light\"] \"float amount\" 0.25\n"
+                        "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+  double a = 1;
+  for (int k = 1; k < depth; ++k) a = 1 + 0.35 * a;
+  const double want = 1 + 0.35 * a;
+  RenderRun run = render_with(ls, "path", 256);
+  Image img = run.film.image();
+  std::vector<float> rms = run.film.rms();
+  double sum = 0, var = 0;
+  for (int i = 0; i < 256; ++i) {
+    float v = img.at(i % 16, i / 16).luminance();
+    EXPECT_NEAR(v, want, 4.5 * rms[size_t(i)] + 1e-3) << "pixel " << i;
+    sum += v, var += double(rms[size_t(i)]) * rms[size_t(i)];
+  }
+  EXPECT_NEAR(sum / 256, want, 4.5 * std::sqrt(var) / 256);
+  EXPECT_LT(std::sqrt(var) / 256, 0.005 * want);
+
+  BpmSettings s = small_batches(1);
+  BlockStats m = image_mean(render_iterations(ls, "bpm", 40, 11, s));
+  float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
+  double r_over_R = s.k1 * pixel_angle * 3, sigma = std::sqrt(m.var);
+  EXPECT_NEAR(m.mean, want, 4.5 * sigma + want * r_over_R * r_over_R / 8) << "sigma " << sigma;
+  EXPECT_LT(sigma, 0.01 * want);
+}
+
 // The caustic of a glass sphere filled with a grey absorbing medium (grey, so that the comparison of
 // luminance sees it): photons lose exp(-sigma_a d) inside
 // as eye paths do, so bpm (D = 1) converges to the path tracer block by block.

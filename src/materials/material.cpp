@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "materials/material.h"
 
@@ -49,6 +50,10 @@ struct Resolver {
     layer.roughness = rough(d.layer.roughness, d.roughness_tex);
     return CoatedConductorMaterial{std::get<ConductorMaterial>((*this)(d.conductor)), layer};
   }
+  Material operator()(const MixDesc&) const {
+    // A mix names other materials: material_at chooses one before resolving.
+    throw std::logic_error("resolve_material: a mix material must be chosen by material_at");
+  }
   Material operator()(const CoatedDiffuseDesc& d) const {
     CoatLayer layer = d.layer;
     layer.roughness = rough(d.layer.roughness, d.roughness_tex);
@@ -89,6 +94,7 @@ bool material_is_textured(const MaterialDesc& desc) {
     bool operator()(const DielectricMaterial&) const { return false; }
     bool operator()(const ThinDielectricMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return false; }
+    bool operator()(const MixDesc&) const { return true; }
   };
   return std::visit(V{}, desc);
 }

@@ -129,16 +129,24 @@ struct CoatedConductorDesc {
   CoatLayer layer;
   RoughnessTextures roughness_tex;  // the coat's
 };
+// pbrt-v4's "mix": at each surface point one of two scene materials (indices into the scene's
+// list), the second with probability `amount`, chosen by a hash of the point so that every path
+// meeting that point sees the same choice. Resolved by material_at (render_scene.h).
+struct MixDesc {
+  int materials[2] = {0, 0};
+  FloatParam amount{0.5f, -1};
+};
 using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
                                   DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc,
-                                  CoatedConductorDesc>;
+                                  CoatedConductorDesc, MixDesc>;
 
 // A material without textures at the wavelengths.
 Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl);
 // Any material, at the wavelengths and the surface point.
 Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl, const TextureSet& textures,
                           const TextureContext& ctx);
-// True when a parameter of the material is a texture (it must be resolved per surface point).
+// True when a parameter of the material is a texture, or it is a mix (it must be resolved per
+// surface point).
 bool material_is_textured(const MaterialDesc& desc);
 
 enum BsdfFlags : unsigned {

@@ -47,6 +47,7 @@ class Flattener {
   std::map<int, int> anonymous_material_ids_;
   std::map<std::string, int> named_material_ids_;
   std::map<std::string, int> medium_ids_;
+  std::set<std::string> building_materials_;
   RenderScene* scene_ = nullptr;
   RenderScene& scene() { return *scene_; }
 
@@ -517,6 +518,15 @@ class Flattener {
         if (!(ph.exponent >= 0 && ph.exponent <= 1e5f)) throw Error(p->loc, "phong exponent must be in [0, 1e5]");
       }
       m = ph;
+    } else if (e.name == "mix") {
+      MixDesc mix;
+      const Param* names = ps.find("materials", "string");
+      if (!names || names->strings.size() != 2)
+        throw Error(names ? names->loc : e.loc, "mix needs \"string materials\" with two named materials");
+      names->used = true;
+      for (int i = 0; i < 2; ++i) mix.materials[i] = material_id(MaterialRef{-1, names->strings[size_t(i)], names->loc});
+      mix.amount = float_or_texture(ps, "amount", 0.5f);
+      m = mix;
     } else if (e.name == "interface" || e.name == "" || e.name == "none") {
       m = InterfaceMaterial{};
     } else {
@@ -569,7 +579,11 @@ class Flattener {
       if (it != named_material_ids_.end()) return it->second;
       auto e = parsed_.named_materials.find(ref.named);
       if (e == parsed_.named_materials.end()) throw Error(ref.loc, "unknown named material \"" + ref.named + "\"");
-      scene().materials.push_back(make_material(e->second));
+      if (!building_materials_.insert(ref.named).second)
+        throw Error(ref.loc, "named material \"" + ref.named + "\" contains itself (through mix)");
+      MaterialDesc made = make_material(e->second);
+      building_materials_.erase(ref.named);
+      scene().materials.push_back(std::move(made));
       return named_material_ids_[ref.named] = int(scene().materials.size()) - 1;
     }
     if (ref.index < 0) return 0;

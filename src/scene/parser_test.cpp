@@ -1669,6 +1669,52 @@ TEST(SceneFlattenError, TextureErrorsNameTheDirective) {
                       at(3, 1), "textured roughness is not supported"));
 }
 
+TEST(SceneParse, MixMaterialNamesTwoMaterials) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n"
+      "MakeNamedMaterial \"b\" \"string type\" \"conductor\"\n"
+      "Texture \"t\" \"float\" \"checkerboard\"\n"
+      "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"a\" \"b\"] \"texture amount\" \"t\"\n"
+      "NamedMaterial \"m\"\nShape \"sphere\"\n"
+      "Material \"mix\" \"string materials\" [\"b\" \"m\"] \"float amount\" 0.3\nShape \"sphere\"\n"));
+  const auto* m = std::get_if<MixDesc>(&ls.scene.materials[size_t(ls.scene.objects[0].material)]);
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(std::holds_alternative<DiffuseDesc>(ls.scene.materials[size_t(m->materials[0])]));
+  EXPECT_TRUE(std::holds_alternative<ConductorDesc>(ls.scene.materials[size_t(m->materials[1])]));
+  EXPECT_TRUE(m->amount.textured());
+  const auto* n = std::get_if<MixDesc>(&ls.scene.materials[size_t(ls.scene.objects[1].material)]);
+  ASSERT_TRUE(n);
+  EXPECT_FLOAT_EQ(n->amount.value, 0.3f);
+  EXPECT_EQ(n->materials[1], ls.scene.objects[0].material);  // a mix of a mix
+  EXPECT_TRUE(material_is_textured(ls.scene.materials[size_t(ls.scene.objects[1].material)]));
+  // The choice: amount 0 and 1 pick one side everywhere; the checkerboard amount (1 then 0)
+  // picks by cell; the nested mix ends at a material that is not a mix.
+  TextureContext in_first{{0, 0, 0}, {0.5f, 0.5f}}, in_second{{0, 0, 0}, {1.5f, 0.5f}};
+  EXPECT_EQ(choose_mix(ls.scene, ls.scene.objects[0].material, in_first), m->materials[1]);
+  EXPECT_EQ(choose_mix(ls.scene, ls.scene.objects[0].material, in_second), m->materials[0]);
+  int hits_b = 0;
+  for (int i = 0; i < 1000; ++i) {
+    TextureContext c{{float(i) * 0.013f, 0.5f, -float(i) * 0.007f}, {1.5f, 0.5f}};
+    int chosen = choose_mix(ls.scene, ls.scene.objects[1].material, c);
+    EXPECT_FALSE(std::holds_alternative<MixDesc>(ls.scene.materials[size_t(chosen)]));
+    hits_b += chosen == n->materials[0];
+    EXPECT_EQ(chosen, choose_mix(ls.scene, ls.scene.objects[1].material, c));  // the same every time
+  }
+  EXPECT_NEAR(hits_b / 1000.0, 0.7, 0.05);  // "b" directly with 1 - 0.3, "a" through "m" otherwise
+}
+
+TEST(SceneFlattenError, MixMaterialErrors) {
+  const std::string one = R"(Material "mix" "string materials" "a")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + one + "\nShape \"sphere\"\n"), at(2, col(one, "\"string materials")),
+                      "mix needs \"string materials\" with two named materials"));
+  const std::string unknown = R"(Material "mix" "string materials" ["a" "b"])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + unknown + "\nShape \"sphere\"\n"), at(2, col(unknown, "\"string materials")),
+                      "unknown named material \"a\""));
+  const std::string self = R"(MakeNamedMaterial "a" "string type" "mix" "string materials" ["a" "a"])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + self + "\nNamedMaterial \"a\"\nShape \"sphere\"\n"),
+                      at(2, col(self, "\"string materials")), "named material \"a\" contains itself"));
+}
+
 TEST(SceneFlattenError, ConductorWithReflectanceAndEta) {
   EXPECT_TRUE(IsError(error_of("WorldBegin\nMaterial \"conductor\" \"rgb reflectance\" [0.5 0.5 0.5] "
                                "\"spectrum eta\" \"metal-Au-eta\"\nShape \"sphere\"\n"),

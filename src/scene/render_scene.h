@@ -108,8 +108,13 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float
   return t;
 }
 
-// The material of a surface point at the wavelengths (resolved there, textures included).
+// The scene material a mix material stands for at a point (a material that is not a mix stands
+// for itself): the second with probability `amount`, by a hash of the point.
+int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx);
+
+// The material of a surface point at the wavelengths (resolved there, textures and mixes included).
 inline Material material_at(const RenderScene& scene, int material, const Wavelengths& wl, const TextureContext& ctx) {
+  material = choose_mix(scene, material, ctx);
   return resolve_material(scene.materials[size_t(material)], wl, scene.textures, ctx);
 }
 
