@@ -111,7 +111,7 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     lc.log = &light_log;
     for (int k = 0; k < bs.photons_per_batch; ++k) {
       Rng rng(stream_key(98, 0, k));
-      trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos}, owner, rng, out, lc);
+      trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos, {}}, owner, rng, out, lc);
     }
   }
   std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n", eye_log.closest_hit.size(),

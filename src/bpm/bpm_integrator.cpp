@@ -151,7 +151,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     // One set of wavelengths for every eye and light path of the iteration.
     const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
     EyePassParams ep{&wm, s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale};
-    LightPassParams lp{&wm, opt.max_depth, s.normal_cos};
+    LightPassParams lp{&wm, opt.max_depth, s.normal_cos, {}};
     const int slots = masks.slots();
     tbb::parallel_for(tbb::blocked_range<int>(0, masks.block_count() * slots, 1), [&](const tbb::blocked_range<int>& r) {
       ObjectPhotonLists& lists = thread_lists.local();
@@ -190,6 +190,7 @@ RenderStats render_bpm(const LoadedScene& ls, const RenderOptions& opt, Film* fi
     std::vector<ObjectPhotonLists*> lists;
     for (ObjectPhotonLists& l : thread_lists) lists.push_back(&l);
     build_backward_maps(lists, scene.objects.size(), s.centre_tree, &maps);
+    resolve_photon_materials(maps, &lp);
     tot.build_s += since(t_stage);
     tot.peak_photon_bytes = std::max(tot.peak_photon_bytes, maps.photon_bytes());
     tot.peak_tree_bytes = std::max(tot.peak_tree_bytes, maps.tree_bytes());

@@ -25,7 +25,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     Hit hit;
     if (counters.rays.log) counters.rays.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) {
-      if (medium >= 0) beta *= medium_transmittance(scene, medium, kInf, wl);
+      cross_medium(scene, medium, kInf, wl, beta);  // escaping through a medium
       for (int li : scene.infinite_lights) {
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
         if (!inf) continue;
@@ -39,10 +39,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       break;
     }
     length += hit.t * bpm::length(ray.d);
-    if (medium >= 0) {
-      beta *= medium_transmittance(scene, medium, hit.t * bpm::length(ray.d), wl);
-      if (beta.is_black()) break;
-    }
+    if (!cross_medium(scene, medium, hit.t * bpm::length(ray.d), wl, beta)) break;
     SurfacePoint sp = scene.surface(ray, hit);
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);

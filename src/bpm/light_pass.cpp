@@ -1,5 +1,8 @@
 #include "bpm/light_pass.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <cmath>
 
 #include "photons/density.h"
@@ -18,7 +21,9 @@ void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     if (!bp.accepts_class(cls) || int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
     Material storage;
-    const Material& m = prm.materials->at(int(bp.material), TextureContext{bp.p, bp.uv}, storage);
+    const Material& m = prm.photon_materials.empty()
+                            ? prm.materials->at(int(bp.material), TextureContext{bp.p, bp.uv}, storage)
+                            : prm.photon_materials[g];
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     out[owner[bp.pixel]].push_back({g, value});
@@ -27,6 +32,18 @@ void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
 }
 
 }  // namespace
+
+void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
+  prm->photon_materials.clear();
+  const WavelengthMaterials& wm = *prm->materials;
+  if (std::none_of(wm.textured.begin(), wm.textured.end(), [](char t) { return t != 0; })) return;
+  prm->photon_materials.resize(maps.photons.size());
+  tbb::parallel_for(size_t(0), maps.photons.size(), [&](size_t g) {
+    const BackwardPhoton& bp = maps.photons[g];
+    Material storage;
+    prm->photon_materials[g] = wm.at(int(bp.material), TextureContext{bp.p, bp.uv}, storage);
+  });
+}
 
 void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
                   const std::vector<uint16_t>& owner, Rng& rng, std::vector<std::vector<PhotonEntry>>& out,

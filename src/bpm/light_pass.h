@@ -23,7 +23,13 @@ struct LightPassParams {
   const WavelengthMaterials* materials = nullptr;  // this iteration's wavelengths
   int max_depth = 5;
   float normal_cos = 0.5f;
+  // When the scene has textured materials: each backward photon's material, resolved once at its
+  // point (resolve_photon_materials) instead of once per photon that reaches it; may be empty.
+  std::vector<Material> photon_materials;
 };
+
+// Fills prm->photon_materials for the backward photons of maps when a material is textured.
+void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm);
 
 
 // Traces one photon. owner[pixel] is the mask slot of the pixel; out has one list per slot.

@@ -108,17 +108,14 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
   for (int guard = 0; guard < 10000; ++guard) {
     Hit hit;
     if (!scene.intersect(ray, &hit)) {
-      if (medium >= 0) beta *= medium_transmittance(scene, medium, kInf, wl);
+      cross_medium(scene, medium, kInf, wl, beta);  // escaping through a medium
       if (!gathering)
         for (int li : scene.infinite_lights)
           if (auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li])) L += beta * inf->radiance.sample(wl);
       break;
     }
     length += hit.t * bpm::length(ray.d);
-    if (medium >= 0) {
-      beta *= medium_transmittance(scene, medium, hit.t * bpm::length(ray.d), wl);
-      if (beta.is_black()) break;
-    }
+    if (!cross_medium(scene, medium, hit.t * bpm::length(ray.d), wl, beta)) break;
     SurfacePoint sp = scene.surface(ray, hit);
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);

@@ -55,7 +55,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     Hit hit;
     if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) {
-      if (medium >= 0) beta *= medium_transmittance(scene, medium, kInf, wl);
+      cross_medium(scene, medium, kInf, wl, beta);  // escaping through a medium
       for (int li : scene.infinite_lights) {
         const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
         if (!inf) continue;
@@ -68,10 +68,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
       }
       break;
     }
-    if (medium >= 0) {
-      beta *= medium_transmittance(scene, medium, hit.t * length(ray.d), wl);
-      if (beta.is_black()) break;
-    }
+    if (!cross_medium(scene, medium, hit.t * length(ray.d), wl, beta)) break;
     SurfacePoint sp = scene.surface(ray, hit);
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);

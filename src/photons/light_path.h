@@ -83,10 +83,7 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     Hit hit;
     if (counters.log) counters.log->closest_hit.push_back(ray);
     if (!scene.intersect(ray, &hit)) break;
-    if (medium >= 0) {
-      beta *= medium_transmittance(scene, medium, hit.t * length(ray.d), wm.wl);
-      if (beta.is_black()) break;
-    }
+    if (!cross_medium(scene, medium, hit.t * length(ray.d), wm.wl, beta)) break;
     SurfacePoint sp = scene.surface(ray, hit);
     Material storage;
     const Material& m = wm.at(scene.objects[hit.object].material, texture_context(sp), storage);

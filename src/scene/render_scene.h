@@ -108,6 +108,14 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float
   return t;
 }
 
+// Attenuates a path's throughput over a segment of `distance` in `medium`; false when nothing is
+// left of it.
+inline bool cross_medium(const RenderScene& scene, int medium, float distance, const Wavelengths& wl, Spectrum& beta) {
+  if (medium < 0) return true;
+  beta *= medium_transmittance(scene, medium, distance, wl);
+  return !beta.is_black();
+}
+
 // The scene material a mix material stands for at a point (a material that is not a mix stands
 // for itself): the second with probability `amount`, by a hash of the point.
 int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx);
