@@ -1,5 +1,6 @@
 // Analytic checks of the path integrator and of the render loop.
 #include <cmath>
+#include <functional>
 
 #include <unistd.h>
 
@@ -220,6 +221,104 @@ TEST(Integrators, AbsorbingMediumAttenuatesByBeerLambert) {
       }
     EXPECT_GT(inside, 40) << integrator;
     EXPECT_LT(img.at(8, 8).luminance(), 0.3f) << integrator;  // exp(-1.4) through the middle
+  }
+}
+
+// The expectation of a pixel under the box filter of radius 1/2: f averaged over the pixel.
+template <class F>
+double pixel_mean(const PerspectiveCamera& cam, int x, int y, F&& f) {
+  const int n = 12;
+  double sum = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) sum += f(cam.generate_ray({x + (i + 0.5f) / n, y + (j + 0.5f) / n}, {0.5f, 0.5f}));
+  return sum / (n * n);
+}
+
+// Alpha masks with every integrator. (1) An emitter of radiance 1 seen through a black square
+// whose alpha is a checkerboard of 0 and 0.25 cells: a pixel shows 1 - alpha averaged over it.
+// (2) A plane under a point light, lit through a black disk of alpha 0.5 (an analytic shape)
+// that covers the sky: half the unobstructed radiance, on camera rays, shadow rays and photons.
+TEST(Integrators, AlphaMasksLetLightThrough) {
+  LoadedScene sheet = load(R"(
+    LookAt 0 0 -4  0 0 0  0 1 0
+    Camera "perspective" "float fov" 30
+    Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.5 "float yradius" 0.5
+    Integrator "path" "integer maxdepth" 5
+    WorldBegin
+    Texture "mask" "float" "checkerboard" "float uscale" 4 "float vscale" 4 "float tex1" 0 "float tex2" 0.25
+    Material "diffuse" "rgb reflectance" [0 0 0]
+    Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] "integer indices" [0 1 2 0 2 3]
+      "point2 uv" [0 0  1 0  1 1  0 1] "texture alpha" "mask"
+    AttributeBegin
+      AreaLightSource "diffuse" "rgb L" [1 1 1]
+      Shape "trianglemesh" "point3 P" [-9 -9 3  9 -9 3  9 9 3  -9 9 3] "integer indices" [0 2 1 0 3 2]
+    AttributeEnd
+  )");
+  auto sheet_value = [](const Ray& r) {
+    Vec3 p = r.o + r.d * (-r.o.z / r.d.z);
+    if (std::fabs(p.x) > 1 || std::fabs(p.y) > 1) return 1.0;
+    int cell = int(std::floor(2 * (p.x + 1))) + int(std::floor(2 * (p.y + 1)));
+    return cell % 2 == 0 ? 1.0 : 0.75;
+  };
+  LoadedScene lit = load(R"(
+    LookAt 0 1 -1  0 0 0.5  0 1 0
+    Camera "perspective" "float fov" 50
+    Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.5 "float yradius" 0.5
+    Integrator "path" "integer maxdepth" 5
+    WorldBegin
+    LightSource "point" "rgb I" [3 3 3] "point3 from" [0.5 3 0.3]
+    AttributeBegin
+      Material "diffuse" "rgb reflectance" [0 0 0]
+      Translate 0 2 0
+      Rotate 90 1 0 0
+      Shape "disk" "float radius" 100 "float alpha" 0.5
+    AttributeEnd
+    Material "diffuse" "rgb reflectance" [0.6 0.6 0.6]
+    Shape "trianglemesh" "point3 P" [-50 0 -50  50 0 -50  50 0 50  -50 0 50] "integer indices" [0 1 2 0 2 3]
+  )");
+  auto lit_value = [](const Ray& r) {
+    if (r.d.y >= 0) return 0.0;
+    Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
+    Vec3 to_light = Vec3(0.5f, 3, 0.3f) - p;
+    double d2 = length_squared(to_light);
+    return 0.5 * 0.6 / M_PI * 3 * (to_light.y / std::sqrt(d2)) / d2;
+  };
+  // Neither scene has caustic or indirect light for bpm's backward photons to gather, so its
+  // light pass would trace its largest number of batches in every iteration; one is enough.
+  struct Case {
+    const LoadedScene* ls;
+    std::function<double(const Ray&)> value;
+    const char* name;
+  };
+  for (const Case& c : {Case{&sheet, sheet_value, "sheet"}, Case{&lit, lit_value, "lit"}}) {
+    PerspectiveCamera cam(c.ls->camera, 16, 16);
+    for (const char* integrator : {"path", "bpm", "fpm"}) {
+      Film film(16, 16);
+      RenderOptions opt = quiet_options(*c.ls, integrator, 64, 1);
+      opt.bpm.max_batches = 1;
+      opt.bpm.photons_per_batch = 20000;
+      render(*c.ls, opt, &film);
+      Image img = film.image();
+      std::vector<float> rms = film.rms();
+      double sum_diff = 0, sum_var = 0;
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) {
+          double expected = pixel_mean(cam, x, y, c.value);
+          // A pixel where few samples meet the mask may see none blocked, and then estimates a
+          // variance of zero: the Bernoulli variance of one camera ray's outcome, over the
+          // number of passes, bounds the noise from below.
+          double blocked = c.name == std::string("sheet") ? 1 - expected : 0.5;
+          double value = c.name == std::string("sheet") ? 1 : 2 * expected;
+          double sigma = std::max(double(rms[size_t(y) * 16 + x]), value * std::sqrt(blocked * (1 - blocked) / 64));
+          EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 2e-3 * expected)
+              << c.name << " " << integrator << " " << x << "," << y;
+          sum_diff += img.at(x, y).luminance() - expected;
+          sum_var += sigma * sigma;
+        }
+      EXPECT_NEAR(sum_diff, 0, 4 * std::sqrt(sum_var) + 1e-3) << c.name << " " << integrator;
+    }
   }
 }
 

@@ -34,6 +34,11 @@ float primitive_area(const Shape& shape, int prim) {
     float r = s->radius * scale;
     return s->phi_max * r * (std::fmin(s->z_max, s->radius) - std::fmax(s->z_min, -s->radius)) * scale;
   }
+  if (auto* c = std::get_if<Cylinder>(&shape)) {
+    float scale = 1;
+    c->world_from_object.is_similarity(&scale);
+    return c->phi_max * c->radius * (c->z_max - c->z_min) * scale * scale;
+  }
   const Disk& k = std::get<Disk>(shape);
   float scale = 1;
   k.world_from_object.is_similarity(&scale);
@@ -47,8 +52,8 @@ struct AreaSample {
   float pdf_area;
 };
 
-// Uniform point on the primitive (triangles, full spheres and disks under similarity transforms,
-// which flatten.cpp guarantees for emitters).
+// Uniform point on the primitive (triangles; full spheres and disks, and cylinders, under
+// similarity transforms, which flatten.cpp guarantees for emitters).
 AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
   if (std::holds_alternative<TriangleMesh>(shape)) {
     Vec2 b = sample_uniform_triangle(u);  // (b0, b1); surface_point takes (b1, b2)
@@ -58,6 +63,12 @@ AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
   if (auto* s = std::get_if<Sphere>(&shape)) {
     Vec3 po = sample_uniform_sphere(u) * s->radius;
     SurfacePoint sp = surface_point(shape, 0, {}, s->world_from_object.point(po));
+    return {sp.p, sp.ng, 1 / l.area};
+  }
+  if (auto* c = std::get_if<Cylinder>(&shape)) {
+    float phi = u.y * c->phi_max;
+    Vec3 po(c->radius * std::cos(phi), c->radius * std::sin(phi), c->z_min + u.x * (c->z_max - c->z_min));
+    SurfacePoint sp = surface_point(shape, 0, {}, c->world_from_object.point(po));
     return {sp.p, sp.ng, 1 / l.area};
   }
   const Disk& k = std::get<Disk>(shape);

@@ -35,7 +35,8 @@ struct UniformInfiniteLight {
   SpectrumCurve radiance;
 };
 
-// Diffuse emission from one primitive of an object (a triangle, a full sphere or a disk).
+// Diffuse emission from one primitive of an object (a triangle, a full sphere or disk, or a
+// cylinder).
 struct AreaLight {
   int object = 0;
   int primitive = 0;

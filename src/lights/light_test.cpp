@@ -81,6 +81,18 @@ Sphere make_sphere(Vec3 center, float radius) {
   return s;
 }
 
+// A partial cylinder under a similarity transform.
+Cylinder make_cylinder() {
+  Cylinder c;
+  c.world_from_object = Transform::translate(Vec3(1, 2, 3)) * Transform::rotate(30, normalize(Vec3(1, 1, 0))) *
+                        Transform::scale(Vec3(2, 2, 2));
+  c.radius = 0.25f;
+  c.z_min = -0.2f;
+  c.z_max = 0.3f;
+  c.phi_max = 1.5f * kPi;
+  return c;
+}
+
 AreaLight make_area_light(const Shape& shape, bool two_sided) {
   AreaLight l;
   l.object = 0;
@@ -157,6 +169,24 @@ TEST(LightPower, SphereAreaLight) {
           return sp.ng;
         },
         3 + two_sided);
+  }
+}
+
+TEST(LightPower, CylinderAreaLight) {
+  Cylinder c = make_cylinder();
+  Shape shape = c;
+  double area = 1.5 * M_PI * (0.25 * 2) * (0.5 * 2);  // phi_max r h in world units (scale 2)
+  EXPECT_NEAR(primitive_area(shape, 0), area, 1e-5 * area);
+  for (bool two_sided : {false, true}) {
+    AreaLight l = make_area_light(shape, two_sided);
+    check_area_light_power(
+        shape, l, area,
+        [&](Rng& rng) {
+          float phi = rng.uniform() * c.phi_max, z = c.z_min + rng.uniform() * (c.z_max - c.z_min);
+          SurfacePoint sp = surface_point(shape, 0, {}, c.world_from_object.point(Vec3(c.radius * std::cos(phi), c.radius * std::sin(phi), z)));
+          return sp.ng;
+        },
+        5 + two_sided);
   }
 }
 
@@ -353,6 +383,39 @@ TEST(LightSampleLi, SphereFromOutsideSamplesTheCone) {
 }
 
 // From inside, points are sampled by area; a two-sided sphere surrounds p_ref with radiance L.
+// From a point outside a partial cylinder, E[Li / pdf] counts every emitting-side crossing of
+// each direction (light_sample_li leaves occlusion to the shadow ray): the reference counts
+// them along uniformly drawn directions.
+TEST(LightSampleLi, CylinderMatchesCountedCrossings) {
+  Cylinder c = make_cylinder();
+  Shape shape = c;
+  Vec3 p_ref = c.world_from_object.point(Vec3(0.6f, -0.5f, 0.1f));
+  for (bool two_sided : {false, true}) {
+    Light light = make_area_light(shape, two_sided);
+    Rng rng(400 + two_sided);
+    MeanAccumulator ref;
+    for (int k = 0; k < 400000; ++k) {
+      Vec3 w = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+      int n = 0;
+      double t = 0;
+      while ((t = intersect_cylinder(c, p_ref, w, t + 1e-5, 1e30)) > 0) {
+        SurfacePoint sp = surface_point(shape, 0, {}, p_ref + w * float(t));
+        if (two_sided || dot(sp.ng, w) < 0) ++n;
+      }
+      ref.add(n / kUniformSpherePdfSolidAngle);
+    }
+    LiCheck r = run_li(light, shape, p_ref, 410 + two_sided, 200000, [&](const LightLiSample& s) {
+      Vec3 po = c.world_from_object.inverse().point(s.p_light);
+      EXPECT_NEAR(std::hypot(po.x, po.y), c.radius, 1e-4f);
+    });
+    for (int ch = 0; ch < Spectrum::kChannels; ++ch) {
+      double se = std::sqrt(r.est[ch].standard_error() * r.est[ch].standard_error() +
+                            kLs[ch] * ref.standard_error() * kLs[ch] * ref.standard_error());
+      EXPECT_NEAR(r.est[ch].mean, kLs[ch] * ref.mean, kMeanTestSigmas * se) << "two-sided " << two_sided;
+    }
+  }
+}
+
 TEST(LightSampleLi, SphereFromInside) {
   Vec3 c(1, 2, 3);
   float radius = 0.5f;
@@ -444,6 +507,13 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
   check_emission("sphere", Light(make_area_light(sphere, false)), &sphere, [&](const LightLeSample& s) {
     EXPECT_NEAR(length(s.origin - Vec3(1, 2, 3)), 0.5f, 1e-4f);
     EXPECT_GT(dot(s.direction, s.origin - Vec3(1, 2, 3)), 0.0f);
+  });
+  Cylinder cyl = make_cylinder();
+  Shape cyl_shape = cyl;
+  check_emission("cylinder", Light(make_area_light(cyl_shape, false)), &cyl_shape, [&](const LightLeSample& s) {
+    Vec3 po = cyl.world_from_object.inverse().point(s.origin);
+    EXPECT_NEAR(std::hypot(po.x, po.y), cyl.radius, 1e-4f);
+    EXPECT_GT(dot(s.direction, s.n_light), 0.0f);
   });
 }
 

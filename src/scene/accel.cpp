@@ -1,5 +1,5 @@
-// Embree 3 acceleration structure: one geometry per object (triangle meshes natively, spheres
-// and disks as user geometry with analytic intersection).
+// Embree 3 acceleration structure: one geometry per object (triangle meshes natively, spheres,
+// disks and cylinders as user geometry with analytic intersection).
 #include <cmath>
 #include <limits>
 
@@ -15,9 +15,33 @@ void embree_error(void*, RTCError code, const char* str) {
   std::fprintf(stderr, "Embree error %d: %s\n", int(code), str ? str : "");
 }
 
+// What the callbacks of one geometry need. textures is the Accel's own copy (the RenderScene,
+// and so its members, may move after the build; its vectors' elements do not).
 struct UserShape {
   const Shape* shape;
+  const Object* object;
+  const TextureSet* textures;
 };
+
+bool alpha_rejects(const UserShape* us, int prim, Vec2 bary, Vec3 o, Vec3 d, float t) {
+  if (!us->object->has_alpha()) return false;
+  SurfacePoint sp = surface_point(*us->shape, prim, bary, o + d * t);
+  return alpha_passes(*us->textures, us->object->alpha, sp, o, d);
+}
+
+// Intersection and occlusion filter of alpha-masked triangle meshes: drops the hits the surface's
+// alpha lets through, so that Embree goes on to the next one.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* us = static_cast<const UserShape*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    Vec3 o(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i), RTCRayN_org_z(args->ray, args->N, i));
+    Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i));
+    float t = RTCRayN_tfar(args->ray, args->N, i);
+    Vec2 bary(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (alpha_rejects(us, int(RTCHitN_primID(args->hit, args->N, i)), bary, o, d, t)) args->valid[i] = 0;
+  }
+}
 
 void user_bounds(const RTCBoundsFunctionArguments* args) {
   const auto* us = static_cast<const UserShape*>(args->geometryUserPtr);
@@ -34,8 +58,13 @@ double user_hit(const UserShape* us, RTCRayN* ray, unsigned N, unsigned i) {
   Vec3 o(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i));
   Vec3 d(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i));
   double t0 = RTCRayN_tnear(ray, N, i), t1 = RTCRayN_tfar(ray, N, i);
-  if (auto* s = std::get_if<Sphere>(us->shape)) return intersect_sphere(*s, o, d, t0, t1);
-  return intersect_disk(std::get<Disk>(*us->shape), o, d, t0, t1);
+  // Analytic shapes meet a ray at most twice: the hits alpha lets through are skipped here.
+  for (int k = 0; k < 4; ++k) {
+    double t = intersect_analytic(*us->shape, o, d, t0, t1);
+    if (t <= 0 || !alpha_rejects(us, 0, {}, o, d, float(t))) return t;
+    t0 = t;
+  }
+  return -1;
 }
 
 void user_intersect(const RTCIntersectFunctionNArguments* args) {
@@ -71,7 +100,7 @@ void user_occluded(const RTCOccludedFunctionNArguments* args) {
 
 class Accel {
  public:
-  explicit Accel(const std::vector<Object>& objects) {
+  Accel(const std::vector<Object>& objects, const TextureSet& textures) : textures_(textures) {
     device_ = rtcNewDevice(nullptr);
     if (!device_) throw Error("cannot create the Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
@@ -89,9 +118,15 @@ class Accel {
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->indices.data(), 0,
                                    3 * sizeof(uint32_t), m->indices.size() / 3);
         triangles_ += m->indices.size() / 3;
+        if (obj.has_alpha()) {
+          user_shapes_.push_back(UserShape{&obj.shape, &obj, &textures_});
+          rtcSetGeometryUserData(g, &user_shapes_.back());
+          rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+          rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+        }
       } else {
         g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
-        user_shapes_.push_back(UserShape{&obj.shape});
+        user_shapes_.push_back(UserShape{&obj.shape, &obj, &textures_});
         rtcSetGeometryUserPrimitiveCount(g, 1);
         rtcSetGeometryUserData(g, &user_shapes_.back());
         rtcSetGeometryBoundsFunction(g, user_bounds, nullptr);
@@ -165,6 +200,7 @@ class Accel {
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  TextureSet textures_;
   std::vector<UserShape> user_shapes_;
   size_t triangles_ = 0;
 };
@@ -188,7 +224,7 @@ void RenderScene::commit() {
     if (std::holds_alternative<UniformInfiniteLight>(lights[i])) infinite_lights.push_back(int(i));
   }
   light_distribution = Distribution1D(weights);
-  accel_ = std::make_unique<Accel>(objects);
+  accel_ = std::make_unique<Accel>(objects, textures);
 }
 
 bool RenderScene::intersect(const Ray& ray, Hit* hit) const { return accel_->intersect(ray, hit); }

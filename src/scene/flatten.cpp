@@ -615,15 +615,17 @@ class Flattener {
   void add_shape(const ShapeEntity& s, RenderScene* rs) {
     const ParamSet& ps = s.params;
     bool flip = s.reverse_orientation != s.world_from_object.swaps_handedness();
-    if (auto* a = ps.find_any("alpha")) {
-      if (!(a->type == "float" && a->numbers.size() == 1 && a->numbers[0] == 1))
-        throw Error(a->loc, "alpha cut-outs are not supported");
-      a->used = true;
-    }
     for (const char* ignored : {"emission", "faceIndices"})
       if (auto* p = ps.find_any(ignored)) p->used = true;
     Object obj;
     obj.source = s.loc.str();
+    if (const Param* a = ps.find_any("alpha")) {
+      obj.alpha = float_or_texture(ps, "alpha", 1);
+      if (!obj.alpha.textured() && !(obj.alpha.value >= 0 && obj.alpha.value <= 1))
+        throw Error(a->loc, "alpha must be in [0, 1]");
+      if (obj.has_alpha() && s.area_light)
+        throw Error(a->loc, "alpha on an emitting shape is not supported (the area light at " + s.area_light->loc.str() + ")");
+    }
     if (s.name == "trianglemesh" || s.name == "bilinearmesh") {
       bool bilinear = s.name == "bilinearmesh";
       auto P = ps.get_point3s("P");
@@ -698,6 +700,19 @@ class Flattener {
       d.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
       d.flip_normal = flip;
       obj.shape = d;
+    } else if (s.name == "cylinder") {
+      Cylinder c;
+      c.world_from_object = s.world_from_object;
+      c.radius = ps.get_float("radius", 1);
+      if (!(c.radius > 0)) throw Error(s.loc, "cylinder radius must be positive");
+      float z0 = ps.get_float("zmin", -1), z1 = ps.get_float("zmax", 1);
+      c.z_min = std::fmin(z0, z1);
+      c.z_max = std::fmax(z0, z1);
+      if (!(c.z_max > c.z_min)) throw Error(s.loc, "cylinder needs zmin != zmax");
+      c.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
+      if (!(c.phi_max > 0)) throw Error(s.loc, "cylinder phimax must be positive");
+      c.flip_normal = flip;
+      obj.shape = c;
     } else {
       throw Error(s.loc, "shape \"" + s.name + "\" is not supported");
     }
@@ -743,6 +758,8 @@ class Flattener {
       if (!xf.is_similarity() || !full)
         throw Error(a.loc, "emitting spheres and disks must be whole and not non-uniformly scaled");
     }
+    if (auto* c = std::get_if<Cylinder>(&obj->shape); c && !c->world_from_object.is_similarity())
+      throw Error(a.loc, "emitting cylinders must not be non-uniformly scaled");
     obj->first_light = int(rs->lights.size());
     for (int p = 0; p < primitive_count(obj->shape); ++p) {
       AreaLight l;

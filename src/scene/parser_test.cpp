@@ -641,8 +641,10 @@ TEST(SceneParse, Shapes) {
       "Shape \"sphere\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 1.5 \"float phimax\" 180\n"
       "Shape \"disk\" \"float radius\" 3 \"float innerradius\" 1 \"float height\" 0.5\n"
       "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"point2 uv\" [0 0 1 0 0 1]\n"
-      "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"));
-  ASSERT_EQ(ls.scene.objects.size(), 4u);
+      "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"
+      "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 2 \"float zmax\" -1 \"float phimax\" 90\n"
+      "ReverseOrientation\nShape \"cylinder\"\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 6u);
   const Sphere& s = std::get<Sphere>(ls.scene.objects[0].shape);
   EXPECT_FLOAT_EQ(s.radius, 2);
   EXPECT_FLOAT_EQ(s.z_min, -1);
@@ -661,6 +663,18 @@ TEST(SceneParse, Shapes) {
   EXPECT_FLOAT_EQ(t.uvs[2].y, 1);
   const TriangleMesh& b = std::get<TriangleMesh>(ls.scene.objects[3].shape);
   EXPECT_EQ(b.triangle_count(), 2);
+  const Cylinder& c = std::get<Cylinder>(ls.scene.objects[4].shape);
+  EXPECT_FLOAT_EQ(c.radius, 0.5f);
+  EXPECT_FLOAT_EQ(c.z_min, -1);  // pbrt-v4 orders zmin and zmax
+  EXPECT_FLOAT_EQ(c.z_max, 2);
+  EXPECT_NEAR(c.phi_max, kPi / 2, 1e-6f);
+  EXPECT_FALSE(c.flip_normal);
+  const Cylinder& c2 = std::get<Cylinder>(ls.scene.objects[5].shape);
+  EXPECT_FLOAT_EQ(c2.radius, 1);  // pbrt-v4's defaults
+  EXPECT_FLOAT_EQ(c2.z_min, -1);
+  EXPECT_FLOAT_EQ(c2.z_max, 1);
+  EXPECT_NEAR(c2.phi_max, 2 * kPi, 1e-6f);
+  EXPECT_TRUE(c2.flip_normal);
 }
 
 TEST(SceneParse, TriangleMeshTransformsPositionsAndNormals) {
@@ -1418,15 +1432,49 @@ TEST(SceneFlattenError, DiskInnerRadiusNotBelowRadius) {
                       "disk needs 0 <= innerradius < radius"));
 }
 
+TEST(SceneFlattenError, CylinderErrors) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"cylinder\" \"float radius\" 0\n"), at(2, 1),
+                      "cylinder radius must be positive"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"cylinder\" \"float zmin\" 1 \"float zmax\" 1\n"), at(2, 1),
+                      "cylinder needs zmin != zmax"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"cylinder\" \"float phimax\" 0\n"), at(2, 1),
+                      "cylinder phimax must be positive"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 1 3\nAreaLightSource \"diffuse\"\nShape \"cylinder\"\n"),
+                      at(3, 1), "emitting cylinders must not be non-uniformly scaled"));
+}
+
 TEST(SceneFlattenError, UnsupportedShape) {
   EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n"), at(2, 1),
                       "shape \"curve\" is not supported"));
 }
 
-TEST(SceneFlattenError, AlphaCutout) {
-  const std::string l2 = R"(Shape "sphere" "float alpha" 0.5)";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")),
-                      "alpha cut-outs are not supported"));
+TEST(SceneParse, AlphaConstantOrTexture) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\n"
+      "Texture \"mask\" \"float\" \"checkerboard\" \"float tex1\" 0 \"float tex2\" 1\n"
+      "Texture \"half\" \"float\" \"constant\" \"float value\" 0.5\n"
+      "Shape \"sphere\" \"float alpha\" 0.25\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"texture alpha\" \"mask\"\n"
+      "Shape \"disk\" \"texture alpha\" \"half\"\n"
+      "Shape \"disk\" \"float alpha\" 1\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 4u);
+  EXPECT_FLOAT_EQ(ls.scene.objects[0].alpha.value, 0.25f);
+  EXPECT_TRUE(ls.scene.objects[0].has_alpha());
+  ASSERT_TRUE(ls.scene.objects[1].alpha.textured());
+  EXPECT_TRUE(std::holds_alternative<CheckerboardTexture>(ls.scene.textures.node(ls.scene.objects[1].alpha.texture)));
+  EXPECT_FLOAT_EQ(ls.scene.objects[2].alpha.value, 0.5f);  // a constant texture is a constant
+  EXPECT_FALSE(ls.scene.objects[2].alpha.textured());
+  EXPECT_FALSE(ls.scene.objects[3].has_alpha());
+}
+
+TEST(SceneFlattenError, AlphaErrors) {
+  const std::string l2 = R"(Shape "sphere" "float alpha" 1.5)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")), "alpha must be in [0, 1]"));
+  const std::string l3 = R"(Shape "sphere" "float alpha" 0.5)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"diffuse\"\n" + l3 + "\n"), at(3, col(l3, "\"float")),
+                      "alpha on an emitting shape is not supported (the area light at"));
+  const std::string l4 = R"(Shape "sphere" "texture alpha" "colour")";
+  EXPECT_FALSE(error_of("WorldBegin\nTexture \"colour\" \"spectrum\" \"constant\" \"rgb value\" [1 1 1]\n" + l4 + "\n").empty());
 }
 
 TEST(SceneFlattenError, UnsupportedMaterial) {

@@ -5,6 +5,19 @@
 
 namespace bpm {
 
+bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const SurfacePoint& sp, Vec3 o, Vec3 d) {
+  float a = alpha.textured() ? textures.value(alpha.texture, texture_context(sp)) : alpha.value;
+  if (a >= 1) return false;
+  if (!(a > 0)) return true;
+  auto bits = [](Vec3 v) {
+    return (uint64_t(std::bit_cast<uint32_t>(v.x)) << 32 | std::bit_cast<uint32_t>(v.y)) ^
+           mix64(std::bit_cast<uint32_t>(v.z));
+  };
+  uint64_t h = stream_key(bits(o), bits(d), bits(sp.p), 0xa1fa);
+  double u = double(h >> 11) * 0x1.0p-53;
+  return u >= a;
+}
+
 int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx) {
   // Nested mixes choose in turn; flatten.cpp rejects cycles, the bound is a safeguard.
   for (int depth = 0; depth < 64; ++depth) {

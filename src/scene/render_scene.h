@@ -28,6 +28,10 @@ struct Object {
   // with the same medium on both sides leaves a ray in the medium it travels in.
   int medium_inside = -1, medium_outside = -1;
   int first_light = -1;  // index of the area light of primitive 0; primitive i is first_light + i
+  // pbrt-v4 "alpha": where it is below 1 a ray passes through the surface with probability
+  // 1 - alpha (a cut-out where it is 0).
+  FloatParam alpha{1, -1};
+  bool has_alpha() const { return alpha.textured() || alpha.value < 1; }
   std::string source;    // file:line of the Shape directive, for statistics and messages
 };
 
@@ -115,6 +119,11 @@ inline bool cross_medium(const RenderScene& scene, int medium, float distance, c
   beta *= medium_transmittance(scene, medium, distance, wl);
   return !beta.is_black();
 }
+
+// Whether a ray from o along d passes through an alpha-masked surface at sp: true with
+// probability 1 - alpha there, decided by a hash of the ray and the point, so that the same query
+// always gets the same answer and the layers a ray crosses decide independently.
+bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const SurfacePoint& sp, Vec3 o, Vec3 d);
 
 // The scene material a mix material stands for at a point (a material that is not a mix stands
 // for itself): the second with probability `amount`, by a hash of the point.

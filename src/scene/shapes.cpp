@@ -65,6 +65,39 @@ double intersect_disk(const Disk& k, Vec3 o_world, Vec3 d_world, double t_min, d
   return t;
 }
 
+double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min, double t_max) {
+  DVec o = to_object(c.world_from_object, o_world, true);
+  DVec d = to_object(c.world_from_object, d_world, false);
+  double a = d.x * d.x + d.y * d.y;
+  if (a == 0) return -1;  // parallel to the axis
+  double b = 2 * (d.x * o.x + d.y * o.y);
+  double r2 = double(c.radius) * c.radius;
+  double cc = o.x * o.x + o.y * o.y - r2;
+  // The same stable discriminant as the sphere's, in the xy plane.
+  double fx = o.x - b / (2 * a) * d.x, fy = o.y - b / (2 * a) * d.y;
+  double disc = 4 * a * (r2 - (fx * fx + fy * fy));
+  if (disc < 0) return -1;
+  double root = std::sqrt(disc);
+  double q = b < 0 ? -0.5 * (b - root) : -0.5 * (b + root);
+  if (q == 0) return -1;
+  double t0 = q / a, t1 = cc / q;
+  if (t0 > t1) std::swap(t0, t1);
+  for (double t : {t0, t1}) {
+    if (!(t > t_min && t < t_max)) continue;
+    double pz = o.z + t * d.z;
+    if (pz < c.z_min || pz > c.z_max) continue;
+    if (c.phi_max < 2 * kPi && phi_of(o.x + t * d.x, o.y + t * d.y) > c.phi_max) continue;
+    return t;
+  }
+  return -1;
+}
+
+double intersect_analytic(const Shape& shape, Vec3 o, Vec3 d, double t_min, double t_max) {
+  if (auto* s = std::get_if<Sphere>(&shape)) return intersect_sphere(*s, o, d, t_min, t_max);
+  if (auto* k = std::get_if<Disk>(&shape)) return intersect_disk(*k, o, d, t_min, t_max);
+  return intersect_cylinder(std::get<Cylinder>(shape), o, d, t_min, t_max);
+}
+
 namespace {
 
 SurfacePoint mesh_point(const TriangleMesh& m, int prim, Vec2 b) {
@@ -114,6 +147,19 @@ SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) 
     sp.uv = {phi / s->phi_max, theta_max != theta_min ? (theta - theta_min) / (theta_max - theta_min) : 0.0f};
     return sp;
   }
+  if (auto* c = std::get_if<Cylinder>(&shape)) {
+    Vec3 po = c->world_from_object.inverse().point(p_hit);
+    float rxy = std::sqrt(po.x * po.x + po.y * po.y);
+    if (rxy > 0) {
+      po.x *= c->radius / rxy;  // re-project onto the surface
+      po.y *= c->radius / rxy;
+    }
+    sp.p = c->world_from_object.point(po);
+    Vec3 n = normalize(c->world_from_object.normal(Vec3(po.x, po.y, 0)));
+    sp.ng = sp.ns = c->flip_normal ? -n : n;
+    sp.uv = {float(phi_of(po.x, po.y)) / c->phi_max, (po.z - c->z_min) / (c->z_max - c->z_min)};
+    return sp;
+  }
   const Disk& k = std::get<Disk>(shape);
   Vec3 po = k.world_from_object.inverse().point(p_hit);
   po.z = k.height;
@@ -137,6 +183,10 @@ Bounds3 world_bounds(const Shape& shape, int prim) {
     t = &s->world_from_object;
     lo = Vec3(-s->radius, -s->radius, std::fmax(s->z_min, -s->radius));
     hi = Vec3(s->radius, s->radius, std::fmin(s->z_max, s->radius));
+  } else if (auto* c = std::get_if<Cylinder>(&shape)) {
+    t = &c->world_from_object;
+    lo = Vec3(-c->radius, -c->radius, c->z_min);
+    hi = Vec3(c->radius, c->radius, c->z_max);
   } else {
     const Disk& k = std::get<Disk>(shape);
     t = &k.world_from_object;

@@ -1,5 +1,5 @@
-// Render-time shapes: triangle meshes in world space, and analytic spheres and disks kept in
-// their object space (a tessellated sphere would bend caustics wrongly).
+// Render-time shapes: triangle meshes in world space, and analytic spheres, disks and cylinders
+// kept in their object space (a tessellated sphere would bend caustics wrongly).
 #pragma once
 #include <variant>
 #include <vector>
@@ -37,7 +37,17 @@ struct Disk {
   bool is_full() const { return inner_radius == 0 && phi_max >= 2 * kPi; }
 };
 
-using Shape = std::variant<TriangleMesh, Sphere, Disk>;
+// pbrt-v4 cylinder: x^2 + y^2 = radius^2 for z in [z_min, z_max], phi up to phi_max, open at
+// both ends; the normal points away from the axis unless flipped.
+struct Cylinder {
+  Transform world_from_object;
+  float radius = 1;
+  float z_min = -1, z_max = 1;
+  float phi_max = 2 * kPi;
+  bool flip_normal = false;
+};
+
+using Shape = std::variant<TriangleMesh, Sphere, Disk, Cylinder>;
 
 // A point on a surface as the integrators see it.
 struct SurfacePoint {
@@ -51,6 +61,9 @@ struct SurfacePoint {
 // the nearest hit in (t_min, t_max) or a negative value.
 double intersect_sphere(const Sphere& s, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
 double intersect_disk(const Disk& d, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
+double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
+// The analytic shapes (all but meshes) in one call.
+double intersect_analytic(const Shape& shape, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
 
 // Surface point of a hit: for meshes from the primitive and Embree's barycentrics (b1, b2).
 SurfacePoint surface_point(const Shape& shape, int prim, Vec2 barycentric, Vec3 p_hit);
