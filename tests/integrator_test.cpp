@@ -322,6 +322,99 @@ TEST(Integrators, AlphaMasksLetLightThrough) {
   }
 }
 
+// An environment image written to a temporary EXR: a dim gradient, a bright patch in the upper
+// hemisphere of the light's frame and a brighter one below it.
+std::string write_environment_exr(const std::string& name, int width, int height) {
+  Image env;
+  env.width = width;
+  env.height = height;
+  env.rgb.resize(size_t(width) * height * 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float* t = &env.rgb[(size_t(y) * width + x) * 3];
+      t[0] = 0.3f + 0.4f * x / width;
+      t[1] = 0.2f + 0.3f * y / height;
+      t[2] = 0.5f;
+    }
+  auto patch = [&](int x0, int y0, float v) {
+    for (int y = y0; y < y0 + 2; ++y)
+      for (int x = x0; x < x0 + 2; ++x)
+        for (int c = 0; c < 3; ++c) env.rgb[(size_t(y) * width + x) * 3 + c] = v;
+  };
+  patch(width / 2 + 1, height / 2 - 3, 30);  // upper hemisphere (near the square's centre, or the top rows)
+  patch(0, height - 2, 100);                 // lower hemisphere (a corner, or the bottom rows)
+  std::filesystem::path path = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".exr");
+  write_exr(path.string(), env);
+  return path.string();
+}
+
+// A diffuse plane (rho = 0.5) facing the light's +z under an environment image normalised by
+// "illuminance" 2: the plane's luminance is rho / pi * 2 wherever the image's light comes from,
+// since light from below the horizon cannot reach it. Both layouts, path and bpm (direct light by
+// sampling the image and by the BSDF, weighed by MIS). The same camera then looks at the sky: a
+// pixel shows the texel its ray points at.
+TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
+  for (bool equal_area : {true, false}) {
+    std::string exr = write_environment_exr("bpm_env", equal_area ? 16 : 32, 16);
+    LoadedScene ls = load(R"(
+      LookAt 0 0 3  0 0 0  0 1 0
+      Camera "perspective" "float fov" 40
+      Film "rgb" "integer xresolution" 12 "integer yresolution" 12
+      PixelFilter "box" "float xradius" 0.5 "float yradius" 0.5
+      Integrator "path" "integer maxdepth" 1
+      WorldBegin
+      LightSource "infinite" "string filename" ")" + exr + R"(" "float illuminance" 2
+      Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+      Shape "trianglemesh" "point3 P" [-50 -50 0  50 -50 0  50 50 0  -50 50 0] "integer indices" [0 1 2 0 2 3]
+    )");
+    const double expected = 0.5 / M_PI * 2;
+    for (const char* integrator : {"path", "bpm"}) {
+      Film film(12, 12);
+      RenderOptions opt = quiet_options(ls, integrator, 64, 1);
+      opt.bpm.max_batches = 1;  // no caustic or indirect light to gather
+      opt.bpm.photons_per_batch = 20000;
+      render(ls, opt, &film);
+      Image img = film.image();
+      std::vector<float> rms = film.rms();
+      double sum = 0, var = 0;
+      for (int i = 0; i < 144; ++i) {
+        double lum = img.at(i % 12, i / 12).luminance();
+        EXPECT_NEAR(lum, expected, 5 * rms[size_t(i)] + 1e-3) << integrator << " " << equal_area << " pixel " << i;
+        sum += lum;
+        var += double(rms[size_t(i)]) * rms[size_t(i)];
+      }
+      EXPECT_NEAR(sum / 144, expected, 4 * std::sqrt(var) / 144 + 1e-3) << integrator << " " << equal_area;
+    }
+    // Looking up from below the plane's edge: the sky, texel by texel.
+    LoadedScene sky = load(R"(
+      LookAt 0 0 0  0.3 0.2 1  0 1 0
+      Camera "perspective" "float fov" 60
+      Film "rgb" "integer xresolution" 12 "integer yresolution" 12
+      PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+      WorldBegin
+      LightSource "infinite" "string filename" ")" + exr + R"(" "float scale" 1.5
+    )");
+    const auto& light = std::get<ImageInfiniteLight>(sky.scene.lights[0]);
+    Film film(12, 12);
+    render(sky, quiet_options(sky, "path", 16, 1), &film);
+    Image img = film.image();
+    std::vector<float> sky_rms = film.rms();
+    PerspectiveCamera cam(sky.camera, 12, 12);
+    for (int y = 0; y < 12; ++y)
+      for (int x = 0; x < 12; ++x) {
+        Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).d);
+        Vec2 uv = image_light_uv(light, d);
+        // pbrt-v4's image coordinates: (u, v) with v down the image's rows.
+        Rgb texel = light.image->texel(std::min(int(uv.x * light.image->width), light.image->width - 1),
+                                       std::min(int(uv.y * light.image->height), light.image->height - 1), TexWrap::kClamp);
+        // The only noise is that of the sampled wavelengths (the sigmoid fit errs by < 0.2%).
+        EXPECT_NEAR(img.at(x, y).luminance(), 1.5f * texel.luminance(), 5 * sky_rms[size_t(y) * 12 + x] + 0.005f * texel.luminance())
+            << equal_area << " " << x << "," << y;
+      }
+    std::filesystem::remove(exr);
+  }
+}
+
 // Same seed and budget give the same image whatever the number of threads.
 TEST(Renderer, SameImageWithOneAndTwoThreads) {
   LoadedScene ls = load(R"(

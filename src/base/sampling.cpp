@@ -42,4 +42,60 @@ int Distribution1D::sample(float u, float* pmf_out, float* u_remapped) const {
   return i;
 }
 
+Distribution2D::Distribution2D(const std::vector<float>& weights, int w, int h) : w_(w), h_(h) {
+  BPM_CHECK(w > 0 && h > 0 && weights.size() == size_t(w) * size_t(h));
+  std::vector<float> row_totals(static_cast<size_t>(h));
+  rows_.reserve(size_t(h));
+  for (int y = 0; y < h; ++y) {
+    std::vector<float> row(weights.begin() + ptrdiff_t(y) * w, weights.begin() + ptrdiff_t(y + 1) * w);
+    rows_.emplace_back(row);
+    row_totals[size_t(y)] = float(rows_.back().total());
+  }
+  marginal_ = Distribution1D(row_totals);
+}
+
+Vec2 Distribution2D::sample(Vec2 u, float* pdf) const {
+  float pm = 0, pc = 0, uy = 0, ux = 0;
+  int y = marginal_.sample(u.y, &pm, &uy);
+  int x = rows_[size_t(y)].sample(u.x, &pc, &ux);
+  *pdf = pm * pc * float(w_) * float(h_);
+  return {(float(x) + ux) / float(w_), (float(y) + uy) / float(h_)};
+}
+
+float Distribution2D::pdf(Vec2 p) const {
+  int x = std::clamp(int(p.x * float(w_)), 0, w_ - 1), y = std::clamp(int(p.y * float(h_)), 0, h_ - 1);
+  return marginal_.pmf(y) * rows_[size_t(y)].pmf(x) * float(w_) * float(h_);
+}
+
+Vec3 equal_area_square_to_sphere(Vec2 p) {
+  // Fold the square into the first quadrant, find the ring (r) and the position along it (phi).
+  float u = 2 * p.x - 1, v = 2 * p.y - 1;
+  float up = std::fabs(u), vp = std::fabs(v);
+  float signed_distance = 1 - (up + vp);  // > 0 inside the central diamond (the upper hemisphere)
+  float r = 1 - std::fabs(signed_distance);
+  float phi = (r == 0 ? 1 : (vp - up) / r + 1) * kPi / 4;
+  float z = std::copysign(1 - r * r, signed_distance);
+  float cos_phi = std::copysign(std::cos(phi), u), sin_phi = std::copysign(std::sin(phi), v);
+  float s = r * std::sqrt(std::fmax(0.0f, 2 - r * r));
+  return {cos_phi * s, sin_phi * s, z};
+}
+
+Vec2 equal_area_sphere_to_square(Vec3 d) {
+  float x = std::fabs(d.x), y = std::fabs(d.y), z = std::fabs(d.z);
+  float r = std::sqrt(std::fmax(0.0f, 1 - z));
+  float a = std::fmax(x, y), b = std::fmin(x, y);
+  b = a == 0 ? 0 : b / a;
+  float phi = std::atan(b) * 2 / kPi;
+  if (x < y) phi = 1 - phi;
+  float v = phi * r, u = r - v;
+  if (d.z < 0) {  // lower hemisphere: mirror across the diamond's edge
+    std::swap(u, v);
+    u = 1 - u;
+    v = 1 - v;
+  }
+  u = std::copysign(u, d.x);
+  v = std::copysign(v, d.y);
+  return {(u + 1) / 2, (v + 1) / 2};
+}
+
 }  // namespace bpm

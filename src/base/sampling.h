@@ -83,4 +83,27 @@ class Distribution1D {
   double total_ = 0;
 };
 
+// Piecewise-constant density over [0, 1]^2 on a w x h grid of non-negative weights (row-major,
+// row 0 at the smallest y); an all-zero grid is uniform.
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  Distribution2D(const std::vector<float>& weights, int w, int h);
+  bool empty() const { return rows_.empty(); }
+  // A point with density pdf (over the unit square's area).
+  Vec2 sample(Vec2 u, float* pdf) const;
+  float pdf(Vec2 p) const;
+
+ private:
+  int w_ = 0, h_ = 0;
+  Distribution1D marginal_;
+  std::vector<Distribution1D> rows_;
+};
+
+// Clarberg's equal-area map between the unit square and the unit sphere (an octahedron unfolded:
+// the square's centre is +z, its corners -z), the layout of pbrt-v4's environment images. Equal
+// areas of the square map to equal solid angles: d omega = 4 pi du dv.
+Vec3 equal_area_square_to_sphere(Vec2 p);
+Vec2 equal_area_sphere_to_square(Vec3 d);
+
 }  // namespace bpm

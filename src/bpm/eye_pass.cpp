@@ -27,13 +27,14 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     if (!scene.intersect(ray, &hit)) {
       cross_medium(scene, medium, kInf, wl, beta);  // escaping through a medium
       for (int li : scene.infinite_lights) {
-        const auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li]);
-        if (!inf) continue;
+        const Light& light = scene.lights[size_t(li)];
+        Spectrum Le = environment_radiance(light, ray.d, wl);
+        if (Le.is_black()) continue;
         if (diffuse == 0) {
-          L += beta * inf->radiance.sample(wl);
+          L += beta * Le;
         } else if (after_diffuse_sample) {
-          float p_l = scene.light_distribution.pmf(li) * kUniformSpherePdfSolidAngle;
-          L += beta * inf->radiance.sample(wl) * power_heuristic(prev_pdf_bsdf, p_l);
+          float p_l = scene.light_distribution.pmf(li) * light_pdf_li(light, nullptr, prev_p, ray.d, {}, {});
+          L += beta * Le * power_heuristic(prev_pdf_bsdf, p_l);
         }
       }
       break;

@@ -111,7 +111,7 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
       cross_medium(scene, medium, kInf, wl, beta);  // escaping through a medium
       if (!gathering)
         for (int li : scene.infinite_lights)
-          if (auto* inf = std::get_if<UniformInfiniteLight>(&scene.lights[li])) L += beta * inf->radiance.sample(wl);
+          L += beta * environment_radiance(scene.lights[size_t(li)], ray.d, wl);
       break;
     }
     length += hit.t * bpm::length(ray.d);

@@ -2,13 +2,16 @@
 // direction toward the light from a reference point), pdf_li (its density, for MIS), emitted
 // radiance, and power (for choosing lights in proportion to their flux).
 #pragma once
+#include <memory>
 #include <optional>
 #include <variant>
 
 #include "base/color.h"
 #include "base/spectrum.h"
 #include "base/vec.h"
+#include "base/sampling.h"
 #include "scene/shapes.h"
+#include "textures/texture.h"
 
 namespace bpm {
 
@@ -35,6 +38,34 @@ struct UniformInfiniteLight {
   SpectrumCurve radiance;
 };
 
+// pbrt-v4 "infinite" light with an environment image. A square image is pbrt-v4's equal-area
+// octahedral layout (equal_area_sphere_to_square of the direction in the light's frame); an image
+// twice as wide as high is the latitude-longitude layout of pbrt-v3 (u = phi / 2 pi, v = theta / pi
+// from +z, rows from the top). The radiance toward a direction is its nearest texel, read as an
+// illuminant RGB, times scale; directions are sampled in proportion to texel brightness times the
+// texel's solid angle, uniformly within a texel.
+struct ImageInfiniteLight {
+  std::shared_ptr<const TexImage> image;
+  bool equal_area = true;
+  Transform world_from_light;  // a rotation
+  float scale = 1;
+  Distribution2D distribution;  // over the image's (u, v), rows from the top
+  Rgb mean_radiance;            // over directions, scale included
+};
+// Builds the distribution and the mean of an image light whose image, layout, frame and scale
+// are set.
+void prepare_image_light(ImageInfiniteLight* l);
+// The direction (world space) of image coordinates (u, v), and back.
+Vec3 image_light_direction(const ImageInfiniteLight& l, Vec2 uv);
+Vec2 image_light_uv(const ImageInfiniteLight& l, Vec3 w_world);
+// Image coordinates drawn by the light's distribution, with their density over solid angle; and
+// that density at given coordinates.
+Vec2 image_light_sample(const ImageInfiniteLight& l, Vec2 u, float* pdf_solid_angle);
+float image_light_pdf(const ImageInfiniteLight& l, Vec2 uv);
+// The illuminance (luminance-weighted irradiance) of the light at a surface facing the light's +z,
+// at scale 1: what pbrt-v4's "illuminance" parameter normalises.
+double image_light_illuminance(const ImageInfiniteLight& l);
+
 // Diffuse emission from one primitive of an object (a triangle, a full sphere or disk, or a
 // cylinder).
 struct AreaLight {
@@ -45,7 +76,7 @@ struct AreaLight {
   float area = 0;
 };
 
-using Light = std::variant<PointLight, SpotLight, DistantLight, UniformInfiniteLight, AreaLight>;
+using Light = std::variant<PointLight, SpotLight, DistantLight, UniformInfiniteLight, ImageInfiniteLight, AreaLight>;
 
 struct LightLiSample {
   Spectrum radiance;    // arriving at the reference point along -wi
@@ -73,6 +104,11 @@ struct LightLeSample {
 
 bool light_is_delta(const Light& l);
 bool light_is_infinite(const Light& l);
+// Lights that a ray escaping the scene sees (uniform and image infinite lights).
+bool light_is_environment(const Light& l);
+// The radiance an environment light sends along -w toward the scene (w: unit, world space, the
+// direction the escaping ray travels); zero for other lights.
+Spectrum environment_radiance(const Light& l, Vec3 w, const Wavelengths& wl);
 
 // The shape is needed only for area lights (pass the object's shape).
 std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec2 u,

@@ -13,6 +13,7 @@
 #include "base/sampling.h"
 #include "base/transform.h"
 #include "lights/light.h"
+#include "textures/texture.h"
 #include "scene/shapes.h"
 
 namespace bpm {
@@ -429,10 +430,10 @@ TEST(LightSampleLi, SphereFromInside) {
   LiCheck r = run_li(light, shape, p_ref, 301, 100000, none);
   for (int ch = 0; ch < Spectrum::kChannels; ++ch) expect_mean(r.est[ch], kLs[ch] * 4 * M_PI, 0, "inside sphere");
 
-  // The directions follow light_pdf_li (the chi-square harness of the BSDF tests; this is the
-  // only chi-square test in this file, hence n_tests = 1).
+  // The directions follow light_pdf_li (the chi-square harness of the BSDF tests; the image
+  // lights' test runs two more, on their texels).
   chi2::Options o;
-  o.n_tests = 1;
+  o.n_tests = 3;
   o.sub = 32;  // this pdf is smooth (no discontinuity inside cells): O(h^2) integration suffices
   auto res = chi2::run(
       [&](Rng& rng) -> std::optional<Vec3> {
@@ -451,6 +452,172 @@ TEST(LightSampleLi, SphereFromInside) {
   EXPECT_TRUE(res.passed()) << res.report;
 }
 
+
+// ---------------------------------------------------------------------------------------------
+// Environment image lights.
+
+// A small image with a smooth gradient and one bright texel, in either layout, rotated so that
+// the light's +z is the world's +y.
+ImageInfiniteLight make_image_light(bool equal_area) {
+  auto im = std::make_shared<TexImage>();
+  im->width = equal_area ? 16 : 32;
+  im->height = 16;
+  im->channels = 3;
+  im->texels.resize(size_t(im->width) * im->height * 3);
+  for (int y = 0; y < im->height; ++y)
+    for (int x = 0; x < im->width; ++x) {
+      float* t = &im->texels[(size_t(y) * im->width + x) * 3];
+      t[0] = 0.2f + 0.6f * x / im->width;
+      t[1] = 0.1f + 0.5f * y / im->height;
+      t[2] = 0.3f;
+      if (x == 5 && y == 9) t[0] = t[1] = t[2] = 40;  // a sun
+    }
+  ImageInfiniteLight l;
+  l.image = im;
+  l.equal_area = equal_area;
+  l.world_from_light = Transform::rotate(-90, Vec3(1, 0, 0));
+  l.scale = 1.5f;
+  prepare_image_light(&l);
+  return l;
+}
+
+// The texel (x, y) an image light's direction falls in.
+std::pair<int, int> texel_of(const ImageInfiniteLight& l, Vec3 w) {
+  Vec2 uv = image_light_uv(l, w);
+  return {std::clamp(int(uv.x * l.image->width), 0, l.image->width - 1),
+          std::clamp(int(uv.y * l.image->height), 0, l.image->height - 1)};
+}
+Spectrum texel_radiance(const ImageInfiniteLight& l, int x, int y) {
+  return rgb_texel_spectrum(l.image->texel(x, y, TexWrap::kClamp), SpectrumKind::kIlluminant, kWl) * l.scale;
+}
+// The integral of the radiance over the sphere, texel by texel (each texel's solid angle from
+// the layout's geometry, independently of image_light_jacobian).
+Spectrum integrated_radiance(const ImageInfiniteLight& l) {
+  const TexImage& im = *l.image;
+  Spectrum sum;
+  for (int y = 0; y < im.height; ++y) {
+    double omega = l.equal_area ? 4 * M_PI / (im.width * im.height)
+                                : 2 * M_PI / im.width * (std::cos(M_PI * y / im.height) - std::cos(M_PI * (y + 1) / im.height));
+    for (int x = 0; x < im.width; ++x) sum += texel_radiance(l, x, y) * float(omega);
+  }
+  return sum;
+}
+
+TEST(ImageLight, OrientationAndRadiance) {
+  for (bool equal_area : {true, false}) {
+    ImageInfiniteLight l = make_image_light(equal_area);
+    // The light's +z is the world's +y: the centre of an equal-area image, the top row of a
+    // latitude-longitude one.
+    auto [x, y] = texel_of(l, Vec3(0, 1, 0));
+    if (equal_area) {
+      EXPECT_TRUE((x == 7 || x == 8) && (y == 7 || y == 8)) << x << "," << y;
+    } else {
+      EXPECT_EQ(y, 0);
+    }
+    Rng rng(17);
+    for (int k = 0; k < 2000; ++k) {
+      Vec3 w = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+      auto [tx, ty] = texel_of(l, w);
+      Spectrum L = environment_radiance(Light(l), w, kWl);
+      Spectrum expected = texel_radiance(l, tx, ty);
+      for (int c = 0; c < Spectrum::kChannels; ++c) ASSERT_NEAR(L[c], expected[c], 1e-4f * expected[c] + 1e-6f);
+      // The mapping's inverse.
+      EXPECT_NEAR(dot(image_light_direction(l, image_light_uv(l, w)), w), 1.0f, 1e-4f);
+    }
+    EXPECT_TRUE(environment_radiance(Light(PointLight{}), Vec3(0, 0, 1), kWl).is_black());
+  }
+}
+
+TEST(ImageLight, SampledRadianceIntegratesToTheImageAndDensitiesAgree) {
+  for (bool equal_area : {true, false}) {
+    ImageInfiniteLight l = make_image_light(equal_area);
+    Light light = l;
+    Shape none = Sphere{};  // unused by environment lights
+    Spectrum expected = integrated_radiance(l);
+    LiCheck r = run_li(light, none, Vec3(0.3f, 0.1f, -0.2f), 500 + equal_area, 200000, [&](const LightLiSample& s) {
+      EXPECT_TRUE(s.is_infinite);
+      Spectrum L = environment_radiance(light, s.wi, kWl);
+      EXPECT_NEAR(s.radiance[0], L[0], 1e-4f * L[0]);
+    });
+    for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(r.est[c], expected[c], 0, equal_area ? "equal-area" : "lat-long");
+    // The power the light sampler uses: the mean radiance times 4 pi, times the disk pi r^2.
+    Rgb power = light_power(light, kBounds);
+    double disk = M_PI * kBounds.radius * kBounds.radius;
+    Rgb sum(0.0f);
+    for (int y = 0; y < l.image->height; ++y)
+      for (int x = 0; x < l.image->width; ++x) {
+        double omega = l.equal_area ? 4 * M_PI / (l.image->width * l.image->height)
+                                    : 2 * M_PI / l.image->width * (std::cos(M_PI * y / l.image->height) - std::cos(M_PI * (y + 1) / l.image->height));
+        sum += l.image->texel(x, y, TexWrap::kClamp) * float(omega);
+      }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(power[c], sum[c] * l.scale * disk, 0.01 * power[c]) << c;
+  }
+}
+
+// The directions light_sample_li draws follow light_pdf_li: a chi-square test over quarters of
+// texels of equal solid angle (halves in u, and halves in v for the equal-area layout or in
+// cos theta for the latitude-longitude one), whose expected counts are exact since the density is
+// constant over each texel; the solid angles come from the layouts' geometry. Both layouts.
+TEST(ImageLight, SampledDirectionsFollowThePdf) {
+  for (bool equal_area : {true, false}) {
+    ImageInfiniteLight l = make_image_light(equal_area);
+    Light light = l;
+    const TexImage& im = *l.image;
+    auto row_cos = [&](int y) { return std::cos(M_PI * y / im.height); };
+    const int n = 800000;
+    std::vector<int> count(size_t(im.width) * im.height * 4, 0);
+    Rng rng(600 + equal_area);
+    for (int k = 0; k < n; ++k) {
+      auto s = light_sample_li(light, nullptr, Vec3(0, 0, 0), {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      ASSERT_TRUE(s.has_value());
+      Vec2 uv = image_light_uv(l, s->wi);
+      auto [x, y] = texel_of(l, s->wi);
+      int qu = uv.x * im.width - x >= 0.5f;
+      int qv;
+      if (equal_area) {
+        qv = uv.y * im.height - y >= 0.5f;
+      } else {
+        double c = dot(s->wi, l.world_from_light.vector(Vec3(0, 0, 1)));
+        qv = (c - row_cos(y)) / (row_cos(y + 1) - row_cos(y)) >= 0.5;
+      }
+      ++count[(size_t(y) * im.width + x) * 4 + qv * 2 + qu];
+    }
+    double chi2 = 0, mass = 0;
+    for (int y = 0; y < im.height; ++y) {
+      double omega = equal_area ? 4 * M_PI / (im.width * im.height) : 2 * M_PI / im.width * (row_cos(y) - row_cos(y + 1));
+      for (int x = 0; x < im.width; ++x) {
+        Vec3 centre = image_light_direction(l, {(x + 0.5f) / im.width, (y + 0.5f) / im.height});
+        double p = light_pdf_li(light, nullptr, Vec3(0, 0, 0), centre, {}, {}) * omega;
+        mass += p;
+        for (int q = 0; q < 4; ++q) {
+          double e = n * p / 4, o = count[(size_t(y) * im.width + x) * 4 + q];
+          chi2 += (o - e) * (o - e) / e;
+        }
+      }
+    }
+    EXPECT_NEAR(mass, 1.0, 1e-4) << equal_area;
+    int dof = im.width * im.height * 4 - 1;
+    // Two tests in this file at a family-wise level of 1%.
+    EXPECT_GT(chi2::chi2_survival(chi2, dof), chi2::sidak_alpha(0.01, 2))
+        << (equal_area ? "equal-area" : "lat-long") << ": chi2 " << chi2 << " dof " << dof;
+  }
+}
+
+TEST(ImageLight, IlluminanceOfAConstantImageIsPiTimesItsLuminance) {
+  for (bool equal_area : {true, false}) {
+    ImageInfiniteLight l = make_image_light(equal_area);
+    auto im = std::make_shared<TexImage>(*l.image);
+    for (size_t i = 0; i < im->texels.size(); i += 3) {
+      im->texels[i] = 0.5f;
+      im->texels[i + 1] = 1.0f;
+      im->texels[i + 2] = 2.0f;
+    }
+    l.image = im;
+    // Integrated within each texel, the horizon's texels included.
+    double expected = M_PI * Rgb(0.5f, 1.0f, 2.0f).luminance();
+    EXPECT_NEAR(image_light_illuminance(l), expected, 1e-3 * expected) << equal_area;
+  }
+}
 
 // Photon emission: the mean flux weight of light_sample_le is the light's power (what the photon
 // passes divide by the number of photons), and photons leave where and whither the light emits.
@@ -502,6 +669,25 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     });
     if (two_sided) EXPECT_NEAR(back, 100000, 1500);
     else EXPECT_EQ(back, 0);
+  }
+  for (bool equal_area : {true, false}) {
+    ImageInfiniteLight im = make_image_light(equal_area);
+    // The flux of an environment light through the scene's disk: its integrated radiance times
+    // pi r^2 (check_emission's closed form does not apply to an image).
+    Light light = im;
+    Rng rng(43 + equal_area);
+    MeanAccumulator est[Spectrum::kChannels];
+    for (int k = 0; k < 200000; ++k) {
+      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
+      if (!s) continue;
+      crosses_scene(*s);
+      // The photon travels away from the direction whose radiance it carries.
+      Spectrum L = environment_radiance(light, -s->direction, kWl);
+      EXPECT_GT(L[0], 0.0f);
+    }
+    Spectrum expected = integrated_radiance(im) * float(M_PI * kBounds.radius * kBounds.radius);
+    for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], expected[c], 0, equal_area ? "image equal-area" : "image lat-long");
   }
   Shape sphere = make_sphere(Vec3(1, 2, 3), 0.5f);
   check_emission("sphere", Light(make_area_light(sphere, false)), &sphere, [&](const LightLeSample& s) {

@@ -221,7 +221,7 @@ void RenderScene::commit() {
   infinite_lights.clear();
   for (size_t i = 0; i < lights.size(); ++i) {
     weights.push_back(std::fmax(0.0f, light_power(lights[i], bounds_info).average()));
-    if (std::holds_alternative<UniformInfiniteLight>(lights[i])) infinite_lights.push_back(int(i));
+    if (light_is_environment(lights[i])) infinite_lights.push_back(int(i));
   }
   light_distribution = Distribution1D(weights);
   accel_ = std::make_unique<Accel>(objects, textures);

@@ -782,6 +782,45 @@ class Flattener {
         .value_or(SpectrumCurve::from_rgb(Rgb(1.0f), SpectrumKind::kIlluminant));
   }
 
+  // An environment image light; scale comes in with the light's "scale" and leaves with the
+  // "illuminance" normalisation applied.
+  ImageInfiniteLight image_light(const LightEntity& e, const Param& file_param, float* scale) {
+    const ParamSet& ps = e.params;
+    std::string file = ps.get_string("filename", "");
+    fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+    ImageInfiniteLight l;
+    try {
+      l.image = load_texture_image(path.string(), TexEncoding{});  // 8-bit images are sRGB, as in pbrt-v4
+    } catch (const Error& err) {
+      throw Error(file_param.loc, err.what());
+    }
+    const TexImage& im = *l.image;
+    if (im.width == im.height) {
+      l.equal_area = true;
+    } else if (im.width == 2 * im.height) {
+      l.equal_area = false;
+      warning(file_param.loc, "\"" + file + "\" is " + std::to_string(im.width) + "x" + std::to_string(im.height) +
+                                  ": read as a latitude-longitude map (pbrt-v3's layout); pbrt-v4 takes only square "
+                                  "equal-area images");
+    } else {
+      throw Error(file_param.loc, "environment image \"" + file + "\" is " + std::to_string(im.width) + "x" +
+                                      std::to_string(im.height) + ": it must be square (equal-area) or twice as wide as high (latitude-longitude)");
+    }
+    if (!e.world_from_light.is_similarity())
+      throw Error(e.loc, "the transform of an environment light must be a rotation (no non-uniform scale)");
+    l.world_from_light = e.world_from_light;
+    float E = ps.get_float("illuminance", -1);
+    if (E > 0) {
+      double e_image = image_light_illuminance(l);
+      if (!(e_image > 0))
+        throw Error(ps.find_any("illuminance")->loc, "\"illuminance\" is given but the image sends no light to the upper hemisphere");
+      *scale *= float(E / e_image);
+    }
+    l.scale = *scale;
+    prepare_image_light(&l);
+    return l;
+  }
+
   void add_light(const LightEntity& e, RenderScene* rs) {
     const ParamSet& ps = e.params;
     if (!e.medium.outside.empty() && medium_id(e.medium.outside, e.medium.loc) >= 0)
@@ -816,8 +855,14 @@ class Flattener {
       if (E > 0) scale *= E;
       rs->lights.push_back(DistantLight{normalize(xf.vector(from - to)), L.scaled(scale)});
     } else if (e.name == "infinite") {
-      if (auto* f = ps.find_any("filename")) throw Error(f->loc, "environment map lights are not supported");
       if (auto* p = ps.find_any("portal")) throw Error(p->loc, "light portals are not supported");
+      if (const Param* f = ps.find_any("filename")) {
+        if (const Param* l = ps.find_any("L")) throw Error(l->loc, "an infinite light takes \"L\" or \"filename\", not both");
+        rs->lights.push_back(image_light(e, *f, &scale));
+        if (!(scale >= 0) || !std::isfinite(scale)) throw Error(e.loc, "light scale must be a non-negative number");
+        ps.warn_unused("light \"" + e.name + "\"");
+        return;
+      }
       SpectrumCurve L = light_spectrum(ps, "L");
       float E = ps.get_float("illuminance", -1);
       if (E > 0) scale *= E / kPi;

@@ -1507,10 +1507,58 @@ TEST(SceneFlattenError, NanParameter) {
   EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"float")), "parameter \"radius\" has a non-finite value"));
 }
 
-TEST(SceneFlattenError, InfiniteLightWithFilename) {
-  const std::string l2 = R"(LightSource "infinite" "string filename" "sky.exr")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"string")),
-                      "environment map lights are not supported"));
+// A PFM image of one colour (PFM: header, then little-endian floats, rows from the bottom).
+std::string constant_pfm(int w, int h, Rgb c) {
+  std::string s = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
+  for (int i = 0; i < w * h; ++i)
+    for (int k = 0; k < 3; ++k) put_le(&s, c[k]);
+  return s;
+}
+
+TEST(SceneParse, InfiniteLightWithImage) {
+  TempDir dir;
+  const Rgb c(0.5f, 1.0f, 2.0f);
+  dir.write("sky.pfm", constant_pfm(8, 8, c));
+  dir.write("latlong.pfm", constant_pfm(16, 8, c));
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nAttributeBegin\nRotate -90 1 0 0\n"
+      "LightSource \"infinite\" \"string filename\" \"sky.pfm\" \"float scale\" 2\nAttributeEnd\n"
+      "LightSource \"infinite\" \"string filename\" \"sky.pfm\" \"float illuminance\" 3\n"
+      "LightSource \"infinite\" \"string filename\" \"latlong.pfm\"\n",
+      dir.str()));
+  ASSERT_EQ(ls.scene.lights.size(), 3u);
+  EXPECT_EQ(ls.scene.infinite_lights, (std::vector<int>{0, 1, 2}));
+  const auto& a = std::get<ImageInfiniteLight>(ls.scene.lights[0]);
+  EXPECT_TRUE(a.equal_area);
+  EXPECT_FLOAT_EQ(a.scale, 2);
+  expect_vec_near(a.world_from_light.vector(Vec3(0, 0, 1)), Vec3(0, 1, 0));
+  EXPECT_NEAR(a.mean_radiance[2], 2 * 2.0f, 1e-4f);
+  // "illuminance": the upper hemisphere of a constant image gives pi Y.
+  const auto& b = std::get<ImageInfiniteLight>(ls.scene.lights[1]);
+  EXPECT_NEAR(b.scale, 3 / (kPi * c.luminance()), 1e-3f * b.scale);
+  const auto& l = std::get<ImageInfiniteLight>(ls.scene.lights[2]);
+  EXPECT_FALSE(l.equal_area);
+}
+
+TEST(SceneFlattenError, InfiniteLightImageErrors) {
+  TempDir dir;
+  dir.write("sky.pfm", constant_pfm(8, 8, Rgb(1.0f)));
+  dir.write("odd.pfm", constant_pfm(12, 8, Rgb(1.0f)));
+  const std::string odd = R"(LightSource "infinite" "string filename" "odd.pfm")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + odd + "\n", dir.str()), at(2, col(odd, "\"string")),
+                      "environment image \"odd.pfm\" is 12x8: it must be square (equal-area) or twice as wide as high"));
+  const std::string both = R"(LightSource "infinite" "string filename" "sky.pfm" "rgb L" [1 1 1])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + both + "\n", dir.str()), at(2, col(both, "\"rgb")),
+                      "an infinite light takes \"L\" or \"filename\", not both"));
+  const std::string missing = R"(LightSource "infinite" "string filename" "none.exr")";
+  std::string msg = error_of("WorldBegin\n" + missing + "\n", dir.str());
+  EXPECT_TRUE(IsError(msg, at(2, col(missing, "\"string")), ""));
+  EXPECT_TRUE(Contains(msg, "none.exr"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 2 1\nLightSource \"infinite\" \"string filename\" \"sky.pfm\"\n", dir.str()),
+                      at(3, 1), "the transform of an environment light must be a rotation"));
+  const std::string portal = R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 1 0 0 1 0])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + portal + "\n", dir.str()), at(2, col(portal, "\"point3")),
+                      "light portals are not supported"));
 }
 
 TEST(SceneFlattenError, AreaLightOnPartialSphere) {

@@ -1,0 +1,97 @@
+// Tests of the equal-area square-sphere map (orientation, inverse, equal solid angles) and of
+// the 2D piecewise-constant distribution (density against its own pdf and cell frequencies).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "base/chi2_test_util.h"
+#include "base/rng.h"
+#include "base/sampling.h"
+
+namespace bpm {
+namespace {
+
+TEST(EqualArea, CentreIsUpAndCornersAreDown) {
+  Vec3 up = equal_area_square_to_sphere({0.5f, 0.5f});
+  EXPECT_NEAR(up.z, 1.0f, 1e-6f);
+  for (Vec2 c : {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)}) EXPECT_NEAR(equal_area_square_to_sphere(c).z, -1.0f, 1e-6f);
+  // The midpoints of the edges and the diamond's corners lie on the equator, +x at u = 1.
+  Vec3 px = equal_area_square_to_sphere({1.0f, 0.5f});
+  EXPECT_NEAR(px.x, 1.0f, 1e-6f);
+  Vec3 py = equal_area_square_to_sphere({0.5f, 1.0f});
+  EXPECT_NEAR(py.y, 1.0f, 1e-6f);
+}
+
+TEST(EqualArea, InverseAndUnitLength) {
+  Rng rng(3);
+  for (int k = 0; k < 100000; ++k) {
+    Vec2 p(rng.uniform(), rng.uniform());
+    Vec3 w = equal_area_square_to_sphere(p);
+    ASSERT_NEAR(length(w), 1.0f, 1e-5f);
+    Vec2 q = equal_area_sphere_to_square(w);
+    ASSERT_NEAR(q.x, p.x, 2e-4f) << p.x << " " << p.y;
+    ASSERT_NEAR(q.y, p.y, 2e-4f) << p.x << " " << p.y;
+    // And from the sphere's side.
+    Vec3 d = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+    Vec3 back = equal_area_square_to_sphere(equal_area_sphere_to_square(d));
+    ASSERT_NEAR(dot(back, d), 1.0f, 1e-5f);
+  }
+}
+
+// Uniform points of the square give uniform directions: the fraction of directions in each of 8
+// bands of z and 8 sectors of phi is 1/64 of the sphere (Archimedes: bands of equal height have
+// equal area), checked cell by cell within 4 sigma.
+TEST(EqualArea, EqualAreasOfTheSquareAreEqualSolidAngles) {
+  Rng rng(5);
+  const int n = 640000, cells = 64;
+  std::vector<int> count(cells, 0);
+  for (int k = 0; k < n; ++k) {
+    Vec3 w = equal_area_square_to_sphere({rng.uniform(), rng.uniform()});
+    int band = std::clamp(int((w.z + 1) / 2 * 8), 0, 7);
+    float phi = std::atan2(w.y, w.x);
+    if (phi < 0) phi += 2 * kPi;
+    int sector = std::clamp(int(phi / (2 * kPi) * 8), 0, 7);
+    ++count[size_t(band * 8 + sector)];
+  }
+  double p = 1.0 / cells, sigma = std::sqrt(n * p * (1 - p));
+  for (int c = 0; c < cells; ++c) EXPECT_NEAR(count[size_t(c)], n * p, 4 * sigma) << "cell " << c;
+}
+
+TEST(Distribution2D, SamplesFollowTheWeights) {
+  const int w = 5, h = 4;
+  std::vector<float> weights = {1, 0, 2, 3, 0.5f,  //
+                                0, 0, 0, 0, 0,     // an empty row is never drawn
+                                4, 1, 1, 1, 1,     //
+                                0.2f, 3, 0, 2, 1};
+  Distribution2D d(weights, w, h);
+  double total = 0;
+  for (float x : weights) total += x;
+  Rng rng(9);
+  const int n = 400000;
+  std::vector<int> count(weights.size(), 0);
+  for (int k = 0; k < n; ++k) {
+    float pdf = 0;
+    Vec2 p = d.sample({rng.uniform(), rng.uniform()}, &pdf);
+    ASSERT_GE(p.x, 0.0f);
+    ASSERT_LT(p.x, 1.0f);
+    ASSERT_GE(p.y, 0.0f);
+    ASSERT_LT(p.y, 1.0f);
+    int x = int(p.x * w), y = int(p.y * h);
+    ASSERT_GT(weights[size_t(y * w + x)], 0.0f);
+    ASSERT_NEAR(pdf, d.pdf(p), 1e-5f * pdf);
+    ASSERT_NEAR(pdf, weights[size_t(y * w + x)] / total * w * h, 1e-4f * pdf);
+    ++count[size_t(y * w + x)];
+  }
+  for (size_t i = 0; i < weights.size(); ++i) {
+    double p = weights[i] / total;
+    EXPECT_NEAR(count[i], n * p, 4 * std::sqrt(n * p * (1 - p)) + 1e-9) << "cell " << i;
+  }
+  // All-zero weights: uniform.
+  Distribution2D zero(std::vector<float>(6, 0.0f), 3, 2);
+  float pdf = 0;
+  zero.sample({0.3f, 0.7f}, &pdf);
+  EXPECT_NEAR(pdf, 1.0f, 1e-6f);
+}
+
+}  // namespace
+}  // namespace bpm
