@@ -415,6 +415,82 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
   }
 }
 
+// A diffuse plane (rho = 0.6) under image point lights, with path and bpm: a goniometric light of
+// I = 3 with a constant image of 0.5 is a point light of intensity 1.5; a projection light of a
+// constant white image pointing down lights the square its 90-degree frame cuts out of the plane
+// with intensity "scale", and nothing outside.
+TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("bpm_gonio_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  Image flat;
+  flat.width = flat.height = 8;
+  flat.rgb.assign(8 * 8 * 3, 0.5f);
+  write_exr((dir / "half.exr").string(), flat);
+  flat.rgb.assign(8 * 8 * 3, 1.0f);
+  write_exr((dir / "white.exr").string(), flat);
+  const std::string head = R"(
+    LookAt 0 5 -3  0 0 0  0 1 0
+    Camera "perspective" "float fov" 50
+    Film "rgb" "integer xresolution" 24 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+    Integrator "path" "integer maxdepth" 1
+    WorldBegin
+    Material "diffuse" "rgb reflectance" [0.6 0.6 0.6]
+    Shape "trianglemesh" "point3 P" [-50 0 -50  50 0 -50  50 0 50  -50 0 50] "integer indices" [0 1 2 0 2 3]
+  )";
+  LoadedScene gonio = load(head + R"(
+    Translate 0.5 2 0.3
+    LightSource "goniometric" "string filename" ")" + (dir / "half.exr").string() + R"(" "rgb I" [3 3 3]
+  )");
+  LoadedScene proj = load(head + R"(
+    Translate 0 2 0
+    Rotate 90 1 0 0
+    LightSource "projection" "string filename" ")" + (dir / "white.exr").string() + R"(" "float scale" 2
+  )");
+  for (bool is_gonio : {true, false}) {
+    const LoadedScene& ls = is_gonio ? gonio : proj;
+    Vec3 light = is_gonio ? Vec3(0.5f, 2, 0.3f) : Vec3(0, 2, 0);
+    float I = is_gonio ? 1.5f : 2.0f;
+    PerspectiveCamera cam(ls.camera, 24, 16);
+    for (const char* integrator : {"path", "bpm"}) {
+      RenderOptions opt = quiet_options(ls, integrator, 16, 1);
+      opt.bpm.max_batches = 1;
+      opt.bpm.photons_per_batch = 20000;
+      Film film(24, 16);
+      render(ls, opt, &film);
+      Image img = film.image();
+      std::vector<float> rms = film.rms();
+      int lit = 0, dark = 0;
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 24; ++x) {
+          Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+          if (r.d.y >= 0) continue;
+          Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
+          float expected = 0;
+          if (!is_gonio) {
+            // The frame covers |x|, |z| < 2 on the plane; skip a band around its edge.
+            float edge = std::fmax(std::fabs(p.x), std::fabs(p.z));
+            if (std::fabs(edge - 2) < 0.1f) continue;
+            if (edge > 2) {
+              EXPECT_EQ(img.at(x, y).luminance(), 0.0f) << integrator << " " << x << "," << y;
+              ++dark;
+              continue;
+            }
+          }
+          Vec3 to_light = light - p;
+          float d2 = length_squared(to_light);
+          expected = 0.6f / kPi * I * (to_light.y / std::sqrt(d2)) / d2;
+          EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 24 + x] + 2e-3f * expected)
+              << (is_gonio ? "goniometric " : "projection ") << integrator << " " << x << "," << y;
+          ++lit;
+        }
+      EXPECT_GT(lit, 40);
+      if (!is_gonio) EXPECT_GT(dark, 40);
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // Same seed and budget give the same image whatever the number of threads.
 TEST(Renderer, SameImageWithOneAndTwoThreads) {
   LoadedScene ls = load(R"(

@@ -8,6 +8,7 @@ namespace bpm {
 
 bool light_is_delta(const Light& l) {
   return std::holds_alternative<PointLight>(l) || std::holds_alternative<SpotLight>(l) ||
+         std::holds_alternative<GoniometricLight>(l) || std::holds_alternative<ProjectionLight>(l) ||
          std::holds_alternative<DistantLight>(l);
 }
 bool light_is_infinite(const Light& l) { return std::holds_alternative<DistantLight>(l) || light_is_environment(l); }
@@ -141,6 +142,108 @@ double image_light_illuminance(const ImageInfiniteLight& l) {
   return e;
 }
 
+// ---- goniometric and projection lights ----
+
+namespace {
+float channel_mean(const TexImage& im, int x, int y) {
+  Rgb rgb = im.texel(x, y, TexWrap::kClamp);
+  return (rgb[0] + rgb[1] + rgb[2]) / 3;
+}
+}  // namespace
+
+void prepare_goniometric_light(GoniometricLight* l) {
+  const TexImage& im = *l->image;
+  std::vector<float> weights(size_t(im.width) * size_t(im.height));
+  double sum = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      float v = std::fmax(0.0f, channel_mean(im, x, y));
+      weights[size_t(y) * im.width + x] = v;
+      sum += v;
+    }
+  l->distribution = Distribution2D(weights, im.width, im.height);
+  l->mean_value = float(sum / weights.size());
+}
+
+namespace {
+// pbrt-v4 swaps y and z between the light's frame and the image's sphere.
+Vec3 swap_yz(Vec3 v) { return {v.x, v.z, v.y}; }
+}  // namespace
+
+float goniometric_value(const GoniometricLight& l, Vec3 w) {
+  Vec3 wl = swap_yz(normalize(l.world_from_light.inverse().vector(w)));
+  Vec2 uv = equal_area_sphere_to_square(wl);
+  const TexImage& im = *l.image;
+  int x = std::clamp(int(uv.x * float(im.width)), 0, im.width - 1), y = std::clamp(int(uv.y * float(im.height)), 0, im.height - 1);
+  return std::fmax(0.0f, channel_mean(im, x, y));
+}
+
+Spectrum light_intensity(const GoniometricLight& l, Vec3 w, const Wavelengths& wl) {
+  float v = goniometric_value(l, w);
+  if (v == 0) return {};
+  return l.intensity.sample(wl) * v;
+}
+
+Vec3 projection_direction_light(const ProjectionLight& l, Vec2 uv) {
+  // Screen coordinates in [-half_width, half_width] x [-half_height, half_height], y down the
+  // image; at unit distance along +z they lie tan_half_fov times further out, y flipped.
+  float sx = (2 * uv.x - 1) * l.half_width, sy = (2 * uv.y - 1) * l.half_height;
+  return normalize(Vec3(sx * l.tan_half_fov, -sy * l.tan_half_fov, 1));
+}
+
+float projection_solid_angle_per_area(const ProjectionLight& l, Vec2 uv) {
+  // The frame covers 4 hw hh tan^2 of the plane z = 1, where d omega = cos^3 dA.
+  float c = projection_direction_light(l, uv).z;
+  return 4 * l.half_width * l.half_height * l.tan_half_fov * l.tan_half_fov * c * c * c;
+}
+
+std::optional<Vec2> projection_uv(const ProjectionLight& l, Vec3 w) {
+  Vec3 d = l.world_from_light.inverse().vector(w);
+  if (!(d.z > 1e-3f * length(d))) return std::nullopt;  // behind the light (pbrt-v4's hither)
+  float sx = d.x / (d.z * l.tan_half_fov), sy = -d.y / (d.z * l.tan_half_fov);
+  if (std::fabs(sx) > l.half_width || std::fabs(sy) > l.half_height) return std::nullopt;
+  return Vec2((sx / l.half_width + 1) / 2, (sy / l.half_height + 1) / 2);
+}
+
+namespace {
+Rgb projection_texel(const ProjectionLight& l, Vec2 uv) {
+  const TexImage& im = *l.image;
+  int x = std::clamp(int(uv.x * float(im.width)), 0, im.width - 1), y = std::clamp(int(uv.y * float(im.height)), 0, im.height - 1);
+  Rgb rgb = im.texel(x, y, TexWrap::kClamp);
+  for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
+  return rgb;
+}
+}  // namespace
+
+Spectrum light_intensity(const ProjectionLight& l, Vec3 w, const Wavelengths& wl) {
+  auto uv = projection_uv(l, w);
+  if (!uv) return {};
+  Rgb rgb = projection_texel(l, *uv);
+  if (rgb.max_component() == 0) return {};
+  return rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) * l.scale;
+}
+
+void prepare_projection_light(ProjectionLight* l) {
+  const TexImage& im = *l->image;
+  float aspect = float(im.width) / float(im.height);
+  l->half_width = aspect > 1 ? aspect : 1;
+  l->half_height = aspect > 1 ? 1 : 1 / aspect;
+  // Texels weighted by their solid angle (cos^3 at the centre; sub-texel points would matter only
+  // for fields of view near 180 degrees).
+  std::vector<float> weights(size_t(im.width) * size_t(im.height));
+  Rgb power(0.0f);
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      Vec2 uv((x + 0.5f) / im.width, (y + 0.5f) / im.height);
+      float omega = projection_solid_angle_per_area(*l, uv) / float(im.width * im.height);
+      Rgb rgb = projection_texel(*l, uv);
+      weights[size_t(y) * im.width + x] = (rgb[0] + rgb[1] + rgb[2]) / 3 * omega;
+      power += rgb * (omega * l->scale);
+    }
+  l->distribution = Distribution2D(weights, im.width, im.height);
+  l->power_rgb = power;
+}
+
 Spectrum environment_radiance(const Light& light, Vec3 w, const Wavelengths& wl) {
   if (auto* u = std::get_if<UniformInfiniteLight>(&light)) return u->radiance.sample(wl);
   if (auto* im = std::get_if<ImageInfiniteLight>(&light)) return image_radiance(*im, image_light_uv(*im, w), wl);
@@ -246,6 +349,23 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
     if (fall == 0) return std::nullopt;
     ls.radiance = l->intensity.sample(wl) * (fall / d2);
     ls.p_light = l->position;
+    ls.pdf_solid_angle = 1;
+    ls.is_delta = true;
+    return ls;
+  }
+  if (std::holds_alternative<GoniometricLight>(light) || std::holds_alternative<ProjectionLight>(light)) {
+    const Transform& xf = std::holds_alternative<GoniometricLight>(light) ? std::get<GoniometricLight>(light).world_from_light
+                                                                          : std::get<ProjectionLight>(light).world_from_light;
+    Vec3 position = xf.point(Vec3(0, 0, 0));
+    Vec3 d = position - p_ref;
+    float d2 = length_squared(d);
+    if (d2 == 0) return std::nullopt;
+    ls.wi = d / std::sqrt(d2);
+    Spectrum I = std::holds_alternative<GoniometricLight>(light) ? light_intensity(std::get<GoniometricLight>(light), -ls.wi, wl)
+                                                                 : light_intensity(std::get<ProjectionLight>(light), -ls.wi, wl);
+    if (I.is_black()) return std::nullopt;
+    ls.radiance = I / d2;
+    ls.p_light = position;
     ls.pdf_solid_angle = 1;
     ls.is_delta = true;
     return ls;
@@ -360,6 +480,28 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
     s.flux = l->intensity.sample(wl) * (fall / uniform_cone_pdf_solid_angle(l->cos_falloff_end));
     return s;
   }
+  if (auto* l = std::get_if<GoniometricLight>(&light)) {
+    float pdf_uv = 0;
+    Vec2 uv = l->distribution.sample(u_dir, &pdf_uv);
+    if (!(pdf_uv > 0)) return std::nullopt;
+    s.origin = l->world_from_light.point(Vec3(0, 0, 0));
+    s.direction = normalize(l->world_from_light.vector(swap_yz(equal_area_square_to_sphere(uv))));
+    s.flux = light_intensity(*l, s.direction, wl) * (4 * kPi / pdf_uv);
+    if (s.flux.is_black()) return std::nullopt;
+    return s;
+  }
+  if (auto* l = std::get_if<ProjectionLight>(&light)) {
+    float pdf_uv = 0;
+    Vec2 uv = l->distribution.sample(u_dir, &pdf_uv);
+    if (!(pdf_uv > 0)) return std::nullopt;
+    s.origin = l->world_from_light.point(Vec3(0, 0, 0));
+    s.direction = normalize(l->world_from_light.vector(projection_direction_light(*l, uv)));
+    Rgb rgb = projection_texel(*l, uv);
+    s.flux = rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) *
+             (l->scale * projection_solid_angle_per_area(*l, uv) / pdf_uv);
+    if (s.flux.is_black()) return std::nullopt;
+    return s;
+  }
   // Infinite lights emit through a disk of the scene's bounding radius, facing the direction of
   // travel, placed outside the scene (pbrt-v4 DistantLight/UniformInfiniteLight::SampleLe).
   auto disk_origin = [&](Vec3 d) {
@@ -418,6 +560,8 @@ Rgb light_power(const Light& light, const SceneBoundsInfo& bounds) {
   if (auto* l = std::get_if<PointLight>(&light)) return l->intensity.rgb() * (4 * kPi);
   if (auto* l = std::get_if<SpotLight>(&light))
     return l->intensity.rgb() * (2 * kPi * ((1 - l->cos_falloff_start) + (l->cos_falloff_start - l->cos_falloff_end) / 2));
+  if (auto* l = std::get_if<GoniometricLight>(&light)) return l->intensity.rgb() * (4 * kPi * l->mean_value);
+  if (auto* l = std::get_if<ProjectionLight>(&light)) return l->power_rgb;
   if (auto* l = std::get_if<DistantLight>(&light)) return l->radiance.rgb() * (kPi * bounds.radius * bounds.radius);
   if (auto* l = std::get_if<UniformInfiniteLight>(&light))
     return l->radiance.rgb() * (4 * kPi * kPi * bounds.radius * bounds.radius);

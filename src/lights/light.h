@@ -66,6 +66,44 @@ float image_light_pdf(const ImageInfiniteLight& l, Vec2 uv);
 // at scale 1: what pbrt-v4's "illuminance" parameter normalises.
 double image_light_illuminance(const ImageInfiniteLight& l);
 
+// pbrt-v4 goniometric light: a point whose intensity toward w is the spectrum I times the value
+// of a square equal-area image (the mean of its channels) at the direction in the light's frame
+// with y and z swapped (pbrt-v4's convention: the image's centre points along the light's +y).
+struct GoniometricLight {
+  Transform world_from_light;  // origin at the light; a rotation otherwise
+  SpectrumCurve intensity;     // scale included
+  std::shared_ptr<const TexImage> image;
+  Distribution2D distribution;  // over the image, in proportion to its values
+  float mean_value = 0;
+};
+void prepare_goniometric_light(GoniometricLight* l);
+// The image value toward the world direction w (unit).
+float goniometric_value(const GoniometricLight& l, Vec3 w);
+
+// pbrt-v4 projection light: a point that projects an image along the light's +z through a
+// pinhole with field of view fov on the image's shorter axis; the intensity toward a direction is
+// the nearest texel, as an illuminant RGB, times scale (the image appears upright with the light's
+// +y up, as pbrt-v4 shows it).
+struct ProjectionLight {
+  Transform world_from_light;
+  std::shared_ptr<const TexImage> image;
+  float scale = 1;
+  float tan_half_fov = 1;
+  float half_width = 1, half_height = 1;  // of the screen at unit distance, over tan_half_fov
+  Distribution2D distribution;            // over the image's (u, v), in proportion to power
+  Rgb power_rgb;                          // integral of the intensity over directions
+};
+void prepare_projection_light(ProjectionLight* l);
+// Image coordinates (u, v, rows from the top) toward the world direction w, or nullopt outside
+// the projected frame.
+std::optional<Vec2> projection_uv(const ProjectionLight& l, Vec3 w);
+// The light-space direction through image coordinates, and the solid angle per unit image area.
+Vec3 projection_direction_light(const ProjectionLight& l, Vec2 uv);
+float projection_solid_angle_per_area(const ProjectionLight& l, Vec2 uv);
+// Intensity toward the world direction w at the wavelengths.
+Spectrum light_intensity(const GoniometricLight& l, Vec3 w, const Wavelengths& wl);
+Spectrum light_intensity(const ProjectionLight& l, Vec3 w, const Wavelengths& wl);
+
 // Diffuse emission from one primitive of an object (a triangle, a full sphere or disk, or a
 // cylinder).
 struct AreaLight {
@@ -76,7 +114,8 @@ struct AreaLight {
   float area = 0;
 };
 
-using Light = std::variant<PointLight, SpotLight, DistantLight, UniformInfiniteLight, ImageInfiniteLight, AreaLight>;
+using Light = std::variant<PointLight, SpotLight, GoniometricLight, ProjectionLight, DistantLight,
+                           UniformInfiniteLight, ImageInfiniteLight, AreaLight>;
 
 struct LightLiSample {
   Spectrum radiance;    // arriving at the reference point along -wi

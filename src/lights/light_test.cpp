@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <tuple>
 #include <optional>
 
 #include "base/chi2_test_util.h"
@@ -31,6 +32,7 @@ SpectrumCurve light_rgb(float r, float g, float b) { return SpectrumCurve::from_
 const SpectrumCurve& emission_curve(const Light& l) {
   if (auto* p = std::get_if<PointLight>(&l)) return p->intensity;
   if (auto* p = std::get_if<SpotLight>(&l)) return p->intensity;
+  if (auto* p = std::get_if<GoniometricLight>(&l)) return p->intensity;
   if (auto* p = std::get_if<DistantLight>(&l)) return p->radiance;
   if (auto* p = std::get_if<UniformInfiniteLight>(&l)) return p->radiance;
   return std::get<AreaLight>(l).radiance;
@@ -617,6 +619,146 @@ TEST(ImageLight, IlluminanceOfAConstantImageIsPiTimesItsLuminance) {
     double expected = M_PI * Rgb(0.5f, 1.0f, 2.0f).luminance();
     EXPECT_NEAR(image_light_illuminance(l), expected, 1e-3 * expected) << equal_area;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Goniometric and projection lights.
+
+std::shared_ptr<TexImage> gradient_image(int w, int h) {
+  auto im = std::make_shared<TexImage>();
+  im->width = w;
+  im->height = h;
+  im->texels.resize(size_t(w) * h * 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float* t = &im->texels[(size_t(y) * w + x) * 3];
+      t[0] = 0.1f + float(x) / w;
+      t[1] = 0.2f + float(y) / h;
+      t[2] = (x + y) % 3 == 0 ? 2.0f : 0.5f;
+    }
+  return im;
+}
+
+GoniometricLight make_goniometric() {
+  GoniometricLight l;
+  l.world_from_light = Transform::translate(Vec3(0.5f, 1, -1)) * Transform::rotate(30, normalize(Vec3(1, 1, 0)));
+  l.intensity = light_rgb(2.0f, 1.0f, 0.5f);
+  l.image = gradient_image(8, 8);
+  prepare_goniometric_light(&l);
+  return l;
+}
+
+ProjectionLight make_projection(int w, int h, float fov_degrees) {
+  ProjectionLight l;
+  l.world_from_light = Transform::translate(Vec3(0.5f, 1, -1)) * Transform::rotate(-20, normalize(Vec3(1, 0, 1)));
+  l.image = gradient_image(w, h);
+  l.scale = 1.5f;
+  l.tan_half_fov = std::tan(fov_degrees * kPi / 360);
+  prepare_projection_light(&l);
+  return l;
+}
+
+TEST(GoniometricLight, ImageCentreFacesTheLightsY) {
+  GoniometricLight l = make_goniometric();
+  // pbrt-v4 swaps y and z: the centre of the image (the equal-area square's +z) is the light's +y,
+  // its corners the light's -y.
+  const TexImage& im = *l.image;
+  auto mean = [&](int x, int y) {
+    Rgb c = im.texel(x, y, TexWrap::kClamp);
+    return (c[0] + c[1] + c[2]) / 3;
+  };
+  Vec3 up = l.world_from_light.vector(Vec3(0, 1, 0));
+  float centre = goniometric_value(l, up);
+  EXPECT_TRUE(centre == mean(3, 3) || centre == mean(4, 4) || centre == mean(3, 4) || centre == mean(4, 3)) << centre;
+  float pole = goniometric_value(l, -up);  // one of the four corners, by the signs of x and z there
+  EXPECT_TRUE(pole == mean(0, 0) || pole == mean(7, 0) || pole == mean(0, 7) || pole == mean(7, 7)) << pole;
+  // Shading toward a point: I times the value over d^2, a delta light.
+  Vec3 p = l.world_from_light.point(Vec3(0.3f, 2, 0.1f));
+  auto s = light_sample_li(Light(l), nullptr, p, {0.5f, 0.5f}, kBounds, kWl);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_TRUE(s->is_delta);
+  float d2 = length_squared(p - l.world_from_light.point(Vec3(0, 0, 0)));
+  Spectrum I = l.intensity.sample(kWl) * goniometric_value(l, -s->wi);
+  EXPECT_NEAR(s->radiance[0], I[0] / d2, 1e-5f * I[0] / d2);
+}
+
+TEST(ProjectionLight, FrameOrientationAndInverse) {
+  ProjectionLight l = make_projection(8, 4, 60);  // wider than high: fov on the height
+  const float t = std::tan(kPi / 6);
+  auto at = [&](Vec3 d_light) { return projection_uv(l, l.world_from_light.vector(d_light)); };
+  // The centre; up (+y) is the image's top rows, +x its right columns.
+  auto c = at(Vec3(0, 0, 1));
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->x, 0.5f, 1e-5f);
+  EXPECT_NEAR(c->y, 0.5f, 1e-5f);
+  EXPECT_LT(at(Vec3(0, 0.2f, 1))->y, 0.5f);
+  EXPECT_GT(at(Vec3(0.2f, 0, 1))->x, 0.5f);
+  // The frame: +-tan(fov / 2) vertically, twice that horizontally; nothing behind.
+  EXPECT_TRUE(at(Vec3(0, 0.99f * t, 1)).has_value());
+  EXPECT_FALSE(at(Vec3(0, 1.01f * t, 1)).has_value());
+  EXPECT_TRUE(at(Vec3(1.98f * t, 0, 1)).has_value());
+  EXPECT_FALSE(at(Vec3(2.02f * t, 0, 1)).has_value());
+  EXPECT_FALSE(at(Vec3(0, 0, -1)).has_value());
+  Rng rng(8);
+  for (int k = 0; k < 1000; ++k) {
+    Vec2 uv(rng.uniform(), rng.uniform());
+    Vec3 w = l.world_from_light.vector(projection_direction_light(l, uv));
+    auto back = projection_uv(l, w);
+    ASSERT_TRUE(back.has_value());
+    EXPECT_NEAR(back->x, uv.x, 1e-4f);
+    EXPECT_NEAR(back->y, uv.y, 1e-4f);
+  }
+}
+
+// The solid angle of the projected frame, integrated from the per-area factor, against the
+// closed form for a rectangle at unit distance: 4 atan(a b / sqrt(1 + a^2 + b^2)).
+TEST(ProjectionLight, FrameSolidAngle) {
+  for (float fov : {30.0f, 90.0f, 120.0f}) {
+    ProjectionLight l = make_projection(6, 4, fov);
+    const int n = 400;
+    double omega = 0;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) omega += projection_solid_angle_per_area(l, {(i + 0.5f) / n, (j + 0.5f) / n});
+    omega /= double(n) * n;
+    double a = 1.5 * l.tan_half_fov, b = l.tan_half_fov;
+    double expected = 4 * std::atan(a * b / std::sqrt(1 + a * a + b * b));
+    EXPECT_NEAR(omega, expected, 1e-4 * expected) << fov;
+  }
+}
+
+// Photons from both lights: the mean flux is the integral of the intensity over directions,
+// computed here texel by texel on a fine grid of directions.
+TEST(GoniometricAndProjectionLights, MeanFluxIsTheIntegratedIntensity) {
+  GoniometricLight g = make_goniometric();
+  ProjectionLight p = make_projection(8, 4, 70);
+  Spectrum expected_g, expected_p;
+  const int n = 256;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      Vec2 uv((i + 0.5f) / n, (j + 0.5f) / n);
+      Vec3 w = equal_area_square_to_sphere(uv);
+      expected_g += light_intensity(g, g.world_from_light.vector(Vec3(w.x, w.z, w.y)), kWl) * float(4 * M_PI / (n * n));
+      Vec3 wp = p.world_from_light.vector(projection_direction_light(p, uv));
+      expected_p += light_intensity(p, wp, kWl) * (projection_solid_angle_per_area(p, uv) / float(n * n));
+    }
+  // The goniometric light's power as the light sampler sees it.
+  Spectrum power_g = spectral_power(Light(g));
+  for (int c = 0; c < Spectrum::kChannels; ++c) EXPECT_NEAR(power_g[c], expected_g[c], 2e-3f * expected_g[c]);
+  for (auto [light, expected, name] : {std::tuple{Light(g), expected_g, "goniometric"}, std::tuple{Light(p), expected_p, "projection"}}) {
+    Rng rng(77);
+    MeanAccumulator est[Spectrum::kChannels];
+    Vec3 origin = std::holds_alternative<GoniometricLight>(light) ? g.world_from_light.point(Vec3(0, 0, 0))
+                                                                  : p.world_from_light.point(Vec3(0, 0, 0));
+    for (int k = 0; k < 200000; ++k) {
+      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
+      if (s) ASSERT_LT(length(s->origin - origin), 1e-5f);
+    }
+    for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], expected[c], 2e-3 * expected[c], name);
+  }
+  // The projection light's RGB power, which "power" normalises, is the same integral.
+  Rgb prgb = light_power(Light(p), kBounds);
+  EXPECT_GT(prgb.luminance(), 0);
 }
 
 // Photon emission: the mean flux weight of light_sample_le is the light's power (what the photon

@@ -784,16 +784,29 @@ class Flattener {
 
   // An environment image light; scale comes in with the light's "scale" and leaves with the
   // "illuminance" normalisation applied.
+  // The image a light's "filename" names (8-bit images decoded as sRGB, as pbrt-v4 does); errors
+  // name the parameter.
+  std::shared_ptr<const TexImage> light_image(const ParamSet& ps, const std::string& light) {
+    const Param* f = ps.find_any("filename");
+    std::string file = ps.get_string("filename", "");
+    if (!f || file.empty()) throw Error(f ? f->loc : FileLoc{}, light + " light needs \"string filename\"");
+    fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+    std::shared_ptr<const TexImage> image;
+    try {
+      image = load_texture_image(path.string(), TexEncoding{});
+    } catch (const Error& err) {
+      throw Error(f->loc, err.what());
+    }
+    for (float v : image->texels)
+      if (!std::isfinite(v)) throw Error(f->loc, "\"" + file + "\" has infinite or not-a-number texels and cannot be a light");
+    return image;
+  }
+
   ImageInfiniteLight image_light(const LightEntity& e, const Param& file_param, float* scale) {
     const ParamSet& ps = e.params;
     std::string file = ps.get_string("filename", "");
-    fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
     ImageInfiniteLight l;
-    try {
-      l.image = load_texture_image(path.string(), TexEncoding{});  // 8-bit images are sRGB, as in pbrt-v4
-    } catch (const Error& err) {
-      throw Error(file_param.loc, err.what());
-    }
+    l.image = light_image(ps, "an infinite");
     const TexImage& im = *l.image;
     if (im.width == im.height) {
       l.equal_area = true;
@@ -832,6 +845,45 @@ class Flattener {
       float power = ps.get_float("power", -1);
       if (power > 0) scale *= power / (4 * kPi);
       rs->lights.push_back(PointLight{xf.point(ps.get_point3("from", Vec3(0, 0, 0))), I.scaled(scale)});
+    } else if (e.name == "goniometric") {
+      if (!ps.find_any("filename")) throw Error(e.loc, "goniometric light needs \"string filename\" (its intensity image)");
+      GoniometricLight l;
+      l.image = light_image(ps, "goniometric");
+      if (l.image->width != l.image->height)
+        throw Error(ps.find_any("filename")->loc, "goniometric image \"" + ps.get_string("filename", "") + "\" is " +
+                                                      std::to_string(l.image->width) + "x" + std::to_string(l.image->height) +
+                                                      ": it must be square (pbrt-v4's equal-area layout)");
+      if (!xf.is_similarity()) throw Error(e.loc, "the transform of a goniometric light must not scale non-uniformly");
+      l.world_from_light = xf;
+      prepare_goniometric_light(&l);
+      float power = ps.get_float("power", -1);
+      if (power > 0) {
+        if (!(l.mean_value > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the goniometric image is black");
+        scale *= power / (4 * kPi * l.mean_value);
+      }
+      l.intensity = light_spectrum(ps, "I").scaled(scale);
+      rs->lights.push_back(std::move(l));
+    } else if (e.name == "projection") {
+      if (!ps.find_any("filename")) throw Error(e.loc, "projection light needs \"string filename\" (the projected image)");
+      ProjectionLight l;
+      l.image = light_image(ps, "projection");
+      float fov = ps.get_float("fov", 90);
+      if (!(fov > 0 && fov < 180)) throw Error(ps.find_any("fov")->loc, "projection fov must be in (0, 180) degrees");
+      l.tan_half_fov = std::tan(radians(fov) / 2);
+      if (!xf.is_similarity()) throw Error(e.loc, "the transform of a projection light must not scale non-uniformly");
+      l.world_from_light = xf;
+      l.scale = 1;
+      prepare_projection_light(&l);
+      float power = ps.get_float("power", -1);
+      if (power > 0) {
+        // pbrt-v4 normalises the luminance-weighted power of the image.
+        float phi = l.power_rgb.luminance();
+        if (!(phi > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the projected image is black");
+        scale *= power / phi;
+      }
+      l.scale = scale;
+      prepare_projection_light(&l);
+      rs->lights.push_back(std::move(l));
     } else if (e.name == "spot") {
       SpectrumCurve I = light_spectrum(ps, "I");
       Vec3 from = ps.get_point3("from", Vec3(0, 0, 0)), to = ps.get_point3("to", Vec3(0, 0, 1));

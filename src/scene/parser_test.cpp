@@ -1483,8 +1483,7 @@ TEST(SceneFlattenError, UnsupportedMaterial) {
 }
 
 TEST(SceneFlattenError, UnsupportedLight) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"goniometric\" \"string filename\" \"g.exr\"\n"), at(2, 1),
-                      "light \"goniometric\" is not supported"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"laser\"\n"), at(2, 1), "light \"laser\" is not supported"));
 }
 
 TEST(SceneFlattenError, NegativeReflectance) {
@@ -1559,6 +1558,47 @@ TEST(SceneFlattenError, InfiniteLightImageErrors) {
   const std::string portal = R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 1 0 0 1 0])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + portal + "\n", dir.str()), at(2, col(portal, "\"point3")),
                       "light portals are not supported"));
+}
+
+TEST(SceneParse, GoniometricAndProjectionLights) {
+  TempDir dir;
+  dir.write("gonio.pfm", constant_pfm(8, 8, Rgb(0.25f, 0.5f, 0.75f)));
+  dir.write("slide.pfm", constant_pfm(8, 4, Rgb(1.0f, 1.0f, 1.0f)));
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nTranslate 1 2 3\n"
+      "LightSource \"goniometric\" \"string filename\" \"gonio.pfm\" \"float power\" 10\n"
+      "LightSource \"projection\" \"string filename\" \"slide.pfm\" \"float fov\" 40 \"float scale\" 3\n"
+      "LightSource \"projection\" \"string filename\" \"slide.pfm\" \"float power\" 7\n",
+      dir.str()));
+  ASSERT_EQ(ls.scene.lights.size(), 3u);
+  const auto& g = std::get<GoniometricLight>(ls.scene.lights[0]);
+  expect_vec_near(g.world_from_light.point(Vec3(0, 0, 0)), Vec3(1, 2, 3));
+  EXPECT_NEAR(g.mean_value, 0.5f, 1e-6f);  // the mean of the channels
+  // "power": 4 pi times the mean value times the unit-luminance spectrum's scale.
+  EXPECT_NEAR(g.intensity.rgb().luminance() * 4 * kPi * g.mean_value, 10.0f, 0.02f);
+  const auto& p = std::get<ProjectionLight>(ls.scene.lights[1]);
+  EXPECT_NEAR(p.tan_half_fov, std::tan(20 * kPi / 180), 1e-6f);
+  EXPECT_FLOAT_EQ(p.half_width, 2);
+  EXPECT_FLOAT_EQ(p.half_height, 1);
+  EXPECT_FLOAT_EQ(p.scale, 3);
+  const auto& q = std::get<ProjectionLight>(ls.scene.lights[2]);
+  EXPECT_NEAR(q.tan_half_fov, 1.0f, 1e-6f);  // pbrt-v4's default fov, 90
+  EXPECT_NEAR(q.power_rgb.luminance(), 7.0f, 1e-3f);
+}
+
+TEST(SceneFlattenError, GoniometricAndProjectionErrors) {
+  TempDir dir;
+  dir.write("wide.pfm", constant_pfm(8, 4, Rgb(1.0f)));
+  const std::string wide = R"(LightSource "goniometric" "string filename" "wide.pfm")";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + wide + "\n", dir.str()), at(2, col(wide, "\"string")),
+                      "goniometric image \"wide.pfm\" is 8x4: it must be square"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"goniometric\"\n", dir.str()), at(2, 1),
+                      "goniometric light needs \"string filename\""));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"projection\" \"float fov\" 30\n", dir.str()), at(2, 1),
+                      "projection light needs \"string filename\""));
+  const std::string fov = R"(LightSource "projection" "string filename" "wide.pfm" "float fov" 180)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + fov + "\n", dir.str()), at(2, col(fov, "\"float")),
+                      "projection fov must be in (0, 180) degrees"));
 }
 
 TEST(SceneFlattenError, AreaLightOnPartialSphere) {
