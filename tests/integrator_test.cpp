@@ -491,6 +491,52 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
   std::filesystem::remove_all(dir);
 }
 
+// An image area light (pbrt-v4's "filename" on a diffuse area light) seen face on: each pixel
+// shows the image bilinearly filtered at (u, 1 - v), times scale, so the image appears upright on
+// a quad whose v runs up.
+TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
+  std::filesystem::path exr = std::filesystem::temp_directory_path() / ("bpm_area_image_" + std::to_string(::getpid()) + ".exr");
+  Image img_in;
+  img_in.width = 4;
+  img_in.height = 3;
+  for (int i = 0; i < 12; ++i)
+    for (int c = 0; c < 3; ++c) img_in.rgb.push_back(0.1f + 0.15f * i + 0.02f * c);
+  write_exr(exr.string(), img_in);
+  LoadedScene ls = load(R"(
+    LookAt 0 0 -4  0 0 0  0 1 0
+    Camera "perspective" "float fov" 30
+    Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+    PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+    Integrator "path" "integer maxdepth" 1
+    WorldBegin
+    AreaLightSource "diffuse" "string filename" ")" + exr.string() + R"(" "float scale" 2 "bool twosided" true
+    Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] "integer indices" [0 1 2 0 2 3]
+      "point2 uv" [0 0  1 0  1 1  0 1]
+  )");
+  std::filesystem::remove(exr);
+  const auto& light = std::get<AreaLight>(ls.scene.lights[0]);
+  Film film(16, 16);
+  render(ls, quiet_options(ls, "path", 16, 1), &film);
+  Image img = film.image();
+  std::vector<float> rms = film.rms();
+  PerspectiveCamera cam(ls.camera, 16, 16);
+  int inside = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+      Vec3 p = r.o + r.d * (-r.o.z / r.d.z);
+      if (std::fabs(p.x) > 1 || std::fabs(p.y) > 1) continue;
+      Vec2 uv((p.x + 1) / 2, (p.y + 1) / 2);
+      // The image's top row at the quad's top (v = 1).
+      float expected = 2 * light.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp).luminance();
+      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 16 + x] + 0.005f * expected) << x << "," << y;
+      ++inside;
+    }
+  EXPECT_GT(inside, 150);
+  // Brighter rows lower in the file: the bottom of the quad is brighter than its top.
+  EXPECT_GT(img.at(8, 13).luminance(), img.at(8, 2).luminance() * 1.5f);
+}
+
 // Same seed and budget give the same image whatever the number of threads.
 TEST(Renderer, SameImageWithOneAndTwoThreads) {
   LoadedScene ls = load(R"(

@@ -46,7 +46,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0 && (diffuse == 0 || after_diffuse_sample)) {
       const AreaLight& al = std::get<AreaLight>(scene.lights[light_index]);
-      Spectrum Le = area_light_radiance(al, sp.ng, wo, wl);
+      Spectrum Le = area_light_radiance(al, sp.ng, sp.uv, wo, wl);
       if (!Le.is_black()) {
         if (diffuse == 0) {
           L += beta * Le;  // seen from the camera through specular vertices only

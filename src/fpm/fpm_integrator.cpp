@@ -120,7 +120,7 @@ Spectrum eye_radiance(const RenderScene& scene, const PhotonMap& global, const P
     Vec3 wo = -ray.d;
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0 && !gathering)
-      L += beta * area_light_radiance(std::get<AreaLight>(scene.lights[light_index]), sp.ng, wo, wl);
+      L += beta * area_light_radiance(std::get<AreaLight>(scene.lights[light_index]), sp.ng, sp.uv, wo, wl);
     Material storage;
     const Material& m = prm.materials->at(scene.objects[hit.object].material, texture_context(sp), storage);
     if (std::holds_alternative<InterfaceMaterial>(m)) {

@@ -250,6 +250,15 @@ Spectrum environment_radiance(const Light& light, Vec3 w, const Wavelengths& wl)
   return {};
 }
 
+Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl) {
+  if (!l.two_sided && dot(n, w) <= 0) return {};
+  if (!l.image) return l.radiance.sample(wl);
+  Rgb rgb = l.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp);
+  for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
+  if (rgb.max_component() == 0) return {};
+  return rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) * l.image_scale;
+}
+
 float spot_falloff(const SpotLight& l, Vec3 w) {
   float c = w.z;
   if (c >= l.cos_falloff_start) return 1;
@@ -286,6 +295,7 @@ namespace {
 struct AreaSample {
   Vec3 p, n;
   float pdf_area;
+  Vec2 uv;
 };
 
 // Uniform point on the primitive (triangles; full spheres and disks, and cylinders, under
@@ -294,24 +304,24 @@ AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
   if (std::holds_alternative<TriangleMesh>(shape)) {
     Vec2 b = sample_uniform_triangle(u);  // (b0, b1); surface_point takes (b1, b2)
     SurfacePoint sp = surface_point(shape, l.primitive, {b.y, 1 - b.x - b.y}, {});
-    return {sp.p, sp.ng, 1 / l.area};
+    return {sp.p, sp.ng, 1 / l.area, sp.uv};
   }
   if (auto* s = std::get_if<Sphere>(&shape)) {
     Vec3 po = sample_uniform_sphere(u) * s->radius;
     SurfacePoint sp = surface_point(shape, 0, {}, s->world_from_object.point(po));
-    return {sp.p, sp.ng, 1 / l.area};
+    return {sp.p, sp.ng, 1 / l.area, sp.uv};
   }
   if (auto* c = std::get_if<Cylinder>(&shape)) {
     float phi = u.y * c->phi_max;
     Vec3 po(c->radius * std::cos(phi), c->radius * std::sin(phi), c->z_min + u.x * (c->z_max - c->z_min));
     SurfacePoint sp = surface_point(shape, 0, {}, c->world_from_object.point(po));
-    return {sp.p, sp.ng, 1 / l.area};
+    return {sp.p, sp.ng, 1 / l.area, sp.uv};
   }
   const Disk& k = std::get<Disk>(shape);
   Vec2 d = sample_uniform_disk_concentric(u);
   Vec3 po(d.x * k.radius, d.y * k.radius, k.height);
   SurfacePoint sp = surface_point(shape, 0, {}, k.world_from_object.point(po));
-  return {sp.p, sp.ng, 1 / l.area};
+  return {sp.p, sp.ng, 1 / l.area, sp.uv};
 }
 
 struct SphereWorld {
@@ -420,7 +430,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
       ls.wi = w;
       ls.p_light = sp.p;
       ls.n_light = sp.ng;
-      ls.radiance = area_light_radiance(l, sp.ng, -w, wl);
+      ls.radiance = area_light_radiance(l, sp.ng, sp.uv, -w, wl);
       ls.pdf_solid_angle = uniform_cone_pdf_solid_angle(cos_max);
       if (ls.radiance.is_black()) return std::nullopt;
       return ls;
@@ -435,7 +445,7 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
   if (cos_l == 0) return std::nullopt;
   ls.p_light = as.p;
   ls.n_light = as.n;
-  ls.radiance = area_light_radiance(l, as.n, -ls.wi, wl);
+  ls.radiance = area_light_radiance(l, as.n, as.uv, -ls.wi, wl);
   ls.pdf_solid_angle = as.pdf_area * d2 / cos_l;
   if (ls.radiance.is_black()) return std::nullopt;
   return ls;
@@ -552,7 +562,7 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
   s.direction = Frame::from_z(n).to_world(w_local);
   s.origin = as.p;
   s.n_light = as.n;
-  s.flux = l.radiance.sample(wl) * (w_local.z / (as.pdf_area * pdf_dir));
+  s.flux = area_light_radiance(l, as.n, as.uv, s.direction, wl) * (w_local.z / (as.pdf_area * pdf_dir));
   return s;
 }
 
@@ -568,7 +578,8 @@ Rgb light_power(const Light& light, const SceneBoundsInfo& bounds) {
   if (auto* l = std::get_if<ImageInfiniteLight>(&light))
     return l->mean_radiance * (4 * kPi * kPi * bounds.radius * bounds.radius);
   const AreaLight& l = std::get<AreaLight>(light);
-  return l.radiance.rgb() * (kPi * (l.two_sided ? 2 : 1) * l.area);
+  Rgb L = l.image ? l.image_mean * l.image_scale : l.radiance.rgb();
+  return L * (kPi * (l.two_sided ? 2 : 1) * l.area);
 }
 
 }  // namespace bpm

@@ -112,6 +112,11 @@ struct AreaLight {
   SpectrumCurve radiance;
   bool two_sided = false;
   float area = 0;
+  // pbrt-v4's image area lights ("filename"): the radiance at surface coordinates (u, v) is the
+  // image bilinearly filtered at (u, 1 - v), an illuminant RGB, times image_scale.
+  std::shared_ptr<const TexImage> image;
+  float image_scale = 1;
+  Rgb image_mean;  // mean texel, for the light's power
 };
 
 using Light = std::variant<PointLight, SpotLight, GoniometricLight, ProjectionLight, DistantLight,
@@ -155,11 +160,9 @@ std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape,
 // Solid-angle density of light_sample_li choosing direction wi that reaches the light at
 // p_light (area lights) or escapes (infinite lights).
 float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light);
-// Radiance leaving an area light with geometric normal n toward w.
-inline Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec3 w, const Wavelengths& wl) {
-  if (!l.two_sided && dot(n, w) <= 0) return {};
-  return l.radiance.sample(wl);
-}
+// Radiance leaving an area light at a point with geometric normal n and surface coordinates uv
+// toward w.
+Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl);
 // Samples an emitted photon; u_pos picks the point, u_dir the direction.
 std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
                                              const SceneBoundsInfo& bounds, const Wavelengths& wl);

@@ -126,7 +126,7 @@ void check_area_light_power(const Shape& shape, const AreaLight& l, double area,
   for (int k = 0; k < 200000; ++k) {
     Vec3 n = sample_point(rng);
     Vec3 w = sample_uniform_sphere({rng.uniform(), rng.uniform()});
-    Spectrum le = area_light_radiance(l, n, w, kWl);
+    Spectrum le = area_light_radiance(l, n, {}, w, kWl);
     for (int c = 0; c < Spectrum::kChannels; ++c)
       est[c].add(double(le[c]) * std::fabs(dot(n, w)) * area / kUniformSpherePdfSolidAngle);
   }
@@ -830,6 +830,36 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     }
     Spectrum expected = integrated_radiance(im) * float(M_PI * kBounds.radius * kBounds.radius);
     for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], expected[c], 0, equal_area ? "image equal-area" : "image lat-long");
+  }
+  {
+    // An image area light: the flux is pi A times the mean texel radiance.
+    Shape tri = make_triangle();
+    AreaLight l = make_area_light(tri, false);
+    auto im = gradient_image(4, 4);
+    l.image = im;
+    l.image_scale = 1.5f;
+    l.image_mean = Rgb(0.0f);
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) l.image_mean += im->texel(x, y, TexWrap::kClamp) / 16.0f;
+    Rng rng(91);
+    MeanAccumulator est[Spectrum::kChannels], radiance[Spectrum::kChannels];
+    for (int k = 0; k < 200000; ++k) {
+      auto s = light_sample_le(Light(l), &tri, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
+    }
+    // The mean radiance over the triangle by uniform points, against the flux over pi A.
+    for (int k = 0; k < 200000; ++k) {
+      float su = std::sqrt(rng.uniform()), v = rng.uniform();
+      SurfacePoint sp = surface_point(tri, 0, {su * (1 - v), su * v}, {});
+      Spectrum L = area_light_radiance(l, sp.ng, sp.uv, sp.ng, kWl);
+      for (int c = 0; c < Spectrum::kChannels; ++c) radiance[c].add(L[c]);
+    }
+    for (int c = 0; c < Spectrum::kChannels; ++c) {
+      double flux_over = est[c].mean / (M_PI * l.area);
+      EXPECT_NEAR(flux_over, radiance[c].mean, 4 * (est[c].standard_error() / (M_PI * l.area) + radiance[c].standard_error()));
+    }
+    Rgb power = light_power(Light(l), kBounds);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(power[c], l.image_mean[c] * 1.5f * kPi * l.area, 1e-4f * power[c]);
   }
   Shape sphere = make_sphere(Vec3(1, 2, 3), 0.5f);
   check_emission("sphere", Light(make_area_light(sphere, false)), &sphere, [&](const LightLeSample& s) {

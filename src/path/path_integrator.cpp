@@ -75,7 +75,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     int light_index = scene.light_of_hit(hit);
     if (light_index >= 0) {
       const AreaLight& al = std::get<AreaLight>(scene.lights[light_index]);
-      Spectrum Le = area_light_radiance(al, sp.ng, wo, wl);
+      Spectrum Le = area_light_radiance(al, sp.ng, sp.uv, wo, wl);
       if (!Le.is_black()) {
         if (depth == 0 || specular_bounce) {
           L += beta * Le;

@@ -743,12 +743,28 @@ class Flattener {
   void add_area_light(const SceneEntity& a, Object* obj, int id, RenderScene* rs) {
     if (a.name != "diffuse") throw Error(a.loc, "area light \"" + a.name + "\" is not supported");
     const ParamSet& ps = a.params;
-    if (auto* f = ps.find_any("filename")) throw Error(f->loc, "image area lights are not supported");
-    SpectrumCurve L = light_spectrum(ps, "L");
+    std::shared_ptr<const TexImage> image;
+    Rgb image_mean(0.0f);
+    if (ps.find_any("filename")) {
+      if (const Param* l = ps.find_any("L")) throw Error(l->loc, "an area light takes \"L\" or \"filename\", not both");
+      image = light_image(ps, "an image area");
+      for (int y = 0; y < image->height; ++y)
+        for (int x = 0; x < image->width; ++x) {
+          Rgb c = image->texel(x, y, TexWrap::kClamp);
+          for (int k = 0; k < 3; ++k) image_mean[k] += std::fmax(0.0f, c[k]);
+        }
+      image_mean = image_mean / float(image->width * image->height);
+    }
+    SpectrumCurve L = image ? SpectrumCurve(0.0f) : light_spectrum(ps, "L");
     float scale = ps.get_float("scale", 1);
     if (scale < 0) throw Error(ps.find_any("scale")->loc, "area light scale must not be negative");
     bool two_sided = ps.get_bool("twosided", false);
     float power = ps.get_float("power", -1);
+    if (image && power > 0) {
+      // pbrt-v4 normalises by the image's mean luminance.
+      if (!(image_mean.luminance() > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the image is black");
+      scale /= image_mean.luminance();
+    }
     ps.warn_unused("area light");
     if (std::holds_alternative<Sphere>(obj->shape) || std::holds_alternative<Disk>(obj->shape)) {
       const Transform& xf = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).world_from_object
@@ -771,6 +787,9 @@ class Flattener {
       // pbrt-v4 applies "power" to each shape it creates, i.e. to each triangle of a mesh.
       if (power > 0 && l.area > 0) s *= power / (kPi * (two_sided ? 2 : 1) * l.area);
       l.radiance = L.scaled(s);
+      l.image = image;
+      l.image_scale = s;
+      l.image_mean = image_mean;
       rs->lights.push_back(l);
     }
   }

@@ -1612,6 +1612,28 @@ TEST(SceneFlattenError, AreaLightOnNonUniformlyScaledDisk) {
                       at(3, 1), "not non-uniformly scaled"));
 }
 
+TEST(SceneParse, ImageAreaLight) {
+  TempDir dir;
+  dir.write("glow.pfm", constant_pfm(4, 2, Rgb(0.5f, 1.0f, 2.0f)));
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" \"float scale\" 3\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\nAttributeEnd\n"
+      "AreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" \"float power\" 5\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n",
+      dir.str()));
+  ASSERT_EQ(ls.scene.lights.size(), 2u);
+  const auto& a = std::get<AreaLight>(ls.scene.lights[0]);
+  ASSERT_TRUE(a.image != nullptr);
+  EXPECT_FLOAT_EQ(a.image_scale, 3);
+  EXPECT_NEAR(a.image_mean[2], 2.0f, 1e-6f);
+  // "power": pi A times the image's mean luminance times the scale.
+  const auto& b = std::get<AreaLight>(ls.scene.lights[1]);
+  EXPECT_NEAR(b.image_scale * b.image_mean.luminance() * kPi * 0.5f, 5.0f, 1e-3f);
+  const std::string both = R"(AreaLightSource "diffuse" "string filename" "glow.pfm" "rgb L" [1 1 1])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + both + "\nShape \"sphere\"\n", dir.str()), at(2, col(both, "\"rgb")),
+                      "an area light takes \"L\" or \"filename\", not both"));
+}
+
 TEST(SceneFlattenError, UnsupportedAreaLight) {
   EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"projection\"\nShape \"sphere\"\n"), at(2, 1),
                       "area light \"projection\" is not supported"));
