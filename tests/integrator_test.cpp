@@ -485,7 +485,9 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
           ++lit;
         }
       EXPECT_GT(lit, 40);
-      if (!is_gonio) EXPECT_GT(dark, 40);
+      if (!is_gonio) {
+        EXPECT_GT(dark, 40);
+      }
     }
   }
   std::filesystem::remove_all(dir);

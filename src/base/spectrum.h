@@ -59,6 +59,12 @@ struct Channels {
       if (!std::isfinite(v)) return false;
     return true;
   }
+  // Negative values set to zero.
+  Channels clamped_zero() const {
+    Channels r = *this;
+    for (float& v : r.c) v = std::fmax(0.0f, v);
+    return r;
+  }
   bool has_negative() const {
     for (float v : c)
       if (v < 0) return true;

@@ -22,6 +22,13 @@ namespace {
 
 constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
+// An image light's texel (negative values clamped) as an illuminant spectrum times scale.
+Spectrum illuminant_texel(Rgb rgb, float scale, const Wavelengths& wl) {
+  rgb = rgb.clamped_zero();
+  if (rgb.max_component() == 0) return {};
+  return rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) * scale;
+}
+
 Spectrum image_radiance(const ImageInfiniteLight& l, Vec2 uv, const Wavelengths& wl) {
   Rgb rgb;
   if (l.equal_area) {
@@ -29,9 +36,7 @@ Spectrum image_radiance(const ImageInfiniteLight& l, Vec2 uv, const Wavelengths&
   } else {
     rgb = l.image->lookup({uv.x, std::clamp(uv.y, 0.0f, kOneMinusEpsilon)}, TexFilter::kPoint, TexWrap::kRepeat);
   }
-  for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
-  if (rgb.max_component() == 0) return {};
-  return rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) * l.scale;
+  return illuminant_texel(rgb, l.scale, wl);
 }
 
 // The solid angle of texel row y (all texels of a row cover the same one).
@@ -101,9 +106,8 @@ void prepare_image_light(ImageInfiniteLight* l) {
     double omega = texel_solid_angle(*l, y);
     omega_total += omega * im.width;
     for (int x = 0; x < im.width; ++x) {
-      Rgb rgb = im.texel(x, y, TexWrap::kClamp);
-      for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
-      weights[size_t(y) * im.width + x] = float((rgb[0] + rgb[1] + rgb[2]) / 3 * omega);
+      Rgb rgb = im.texel(x, y, TexWrap::kClamp).clamped_zero();
+      weights[size_t(y) * im.width + x] = float(rgb.average() * omega);
       for (int c = 0; c < 3; ++c) sum[c] += float(rgb[c] * omega);
     }
   }
@@ -119,9 +123,7 @@ double image_light_illuminance(const ImageInfiniteLight& l) {
   double e = 0;
   for (int y = 0; y < im.height; ++y)
     for (int x = 0; x < im.width; ++x) {
-      Rgb rgb = im.texel(x, y, TexWrap::kClamp);
-      for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
-      double lum = rgb.luminance();
+      double lum = im.texel(x, y, TexWrap::kClamp).clamped_zero().luminance();
       if (lum == 0) continue;
       double cos_sum = 0;
       for (int j = 0; j < sub; ++j)
@@ -144,20 +146,13 @@ double image_light_illuminance(const ImageInfiniteLight& l) {
 
 // ---- goniometric and projection lights ----
 
-namespace {
-float channel_mean(const TexImage& im, int x, int y) {
-  Rgb rgb = im.texel(x, y, TexWrap::kClamp);
-  return (rgb[0] + rgb[1] + rgb[2]) / 3;
-}
-}  // namespace
-
 void prepare_goniometric_light(GoniometricLight* l) {
   const TexImage& im = *l->image;
   std::vector<float> weights(size_t(im.width) * size_t(im.height));
   double sum = 0;
   for (int y = 0; y < im.height; ++y)
     for (int x = 0; x < im.width; ++x) {
-      float v = std::fmax(0.0f, channel_mean(im, x, y));
+      float v = std::fmax(0.0f, im.texel(x, y, TexWrap::kClamp).average());
       weights[size_t(y) * im.width + x] = v;
       sum += v;
     }
@@ -172,10 +167,8 @@ Vec3 swap_yz(Vec3 v) { return {v.x, v.z, v.y}; }
 
 float goniometric_value(const GoniometricLight& l, Vec3 w) {
   Vec3 wl = swap_yz(normalize(l.world_from_light.inverse().vector(w)));
-  Vec2 uv = equal_area_sphere_to_square(wl);
-  const TexImage& im = *l.image;
-  int x = std::clamp(int(uv.x * float(im.width)), 0, im.width - 1), y = std::clamp(int(uv.y * float(im.height)), 0, im.height - 1);
-  return std::fmax(0.0f, channel_mean(im, x, y));
+  Rgb texel = l.image->lookup(equal_area_sphere_to_square(wl), TexFilter::kPoint, TexWrap::kClamp);
+  return std::fmax(0.0f, texel.average());
 }
 
 Spectrum light_intensity(const GoniometricLight& l, Vec3 w, const Wavelengths& wl) {
@@ -207,20 +200,14 @@ std::optional<Vec2> projection_uv(const ProjectionLight& l, Vec3 w) {
 
 namespace {
 Rgb projection_texel(const ProjectionLight& l, Vec2 uv) {
-  const TexImage& im = *l.image;
-  int x = std::clamp(int(uv.x * float(im.width)), 0, im.width - 1), y = std::clamp(int(uv.y * float(im.height)), 0, im.height - 1);
-  Rgb rgb = im.texel(x, y, TexWrap::kClamp);
-  for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
-  return rgb;
+  return l.image->lookup(uv, TexFilter::kPoint, TexWrap::kClamp).clamped_zero();
 }
 }  // namespace
 
 Spectrum light_intensity(const ProjectionLight& l, Vec3 w, const Wavelengths& wl) {
   auto uv = projection_uv(l, w);
   if (!uv) return {};
-  Rgb rgb = projection_texel(l, *uv);
-  if (rgb.max_component() == 0) return {};
-  return rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) * l.scale;
+  return illuminant_texel(projection_texel(l, *uv), l.scale, wl);
 }
 
 void prepare_projection_light(ProjectionLight* l) {
@@ -237,7 +224,7 @@ void prepare_projection_light(ProjectionLight* l) {
       Vec2 uv((x + 0.5f) / im.width, (y + 0.5f) / im.height);
       float omega = projection_solid_angle_per_area(*l, uv) / float(im.width * im.height);
       Rgb rgb = projection_texel(*l, uv);
-      weights[size_t(y) * im.width + x] = (rgb[0] + rgb[1] + rgb[2]) / 3 * omega;
+      weights[size_t(y) * im.width + x] = rgb.average() * omega;
       power += rgb * (omega * l->scale);
     }
   l->distribution = Distribution2D(weights, im.width, im.height);
@@ -253,10 +240,7 @@ Spectrum environment_radiance(const Light& light, Vec3 w, const Wavelengths& wl)
 Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl) {
   if (!l.two_sided && dot(n, w) <= 0) return {};
   if (!l.image) return l.radiance.sample(wl);
-  Rgb rgb = l.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp);
-  for (int c = 0; c < 3; ++c) rgb[c] = std::fmax(0.0f, rgb[c]);
-  if (rgb.max_component() == 0) return {};
-  return rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) * l.image_scale;
+  return illuminant_texel(l.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp), l.image_scale, wl);
 }
 
 float spot_falloff(const SpotLight& l, Vec3 w) {
@@ -363,16 +347,15 @@ std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* sh
     ls.is_delta = true;
     return ls;
   }
-  if (std::holds_alternative<GoniometricLight>(light) || std::holds_alternative<ProjectionLight>(light)) {
-    const Transform& xf = std::holds_alternative<GoniometricLight>(light) ? std::get<GoniometricLight>(light).world_from_light
-                                                                          : std::get<ProjectionLight>(light).world_from_light;
-    Vec3 position = xf.point(Vec3(0, 0, 0));
+  auto* gonio = std::get_if<GoniometricLight>(&light);
+  auto* proj = std::get_if<ProjectionLight>(&light);
+  if (gonio || proj) {
+    Vec3 position = (gonio ? gonio->world_from_light : proj->world_from_light).point(Vec3(0, 0, 0));
     Vec3 d = position - p_ref;
     float d2 = length_squared(d);
     if (d2 == 0) return std::nullopt;
     ls.wi = d / std::sqrt(d2);
-    Spectrum I = std::holds_alternative<GoniometricLight>(light) ? light_intensity(std::get<GoniometricLight>(light), -ls.wi, wl)
-                                                                 : light_intensity(std::get<ProjectionLight>(light), -ls.wi, wl);
+    Spectrum I = gonio ? light_intensity(*gonio, -ls.wi, wl) : light_intensity(*proj, -ls.wi, wl);
     if (I.is_black()) return std::nullopt;
     ls.radiance = I / d2;
     ls.p_light = position;
@@ -506,9 +489,7 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
     if (!(pdf_uv > 0)) return std::nullopt;
     s.origin = l->world_from_light.point(Vec3(0, 0, 0));
     s.direction = normalize(l->world_from_light.vector(projection_direction_light(*l, uv)));
-    Rgb rgb = projection_texel(*l, uv);
-    s.flux = rgb_texel_spectrum(rgb, SpectrumKind::kIlluminant, wl) *
-             (l->scale * projection_solid_angle_per_area(*l, uv) / pdf_uv);
+    s.flux = illuminant_texel(projection_texel(*l, uv), l->scale, wl) * (projection_solid_angle_per_area(*l, uv) / pdf_uv);
     if (s.flux.is_black()) return std::nullopt;
     return s;
   }

@@ -752,7 +752,9 @@ TEST(GoniometricAndProjectionLights, MeanFluxIsTheIntegratedIntensity) {
     for (int k = 0; k < 200000; ++k) {
       auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
       for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
-      if (s) ASSERT_LT(length(s->origin - origin), 1e-5f);
+      if (s) {
+        ASSERT_LT(length(s->origin - origin), 1e-5f);
+      }
     }
     for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], expected[c], 2e-3 * expected[c], name);
   }

@@ -750,8 +750,7 @@ class Flattener {
       image = light_image(ps, "an image area");
       for (int y = 0; y < image->height; ++y)
         for (int x = 0; x < image->width; ++x) {
-          Rgb c = image->texel(x, y, TexWrap::kClamp);
-          for (int k = 0; k < 3; ++k) image_mean[k] += std::fmax(0.0f, c[k]);
+          image_mean += image->texel(x, y, TexWrap::kClamp).clamped_zero();
         }
       image_mean = image_mean / float(image->width * image->height);
     }
@@ -892,7 +891,7 @@ class Flattener {
       if (!xf.is_similarity()) throw Error(e.loc, "the transform of a projection light must not scale non-uniformly");
       l.world_from_light = xf;
       l.scale = 1;
-      prepare_projection_light(&l);
+      prepare_projection_light(&l);  // power_rgb at scale 1; the distribution does not depend on it
       float power = ps.get_float("power", -1);
       if (power > 0) {
         // pbrt-v4 normalises the luminance-weighted power of the image.
@@ -901,7 +900,7 @@ class Flattener {
         scale *= power / phi;
       }
       l.scale = scale;
-      prepare_projection_light(&l);
+      l.power_rgb *= scale;
       rs->lights.push_back(std::move(l));
     } else if (e.name == "spot") {
       SpectrumCurve I = light_spectrum(ps, "I");
