@@ -1,0 +1,105 @@
+// The class behind flatten_scene (flatten.h), private to the files that define it:
+//   flatten.cpp            the order of the steps
+//   flatten_settings.cpp   camera, film, pixel filter, sampler and integrator settings
+//   flatten_textures.cpp   texture nodes
+//   flatten_materials.cpp  spectral and float parameters, materials, media
+//   flatten_shapes.cpp     shapes and the area lights attached to them
+//   flatten_lights.cpp     the other lights
+#pragma once
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "scene/flatten.h"
+
+namespace bpm::flatten_internal {
+
+inline float radians(float deg) { return deg * kPi / 180; }
+
+class Flattener {
+ public:
+  explicit Flattener(const ParsedScene& p);
+  LoadedScene run();
+
+ private:
+  const ParsedScene& parsed_;
+  // Textures by name, and the nodes built from them, keyed by (name, as float, SpectrumKind);
+  // building_ holds the textures under construction, to report one that refers to itself.
+  std::map<std::string, const TextureEntity*> textures_;
+  std::map<std::tuple<std::string, bool, int>, int> texture_nodes_;
+  std::set<std::string> building_;
+  // Indices in the render scene of the materials and media made so far; building_materials_
+  // holds the named materials under construction, to report one that contains itself.
+  std::map<int, int> anonymous_material_ids_;
+  std::map<std::string, int> named_material_ids_;
+  std::map<std::string, int> medium_ids_;
+  std::set<std::string> building_materials_;
+  // The render scene being filled (set by read_camera, the first step).
+  RenderScene* scene_ = nullptr;
+  RenderScene& scene() { return *scene_; }
+
+  // Camera, film, filter, sampler and integrator settings (flatten_settings.cpp).
+  void read_camera(LoadedScene* out);
+  void read_film(LoadedScene* out);
+  void read_filter(LoadedScene* out);
+  void read_sampler_and_integrator(LoadedScene* out);
+  static void read_bpm_settings(const SceneEntity& in, BpmSettings* b);
+
+  // Texture nodes (flatten_textures.cpp).
+  const TextureEntity& texture_entity(const Param& ref);
+  int texture_node(const TextureEntity& t, bool as_float, SpectrumKind kind);
+  int spectrum_node(const ParamSet& ps, const std::string& name, SpectrumKind kind, float def);
+  int float_node(const ParamSet& ps, const std::string& name, float def);
+  static TexMapping texture_mapping(const TextureEntity& t);
+  int build_texture(const TextureEntity& t, bool as_float, SpectrumKind kind);
+  ImageTexture image_texture(const TextureEntity& t, SpectrumKind kind);
+
+  // Material parameters, materials and media (flatten_materials.cpp).
+  std::optional<SpectrumParam> spectrum_param(const ParamSet& ps, const std::string& name,
+                                              SpectrumKind kind);
+  float float_param(const ParamSet& ps, const std::string& name, float def);
+  FloatParam float_or_texture(const ParamSet& ps, const std::string& name, float def);
+  Roughness roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix = "",
+                      RoughnessTextures* tex = nullptr);
+  float dielectric_eta(const ParamSet& ps, const FileLoc& loc, const std::string& name = "eta");
+  ConductorDesc conductor_desc(const ParamSet& ps, const FileLoc& loc, const std::string& prefix);
+  CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
+                       RoughnessTextures* tex);
+  MaterialDesc make_material(const SceneEntity& e);
+  int medium_id(const std::string& name, const FileLoc& loc);
+  int material_id(const MaterialRef& ref);
+
+  // Shapes and their area lights (flatten_shapes.cpp).
+  static void check_indices(const std::vector<int>& idx, size_t n, const FileLoc& loc);
+  TriangleMesh mesh_from(const Transform& xf, bool flip, std::vector<Vec3> P, std::vector<Vec3> N,
+                         std::vector<Vec2> uv, const std::vector<int>& idx);
+  void add_shape(const ShapeEntity& s, RenderScene* rs);
+  TriangleMesh mesh_shape(const ShapeEntity& s, bool flip);
+  TriangleMesh loopsubdiv_shape(const ShapeEntity& s, bool flip);
+  TriangleMesh plymesh_shape(const ShapeEntity& s, bool flip);
+  static Sphere sphere_shape(const ShapeEntity& s, bool flip);
+  static Disk disk_shape(const ShapeEntity& s, bool flip);
+  static Cylinder cylinder_shape(const ShapeEntity& s, bool flip);
+  static std::vector<int> bilinear_to_triangles(const std::vector<Vec3>& P,
+                                                const std::vector<int>& idx, const FileLoc& loc);
+  void add_area_light(const SceneEntity& a, Object* obj, int id, RenderScene* rs);
+
+  // Light sources other than area lights (flatten_lights.cpp). The add_*_light helpers take the
+  // light's "scale" and apply their kind's "power" or "illuminance" to it.
+  SpectrumCurve light_spectrum(const ParamSet& ps, const std::string& name);
+  std::shared_ptr<const TexImage> light_image(const ParamSet& ps, const std::string& light);
+  ImageInfiniteLight image_light(const LightEntity& e, const Param& file_param, float* scale);
+  void add_light(const LightEntity& e, RenderScene* rs);
+  void add_point_light(const LightEntity& e, float* scale, RenderScene* rs);
+  void add_goniometric_light(const LightEntity& e, float* scale, RenderScene* rs);
+  void add_projection_light(const LightEntity& e, float* scale, RenderScene* rs);
+  void add_spot_light(const LightEntity& e, float* scale, RenderScene* rs);
+  void add_distant_light(const LightEntity& e, float* scale, RenderScene* rs);
+  void add_infinite_light(const LightEntity& e, float* scale, RenderScene* rs);
+};
+
+}  // namespace bpm::flatten_internal

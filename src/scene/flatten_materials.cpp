@@ -1,0 +1,261 @@
+// Materials (pbrt-v4's, plus bpm's "phong") with their spectral and float parameters, and the
+// media shapes and lights refer to.
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "scene/flatten_internal.h"
+#include "scene/spectra.h"
+
+namespace bpm::flatten_internal {
+
+// A spectral material parameter: a constant (a constant texture included) or a texture node.
+std::optional<SpectrumParam> Flattener::spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
+  const Param* p = ps.find_any(name);
+  if (p && p->type == "texture") {
+    const TextureEntity& t = texture_entity(*p);
+    if (t.name == "constant" && t.value_type == "float") {
+      float v = t.params.get_float("value", 1);
+      if (v < 0 || (kind == SpectrumKind::kAlbedo && v > 1))
+        throw Error(t.loc, "constant texture \"" + t.texture_name + "\" used as a reflectance must lie in [0, 1]");
+      return SpectrumParam(SpectrumCurve(v));
+    }
+    if (t.name == "constant") {
+      auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
+      return SpectrumParam(v ? *v : SpectrumCurve(1.0f));
+    }
+    SpectrumParam sp;
+    sp.texture = texture_node(t, false, kind);
+    return sp;
+  }
+  if (auto c = get_spectrum(ps, name, kind, parsed_.base_directory)) return SpectrumParam(*c);
+  return std::nullopt;
+}
+// A float material parameter that must not vary over the surface (a constant texture is fine).
+float Flattener::float_param(const ParamSet& ps, const std::string& name, float def) {
+  const Param* p = ps.find_any(name);
+  if (p && p->type == "texture") {
+    const TextureEntity& t = texture_entity(*p);
+    if (t.name != "constant" || t.value_type != "float")
+      throw Error(p->loc, "\"" + name + "\" must be a float or a constant float texture; \"" + p->strings[0] + "\" is not");
+    return t.params.get_float("value", 1);
+  }
+  return ps.get_float(name, def);
+}
+// A float parameter that may vary: its constant, or the node of a non-constant float texture.
+FloatParam Flattener::float_or_texture(const ParamSet& ps, const std::string& name, float def) {
+  const Param* p = ps.find_any(name);
+  if (p && p->type == "texture") {
+    const TextureEntity& t = texture_entity(*p);
+    if (!(t.name == "constant" && t.value_type == "float")) return FloatParam{0, texture_node(t, true, SpectrumKind::kAlbedo)};
+  }
+  return FloatParam{float_param(ps, name, def), -1};
+}
+
+// prefix: "" for most materials, "interface." or "conductor." for coatedconductor's two layers.
+// Textured roughness goes to tex; a material that takes none passes null.
+Roughness Flattener::roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix,
+                               RoughnessTextures* tex) {
+  FloatParam r = float_or_texture(ps, prefix + "roughness", 0);
+  FloatParam u = ps.find_any(prefix + "uroughness") ? float_or_texture(ps, prefix + "uroughness", 0) : r;
+  FloatParam v = ps.find_any(prefix + "vroughness") ? float_or_texture(ps, prefix + "vroughness", 0) : r;
+  bool remap = ps.get_bool("remaproughness", true);
+  if (u.textured() || v.textured()) {
+    if (!tex) throw Error(loc, "textured roughness is not supported for this material");
+    tex->u = u.texture;
+    tex->v = v.texture;
+    tex->remap = remap;
+  }
+  if (u.value < 0 || v.value < 0) throw Error(loc, "roughness must not be negative");
+  if (remap) {
+    u.value = std::sqrt(u.value);  // pbrt-v4 TrowbridgeReitzDistribution::RoughnessToAlpha
+    v.value = std::sqrt(v.value);
+  }
+  return Roughness{u.value, v.value};
+}
+
+// A dielectric's index of refraction: a float, or a spectrum reduced to its value at 550 nm.
+float Flattener::dielectric_eta(const ParamSet& ps, const FileLoc& loc, const std::string& name) {
+  float eta = 1.5f;
+  const Param* p = ps.find_any(name);
+  if (p && p->type == "float") {
+    eta = ps.get_float(name, 1.5f);
+  } else if (p) {
+    SpectrumParam sp = *spectrum_param(ps, name, SpectrumKind::kUnbounded);
+    if (sp.textured()) throw Error(p->loc, "a textured eta is not supported");
+    const SpectrumCurve& s = sp.curve;
+    if (s.max_value() - s.min_value() > 1e-4f)
+      warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
+    eta = s.value(550);
+  }
+  if (!(eta > 0)) throw Error(p ? p->loc : loc, "eta must be positive");
+  return eta;
+}
+
+// A conductor from eta and k (copper by default) or from a reflectance; prefix names the
+// parameters ("conductor." inside coatedconductor).
+ConductorDesc Flattener::conductor_desc(const ParamSet& ps, const FileLoc& loc, const std::string& prefix) {
+  ConductorDesc c;
+  // pbrt-v4's coatedconductor calls the base's reflectance plain "reflectance".
+  if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) {
+    c.reflectance = *r;
+    if (ps.find_any(prefix + "eta") || ps.find_any(prefix + "k"))
+      throw Error(loc, "conductor has both reflectance and eta/k");
+  } else {
+    c.eta = spectrum_param(ps, prefix + "eta", SpectrumKind::kUnbounded)
+                .value_or(SpectrumParam(*named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded)));
+    c.k = spectrum_param(ps, prefix + "k", SpectrumKind::kUnbounded)
+              .value_or(SpectrumParam(*named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded)));
+  }
+  c.roughness = roughness(ps, loc, prefix, &c.roughness_tex);
+  return c;
+}
+
+// The coat of pbrt-v4's coated materials; prefix names the coat's roughness and eta
+// ("interface." in coatedconductor). A scattering medium inside the layer (albedo > 0) is not
+// modelled.
+CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix, RoughnessTextures* tex) {
+  CoatLayer c;
+  c.roughness = roughness(ps, e.loc, prefix, tex);
+  c.eta = dielectric_eta(ps, e.loc, prefix + "eta");
+  c.thickness = float_param(ps, "thickness", 0.01f);
+  if (!(c.thickness > 0) || !std::isfinite(c.thickness))
+    throw Error(ps.find_any("thickness")->loc, "thickness must be positive");
+  auto count = [&](const char* name, int def) {
+    int v = ps.get_int(name, def);
+    if (v < 1 || v > 1000) throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
+    return v;
+  };
+  c.max_depth = count("maxdepth", 10);
+  c.samples = count("nsamples", 1);
+  if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && (a->textured() || !a->curve.is_black()))
+    throw Error(ps.find_any("albedo")->loc, e.name + " with a scattering layer (albedo > 0) is not supported");
+  if (ps.find_any("g")) float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
+  return c;
+}
+
+MaterialDesc Flattener::make_material(const SceneEntity& e) {
+  const ParamSet& ps = e.params;
+  for (const char* unsupported : {"displacement", "normalmap"})
+    if (auto* p = ps.find_any(unsupported)) throw Error(p->loc, std::string(unsupported) + " is not supported");
+  MaterialDesc m;
+  if (e.name == "diffuse") {
+    DiffuseDesc d;
+    if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
+    m = d;
+  } else if (e.name == "conductor") {
+    m = conductor_desc(ps, e.loc, "");
+  } else if (e.name == "dielectric" || e.name == "thindielectric") {
+    float eta = dielectric_eta(ps, e.loc);
+    if (e.name == "dielectric") m = DielectricMaterial{eta, roughness(ps, e.loc)};
+    else m = ThinDielectricMaterial{eta};
+  } else if (e.name == "diffusetransmission") {
+    DiffuseTransmissionDesc d;
+    if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
+    if (auto t = spectrum_param(ps, "transmittance", SpectrumKind::kAlbedo)) d.transmittance = *t;
+    float s = ps.get_float("scale", 1);
+    if (d.reflectance.textured() || d.transmittance.textured()) {
+      if (s != 1) throw Error(ps.find_any("scale")->loc, "diffusetransmission scale with textures is not supported");
+    } else {
+      d.reflectance.curve = d.reflectance.curve.scaled(s);
+      d.transmittance.curve = d.transmittance.curve.scaled(s);
+      if ((d.reflectance.curve.rgb() + d.transmittance.curve.rgb()).max_component() > 1.0001f)
+        throw Error(e.loc, "diffusetransmission reflectance + transmittance exceeds 1");
+    }
+    m = d;
+  } else if (e.name == "coateddiffuse") {
+    CoatedDiffuseDesc c;
+    if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
+    c.layer = coat_layer(ps, e, "", &c.roughness_tex);
+    m = c;
+  } else if (e.name == "coatedconductor") {
+    CoatedConductorDesc c;
+    c.layer = coat_layer(ps, e, "interface.", &c.roughness_tex);
+    c.conductor = conductor_desc(ps, e.loc, "conductor.");
+    m = c;
+  } else if (e.name == "phong") {
+    // bpm's own non-reciprocal glossy lobe (material.h); pbrt-v4 does not know it.
+    PhongDesc ph;
+    if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) ph.reflectance = *r;
+    if (const Param* p = ps.find_any("exponent")) {
+      ph.exponent = ps.get_float("exponent", 20);
+      if (!(ph.exponent >= 0 && ph.exponent <= 1e5f)) throw Error(p->loc, "phong exponent must be in [0, 1e5]");
+    }
+    m = ph;
+  } else if (e.name == "mix") {
+    MixDesc mix;
+    const Param* names = ps.find("materials", "string");
+    if (!names || names->strings.size() != 2)
+      throw Error(names ? names->loc : e.loc, "mix needs \"string materials\" with two named materials");
+    names->used = true;
+    for (int i = 0; i < 2; ++i) mix.materials[i] = material_id(MaterialRef{-1, names->strings[size_t(i)], names->loc});
+    mix.amount = float_or_texture(ps, "amount", 0.5f);
+    m = mix;
+  } else if (e.name == "interface" || e.name == "" || e.name == "none") {
+    m = InterfaceMaterial{};
+  } else {
+    throw Error(e.loc, "material \"" + e.name + "\" is not supported");
+  }
+  if (const Param* type = ps.find_any("type")) type->used = true;  // MakeNamedMaterial's own
+  ps.warn_unused("material \"" + e.name + "\"");
+  return m;
+}
+
+// The index of a named medium, -1 for "" (vacuum). Only media that absorb without scattering
+// or emitting are supported (pbrt-v4 "homogeneous" with sigma_s = 0 and no Le).
+int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
+  if (name.empty()) return -1;
+  if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
+  auto e = parsed_.media.find(name);
+  if (e == parsed_.media.end()) throw Error(loc, "unknown medium \"" + name + "\"");
+  const SceneEntity& m = e->second;
+  const ParamSet& ps = m.params;
+  auto unsupported = [&](const std::string& why) {
+    return Error(loc, "participating media are not supported (medium \"" + name + "\" defined at " + m.loc.str() +
+                          ": " + why + "); only absorbing homogeneous media (sigma_s = 0) are");
+  };
+  if (m.name != "homogeneous") throw unsupported("type \"" + m.name + "\"");
+  if (const Param* p = ps.find_any("preset")) {
+    p->used = true;
+    throw unsupported("preset \"" + (p->strings.empty() ? std::string() : p->strings[0]) + "\" scatters");
+  }
+  float scale = ps.get_float("scale", 1);
+  if (!(scale >= 0) || !std::isfinite(scale)) throw Error(m.loc, "medium scale must be a non-negative number");
+  // pbrt-v4's defaults scatter: sigma_s must be stated, and zero.
+  auto sigma_s = get_spectrum(ps, "sigma_s", SpectrumKind::kUnbounded, parsed_.base_directory);
+  if (!sigma_s || sigma_s->max_value() * scale > 0) throw unsupported("it scatters (sigma_s > 0)");
+  auto Le = get_spectrum(ps, "Le", SpectrumKind::kIlluminant, parsed_.base_directory);
+  float le_scale = ps.get_float("Lescale", 1);
+  if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
+  ps.get_float("g", 0);
+  auto sigma_a = get_spectrum(ps, "sigma_a", SpectrumKind::kUnbounded, parsed_.base_directory)
+                     .value_or(SpectrumCurve::from_rgb(Rgb(0.0011f, 0.0024f, 0.014f), SpectrumKind::kUnbounded));
+  if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
+  ps.warn_unused("medium \"" + name + "\"");
+  scene().media.push_back(AbsorbingMedium{name, sigma_a.scaled(scale)});
+  return medium_ids_[name] = int(scene().media.size()) - 1;
+}
+
+// The index of a material in the render scene, made on first use; 0 (the default material) when
+// the shape names none.
+int Flattener::material_id(const MaterialRef& ref) {
+  if (!ref.named.empty()) {
+    auto it = named_material_ids_.find(ref.named);
+    if (it != named_material_ids_.end()) return it->second;
+    auto e = parsed_.named_materials.find(ref.named);
+    if (e == parsed_.named_materials.end()) throw Error(ref.loc, "unknown named material \"" + ref.named + "\"");
+    if (!building_materials_.insert(ref.named).second)
+      throw Error(ref.loc, "named material \"" + ref.named + "\" contains itself (through mix)");
+    MaterialDesc made = make_material(e->second);
+    building_materials_.erase(ref.named);
+    scene().materials.push_back(std::move(made));
+    return named_material_ids_[ref.named] = int(scene().materials.size()) - 1;
+  }
+  if (ref.index < 0) return 0;
+  auto it = anonymous_material_ids_.find(ref.index);
+  if (it != anonymous_material_ids_.end()) return it->second;
+  scene().materials.push_back(make_material(parsed_.materials[ref.index]));
+  return anonymous_material_ids_[ref.index] = int(scene().materials.size()) - 1;
+}
+
+}  // namespace bpm::flatten_internal

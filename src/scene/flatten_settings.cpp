@@ -1,0 +1,150 @@
+// Camera, film, pixel filter, sampler and integrator settings from the scene file, with
+// pbrt-v4's defaults.
+#include <string>
+
+#include "scene/flatten_internal.h"
+
+namespace bpm::flatten_internal {
+
+void Flattener::read_camera(LoadedScene* out) {
+  scene_ = &out->scene;
+  if (!parsed_.camera) {
+    out->camera.world_from_camera = Transform();
+    return;
+  }
+  const CameraEntity& c = *parsed_.camera;
+  if (!c.medium.outside.empty())
+    throw Error(c.medium.loc, "a camera inside a medium (\"" + c.medium.outside + "\") is not supported");
+  if (c.name != "perspective")
+    throw Error(c.loc, "camera \"" + c.name + "\" is not supported (only perspective)");
+  out->camera.world_from_camera = c.camera_from_world.inverse();
+  out->camera.fov_degrees = c.params.get_float("fov", 90);
+  if (!(out->camera.fov_degrees > 0 && out->camera.fov_degrees < 180))
+    throw Error(c.loc, "fov must lie in (0, 180) degrees");
+  out->camera.lens_radius = c.params.get_float("lensradius", 0);
+  out->camera.focal_distance = c.params.get_float("focaldistance", 1e6f);
+  if (out->camera.lens_radius < 0) throw Error(c.loc, "lensradius must not be negative");
+  if (!(out->camera.focal_distance > 0)) throw Error(c.loc, "focaldistance must be positive");
+  auto sw = c.params.get_floats("screenwindow");
+  if (!sw.empty()) {
+    if (sw.size() != 4) throw Error(c.params.find_any("screenwindow")->loc, "screenwindow needs 4 values");
+    for (int i = 0; i < 4; ++i) out->camera.screen_window[i] = sw[i];
+  }
+  float open = c.params.get_float("shutteropen", 0), close = c.params.get_float("shutterclose", 1);
+  if (close < open) throw Error(c.loc, "shutterclose is before shutteropen");
+  out->film.imaging_ratio = close - open;
+  c.params.warn_unused("camera");
+}
+
+void Flattener::read_film(LoadedScene* out) {
+  const SceneEntity& f = parsed_.film;
+  if (f.name != "rgb") throw Error(f.loc, "film \"" + f.name + "\" is not supported (only rgb)");
+  out->film.width = f.params.get_int("xresolution", 1280);
+  out->film.height = f.params.get_int("yresolution", 720);
+  if (out->film.width <= 0 || out->film.height <= 0 || out->film.width > 65536 || out->film.height > 65536)
+    throw Error(f.loc, "film resolution must be between 1 and 65536 pixels per axis");
+  out->film.filename = f.params.get_string("filename", "pbrt.exr");
+  float iso = f.params.get_float("iso", 100);
+  if (!(iso > 0)) throw Error(f.loc, "iso must be positive");
+  out->film.imaging_ratio *= iso / 100;
+  std::string sensor = f.params.get_string("sensor", "cie1931");
+  if (sensor != "cie1931") throw Error(f.params.find_any("sensor")->loc, "sensor \"" + sensor + "\" is not supported (only cie1931)");
+  if (f.params.get_float("whitebalance", 0) != 0)
+    throw Error(f.params.find_any("whitebalance")->loc, "white balancing is not supported");
+  out->film.max_component_value = f.params.get_float("maxcomponentvalue", kInf);
+  if (auto* cw = f.params.find_any("cropwindow")) throw Error(cw->loc, "cropwindow is not supported");
+  if (auto* pb = f.params.find_any("pixelbounds")) throw Error(pb->loc, "pixelbounds is not supported");
+  f.params.get_bool("savefp16", true);  // bpm always writes 32-bit float EXR
+  f.params.warn_unused("film");
+}
+
+void Flattener::read_filter(LoadedScene* out) {
+  const SceneEntity& f = parsed_.filter;
+  FilterSettings& s = out->filter;
+  float def = 0.5f;
+  if (f.name == "box") s.type = FilterType::kBox, def = 0.5f;
+  else if (f.name == "triangle") s.type = FilterType::kTriangle, def = 2;
+  else if (f.name == "gaussian") s.type = FilterType::kGaussian, def = 1.5f;
+  else if (f.name == "mitchell") s.type = FilterType::kMitchell, def = 2;
+  else if (f.name == "sinc") s.type = FilterType::kLanczos, def = 4;
+  else throw Error(f.loc, "pixel filter \"" + f.name + "\" is unknown");
+  s.radius = {f.params.get_float("xradius", def), f.params.get_float("yradius", def)};
+  if (!(s.radius.x > 0 && s.radius.y > 0)) throw Error(f.loc, "filter radius must be positive");
+  s.sigma = f.params.get_float("sigma", 0.5f);
+  s.b = f.params.get_float("B", 1.0f / 3);
+  s.c = f.params.get_float("C", 1.0f / 3);
+  s.tau = f.params.get_float("tau", 3);
+  f.params.warn_unused("pixel filter");
+}
+
+void Flattener::read_sampler_and_integrator(LoadedScene* out) {
+  const SceneEntity& s = parsed_.sampler;
+  static const char* samplers[] = {"zsobol", "sobol", "paddedsobol", "halton", "independent", "pmj02bn", "stratified"};
+  bool known = false;
+  for (const char* n : samplers) known = known || s.name == n;
+  if (!known) throw Error(s.loc, "sampler \"" + s.name + "\" is unknown");
+  out->render.spp = s.params.get_int("pixelsamples", 16);
+  if (s.name == "stratified")
+    out->render.spp = s.params.get_int("xsamples", 4) * s.params.get_int("ysamples", 4);
+  if (out->render.spp <= 0) throw Error(s.loc, "pixelsamples must be positive");
+  out->render.seed = s.params.get_int("seed", 0);
+  s.params.get_bool("jitter", true);
+  s.params.get_string("randomization", "");
+  s.params.warn_unused("sampler");
+
+  const SceneEntity& in = parsed_.integrator;
+  out->render.integrator_as_written = in.name;
+  out->render.max_depth = in.params.get_int("maxdepth", 5);
+  if (out->render.max_depth < 0) throw Error(in.loc, "maxdepth must not be negative");
+  if (in.name == "path" || in.name == "bpm" || in.name == "fpm") {
+    out->render.integrator = in.name;
+  } else if (in.name == "volpath" || in.name == "bdpt" || in.name == "mlt" || in.name == "sppm" ||
+             in.name == "simplepath" || in.name == "lightpath" || in.name == "randomwalk" ||
+             in.name == "simplevolpath") {
+    // These estimate the same image for scenes without media; bpm's reference for them is path.
+    out->render.integrator = "path";
+    if (parsed_.integrator_given)
+      warning(in.loc, "integrator \"" + in.name + "\" is rendered with bpm's \"path\" integrator (same image for surfaces)");
+  } else {
+    throw Error(in.loc, "integrator \"" + in.name + "\" is not supported");
+  }
+  if (in.name == "bpm" || in.name == "fpm") read_bpm_settings(in, &out->render.bpm);
+  if (in.name == "fpm") {
+    out->render.fpm.final_gather = in.params.get_bool("finalgather", false);
+    out->render.fpm.knn = in.params.get_int("knn", 0);
+    if (out->render.fpm.knn < 0) {
+      const Param* p = in.params.find_any("knn");
+      throw Error(p ? p->loc : in.loc, "knn must not be negative");
+    }
+  }
+  for (const Param& p : in.params.all()) p.used = true;  // other integrators' knobs are advisory
+}
+
+// bpm's own parameters on its Integrator line; the command line may override each.
+void Flattener::read_bpm_settings(const SceneEntity& in, BpmSettings* b) {
+  const ParamSet& ps = in.params;
+  auto check = [&](const char* name, bool ok, const char* what) {
+    if (!ok) throw Error(ps.find_any(name) ? ps.find_any(name)->loc : in.loc, std::string(name) + " " + what);
+  };
+  b->diffuse_depth = ps.get_int("diffusedepth", b->diffuse_depth);
+  check("diffusedepth", b->diffuse_depth >= 0 && b->diffuse_depth <= 3, "must be in 0..3");
+  b->k0 = ps.get_float("k0", b->k0);
+  check("k0", b->k0 > 0 && b->k0 < 1e4f, "must be positive");
+  b->k1 = ps.get_float("k1", b->k1);
+  check("k1", b->k1 > 0 && b->k1 < 1e4f, "must be positive");
+  std::string policy = ps.get_string("radiuspolicy", to_string(b->radius_policy));
+  check("radiuspolicy", policy == "fixed" || policy == "progressive", "must be \"fixed\" or \"progressive\"");
+  b->radius_policy = policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
+  b->alpha = ps.get_float("alpha", b->alpha);
+  check("alpha", b->alpha > 0 && b->alpha < 1, "must be in (0, 1)");
+  b->photons_per_batch = ps.get_int("photonsperbatch", b->photons_per_batch);
+  check("photonsperbatch", b->photons_per_batch > 0, "must be positive");
+  b->coverage = ps.get_float("coverage", b->coverage);
+  check("coverage", b->coverage >= 0 && b->coverage <= 1, "must be in [0, 1]");
+  b->max_batches = ps.get_int("maxbatches", b->max_batches);
+  check("maxbatches", b->max_batches > 0, "must be positive");
+  b->centre_tree = ps.get_string("tree", "spheres") == "centres";
+  check("tree", b->centre_tree || ps.get_string("tree", "spheres") == "spheres", "must be \"spheres\" or \"centres\"");
+}
+
+}  // namespace bpm::flatten_internal

@@ -1,0 +1,251 @@
+// Shapes (triangle, bilinear and subdivision meshes, PLY meshes, spheres, disks, cylinders) and
+// the diffuse area lights attached to them.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scene/flatten_internal.h"
+#include "scene/loop_subdivision.h"
+#include "scene/ply.h"
+
+namespace bpm::flatten_internal {
+
+namespace fs = std::filesystem;
+
+void Flattener::check_indices(const std::vector<int>& idx, size_t n, const FileLoc& loc) {
+  for (int i : idx)
+    if (i < 0 || size_t(i) >= n)
+      throw Error(loc, "vertex index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
+}
+
+TriangleMesh Flattener::mesh_from(const Transform& xf, bool flip, std::vector<Vec3> P, std::vector<Vec3> N,
+                                  std::vector<Vec2> uv, const std::vector<int>& idx) {
+  TriangleMesh m;
+  m.positions.reserve(P.size() + 2);  // Embree reads vertex buffers in 16-byte chunks
+  for (Vec3 p : P) m.positions.push_back(xf.point(p));
+  for (Vec3 n : N) m.normals.push_back(normalize(xf.normal(n)));
+  m.uvs = std::move(uv);
+  m.indices.assign(idx.begin(), idx.end());
+  m.flip_normal = flip;
+  return m;
+}
+
+void Flattener::add_shape(const ShapeEntity& s, RenderScene* rs) {
+  const ParamSet& ps = s.params;
+  bool flip = s.reverse_orientation != s.world_from_object.swaps_handedness();
+  for (const char* ignored : {"emission", "faceIndices"})
+    if (auto* p = ps.find_any(ignored)) p->used = true;
+  Object obj;
+  obj.source = s.loc.str();
+  if (const Param* a = ps.find_any("alpha")) {
+    obj.alpha = float_or_texture(ps, "alpha", 1);
+    if (!obj.alpha.textured() && !(obj.alpha.value >= 0 && obj.alpha.value <= 1))
+      throw Error(a->loc, "alpha must be in [0, 1]");
+    if (obj.has_alpha() && s.area_light)
+      throw Error(a->loc, "alpha on an emitting shape is not supported (the area light at " + s.area_light->loc.str() + ")");
+  }
+  if (s.name == "trianglemesh" || s.name == "bilinearmesh") {
+    obj.shape = mesh_shape(s, flip);
+  } else if (s.name == "loopsubdiv") {
+    obj.shape = loopsubdiv_shape(s, flip);
+  } else if (s.name == "plymesh") {
+    obj.shape = plymesh_shape(s, flip);
+  } else if (s.name == "sphere") {
+    obj.shape = sphere_shape(s, flip);
+  } else if (s.name == "disk") {
+    obj.shape = disk_shape(s, flip);
+  } else if (s.name == "cylinder") {
+    obj.shape = cylinder_shape(s, flip);
+  } else {
+    throw Error(s.loc, "shape \"" + s.name + "\" is not supported");
+  }
+  ps.warn_unused("shape \"" + s.name + "\"");
+  obj.material = material_id(s.material);
+  obj.medium_inside = medium_id(s.medium.inside, s.medium.loc);
+  obj.medium_outside = medium_id(s.medium.outside, s.medium.loc);
+  int id = int(rs->objects.size());
+  if (s.area_light) add_area_light(*s.area_light, &obj, id, rs);
+  rs->objects.push_back(std::move(obj));
+}
+
+// A "trianglemesh", or a "bilinearmesh" of planar patches (two triangles each).
+TriangleMesh Flattener::mesh_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  bool bilinear = s.name == "bilinearmesh";
+  auto P = ps.get_point3s("P");
+  if (P.empty()) throw Error(s.loc, s.name + " has no \"point3 P\"");
+  auto idx = ps.get_ints("indices");
+  size_t per = bilinear ? 4 : 3;
+  if (idx.empty()) {
+    if (P.size() != per) throw Error(s.loc, s.name + " has no \"integer indices\"");
+    for (size_t i = 0; i < per; ++i) idx.push_back(int(i));
+  }
+  const FileLoc& iloc = ps.find_any("indices") ? ps.find_any("indices")->loc : s.loc;
+  if (idx.size() % per != 0)
+    throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of " + std::to_string(per));
+  check_indices(idx, P.size(), iloc);
+  auto N = ps.get_normals("N");
+  auto uv = ps.get_point2s("uv");
+  if (uv.empty()) uv = ps.get_point2s("st");
+  if (!N.empty() && N.size() != P.size())
+    throw Error(ps.find_any("N")->loc, "\"N\" has " + std::to_string(N.size()) + " normals for " + std::to_string(P.size()) + " vertices");
+  if (!uv.empty() && uv.size() != P.size())
+    throw Error(ps.find_any("uv") ? ps.find_any("uv")->loc : s.loc, "\"uv\" count differs from the vertex count");
+  if (auto* S = ps.find_any("S")) {
+    S->used = true;
+    warning(S->loc, "per-vertex tangents \"S\" are ignored");
+  }
+  if (bilinear) idx = bilinear_to_triangles(P, idx, s.loc);
+  return mesh_from(s.world_from_object, flip, P, N, uv, idx);
+}
+
+// A "loopsubdiv" control mesh, subdivided "levels" times (loop_subdivision.h).
+TriangleMesh Flattener::loopsubdiv_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  auto P = ps.get_point3s("P");
+  auto idx = ps.get_ints("indices");
+  if (P.empty() || idx.empty()) throw Error(s.loc, "loopsubdiv needs \"point3 P\" and \"integer indices\"");
+  const FileLoc& iloc = ps.find_any("indices")->loc;
+  if (idx.size() % 3 != 0)
+    throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of 3");
+  check_indices(idx, P.size(), iloc);
+  int levels = ps.get_int("levels", 3);
+  if (levels < 0 || levels > 8) throw Error(ps.find_any("levels")->loc, "loopsubdiv levels must be in [0, 8]");
+  SubdividedMesh sub;
+  try {
+    sub = loop_subdivide(P, idx, levels);
+  } catch (const std::invalid_argument& e) {
+    throw Error(s.loc, std::string("loopsubdiv: ") + e.what());
+  }
+  return mesh_from(s.world_from_object, flip, std::move(sub.positions), std::move(sub.normals), {}, sub.indices);
+}
+
+// A "plymesh", read from its file (relative paths from the file that names it).
+TriangleMesh Flattener::plymesh_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  std::string file = ps.get_string("filename", "");
+  if (file.empty()) throw Error(s.loc, "plymesh has no \"string filename\"");
+  if (auto* d = ps.find_any("displacement")) throw Error(d->loc, "displacement is not supported");
+  ps.get_float("edgelength", 1);
+  fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(s.directory) / file;
+  PlyMesh ply = read_ply(path.string(), ps.find_any("filename")->loc);
+  return mesh_from(s.world_from_object, flip, ply.positions, ply.normals, ply.uvs, ply.indices);
+}
+
+Sphere Flattener::sphere_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  Sphere sp;
+  sp.world_from_object = s.world_from_object;
+  sp.radius = ps.get_float("radius", 1);
+  if (!(sp.radius > 0)) throw Error(s.loc, "sphere radius must be positive");
+  sp.z_min = std::clamp(ps.get_float("zmin", -sp.radius), -sp.radius, sp.radius);
+  sp.z_max = std::clamp(ps.get_float("zmax", sp.radius), -sp.radius, sp.radius);
+  if (sp.z_min > sp.z_max) std::swap(sp.z_min, sp.z_max);
+  sp.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
+  sp.flip_normal = flip;
+  return sp;
+}
+
+Disk Flattener::disk_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  Disk d;
+  d.world_from_object = s.world_from_object;
+  d.height = ps.get_float("height", 0);
+  d.radius = ps.get_float("radius", 1);
+  d.inner_radius = ps.get_float("innerradius", 0);
+  if (!(d.radius > 0) || d.inner_radius < 0 || d.inner_radius >= d.radius)
+    throw Error(s.loc, "disk needs 0 <= innerradius < radius");
+  d.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
+  d.flip_normal = flip;
+  return d;
+}
+
+Cylinder Flattener::cylinder_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  Cylinder c;
+  c.world_from_object = s.world_from_object;
+  c.radius = ps.get_float("radius", 1);
+  if (!(c.radius > 0)) throw Error(s.loc, "cylinder radius must be positive");
+  float z0 = ps.get_float("zmin", -1), z1 = ps.get_float("zmax", 1);
+  c.z_min = std::fmin(z0, z1);
+  c.z_max = std::fmax(z0, z1);
+  if (!(c.z_max > c.z_min)) throw Error(s.loc, "cylinder needs zmin != zmax");
+  c.phi_max = radians(std::clamp(ps.get_float("phimax", 360), 0.0f, 360.0f));
+  if (!(c.phi_max > 0)) throw Error(s.loc, "cylinder phimax must be positive");
+  c.flip_normal = flip;
+  return c;
+}
+
+std::vector<int> Flattener::bilinear_to_triangles(const std::vector<Vec3>& P, const std::vector<int>& idx, const FileLoc& loc) {
+  std::vector<int> tris;
+  for (size_t i = 0; i < idx.size(); i += 4) {
+    int a = idx[i], b = idx[i + 1], c = idx[i + 2], d = idx[i + 3];  // p00 p10 p01 p11
+    Vec3 n = cross(P[b] - P[a], P[c] - P[a]);
+    float size = std::fmax(length(P[b] - P[a]), length(P[c] - P[a]));
+    float ln = length(n);
+    if (ln > 0 && std::fabs(dot(P[d] - P[a], n / ln)) > 1e-4f * size)
+      throw Error(loc, "non-planar bilinear patches are not supported (patch " + std::to_string(i / 4) + ")");
+    int t[6] = {a, b, d, a, d, c};
+    tris.insert(tris.end(), t, t + 6);
+  }
+  return tris;
+}
+
+void Flattener::add_area_light(const SceneEntity& a, Object* obj, int id, RenderScene* rs) {
+  if (a.name != "diffuse") throw Error(a.loc, "area light \"" + a.name + "\" is not supported");
+  const ParamSet& ps = a.params;
+  std::shared_ptr<const TexImage> image;
+  Rgb image_mean(0.0f);
+  if (ps.find_any("filename")) {
+    if (const Param* l = ps.find_any("L")) throw Error(l->loc, "an area light takes \"L\" or \"filename\", not both");
+    image = light_image(ps, "an image area");
+    for (int y = 0; y < image->height; ++y)
+      for (int x = 0; x < image->width; ++x) {
+        image_mean += image->texel(x, y, TexWrap::kClamp).clamped_zero();
+      }
+    image_mean = image_mean / float(image->width * image->height);
+  }
+  SpectrumCurve L = image ? SpectrumCurve(0.0f) : light_spectrum(ps, "L");
+  float scale = ps.get_float("scale", 1);
+  if (scale < 0) throw Error(ps.find_any("scale")->loc, "area light scale must not be negative");
+  bool two_sided = ps.get_bool("twosided", false);
+  float power = ps.get_float("power", -1);
+  if (image && power > 0) {
+    // pbrt-v4 normalises by the image's mean luminance.
+    if (!(image_mean.luminance() > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the image is black");
+    scale /= image_mean.luminance();
+  }
+  ps.warn_unused("area light");
+  if (std::holds_alternative<Sphere>(obj->shape) || std::holds_alternative<Disk>(obj->shape)) {
+    const Transform& xf = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).world_from_object
+                                                                      : std::get<Disk>(obj->shape).world_from_object;
+    bool full = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).is_full()
+                                                           : std::get<Disk>(obj->shape).is_full();
+    if (!xf.is_similarity() || !full)
+      throw Error(a.loc, "emitting spheres and disks must be whole and not non-uniformly scaled");
+  }
+  if (auto* c = std::get_if<Cylinder>(&obj->shape); c && !c->world_from_object.is_similarity())
+    throw Error(a.loc, "emitting cylinders must not be non-uniformly scaled");
+  obj->first_light = int(rs->lights.size());
+  for (int p = 0; p < primitive_count(obj->shape); ++p) {
+    AreaLight l;
+    l.object = id;
+    l.primitive = p;
+    l.two_sided = two_sided;
+    l.area = primitive_area(obj->shape, p);
+    float s = scale;
+    // pbrt-v4 applies "power" to each shape it creates, i.e. to each triangle of a mesh.
+    if (power > 0 && l.area > 0) s *= power / (kPi * (two_sided ? 2 : 1) * l.area);
+    l.radiance = L.scaled(s);
+    l.image = image;
+    l.image_scale = s;
+    l.image_mean = image_mean;
+    rs->lights.push_back(l);
+  }
+}
+
+}  // namespace bpm::flatten_internal
