@@ -113,18 +113,22 @@ int run_render(const RenderArgs& a) {
   opt.progress = !a.quiet;
   if (a.iterations > 0) opt.spp = a.iterations;  // one eye sample per pixel per iteration
   if (a.time > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // the time budget decides
-  opt.bpm = ls.render.bpm;
+  opt.bpm = bpm_settings_from_file(ls.render.integrator_directive);
+  opt.fpm = fpm_settings_from_file(ls.render.integrator_directive);
+  // Both photon methods read the same photon parameters from an Integrator line of either.
+  static_cast<PhotonSettings&>(opt.fpm) = opt.bpm;
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
-  if (a.k0 > 0) opt.bpm.k0 = a.k0;
-  if (a.k1 > 0) opt.bpm.k1 = a.k1;
-  if (a.alpha > 0) opt.bpm.alpha = a.alpha;
   if (a.coverage >= 0) opt.bpm.coverage = a.coverage;
-  if (!a.radius_policy.empty())
-    opt.bpm.radius_policy = a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
-  if (a.photons_per_batch > 0) opt.bpm.photons_per_batch = a.photons_per_batch;
   if (a.max_batches > 0) opt.bpm.max_batches = a.max_batches;
-  opt.fpm = ls.render.fpm;
+  for (PhotonSettings* p : {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
+    if (a.k0 > 0) p->k0 = a.k0;
+    if (a.k1 > 0) p->k1 = a.k1;
+    if (a.alpha > 0) p->alpha = a.alpha;
+    if (!a.radius_policy.empty())
+      p->radius_policy = a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
+    if (a.photons_per_batch > 0) p->photons_per_batch = a.photons_per_batch;
+  }
   if (a.final_gather) opt.fpm.final_gather = true;
   if (a.knn >= 0) opt.fpm.knn = a.knn;
 

@@ -39,6 +39,7 @@ Rendered run(const LoadedScene& ls, const std::string& integrator, int passes, u
   opt.accuracy = accuracy;
   opt.adaptive = adaptive;
   opt.bpm.photons_per_batch = 30000;
+  opt.fpm.photons_per_batch = 30000;
   r.stats = render(ls, opt, &r.film);
   return r;
 }

@@ -96,7 +96,7 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     EyePassParams ep{&wm, bs.diffuse_depth, ls.render.max_depth, 1e-3f, 3e-3f};
     ObjectPhotonLists lists(ls.scene.objects.size());
     EyeCounters c;
-    c.rays.log = &eye_log;
+    c.rays.observer = &eye_log;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         Rng rng(stream_key(99, 0, uint64_t(y) * w + x));
@@ -108,14 +108,14 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     std::vector<uint16_t> owner(size_t(w) * h, 0);
     std::vector<std::vector<PhotonEntry>> out(1);
     LightCounters lc;
-    lc.log = &light_log;
+    lc.observer = &light_log;
     for (int k = 0; k < bs.photons_per_batch; ++k) {
       Rng rng(stream_key(98, 0, k));
       trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos, {}}, owner, rng, out, lc);
     }
   }
-  std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n", eye_log.closest_hit.size(),
-              eye_log.shadow.size(), light_log.closest_hit.size());
+  std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n", eye_log.closest_rays.size(),
+              eye_log.shadow_rays.size(), light_log.closest_rays.size());
   for (int threads : {1, hw}) {
     Film film(w, h);
     RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
   ls.film.width = w;
   ls.film.height = h;
   int hw = int(std::thread::hardware_concurrency());
-  BpmSettings bs = ls.render.bpm;
+  BpmSettings bs = bpm_settings_from_file(ls.render.integrator_directive);
   std::printf("scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per batch\n",
               scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1, bs.photons_per_batch);
   if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);

@@ -13,6 +13,7 @@
 
 #include "camera/camera.h"
 #include "embree_replay.h"
+#include "path/path_integrator.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
   {
     PerspectiveCamera cam(ls.camera, res, res);
     PathCounters c;
-    c.log = &log;
+    c.observer = &log;
     for (int y = 0; y < res; ++y)
       for (int x = 0; x < res; ++x)
         for (int s = 0; s < 4; ++s) {
@@ -52,7 +53,7 @@ int main(int argc, char** argv) {
           path_radiance(ls.scene, r, PathSettings{ls.render.max_depth}, sample_wavelengths(rng.uniform()), rng, c);
         }
   }
-  std::printf("recorded %zu closest-hit and %zu shadow rays\n", log.closest_hit.size(), log.shadow.size());
+  std::printf("recorded %zu closest-hit and %zu shadow rays\n", log.closest_rays.size(), log.shadow_rays.size());
 
   for (int threads : {1, hw}) {
     RenderOptions opt = quiet_options(ls, "path", spp);

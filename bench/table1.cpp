@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
     ls.film.height = h;
     RenderOptions opt = quiet_options(ls, "path", 16, 1);
     opt.bpm.photons_per_batch = photons;
+    opt.fpm.photons_per_batch = photons;
 
     Run f;
     {

@@ -299,6 +299,7 @@ TEST(Integrators, AlphaMasksLetLightThrough) {
       RenderOptions opt = quiet_options(*c.ls, integrator, 64, 1);
       opt.bpm.max_batches = 1;
       opt.bpm.photons_per_batch = 20000;
+      opt.fpm.photons_per_batch = 20000;
       render(*c.ls, opt, &film);
       Image img = film.image();
       std::vector<float> rms = film.rms();

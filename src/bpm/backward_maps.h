@@ -7,7 +7,7 @@
 
 #include "bpm/backward_photon.h"
 #include "bpm/eye_pass.h"
-#include "bpm/sphere_kdtree.h"
+#include "photons/sphere_kdtree.h"
 
 namespace bpm {
 

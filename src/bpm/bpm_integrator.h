@@ -1,16 +1,17 @@
-// The backward photon mapping integrator (the paper's Fig. 3): each iteration is an eye pass
-// that leaves backward photons, per-object sphere trees, a light pass in batches until the
-// backward photons are covered, and the accumulation of the iteration's image into the film.
+// The backward photon mapping integrator (the paper's Fig. 3). Each iteration is an independent
+// estimate of the image in four stages, one file each: the eye pass leaves backward photons
+// (eye_pass), per-object sphere trees are built over them (backward_maps), photons from the lights
+// fill them in batches until they are covered (light_pass), and the iteration's image joins the
+// film (accumulate). integrator/progressive.h runs the iterations until a budget ends the render.
 #pragma once
-#include <nlohmann/json.hpp>
-
 #include "bpm/settings.h"
 #include "film/film.h"
-#include "render/renderer.h"
+#include "integrator/options.h"
 #include "scene/flatten.h"
 
 namespace bpm {
 
-RenderStats render_bpm(const LoadedScene& scene, const RenderOptions& options, Film* film);
+RenderStats render_bpm(const LoadedScene& scene, const IntegratorOptions& options, const BpmSettings& settings,
+                       Film* film);
 
 }  // namespace bpm

@@ -1,15 +1,19 @@
-// The eye pass (DESIGN.md, "one path, counted exactly once"): a camera path through specular
-// vertices and up to D + 1 diffuse vertices. It counts emission seen through specular vertices
-// only, direct light at each diffuse vertex by next-event estimation, and leaves a backward
-// photon at each diffuse vertex for the light pass to fill: caustic photons only at x_1..x_D
-// (radius r0), every photon but direct ones at x_(D+1) (radius r1), where the path ends.
+// Stage 1 of a bpm iteration, the eye pass (DESIGN.md, "one path, counted exactly once"): a
+// camera path through specular vertices and up to D + 1 diffuse vertices. It counts emission seen
+// through specular vertices only, direct light at each diffuse vertex by next-event estimation,
+// and leaves a backward photon at each diffuse vertex for the light pass to fill: caustic photons
+// only at x_1..x_D (radius r0), every photon but direct ones at x_(D+1) (radius r1), where the path
+// ends. The pass runs block by block, each thread over the pixels of its mask (section 3).
 #pragma once
+#include <tbb/enumerable_thread_specific.h>
+
 #include <vector>
 
 #include "base/rng.h"
 #include "bpm/backward_photon.h"
-#include "bpm/settings.h"
-#include "path/path_integrator.h"
+#include "bpm/masks.h"
+#include "integrator/counters.h"
+#include "integrator/progressive.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -36,7 +40,28 @@ using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
 // appends the path's backward photons to out[object].
-Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray, uint32_t pixel, Rng& rng,
-                        ObjectPhotonLists& out, EyeCounters& counters);
+Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray, uint32_t pixel,
+                        Rng& rng, ObjectPhotonLists& out, EyeCounters& counters);
+
+// What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
+struct EyePixels {
+  std::vector<Spectrum> radiance;    // the eye pass's own part of the pixel's estimate
+  std::vector<float> filter_weight;  // of the pixel's camera sample
+  std::vector<float> cost_ns;        // time spent on the pixel, to rebuild the masks
+  std::vector<uint8_t> sampled;      // whether this iteration samples the pixel
+  explicit EyePixels(size_t n) : radiance(n), filter_weight(n), cost_ns(n), sampled(n, 0) {}
+};
+
+// Per-thread state the eye pass fills.
+struct EyeThreadData {
+  tbb::enumerable_thread_specific<ObjectPhotonLists>& lists;
+  tbb::enumerable_thread_specific<EyeCounters>& counters;
+};
+
+// Runs the eye pass of pass `pass` (random streams keyed by `pass_index`) over every pixel the
+// control samples. Returns false when interrupted: the backward photons are then dropped.
+bool run_eye_pass(const RenderScene& scene, const EyePassParams& params, const CameraSampler& camera,
+                  const PixelMasks& masks, const RenderControl& control, int pass, int pass_index,
+                  EyePixels* pixels, EyeThreadData threads);
 
 }  // namespace bpm

@@ -1,14 +1,24 @@
 #include "bpm/light_pass.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
+#include "base/interrupt.h"
 #include "photons/density.h"
 
 namespace bpm {
 namespace {
+
+// Domain separation of photon streams from pixel streams.
+constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
 
 // Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`.
 void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
@@ -54,6 +64,80 @@ void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Ligh
     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
       gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out, counters);
   });
+}
+
+namespace {
+
+// Phase one of a batch: every chunk traces its photons into its own lists.
+void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                 const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t photons_per_batch, int batch,
+                 LightPassBuffers* buf) {
+  const int slots = masks.slots();
+  tbb::parallel_for(tbb::blocked_range<int>(0, int(buf->chunks.size()), 1), [&](const tbb::blocked_range<int>& r) {
+    LightCounters& lc = buf->counters.local();
+    for (int c = r.begin(); c < r.end(); ++c) {
+      std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
+      by_slot.resize(size_t(slots));
+      for (auto& v : by_slot) v.clear();
+      uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+      uint64_t last = std::min(first + kPhotonsPerChunk, photons_per_batch);
+      for (uint64_t k = first; k < last; ++k) {
+        uint64_t index = uint64_t(batch) * photons_per_batch + k;
+        Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
+        trace_photon(scene, maps, prm, masks.owner(), rng, by_slot, lc);
+      }
+    }
+  });
+}
+
+// Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
+void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* flux, std::vector<uint8_t>* hit) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int slot = r.begin(); slot < r.end(); ++slot)
+      for (const auto& by_slot : buf.chunks)
+        for (const PhotonEntry& e : by_slot[size_t(slot)]) {
+          (*flux)[e.backward_photon] += e.value;
+          (*hit)[e.backward_photon] = 1;
+        }
+  });
+}
+
+}  // namespace
+
+LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                               const BpmSettings& s, const PixelMasks& masks, uint64_t seed, int pass_index,
+                               LightPassBuffers* buf) {
+  const uint64_t photons_per_batch = uint64_t(s.photons_per_batch);
+  buf->chunks.resize(size_t((photons_per_batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
+  const size_t n_bp = maps.photons.size();
+  LightPassResult res;
+  res.flux.assign(n_bp, Spectrum());
+  std::vector<uint8_t> hit(n_bp, 0);
+  size_t n_indirect = 0;
+  for (const BackwardPhoton& bp : maps.photons) n_indirect += (bp.accepts & kAcceptsIndirect) != 0;
+  res.coverage = n_indirect ? 0.0 : 1.0;
+  for (int batch = 0; batch < s.max_batches; ++batch) {
+    auto t = std::chrono::steady_clock::now();
+    trace_batch(scene, maps, prm, masks, seed, pass_index, photons_per_batch, batch, buf);
+    res.emitted += photons_per_batch;
+    ++res.batches;
+    res.trace_s += seconds_since(t);
+    size_t entry_bytes = 0;
+    for (const auto& by_slot : buf->chunks)
+      for (const auto& v : by_slot) entry_bytes += v.capacity() * sizeof(PhotonEntry);
+    res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
+
+    t = std::chrono::steady_clock::now();
+    apply_batch(*buf, masks.slots(), &res.flux, &hit);
+    res.apply_s += seconds_since(t);
+    if (n_indirect) {
+      size_t covered = 0;
+      for (size_t g = 0; g < n_bp; ++g) covered += hit[g] && (maps.photons[g].accepts & kAcceptsIndirect);
+      res.coverage = double(covered) / double(n_indirect);
+    }
+    if (res.coverage >= s.coverage || interrupt_flag().load()) break;
+  }
+  return res;
 }
 
 }  // namespace bpm

@@ -1,14 +1,20 @@
-// The light pass, phase one (section 3 of the paper): photons travel as photons/light_path.h
-// says; at each diffuse hit the hit object's tree gives
-// the backward photons whose spheres contain the hit, and each accepted pair is appended as
-// (backward photon, contribution) to the caller's lists, one per mask slot, so that phase two can
-// apply each slot's entries without locks.
+// Stage 3 of a bpm iteration, the light pass (section 3 of the paper), in batches of photons until
+// the backward photons are covered (DESIGN.md, "photon passes per iteration"). Each batch runs in
+// two phases. Phase one: photons travel as photons/light_path.h says; at each diffuse hit the hit
+// object's tree gives the backward photons whose spheres contain the hit, and each accepted pair
+// is appended as (backward photon, contribution) to the lists of its chunk, one list per mask
+// slot. Phase two: each slot applies the entries of its own pixels, chunk by chunk in order, so
+// that no locks are needed and the sums do not depend on the thread count.
 #pragma once
+#include <tbb/enumerable_thread_specific.h>
+
 #include <cstdint>
 #include <vector>
 
 #include "base/rng.h"
 #include "bpm/backward_maps.h"
+#include "bpm/masks.h"
+#include "bpm/settings.h"
 #include "photons/light_path.h"
 #include "scene/render_scene.h"
 
@@ -31,10 +37,31 @@ struct LightPassParams {
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
 void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm);
 
-
 // Traces one photon. owner[pixel] is the mask slot of the pixel; out has one list per slot.
 void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& params,
                   const std::vector<uint16_t>& owner, Rng& rng, std::vector<std::vector<PhotonEntry>>& out,
                   LightCounters& counters);
+
+// What the light pass keeps between iterations: the entry lists of each chunk of a batch and the
+// per-thread counters.
+struct LightPassBuffers {
+  std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [chunk][slot]
+  tbb::enumerable_thread_specific<LightCounters> counters;
+};
+
+struct LightPassResult {
+  std::vector<Spectrum> flux;  // per backward photon: the sum of its entries' values
+  uint64_t emitted = 0;        // photons emitted, N of eq. (2)
+  int batches = 0;
+  double coverage = 0;  // fraction of the backward photons accepting indirect light that were hit
+  double trace_s = 0, apply_s = 0;
+  size_t peak_entry_bytes = 0;
+};
+
+// Shoots batches of photons (streams keyed by seed, pass_index and photon index) until the
+// coverage target, the batch cap or an interrupt.
+LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& params,
+                               const BpmSettings& settings, const PixelMasks& masks, uint64_t seed, int pass_index,
+                               LightPassBuffers* buffers);
 
 }  // namespace bpm

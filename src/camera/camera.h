@@ -1,8 +1,8 @@
 // pbrt-v4's perspective camera: the fov spans the shorter image axis, raster y grows downward,
 // and camera space looks down +z with +x to the right of the image.
 #pragma once
+#include "base/ray.h"
 #include "base/transform.h"
-#include "scene/render_scene.h"
 
 namespace bpm {
 

@@ -8,7 +8,8 @@
 #include <cstdint>
 
 #include "base/rng.h"
-#include "path/path_integrator.h"
+#include "integrator/counters.h"
+#include "integrator/path_vertex.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -34,7 +35,7 @@ struct LightCounters {
   uint64_t diffuse_hits = 0;  // photon hits on diffuse surfaces
   uint64_t queries = 0;       // map lookups (bpm)
   uint64_t entries = 0;       // accepted (backward photon, photon) pairs (bpm); photons stored (fpm)
-  RayLog* log = nullptr;      // null except in benchmarks
+  RayObserver* observer = nullptr;
   void add(const LightCounters& o) {
     photons += o.photons;
     light_rays += o.light_rays;
@@ -69,59 +70,47 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
   Vec2 u_pos{rng.uniform(), rng.uniform()}, u_dir{rng.uniform(), rng.uniform()};
   auto le = light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info, wm.wl);
   if (!le || le->flux.is_black() || pmf == 0) return;
-  Spectrum beta = le->flux / pmf;
   bool has_surface = length_squared(le->n_light) > 0;
-  Ray ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin, le->direction, kInf};
+  PathState s{Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin,
+                  le->direction, kInf},
+              le->flux / pmf};
+  // Only area lights may touch a medium (flatten.cpp): the one on the side the photon leaves to.
+  if (const auto* area = std::get_if<AreaLight>(&light))
+    s.medium = medium_toward(scene, area->object, le->n_light, le->direction,
+                             scene.objects[size_t(area->object)].medium_outside);
   int bounces = 0;
   bool all_specular = true;
-  // Only area lights may touch a medium (flatten.cpp): the one on the side the photon leaves to.
-  int medium = -1;
-  if (const auto* area = std::get_if<AreaLight>(&light))
-    medium = medium_toward(scene, area->object, le->n_light, le->direction, scene.objects[size_t(area->object)].medium_outside);
   ++counters.light_rays;
   for (int guard = 0; guard < 10000; ++guard) {
-    Hit hit;
-    if (counters.log) counters.log->closest_hit.push_back(ray);
-    if (!scene.intersect(ray, &hit)) break;
-    if (!cross_medium(scene, medium, hit.t * length(ray.d), wm.wl, beta)) break;
-    SurfacePoint sp = scene.surface(ray, hit);
-    Material storage;
-    const Material& m = wm.at(scene.objects[hit.object].material, texture_context(sp), storage);
-    if (std::holds_alternative<InterfaceMaterial>(m)) {
-      medium = medium_toward(scene, hit.object, sp.ng, ray.d, medium);
-      ray = spawn_ray(sp, ray.d);
-      ++counters.light_rays;
-      continue;
-    }
-    Vec3 wo = -ray.d;
-    if (!bsdf_is_specular(m)) {
+    PathVertex v;
+    if (next_vertex(scene, wm, s, v, counters.light_rays, counters.observer) != StepEnd::kVertex) break;
+    if (!bsdf_is_specular(v.m())) {
       ++counters.diffuse_hits;
       PhotonClass cls = bounces == 0 ? PhotonClass::kDirect
                                      : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
-      on_hit(PhotonHit{hit.object, sp, wo, beta, cls, bounces});
+      on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces});
     }
     if (bounces + 1 + min_eye_vertices > max_depth) break;
-    Frame frame = Frame::from_z(sp.ns);
-    Vec3 wo_local = frame.to_local(wo);
-    if (wo_local.z == 0) break;
-    auto bs = bsdf_sample(m, wo_local, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kImportance);
+    if (v.wo_local.z == 0) break;
+    Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
+    float uc = rng.uniform();
+    auto bs = sample_bsdf(v, uc, u, TransportMode::kImportance);
     if (!bs) break;
-    Vec3 wi = frame.to_world(bs->wi);
+    Vec3 wi = v.frame.to_world(bs->wi);
     // Adjoint BSDF with shading normals (Veach 1997, 5.3): |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|)
     // times the usual f |wi.ns| / pdf.
-    float cos_o_g = std::fabs(dot(wo, sp.ng));
+    float cos_o_g = std::fabs(dot(v.wo, v.sp.ng));
     if (cos_o_g == 0) break;
-    Spectrum bnew =
-        beta * bs->f * (std::fabs(wo_local.z) * std::fabs(dot(wi, sp.ng)) / (cos_o_g * bs->pdf_solid_angle));
+    Spectrum bnew = s.beta * bs->f *
+                    (std::fabs(v.wo_local.z) * std::fabs(dot(wi, v.sp.ng)) / (cos_o_g * bs->pdf_solid_angle));
     // Russian roulette on the change of power (pbrt-v4's SPPM photon pass).
-    float q = std::fmax(0.0f, 1 - bnew.max_component() / beta.max_component());
+    float q = std::fmax(0.0f, 1 - bnew.max_component() / s.beta.max_component());
     if (rng.uniform() < q) break;
-    beta = bnew / (1 - q);
-    if (beta.is_black() || !beta.is_finite()) break;
+    s.beta = bnew / (1 - q);
+    if (s.beta.is_black() || !s.beta.is_finite()) break;
     ++bounces;
     all_specular = all_specular && bs->is_specular();
-    medium = medium_toward(scene, hit.object, sp.ng, wi, medium);
-    ray = spawn_ray(sp, wi);
+    leave_vertex(scene, v, wi, s);
     ++counters.light_rays;
   }
 }

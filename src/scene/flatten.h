@@ -5,7 +5,6 @@
 #pragma once
 #include <string>
 
-#include "bpm/settings.h"
 #include "camera/camera.h"
 #include "film/filter.h"
 #include "scene/parsed_scene.h"
@@ -27,8 +26,9 @@ struct FileRenderSettings {
   int max_depth = 5;
   int spp = 16;
   int seed = 0;
-  BpmSettings bpm;  // from `Integrator "bpm"` (or "fpm") parameters, else defaults
-  FpmSettings fpm;  // from `Integrator "fpm"` parameters
+  // The Integrator directive as written: each integrator reads its own parameters from it
+  // (bpm/settings.h, fpm/settings.h).
+  SceneEntity integrator_directive;
 };
 
 struct LoadedScene {

@@ -47,7 +47,6 @@ class Flattener {
   void read_film(LoadedScene* out);
   void read_filter(LoadedScene* out);
   void read_sampler_and_integrator(LoadedScene* out);
-  static void read_bpm_settings(const SceneEntity& in, BpmSettings* b);
 
   // Texture nodes (flatten_textures.cpp).
   const TextureEntity& texture_entity(const Param& ref);

@@ -108,43 +108,8 @@ void Flattener::read_sampler_and_integrator(LoadedScene* out) {
   } else {
     throw Error(in.loc, "integrator \"" + in.name + "\" is not supported");
   }
-  if (in.name == "bpm" || in.name == "fpm") read_bpm_settings(in, &out->render.bpm);
-  if (in.name == "fpm") {
-    out->render.fpm.final_gather = in.params.get_bool("finalgather", false);
-    out->render.fpm.knn = in.params.get_int("knn", 0);
-    if (out->render.fpm.knn < 0) {
-      const Param* p = in.params.find_any("knn");
-      throw Error(p ? p->loc : in.loc, "knn must not be negative");
-    }
-  }
   for (const Param& p : in.params.all()) p.used = true;  // other integrators' knobs are advisory
-}
-
-// bpm's own parameters on its Integrator line; the command line may override each.
-void Flattener::read_bpm_settings(const SceneEntity& in, BpmSettings* b) {
-  const ParamSet& ps = in.params;
-  auto check = [&](const char* name, bool ok, const char* what) {
-    if (!ok) throw Error(ps.find_any(name) ? ps.find_any(name)->loc : in.loc, std::string(name) + " " + what);
-  };
-  b->diffuse_depth = ps.get_int("diffusedepth", b->diffuse_depth);
-  check("diffusedepth", b->diffuse_depth >= 0 && b->diffuse_depth <= 3, "must be in 0..3");
-  b->k0 = ps.get_float("k0", b->k0);
-  check("k0", b->k0 > 0 && b->k0 < 1e4f, "must be positive");
-  b->k1 = ps.get_float("k1", b->k1);
-  check("k1", b->k1 > 0 && b->k1 < 1e4f, "must be positive");
-  std::string policy = ps.get_string("radiuspolicy", to_string(b->radius_policy));
-  check("radiuspolicy", policy == "fixed" || policy == "progressive", "must be \"fixed\" or \"progressive\"");
-  b->radius_policy = policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
-  b->alpha = ps.get_float("alpha", b->alpha);
-  check("alpha", b->alpha > 0 && b->alpha < 1, "must be in (0, 1)");
-  b->photons_per_batch = ps.get_int("photonsperbatch", b->photons_per_batch);
-  check("photonsperbatch", b->photons_per_batch > 0, "must be positive");
-  b->coverage = ps.get_float("coverage", b->coverage);
-  check("coverage", b->coverage >= 0 && b->coverage <= 1, "must be in [0, 1]");
-  b->max_batches = ps.get_int("maxbatches", b->max_batches);
-  check("maxbatches", b->max_batches > 0, "must be positive");
-  b->centre_tree = ps.get_string("tree", "spheres") == "centres";
-  check("tree", b->centre_tree || ps.get_string("tree", "spheres") == "spheres", "must be \"spheres\" or \"centres\"");
+  out->render.integrator_directive = in;
 }
 
 }  // namespace bpm::flatten_internal

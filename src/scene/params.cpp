@@ -127,4 +127,10 @@ void ParamSet::warn_unused(const std::string& what) const {
     if (!p.used) warning(p.loc, "parameter \"" + p.type + " " + p.name + "\" of " + what + " is not supported and was ignored");
 }
 
+void ParamSet::require(const std::string& name, bool ok, const std::string& what, const FileLoc& fallback) const {
+  if (ok) return;
+  const Param* p = find_any(name);
+  throw Error(p ? p->loc : fallback, name + " " + what);
+}
+
 }  // namespace bpm

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "base/ray.h"
 #include "base/sampling.h"
 #include "lights/light.h"
 #include "materials/material.h"
@@ -33,18 +34,6 @@ struct Object {
   FloatParam alpha{1, -1};
   bool has_alpha() const { return alpha.textured() || alpha.value < 1; }
   std::string source;    // file:line of the Shape directive, for statistics and messages
-};
-
-struct Ray {
-  Vec3 o, d;
-  float t_max = kInf;
-};
-
-struct Hit {
-  int object = -1;
-  int primitive = -1;
-  Vec2 barycentric;
-  float t = 0;
 };
 
 class Accel;
@@ -143,6 +132,7 @@ struct WavelengthMaterials {
   std::vector<Material> materials;
   std::vector<char> textured;
   const RenderScene* scene;
+  bool per_point = false;  // every material resolved at each point (no copies made)
   WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths) : wl(wavelengths), scene(&s) {
     materials.reserve(s.materials.size());
     for (const MaterialDesc& d : s.materials) {
@@ -150,13 +140,22 @@ struct WavelengthMaterials {
       materials.push_back(textured.back() ? Material{} : resolve_material(d, wl));
     }
   }
+  // For a single path (the path tracer draws wavelengths per pixel sample): copies of every
+  // material would cost more than resolving the few the path meets.
+  static WavelengthMaterials resolved_per_point(const RenderScene& s, const Wavelengths& wavelengths) {
+    return WavelengthMaterials(s, wavelengths, true);
+  }
   // The material at a point: the iteration's copy, or for a textured one its resolution at ctx,
   // made in storage.
   const Material& at(int material, const TextureContext& ctx, Material& storage) const {
-    if (!textured[size_t(material)]) return materials[size_t(material)];
+    if (!per_point && !textured[size_t(material)]) return materials[size_t(material)];
     storage = material_at(*scene, material, wl, ctx);
     return storage;
   }
+
+ private:
+  WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths, bool)
+      : wl(wavelengths), scene(&s), per_point(true) {}
 };
 
 // Offsets a ray origin off the surface at p (normal n) toward direction w, to avoid

@@ -1,4 +1,4 @@
-#include "render/control.h"
+#include "integrator/control.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,8 @@
 #include <limits>
 
 #include "base/rng.h"
-#include "render/renderer.h"
+#include "base/interrupt.h"
+#include "integrator/options.h"
 
 namespace bpm {
 namespace {
@@ -15,7 +16,7 @@ constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
 constexpr int kWarmupPasses = 4;
 }  // namespace
 
-RenderControl::RenderControl(const RenderOptions& opt, const Film& film, const char* unit)
+RenderControl::RenderControl(const IntegratorOptions& opt, const Film& film, const char* unit)
     : opt_(opt), film_(film), unit_(unit), t0_(std::chrono::steady_clock::now()) {}
 
 double RenderControl::elapsed() const {

@@ -22,12 +22,12 @@ namespace bpm {
 using Clock = std::chrono::steady_clock;
 inline double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-struct RenderOptions;
+struct IntegratorOptions;
 
 class RenderControl {
  public:
   // `unit` names a pass in the progress line ("pass" or "iteration").
-  RenderControl(const RenderOptions& opt, const Film& film, const char* unit);
+  RenderControl(const IntegratorOptions& opt, const Film& film, const char* unit);
 
   // Before pass `done` (0-based): false when the render must stop; stop_reason() says why.
   bool keep_going(int done);
@@ -46,7 +46,7 @@ class RenderControl {
 
  private:
   void update_probabilities();
-  const RenderOptions& opt_;
+  const IntegratorOptions& opt_;
   const Film& film_;
   const char* unit_;
   std::chrono::steady_clock::time_point t0_;

@@ -1,5 +1,5 @@
 // The kd-trees over backward photons return exactly the spheres a brute-force scan finds.
-#include "bpm/sphere_kdtree.h"
+#include "photons/sphere_kdtree.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "bpm/sphere_kdtree.h"
+#include "photons/sphere_kdtree.h"
 
 #include <algorithm>
 

@@ -1,0 +1,21 @@
+#include "base/interrupt.h"
+
+#include <csignal>
+
+namespace bpm {
+
+std::atomic<bool>& interrupt_flag() {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+
+namespace {
+void on_signal(int) { interrupt_flag().store(true); }
+}  // namespace
+
+void install_interrupt_handlers() {
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+}
+
+}  // namespace bpm

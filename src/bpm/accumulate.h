@@ -1,0 +1,18 @@
+// Stage 4 of a bpm iteration: every sampled pixel's estimate, the eye pass's part plus what its
+// backward photons gathered (eq. 2), joins the film as one pass; the film's per-pixel moments give
+// the error estimate (eq. 5, 4).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "bpm/backward_maps.h"
+#include "bpm/eye_pass.h"
+#include "film/film.h"
+
+namespace bpm {
+
+// flux[g]: the summed contributions backward photon g received from `emitted` photons.
+void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux, uint64_t emitted,
+                          const EyePixels& eye, const Wavelengths& wl, float max_component_value, Film* film);
+
+}  // namespace bpm

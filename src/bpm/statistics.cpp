@@ -1,0 +1,98 @@
+#include "bpm/statistics.h"
+
+#include <algorithm>
+
+namespace bpm {
+
+void BpmTotals::add_maps(const BackwardMaps& maps) {
+  peak_photon_bytes = std::max(peak_photon_bytes, maps.photon_bytes());
+  peak_tree_bytes = std::max(peak_tree_bytes, maps.tree_bytes());
+  if (maps.centre_tree) return;
+  size_t in = 0, stored = 0;
+  for (size_t o = 0; o + 1 < maps.object_begin.size(); ++o) {
+    in += maps.object_begin[o + 1] - maps.object_begin[o];
+    stored += maps.sphere_trees[o].reference_count();
+  }
+  if (in) {
+    duplication_sum += double(stored) / double(in);
+    ++duplication_n;
+  }
+}
+
+void BpmTotals::add_light_pass(const LightPassResult& r) {
+  batches += uint64_t(r.batches);
+  light_trace_s += r.trace_s;
+  light_apply_s += r.apply_s;
+  peak_entry_bytes = std::max(peak_entry_bytes, r.peak_entry_bytes);
+  coverage_sum += r.coverage;
+  last_coverage = r.coverage;
+}
+
+namespace {
+
+double ratio(double a, double b) { return b > 0 ? a / b : 0.0; }
+
+nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
+  uint64_t backward_rays = t.eye.rays.camera_rays + t.eye.rays.bounce_rays;
+  double backward_photons = double(t.eye.backward_photons);
+  return {{"camera_rays", t.eye.rays.camera_rays},
+          {"bounce_rays", t.eye.rays.bounce_rays},
+          {"shadow_rays", t.eye.rays.shadow_rays},
+          {"backward_photons", t.eye.backward_photons},
+          // The paper's Table 1 counts per ray traced from the camera with all its continuations
+          // (an eye path); per segment counts every camera and bounce ray.
+          {"backward_photons_per_backward_ray", ratio(backward_photons, double(t.eye.rays.camera_rays))},
+          {"backward_photons_per_backward_segment", ratio(backward_photons, double(backward_rays))},
+          {"backward_photons_per_pixel_iteration", ratio(backward_photons, double(iterations) * double(pixels))},
+          {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s)}};
+}
+
+nlohmann::json light_json(const BpmTotals& t, int iterations) {
+  double light_s = t.light_trace_s + t.light_apply_s;
+  return {{"photons", t.light.photons},
+          {"light_rays", t.light.light_rays},
+          {"diffuse_hits", t.light.diffuse_hits},
+          {"queries", t.light.queries},
+          {"queries_per_second", ratio(double(t.light.queries), t.light_trace_s)},
+          {"entries", t.light.entries},
+          {"batches", t.batches},
+          {"batches_per_iteration", ratio(double(t.batches), iterations)},
+          {"coverage_mean", ratio(t.coverage_sum, iterations)},
+          {"coverage_last", t.last_coverage},
+          {"rays_per_second", ratio(double(t.light.light_rays), light_s)}};
+}
+
+}  // namespace
+
+nlohmann::json to_json(const BpmTotals& t, const BpmSettings& s, int iterations, size_t pixels) {
+  return {
+      {"settings",
+       {{"diffuse_depth", s.diffuse_depth},
+        {"k0", s.k0},
+        {"k1", s.k1},
+        {"radius_policy", to_string(s.radius_policy)},
+        {"alpha", s.alpha},
+        {"photons_per_batch", s.photons_per_batch},
+        {"coverage_target", s.coverage},
+        {"max_batches", s.max_batches},
+        {"normal_cos", s.normal_cos},
+        {"tree", s.centre_tree ? "centres" : "spheres"}}},
+      {"eye", eye_json(t, iterations, pixels)},
+      {"maps",
+       {{"peak_photon_bytes", t.peak_photon_bytes},
+        {"peak_tree_bytes", t.peak_tree_bytes},
+        {"peak_entry_bytes", t.peak_entry_bytes},
+        {"backward_photon_bytes_each", sizeof(BackwardPhoton)},
+        {"tree_build_s", t.build_s},
+        {"mean_sphere_duplication", ratio(t.duplication_sum, t.duplication_n)}}},
+      {"light", light_json(t, iterations)},
+      {"stages_s",
+       {{"eye", t.eye_s},
+        {"tree_build", t.build_s},
+        {"light_trace", t.light_trace_s},
+        {"light_apply", t.light_apply_s},
+        {"accumulate", t.accumulate_s}}},
+  };
+}
+
+}  // namespace bpm

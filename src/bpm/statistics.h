@@ -1,0 +1,31 @@
+// What a bpm render reports (DESIGN.md, "statistics every render reports"): rays and backward
+// photons of the eye pass with the paper's Table 1 measures, bytes of maps, trees and entries,
+// photons, queries and batches of the light pass, and time per stage.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include "bpm/backward_maps.h"
+#include "bpm/eye_pass.h"
+#include "bpm/light_pass.h"
+#include "bpm/settings.h"
+
+namespace bpm {
+
+struct BpmTotals {
+  EyeCounters eye;
+  LightCounters light;
+  size_t peak_photon_bytes = 0, peak_tree_bytes = 0, peak_entry_bytes = 0;
+  double eye_s = 0, build_s = 0, light_trace_s = 0, light_apply_s = 0, accumulate_s = 0;
+  uint64_t batches = 0;
+  double coverage_sum = 0, last_coverage = 0;
+  double duplication_sum = 0;
+  int duplication_n = 0;
+
+  // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.
+  void add_maps(const BackwardMaps& maps);
+  void add_light_pass(const LightPassResult& r);
+};
+
+nlohmann::json to_json(const BpmTotals& t, const BpmSettings& s, int iterations, size_t pixels);
+
+}  // namespace bpm

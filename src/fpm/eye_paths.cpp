@@ -1,0 +1,103 @@
+#include "fpm/eye_paths.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "integrator/direct_light.h"
+#include "integrator/path_vertex.h"
+#include "photons/density.h"
+
+namespace bpm {
+namespace {
+
+// Radiance reflected at v toward wo from the map's photons of the accepted classes, eq. (2):
+// sum f dPhi / (pi r^2 N). With knn > 0 the radius is the distance to the knn-th nearest
+// photon within `radius` (Jensen's estimate), else `radius`.
+template <class Accept>
+Spectrum estimate(const PhotonMap& map, const PathVertex& v, float radius, int eye_depth, const FpmEyeParams& prm,
+                  Accept&& accept, FpmEyeCounters& c) {
+  ++c.lookups;
+  const SurfacePoint& sp = v.sp;
+  auto usable = [&](const ForwardPhoton& ph) {
+    return accept(ph.cls) && eye_depth + int(ph.bounces) <= prm.max_depth && dot(ph.ng, sp.ng) >= prm.fpm->normal_cos;
+  };
+  float r = radius;
+  if (prm.fpm->knn > 0) {
+    std::vector<float> d2;
+    map.tree.query_within(sp.p, radius, [&](uint32_t i) {
+      if (usable(map.photons[i])) d2.push_back(length_squared(map.photons[i].p - sp.p));
+    });
+    if (int(d2.size()) > prm.fpm->knn) {
+      std::nth_element(d2.begin(), d2.begin() + prm.fpm->knn - 1, d2.end());
+      r = std::sqrt(d2[size_t(prm.fpm->knn - 1)]) * 1.0001f;
+    }
+  }
+  Spectrum sum;
+  map.tree.query_within(sp.p, r, [&](uint32_t i) {
+    const ForwardPhoton& ph = map.photons[i];
+    if (!usable(ph)) return;
+    ++c.photons_used;
+    sum += photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux);
+  });
+  return sum * float(1.0 / (kPi * double(r) * r * prm.emitted));
+}
+
+bool any_class(PhotonClass) { return true; }
+bool caustic_class(PhotonClass k) { return k == PhotonClass::kCaustic; }
+bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
+
+}  // namespace
+
+Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps, const FpmEyeParams& prm, Ray ray,
+                          Rng& rng, FpmEyeCounters& c) {
+  const Wavelengths& wl = prm.materials->wl;
+  PathState s{ray};
+  Spectrum L;
+  int depth = 0;
+  // Between x1 and x2 on a final-gather ray emission is not counted: next-event estimation at x1
+  // has counted direct light there.
+  EmitterWeight emitter = EmitterWeight::full();
+  bool gathering = false;
+  ++c.rays.camera_rays;
+  for (int guard = 0; guard < 10000; ++guard) {
+    PathVertex v;
+    StepEnd end = next_vertex(scene, *prm.materials, s, v, c.rays.bounce_rays, c.rays.observer,
+                              [&](const Hit& hit, const SurfacePoint& sp) {
+                                L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
+                              });
+    if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
+    if (end != StepEnd::kVertex) break;
+    if (depth++ == prm.max_depth) break;
+    if (v.wo_local.z == 0) break;
+    if (!bsdf_is_specular(v.m())) {
+      float r1 = s.length * prm.radius_per_length1;
+      if (gathering) {
+        // x2: everything the global map holds, direct photons included.
+        L += s.beta * estimate(maps.global, v, r1, depth, prm, any_class, c);
+        break;
+      }
+      // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
+      // counted), caustics from the caustic map.
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local, false, wl,
+                                        rng, c.rays);
+      L += s.beta * estimate(maps.caustic, v, s.length * prm.radius_per_length0, depth, prm, caustic_class, c);
+      if (!prm.fpm->final_gather) {
+        L += s.beta * estimate(maps.global, v, r1, depth, prm, indirect_class, c);
+        break;
+      }
+      gathering = true;
+      emitter = EmitterWeight::none();
+    }
+    Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
+    float uc = rng.uniform();
+    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance);
+    if (!bs) break;
+    s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+    if (s.beta.is_black()) break;
+    leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+    ++c.rays.bounce_rays;
+  }
+  return L;
+}
+
+}  // namespace bpm

@@ -1,0 +1,36 @@
+// The eye side of forward photon mapping: one eye path per pixel through specular vertices to its
+// first diffuse vertex x1, where direct light comes from next-event estimation, caustics from the
+// caustic map and indirect light from the global map, either at x1 or, with final gathering, at
+// the diffuse vertex x2 one BSDF sample further.
+#pragma once
+#include "base/rng.h"
+#include "fpm/photon_maps.h"
+#include "fpm/settings.h"
+#include "integrator/counters.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+struct FpmEyeParams {
+  const WavelengthMaterials* materials;  // this iteration's wavelengths
+  const FpmSettings* fpm;
+  int max_depth;
+  float radius_per_length0, radius_per_length1;  // per unit of eye path length
+  double emitted;                                // photons emitted, N of eq. (2)
+};
+
+struct FpmEyeCounters {
+  PathCounters rays;
+  uint64_t lookups = 0, photons_used = 0;
+  void add(const FpmEyeCounters& o) {
+    rays.add(o.rays);
+    lookups += o.lookups;
+    photons_used += o.photons_used;
+  }
+};
+
+// Radiance arriving along -ray.d at the camera.
+Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps, const FpmEyeParams& params, Ray ray,
+                          Rng& rng, FpmEyeCounters& counters);
+
+}  // namespace bpm

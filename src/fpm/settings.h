@@ -1,0 +1,18 @@
+// Settings of forward photon mapping: the photon settings it shares with bpm (k0 for the caustic
+// map, k1 for the global map, photons_per_batch photons per iteration) and its own.
+#pragma once
+#include "photons/settings.h"
+#include "scene/parsed_scene.h"
+
+namespace bpm {
+
+struct FpmSettings : PhotonSettings {
+  bool final_gather = false;  // read indirect light one diffuse bounce later
+  int knn = 0;                // > 0: radius from the knn nearest photons (capped by the k radius)
+};
+
+// fpm's parameters on the file's Integrator line; defaults for any other integrator. A bad value
+// is an error at its place in the file.
+FpmSettings fpm_settings_from_file(const SceneEntity& integrator);
+
+}  // namespace bpm

@@ -1,0 +1,77 @@
+#include "integrator/direct_light.h"
+
+#include <cmath>
+
+#include "base/sampling.h"
+
+namespace bpm {
+
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
+                             int medium, const Material& m, const Frame& frame, Vec3 wo_local,
+                             bool use_mis, const Wavelengths& wl, Rng& rng,
+                             PathCounters& counters) {
+  if (scene.lights.empty()) return {};
+  float pmf;
+  float ul = rng.uniform();
+  int li = scene.light_distribution.sample(ul, &pmf);
+  const Light& light = scene.lights[li];
+  Vec2 u{rng.uniform(), rng.uniform()};
+  auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info, wl);
+  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
+  Vec3 wi_local = frame.to_local(ls->wi);
+  Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
+  if (f.is_black()) return {};
+  ++counters.shadow_rays;
+  Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi);
+  // Lights with a surface get the shadow ray's end lifted off that surface.
+  bool has_surface = length_squared(ls->n_light) > 0;
+  Vec3 target = has_surface ? offset_origin(ls->p_light, ls->n_light, -ls->wi) : ls->p_light;
+  if (counters.observer) {
+    Vec3 d = target - origin;
+    float len = length(d);
+    counters.observer->shadow(Ray{origin, d / len, len * (1 - 1e-4f)});
+  }
+  if (scene.occluded(origin, target)) return {};
+  if (int toward = medium_toward(scene, object, sp.ng, ls->wi, medium); toward >= 0) {
+    f *= medium_transmittance(scene, toward, ls->is_infinite ? kInf : length(ls->p_light - sp.p),
+                              wl);
+    if (f.is_black()) return {};
+  }
+  float p_light = pmf * ls->pdf_solid_angle;
+  if (ls->is_delta || !use_mis) return ls->radiance * f / p_light;
+  float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance);
+  return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
+}
+
+Spectrum weighted_surface_emission(const RenderScene& scene, const Ray& ray, const Hit& hit,
+                                   const SurfacePoint& sp, const Wavelengths& wl,
+                                   const Spectrum& beta, const EmitterWeight& w) {
+  int light_index = scene.light_of_hit(hit);
+  if (light_index < 0 || w.kind == EmitterWeight::kNone) return {};
+  const Light& light = scene.lights[size_t(light_index)];
+  Spectrum Le = area_light_radiance(std::get<AreaLight>(light), sp.ng, sp.uv, -ray.d, wl);
+  if (Le.is_black()) return {};
+  if (w.kind == EmitterWeight::kFull) return beta * Le;
+  float p_light = scene.light_distribution.pmf(light_index) *
+                  light_pdf_li(light, scene.light_shape(light), w.p_prev, ray.d, sp.p, sp.ng);
+  return beta * Le * power_heuristic(w.pdf_bsdf, p_light);
+}
+
+void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wavelengths& wl,
+                              const Spectrum& beta, const EmitterWeight& w, Spectrum& L) {
+  if (w.kind == EmitterWeight::kNone) return;
+  for (int li : scene.infinite_lights) {
+    const Light& light = scene.lights[size_t(li)];
+    Spectrum Le = environment_radiance(light, ray.d, wl);
+    if (Le.is_black()) continue;
+    if (w.kind == EmitterWeight::kFull) {
+      L += beta * Le;
+    } else {
+      float p_light =
+          scene.light_distribution.pmf(li) * light_pdf_li(light, nullptr, w.p_prev, ray.d, {}, {});
+      L += beta * Le * power_heuristic(w.pdf_bsdf, p_light);
+    }
+  }
+}
+
+}  // namespace bpm

@@ -1,0 +1,43 @@
+// Direct light, shared by every integrator: next-event estimation at a non-specular vertex, and
+// the emission a path finds by BSDF sampling, weighted so that each light path is counted once
+// (Veach 1997, 9.2.4: the power heuristic between the two strategies).
+#pragma once
+#include "base/rng.h"
+#include "integrator/counters.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+// Direct light at a non-specular vertex by sampling one light chosen by power, with the power
+// heuristic against BSDF sampling when use_mis (the caller then weights the emitters its BSDF
+// samples hit by EmitterWeight::mis), else with full weight. sp lies on `object`, reached by a
+// ray in `medium`: the shadow ray's absorption is that of the medium on the light's side.
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
+                             int medium, const Material& m, const Frame& frame, Vec3 wo_local,
+                             bool use_mis, const Wavelengths& wl, Rng& rng,
+                             PathCounters& counters);
+
+// How emission found by the next ray of a path counts: in full (seen from the camera or through
+// specular vertices only), by the power heuristic against next-event estimation at the previous
+// vertex p_prev whose BSDF sample had density pdf_bsdf, or not at all (counted elsewhere).
+struct EmitterWeight {
+  enum Kind { kFull, kMis, kNone } kind = kFull;
+  float pdf_bsdf = 0;  // MIS density of the BSDF sample (BsdfSample::mis_pdf)
+  Vec3 p_prev;
+  static EmitterWeight full() { return {}; }
+  static EmitterWeight none() { return {kNone, 0, {}}; }
+  static EmitterWeight mis(float pdf_bsdf, Vec3 p_prev) { return {kMis, pdf_bsdf, p_prev}; }
+};
+
+// beta times the emission of the area light at a surface hit (nothing if the surface does not
+// emit), weighted as w says; `ray` is the ray that found it.
+Spectrum weighted_surface_emission(const RenderScene& scene, const Ray& ray, const Hit& hit,
+                                   const SurfacePoint& sp, const Wavelengths& wl,
+                                   const Spectrum& beta, const EmitterWeight& w);
+
+// Adds to L beta times the radiance of every environment light seen along an escaping ray,
+// weighted as w says.
+void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wavelengths& wl,
+                              const Spectrum& beta, const EmitterWeight& w, Spectrum& L);
+
+}  // namespace bpm

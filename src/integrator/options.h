@@ -1,0 +1,42 @@
+// What every integrator takes (budgets, threads, seed, depth, accuracy, adaptive sampling,
+// checkpoints) and what every render reports. Integrator-specific settings are their own
+// (bpm/settings.h, fpm/settings.h).
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "integrator/counters.h"
+
+namespace bpm {
+
+struct IntegratorOptions {
+  int spp = 16;             // passes (iterations for the photon integrators)
+  int first_iteration = 0;  // index of the first pass: random streams and radii follow it, so
+                            // passes [a, b) rendered apart average to the same image
+  double time_limit_s = 0;  // 0: none
+  int threads = 0;          // 0: all hardware threads
+  uint64_t seed = 0;
+  int max_depth = 5;
+  bool progress = true;
+  double accuracy = 0;          // stop when the image error delta (eq. 4) is at most this; 0: off
+  bool adaptive = false;        // adaptive sampling (integrator/control.h)
+  float adaptive_floor = 0.1f;  // lowest probability of sampling a pixel in a pass
+  double write_every_s = 0;     // call checkpoint this often (between passes); 0: never
+  std::function<void(int passes)> checkpoint;
+};
+
+struct RenderStats {
+  int passes = 0;
+  std::string stop_reason;               // "samples", "time", "accuracy", "interrupted"
+  double mean_sampling_probability = 1;  // adaptive sampling: the last pass's mean
+  PathCounters rays;                     // eye rays (camera, bounce, shadow)
+  uint64_t light_rays = 0;               // photon rays (bpm, fpm)
+  double render_seconds = 0;
+  double relative_error = 0;  // eq. (4) over per-pass estimates
+  nlohmann::json details;     // integrator-specific statistics
+  uint64_t total_rays() const { return rays.total() + light_rays; }
+};
+
+}  // namespace bpm

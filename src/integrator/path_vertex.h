@@ -1,0 +1,98 @@
+// The vertex step every path loop shares (path tracing, bpm's eye pass, fpm's eye paths and the
+// light paths of both photon methods): follow the ray to the next surface that scatters,
+// attenuating the throughput in absorbing media and crossing interface surfaces on the way; then,
+// after the integrator has done its work at the vertex, sample the BSDF and leave.
+#pragma once
+#include <cmath>
+#include <optional>
+#include <variant>
+
+#include "integrator/counters.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+// A path between two vertices.
+struct PathState {
+  Ray ray;
+  Spectrum beta{1.0f};  // throughput
+  int medium = -1;      // the medium the ray travels in; cameras and lights start in vacuum
+  float length = 0;     // world distance travelled, interfaces included
+};
+
+// A surface where the path scatters.
+struct PathVertex {
+  Hit hit;
+  SurfacePoint sp;
+  Vec3 wo;                // toward where the path came from
+  int material_index;     // the object's material in RenderScene::materials
+  const Material* material;  // resolved at sp (textures, mixes) at the path's wavelengths
+  Material storage;          // holds the material when it had to be resolved at sp
+  Frame frame;               // shading frame
+  Vec3 wo_local;
+  int object() const { return hit.object; }
+  const Material& m() const { return *material; }
+};
+
+enum class StepEnd { kVertex, kEscaped, kAbsorbed };
+
+// Follows s.ray to the next scattering surface and fills v. on_surface(hit, sp) is called at every
+// surface reached, interfaces included, with s.beta already attenuated up to it (emission is
+// counted there). kEscaped: the ray left the scene (s.ray is the escaping ray, s.beta attenuated
+// by the medium it leaves in); kAbsorbed: nothing is left of the throughput. Each crossing of an
+// interface counts one ray in continuation_rays.
+template <class OnSurface>
+StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materials, PathState& s,
+                    PathVertex& v, uint64_t& continuation_rays, RayObserver* observer,
+                    OnSurface&& on_surface) {
+  const Wavelengths& wl = materials.wl;
+  for (int guard = 0; guard < 10000; ++guard) {
+    if (observer) observer->closest_hit(s.ray);
+    v.hit = Hit();
+    if (!scene.intersect(s.ray, &v.hit)) {
+      cross_medium(scene, s.medium, kInf, wl, s.beta);
+      return StepEnd::kEscaped;
+    }
+    float distance = v.hit.t * length(s.ray.d);
+    s.length += distance;
+    if (!cross_medium(scene, s.medium, distance, wl, s.beta)) return StepEnd::kAbsorbed;
+    v.sp = scene.surface(s.ray, v.hit);
+    on_surface(v.hit, v.sp);
+    v.material_index = scene.objects[size_t(v.hit.object)].material;
+    v.material = &materials.at(v.material_index, texture_context(v.sp), v.storage);
+    if (std::holds_alternative<InterfaceMaterial>(*v.material)) {
+      // A boundary that does not scatter: the same ray goes on past it.
+      s.medium = medium_toward(scene, v.hit.object, v.sp.ng, s.ray.d, s.medium);
+      s.ray = spawn_ray(v.sp, s.ray.d);
+      ++continuation_rays;
+      continue;
+    }
+    v.wo = -s.ray.d;
+    v.frame = Frame::from_z(v.sp.ns);
+    v.wo_local = v.frame.to_local(v.wo);
+    return StepEnd::kVertex;
+  }
+  return StepEnd::kAbsorbed;
+}
+
+inline StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
+                           PathState& s, PathVertex& v, uint64_t& continuation_rays,
+                           RayObserver* observer) {
+  return next_vertex(scene, materials, s, v, continuation_rays, observer,
+                     [](const Hit&, const SurfacePoint&) {});
+}
+
+// Samples the BSDF at v. The caller draws uc and u, in an order of its own that is fixed in the
+// code (argument evaluation order is not), so that every compiler gives the same image.
+inline std::optional<BsdfSample> sample_bsdf(const PathVertex& v, float uc, Vec2 u,
+                                             TransportMode mode) {
+  return bsdf_sample(v.m(), v.wo_local, uc, u, mode);
+}
+
+// Leaves v toward wi (world): the medium on that side, and a ray lifted off the surface.
+inline void leave_vertex(const RenderScene& scene, const PathVertex& v, Vec3 wi, PathState& s) {
+  s.medium = medium_toward(scene, v.hit.object, v.sp.ng, wi, s.medium);
+  s.ray = spawn_ray(v.sp, wi);
+}
+
+}  // namespace bpm

@@ -1,0 +1,96 @@
+// The outer loop every integrator shares (sections 3 and 4 of the paper): passes (path) or
+// iterations (bpm, fpm), each a complete and independent estimate of the image, until a budget
+// ends the render: a pass count, time, the requested accuracy, or an interrupt. RenderControl
+// decides when to stop, which pixels a pass samples (adaptive sampling), prints progress and
+// writes checkpoints; the integrator only renders one pass into the film.
+//
+// Also here: what the passes of every integrator share: the camera ray of a pixel sample and the
+// parallel loop over the pixels a pass samples.
+#pragma once
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "base/interrupt.h"
+#include "base/rng.h"
+#include "camera/camera.h"
+#include "film/film.h"
+#include "film/filter.h"
+#include "integrator/control.h"
+#include "integrator/options.h"
+
+namespace bpm {
+
+struct PassResult {
+  bool completed = true;  // false: the pass was abandoned (interrupted) and left the film as it was
+  uint64_t rays = 0;      // rays traced so far in the render, for the progress line
+  std::string progress;   // appended to the progress line
+};
+
+// Renders pass `pass` (0-based; random streams and radii follow pass + first_iteration) into the
+// film, sampling the pixels control.sample_pixel chooses.
+using PassFunction = std::function<PassResult(int pass, const RenderControl& control)>;
+
+// Runs passes until a budget ends the render. `unit` names a pass in the progress line. Fills
+// the passes, stop reason, time, mean sampling probability and error delta of `stats`.
+void run_passes(const IntegratorOptions& opt, Film* film, const char* unit, const PassFunction& pass,
+                RenderStats* stats);
+
+// One pixel sample: its random stream, keyed by (seed, pass index, pixel), which has already
+// drawn the filter offset and the lens position; the camera ray; the filter weight.
+struct CameraSample {
+  Rng rng;
+  Ray ray;
+  float filter_weight;
+};
+
+class CameraSampler {
+ public:
+  CameraSampler(const CameraSettings& camera, const FilterSettings& filter, int width, int height,
+                uint64_t seed)
+      : camera_(camera, width, height), filter_(filter), width_(width), seed_(seed) {}
+  CameraSample sample(int pass_index, uint32_t pixel) const {
+    Rng rng(stream_key(seed_, uint64_t(pass_index), pixel));
+    int x = int(pixel % uint32_t(width_)), y = int(pixel / uint32_t(width_));
+    FilterSample fs = filter_.sample({rng.uniform(), rng.uniform()});
+    Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
+    Vec2 u_lens{rng.uniform(), rng.uniform()};
+    Ray ray = camera_.generate_ray(p_film, u_lens);
+    return {rng, ray, fs.weight};
+  }
+  const PerspectiveCamera& camera() const { return camera_; }
+
+ private:
+  PerspectiveCamera camera_;
+  Filter filter_;
+  int width_;
+  uint64_t seed_;
+};
+
+// Records a pixel's estimate of this pass: the radiance at the pass's wavelengths as film colour.
+inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wavelengths& wl,
+                        float filter_weight, float max_component_value) {
+  int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
+  film->add_sample(x, y, film_rgb(L, wl, max_component_value), filter_weight);
+  film->end_pass(x, y);
+}
+
+// Calls f(pixel) for every pixel that pass samples, over 16 x 16 tiles in parallel; tiles not yet
+// started when an interrupt arrives are skipped.
+template <class F>
+void for_each_sampled_pixel(int width, int height, const RenderControl& control, int pass, F&& f) {
+  tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 16, 0, width, 16),
+                    [&](const tbb::blocked_range2d<int>& r) {
+                      if (interrupted()) return;
+                      for (int y = r.rows().begin(); y < r.rows().end(); ++y)
+                        for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                          uint32_t pixel = uint32_t(y) * uint32_t(width) + uint32_t(x);
+                          if (control.sample_pixel(pass, pixel)) f(pixel);
+                        }
+                    });
+}
+
+}  // namespace bpm

@@ -1,0 +1,32 @@
+#include "photons/settings.h"
+
+#include <cmath>
+#include <string>
+
+namespace bpm {
+
+float radius_scale(const PhotonSettings& s, int iteration) {
+  if (s.radius_policy == RadiusPolicy::kFixed) return 1;
+  // r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1), i counted from 1 (Knaus & Zwicker 2011, eq. 20).
+  double r2 = 1;
+  for (int i = 1; i <= iteration; ++i) r2 *= (i + double(s.alpha)) / (i + 1);
+  return float(std::sqrt(r2));
+}
+
+void read_photon_settings(const SceneEntity& in, PhotonSettings* s) {
+  const ParamSet& ps = in.params;
+  s->k0 = ps.get_float("k0", s->k0);
+  ps.require("k0", s->k0 > 0 && s->k0 < 1e4f, "must be positive", in.loc);
+  s->k1 = ps.get_float("k1", s->k1);
+  ps.require("k1", s->k1 > 0 && s->k1 < 1e4f, "must be positive", in.loc);
+  std::string policy = ps.get_string("radiuspolicy", to_string(s->radius_policy));
+  ps.require("radiuspolicy", policy == "fixed" || policy == "progressive",
+             "must be \"fixed\" or \"progressive\"", in.loc);
+  s->radius_policy = policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
+  s->alpha = ps.get_float("alpha", s->alpha);
+  ps.require("alpha", s->alpha > 0 && s->alpha < 1, "must be in (0, 1)", in.loc);
+  s->photons_per_batch = ps.get_int("photonsperbatch", s->photons_per_batch);
+  ps.require("photonsperbatch", s->photons_per_batch > 0, "must be positive", in.loc);
+}
+
+}  // namespace bpm

@@ -1,0 +1,36 @@
+// What both photon methods share in their settings: integration radii in pixel footprints, how
+// they shrink over iterations, photons per batch and the normal test. Filled from the scene file's
+// Integrator line and the command line, and printed in the run's JSON record.
+#pragma once
+#include "scene/parsed_scene.h"
+
+namespace bpm {
+
+enum class RadiusPolicy { kFixed, kProgressive };
+
+struct PhotonSettings {
+  // Integration radii in pixel footprints (the side of one pixel seen at the vertex): k0 for
+  // caustic photons before the last diffuse vertex (bpm) or in the caustic map (fpm), k1 for the
+  // last diffuse vertex (bpm) or the global map (fpm).
+  float k0 = 1, k1 = 3;
+  RadiusPolicy radius_policy = RadiusPolicy::kProgressive;
+  // Knaus & Zwicker 2011: r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1).
+  float alpha = 2.0f / 3.0f;
+  int photons_per_batch = 100000;  // per light-pass batch (bpm), per iteration (fpm)
+  // Photons count only where the normals of the photon's surface and of the gathering point agree
+  // to within this cosine.
+  float normal_cos = 0.5f;
+};
+
+inline const char* to_string(RadiusPolicy p) {
+  return p == RadiusPolicy::kFixed ? "fixed" : "progressive";
+}
+
+// Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.
+float radius_scale(const PhotonSettings& s, int iteration);
+
+// Reads k0, k1, radiuspolicy, alpha and photonsperbatch from an Integrator line; a bad value is an
+// error at its place in the file.
+void read_photon_settings(const SceneEntity& integrator, PhotonSettings* s);
+
+}  // namespace bpm
