@@ -85,24 +85,19 @@ void print_fpm_summary(const nlohmann::json& d) {
                st["light"].get<double>(), st["tree_build"].get<double>(), st["eye"].get<double>());
 }
 
-int run_render(const RenderArgs& a) {
-  auto t_start = Clock::now();
-  ParsedScene parsed = parse_scene_file(a.scene);
-  double t_parse = seconds_since(t_start);
+// --resolution WxH replaces the Film's resolution.
+void set_resolution(const std::string& resolution, FilmSettings* film) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 ||
+      h <= 0 || w > 65536 || h > 65536)
+    throw Error("--resolution must look like 640x480; got \"" + resolution + "\"");
+  film->width = w;
+  film->height = h;
+}
 
-  auto t1 = Clock::now();
-  LoadedScene ls = flatten_scene(parsed);
-  double t_build = seconds_since(t1);
-
-  if (!a.resolution.empty()) {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(a.resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
-        w <= 0 || h <= 0 || w > 65536 || h > 65536)
-      throw Error("--resolution must look like 640x480; got \"" + a.resolution + "\"");
-    ls.film.width = w;
-    ls.film.height = h;
-  }
+// The scene file's settings, each overridden by its flag where one was given.
+RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls) {
   RenderOptions opt;
   opt.integrator = a.integrator.empty() ? ls.render.integrator : a.integrator;
   opt.spp = a.spp > 0 ? a.spp : ls.render.spp;
@@ -132,39 +127,22 @@ int run_render(const RenderArgs& a) {
   if (a.final_gather) opt.fpm.final_gather = true;
   if (a.knn >= 0) opt.fpm.knn = a.knn;
 
-  std::string out = a.output;
-  if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
-  OutputPaths paths = output_paths(out);
-  // Fail before rendering when the output folder does not exist.
-  auto dir = std::filesystem::path(paths.exr).parent_path();
-  if (!dir.empty() && !std::filesystem::is_directory(dir))
-    throw Error("output folder \"" + dir.string() + "\" does not exist");
-
-  if (!a.quiet)
-    std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n", a.scene.c_str(),
-                 ls.scene.objects.size(), ls.scene.triangle_count(), ls.scene.lights.size(), ls.film.width,
-                 ls.film.height, opt.integrator.c_str());
   opt.accuracy = a.accuracy;
   if (a.accuracy > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // delta decides
   opt.adaptive = !a.no_adaptive;
   opt.adaptive_floor = a.adaptive_floor;
   opt.write_every_s = a.write_every;
-  install_interrupt_handlers();
-  Film film(ls.film.width, ls.film.height, a.m_images);
-  // Intermediate outputs: the images so far and a JSON record that says the render is running.
-  opt.checkpoint = [&](int passes) {
-    write_images(paths, film, ls.film.imaging_ratio);
-    nlohmann::json rec;
-    rec["scene"] = a.scene;
-    rec["settings"] = {{"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
-    rec["result"] = {{"passes", passes}, {"stop_reason", "running"}, {"relative_error_delta", film.relative_error()}};
-    write_text_atomic(paths.json, rec.dump(2) + "\n");
-  };
-  RenderStats st = render(ls, opt, &film);
+  return opt;
+}
 
-  auto t3 = Clock::now();
-  write_images(paths, film, ls.film.imaging_ratio);
-  double t_write = seconds_since(t3);
+struct StageSeconds {
+  double parse, build, write;
+};
+
+// The JSON record of a finished render: how the image was made and what it cost.
+nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt, const RenderStats& st,
+                          const Film& film, const OutputPaths& paths, StageSeconds t) {
+  double t_parse = t.parse, t_build = t.build, t_write = t.write;
   struct rusage ru;
   getrusage(RUSAGE_SELF, &ru);
   unsigned threads = opt.threads > 0 ? unsigned(opt.threads) : std::thread::hardware_concurrency();
@@ -212,6 +190,49 @@ int run_render(const RenderArgs& a) {
   rec["peak_memory_bytes"] = uint64_t(ru.ru_maxrss) * 1024;
   rec["outputs"] = {{"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
   rec["stages_s"] = {{"parse", t_parse}, {"build", t_build}, {"render", st.render_seconds}, {"write_images", t_write}};
+  return rec;
+}
+
+int run_render(const RenderArgs& a) {
+  auto t_start = Clock::now();
+  ParsedScene parsed = parse_scene_file(a.scene);
+  double t_parse = seconds_since(t_start);
+
+  auto t1 = Clock::now();
+  LoadedScene ls = flatten_scene(parsed);
+  double t_build = seconds_since(t1);
+
+  if (!a.resolution.empty()) set_resolution(a.resolution, &ls.film);
+  RenderOptions opt = render_options(a, ls);
+  std::string out = a.output;
+  if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
+  OutputPaths paths = output_paths(out);
+  // Fail before rendering when the output folder does not exist.
+  auto dir = std::filesystem::path(paths.exr).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir))
+    throw Error("output folder \"" + dir.string() + "\" does not exist");
+
+  if (!a.quiet)
+    std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n", a.scene.c_str(),
+                 ls.scene.objects.size(), ls.scene.triangle_count(), ls.scene.lights.size(), ls.film.width,
+                 ls.film.height, opt.integrator.c_str());
+  install_interrupt_handlers();
+  Film film(ls.film.width, ls.film.height, a.m_images);
+  // Intermediate outputs: the images so far and a JSON record that says the render is running.
+  opt.checkpoint = [&](int passes) {
+    write_images(paths, film, ls.film.imaging_ratio);
+    nlohmann::json rec;
+    rec["scene"] = a.scene;
+    rec["settings"] = {{"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
+    rec["result"] = {{"passes", passes}, {"stop_reason", "running"}, {"relative_error_delta", film.relative_error()}};
+    write_text_atomic(paths.json, rec.dump(2) + "\n");
+  };
+  RenderStats st = render(ls, opt, &film);
+
+  auto t3 = Clock::now();
+  write_images(paths, film, ls.film.imaging_ratio);
+  double t_write = seconds_since(t3);
+  nlohmann::json rec = run_record(a, ls, opt, st, film, paths, {t_parse, t_build, t_write});
   write_text_atomic(paths.json, rec.dump(2) + "\n");
   if (!a.quiet) {
     if (opt.integrator == "bpm") print_bpm_summary(st.details);

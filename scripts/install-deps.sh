@@ -9,7 +9,7 @@ packages=(
   libopenexr-dev libpng-dev libopenimageio-dev
   libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3
+  python3 clang-format
 )
 
 missing=()

@@ -49,12 +49,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    StepEnd end = next_vertex(scene, *prm.materials, s, v, counters.rays.bounce_rays, counters.rays.observer,
-                              [&](const Hit& hit, const SurfacePoint& sp) {
-                                L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
-                              });
-    if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
-    if (end != StepEnd::kVertex) break;
+    if (next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L) != StepEnd::kVertex) break;
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
     bool is_diffuse = !bsdf_is_specular(v.m());

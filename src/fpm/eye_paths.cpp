@@ -61,12 +61,7 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps, con
   ++c.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    StepEnd end = next_vertex(scene, *prm.materials, s, v, c.rays.bounce_rays, c.rays.observer,
-                              [&](const Hit& hit, const SurfacePoint& sp) {
-                                L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
-                              });
-    if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
-    if (end != StepEnd::kVertex) break;
+    if (next_eye_vertex(scene, *prm.materials, s, v, c.rays, emitter, L) != StepEnd::kVertex) break;
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
     if (!bsdf_is_specular(v.m())) {

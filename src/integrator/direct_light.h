@@ -4,6 +4,7 @@
 #pragma once
 #include "base/rng.h"
 #include "integrator/counters.h"
+#include "integrator/path_vertex.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -39,5 +40,20 @@ Spectrum weighted_surface_emission(const RenderScene& scene, const Ray& ray, con
 // weighted as w says.
 void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wavelengths& wl,
                               const Spectrum& beta, const EmitterWeight& w, Spectrum& L);
+
+// The next vertex of a camera path (next_vertex), adding to L the emission found on the way:
+// surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says.
+inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
+                               PathState& s, PathVertex& v, PathCounters& counters,
+                               const EmitterWeight& emitter, Spectrum& L) {
+  const Wavelengths& wl = materials.wl;
+  StepEnd end = next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
+                            [&](const Hit& hit, const SurfacePoint& sp) {
+                              L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta,
+                                                             emitter);
+                            });
+  if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
+  return end;
+}
 
 }  // namespace bpm

@@ -132,6 +132,22 @@ Spectrum light_intensity(const GoniometricLight& l, Vec3 w, const Wavelengths& w
   return l.intensity.sample(wl) * v;
 }
 
+// Photon emission of a point light whose image says where its light goes (goniometric,
+// projection): image coordinates drawn by the light's distribution, direction_light(uv) their
+// direction in the light's frame, flux(uv, direction, pdf_uv) the photon's flux.
+template <class L, class Direction, class Flux>
+std::optional<LightLeSample> sample_le_image_point(const L& l, Vec2 u_dir, Direction&& direction_light, Flux&& flux) {
+  LightLeSample s;
+  float pdf_uv = 0;
+  Vec2 uv = l.distribution.sample(u_dir, &pdf_uv);
+  if (!(pdf_uv > 0)) return std::nullopt;
+  s.origin = l.world_from_light.point(Vec3(0, 0, 0));
+  s.direction = normalize(l.world_from_light.vector(direction_light(uv)));
+  s.flux = flux(uv, s.direction, pdf_uv);
+  if (s.flux.is_black()) return std::nullopt;
+  return s;
+}
+
 std::optional<LightLiSample> sample_li_of(const GoniometricLight& l, const Shape*, Vec3 p_ref, Vec2,
                                           const SceneBoundsInfo&, const Wavelengths& wl) {
   return sample_li_directional_point(l, p_ref, wl);
@@ -139,15 +155,9 @@ std::optional<LightLiSample> sample_li_of(const GoniometricLight& l, const Shape
 
 std::optional<LightLeSample> sample_le_of(const GoniometricLight& l, const Shape*, Vec2, Vec2 u_dir,
                                           const SceneBoundsInfo&, const Wavelengths& wl) {
-  LightLeSample s;
-  float pdf_uv = 0;
-  Vec2 uv = l.distribution.sample(u_dir, &pdf_uv);
-  if (!(pdf_uv > 0)) return std::nullopt;
-  s.origin = l.world_from_light.point(Vec3(0, 0, 0));
-  s.direction = normalize(l.world_from_light.vector(swap_yz(equal_area_square_to_sphere(uv))));
-  s.flux = light_intensity(l, s.direction, wl) * (4 * kPi / pdf_uv);
-  if (s.flux.is_black()) return std::nullopt;
-  return s;
+  return sample_le_image_point(
+      l, u_dir, [&](Vec2 uv) { return swap_yz(equal_area_square_to_sphere(uv)); },
+      [&](Vec2, Vec3 direction, float pdf_uv) { return light_intensity(l, direction, wl) * (4 * kPi / pdf_uv); });
 }
 
 Rgb power_of(const GoniometricLight& l, const SceneBoundsInfo&) { return l.intensity.rgb() * (4 * kPi * l.mean_value); }
@@ -215,15 +225,11 @@ std::optional<LightLiSample> sample_li_of(const ProjectionLight& l, const Shape*
 
 std::optional<LightLeSample> sample_le_of(const ProjectionLight& l, const Shape*, Vec2, Vec2 u_dir,
                                           const SceneBoundsInfo&, const Wavelengths& wl) {
-  LightLeSample s;
-  float pdf_uv = 0;
-  Vec2 uv = l.distribution.sample(u_dir, &pdf_uv);
-  if (!(pdf_uv > 0)) return std::nullopt;
-  s.origin = l.world_from_light.point(Vec3(0, 0, 0));
-  s.direction = normalize(l.world_from_light.vector(projection_direction_light(l, uv)));
-  s.flux = illuminant_texel(projection_texel(l, uv), l.scale, wl) * (projection_solid_angle_per_area(l, uv) / pdf_uv);
-  if (s.flux.is_black()) return std::nullopt;
-  return s;
+  return sample_le_image_point(
+      l, u_dir, [&](Vec2 uv) { return projection_direction_light(l, uv); },
+      [&](Vec2 uv, Vec3, float pdf_uv) {
+        return illuminant_texel(projection_texel(l, uv), l.scale, wl) * (projection_solid_angle_per_area(l, uv) / pdf_uv);
+      });
 }
 
 Rgb power_of(const ProjectionLight& l, const SceneBoundsInfo&) { return l.power_rgb; }

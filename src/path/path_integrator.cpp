@@ -21,13 +21,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
   ++counters.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    StepEnd end = next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
-                              [&](const Hit& hit, const SurfacePoint& sp) {
-                                L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta,
-                                                               emitter);
-                              });
-    if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
-    if (end != StepEnd::kVertex) break;
+    if (next_eye_vertex(scene, materials, s, v, counters, emitter, L) != StepEnd::kVertex) break;
     if (depth++ == settings.max_depth) break;
     if (v.wo_local.z == 0) break;
     if (!bsdf_is_specular(v.m()))

@@ -125,6 +125,13 @@ class Parser {
     return v;
   }
 
+  // The type name, place and parameters of a directive that creates something.
+  void read_entity(const Token& d, const char* what, SceneEntity* e) {
+    e->name = expect_string(d, what);
+    e->loc = d.loc;
+    e->params = params();
+  }
+
   ParamSet params() {
     ParamSet ps;
     while (true) {
@@ -225,10 +232,21 @@ class Parser {
   // whichever file names it.
   std::string current_directory() const { return scene_->base_directory; }
 
+  // Each group below returns false, having consumed nothing, when `d` is not one of its
+  // directives, so directive() can try them in turn and still report an unknown keyword itself.
   void directive(const Token& d) {
     const std::string_view k = d.text;
     if (d.is_string() || k == "[" || k == "]")
       throw Error(d.loc, "expected a directive; got '" + std::string(k) + "'");
+    if (transform_directive(d) || graphics_state_directive(d) || render_option_directive(d) ||
+        entity_directive(d) || object_directive(d) || file_directive(d))
+      return;
+    throw Error(d.loc, "unknown directive '" + std::string(k) + "'");
+  }
+
+  // The current transformation matrix, the named coordinate systems and the orientation flag.
+  bool transform_directive(const Token& d) {
+    const std::string_view k = d.text;
     if (k == "Translate") {
       auto v = numbers(d, 3);
       apply_transform(Transform::translate(Vec3(v[0], v[1], v[2])), true);
@@ -273,19 +291,69 @@ class Parser {
       numbers(d, 2);
     } else if (k == "ReverseOrientation") {
       gs_.reverse_orientation = !gs_.reverse_orientation;
-    } else if (k == "AttributeBegin" || k == "TransformBegin") {
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  // The attribute stack and the material and media that later shapes and lights pick up.
+  bool graphics_state_directive(const Token& d) {
+    const std::string_view k = d.text;
+    if (k == "AttributeBegin" || k == "TransformBegin") {
       stack_.push_back({gs_, d.loc, k == "TransformBegin"});
     } else if (k == "AttributeEnd" || k == "TransformEnd") {
       if (stack_.empty()) throw Error(d.loc, std::string(k) + " without a matching begin");
       if (stack_.back().transform_only) gs_.ctm = stack_.back().state.ctm;
       else gs_ = stack_.back().state;
       stack_.pop_back();
-    } else if (k == "Camera") {
+    } else if (k == "Attribute") {
+      std::string target = expect_string(d, "a target");
+      ParamSet ps = params();
+      for (const Param& p : ps.all())
+        warning(p.loc, "Attribute \"" + target + "\" defaults are not supported; \"" + p.name + "\" was ignored");
+    } else if (k == "Material") {
+      require_world(d, true);
+      SceneEntity m{expect_string(d, "a material type"), {}, d.loc};
+      m.params = params();
+      scene_->materials.push_back(std::move(m));
+      gs_.material = {int(scene_->materials.size()) - 1, "", d.loc};
+    } else if (k == "MakeNamedMaterial") {
+      require_world(d, true);
+      std::string name = expect_string(d, "a material name");
+      ParamSet ps = params();
+      const Param* type = ps.find("type", "string");
+      if (!type) throw Error(d.loc, "MakeNamedMaterial \"" + name + "\" has no \"string type\"");
+      if (scene_->named_materials.count(name)) throw Error(d.loc, "named material \"" + name + "\" defined twice");
+      scene_->named_materials[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
+    } else if (k == "NamedMaterial") {
+      require_world(d, true);
+      gs_.material = {-1, expect_string(d, "a material name"), d.loc};
+    } else if (k == "MakeNamedMedium") {
+      std::string name = expect_string(d, "a medium name");
+      ParamSet ps = params();
+      const Param* type = ps.find("type", "string");
+      if (!type || type->strings.size() != 1) throw Error(d.loc, "medium \"" + name + "\" has no \"string type\"");
+      type->used = true;
+      scene_->media[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
+    } else if (k == "MediumInterface") {
+      std::string inside = expect_string(d, "a medium name");
+      std::string outside = inside;
+      if (auto t = peek_token(); t && t->is_string()) outside = next_token()->unquoted();
+      gs_.medium = MediumRef{inside, outside, d.loc};
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  // The camera, film, sampler and other whole-render settings, and WorldBegin that closes them.
+  bool render_option_directive(const Token& d) {
+    const std::string_view k = d.text;
+    if (k == "Camera") {
       require_world(d, false);
       CameraEntity c;
-      c.name = expect_string(d, "a camera type");
-      c.loc = d.loc;
-      c.params = params();
+      read_entity(d, "a camera type", &c);
       c.camera_from_world = gs_.ctm;
       c.medium = gs_.medium;
       coord_systems_["camera"] = gs_.ctm.inverse();
@@ -312,29 +380,16 @@ class Parser {
       coord_systems_["world"] = gs_.ctm;
     } else if (k == "WorldEnd") {
       // pbrt-v3 syntax; nothing to do.
-    } else if (k == "Attribute") {
-      std::string target = expect_string(d, "a target");
-      ParamSet ps = params();
-      for (const Param& p : ps.all())
-        warning(p.loc, "Attribute \"" + target + "\" defaults are not supported; \"" + p.name + "\" was ignored");
-    } else if (k == "Material") {
-      require_world(d, true);
-      SceneEntity m{expect_string(d, "a material type"), {}, d.loc};
-      m.params = params();
-      scene_->materials.push_back(std::move(m));
-      gs_.material = {int(scene_->materials.size()) - 1, "", d.loc};
-    } else if (k == "MakeNamedMaterial") {
-      require_world(d, true);
-      std::string name = expect_string(d, "a material name");
-      ParamSet ps = params();
-      const Param* type = ps.find("type", "string");
-      if (!type) throw Error(d.loc, "MakeNamedMaterial \"" + name + "\" has no \"string type\"");
-      if (scene_->named_materials.count(name)) throw Error(d.loc, "named material \"" + name + "\" defined twice");
-      scene_->named_materials[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
-    } else if (k == "NamedMaterial") {
-      require_world(d, true);
-      gs_.material = {-1, expect_string(d, "a material name"), d.loc};
-    } else if (k == "Texture") {
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  // Textures, lights and shapes, which take the graphics state as it stands now.
+  bool entity_directive(const Token& d) {
+    const std::string_view k = d.text;
+    if (k == "Texture") {
       require_world(d, true);
       TextureEntity t;
       t.texture_name = expect_string(d, "a texture name");
@@ -342,17 +397,13 @@ class Parser {
       if (t.value_type == "color") t.value_type = "spectrum";
       if (t.value_type != "float" && t.value_type != "spectrum")
         throw Error(d.loc, "texture type must be \"float\" or \"spectrum\"; got \"" + t.value_type + "\"");
-      t.name = expect_string(d, "a texture class");
-      t.loc = d.loc;
-      t.params = params();
+      read_entity(d, "a texture class", &t);
       t.world_from_texture = gs_.ctm;
       scene_->textures.push_back(std::move(t));
     } else if (k == "LightSource") {
       require_world(d, true);
       LightEntity l;
-      l.name = expect_string(d, "a light type");
-      l.loc = d.loc;
-      l.params = params();
+      read_entity(d, "a light type", &l);
       l.world_from_light = gs_.ctm;
       l.medium = gs_.medium;
       scene_->lights.push_back(std::move(l));
@@ -364,9 +415,7 @@ class Parser {
     } else if (k == "Shape") {
       require_world(d, true);
       ShapeEntity s;
-      s.name = expect_string(d, "a shape type");
-      s.loc = d.loc;
-      s.params = params();
+      read_entity(d, "a shape type", &s);
       s.world_from_object = gs_.ctm;
       s.reverse_orientation = gs_.reverse_orientation;
       s.material = gs_.material;
@@ -375,7 +424,17 @@ class Parser {
       s.medium = gs_.medium;
       if (object_name_) objects_[*object_name_].push_back(std::move(s));
       else scene_->shapes.push_back(std::move(s));
-    } else if (k == "ObjectBegin") {
+    } else {
+      return false;
+    }
+    return true;
+  }
+
+  // Object definitions collect shapes; each instance copies them into the scene under the
+  // transform in effect where it is placed.
+  bool object_directive(const Token& d) {
+    const std::string_view k = d.text;
+    if (k == "ObjectBegin") {
       require_world(d, true);
       if (object_name_) throw Error(d.loc, "ObjectBegin inside another ObjectBegin");
       object_name_ = expect_string(d, "an object name");
@@ -400,29 +459,24 @@ class Parser {
         copy.world_from_object = gs_.ctm * s.world_from_object;
         scene_->shapes.push_back(std::move(copy));
       }
-    } else if (k == "Include" || k == "Import") {
-      std::string file = expect_string(d, "a file name");
-      fs::path p = fs::path(file).is_absolute() ? fs::path(file) : fs::path(current_directory()) / file;
-      std::string ps = p.lexically_normal().string();
-      if (include_chain_.count(ps)) throw Error(d.loc, "file \"" + file + "\" includes itself");
-      if (peeked_) throw Error(d.loc, "internal: include with pending token");
-      include_chain_.insert(ps);
-      push_file(Tokenizer::from_file(ps, d.loc));
-    } else if (k == "MakeNamedMedium") {
-      std::string name = expect_string(d, "a medium name");
-      ParamSet ps = params();
-      const Param* type = ps.find("type", "string");
-      if (!type || type->strings.size() != 1) throw Error(d.loc, "medium \"" + name + "\" has no \"string type\"");
-      type->used = true;
-      scene_->media[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
-    } else if (k == "MediumInterface") {
-      std::string inside = expect_string(d, "a medium name");
-      std::string outside = inside;
-      if (auto t = peek_token(); t && t->is_string()) outside = next_token()->unquoted();
-      gs_.medium = MediumRef{inside, outside, d.loc};
     } else {
-      throw Error(d.loc, "unknown directive '" + std::string(k) + "'");
+      return false;
     }
+    return true;
+  }
+
+  // Include and Import are read alike: the named file's directives are parsed in place.
+  bool file_directive(const Token& d) {
+    const std::string_view k = d.text;
+    if (k != "Include" && k != "Import") return false;
+    std::string file = expect_string(d, "a file name");
+    fs::path p = fs::path(file).is_absolute() ? fs::path(file) : fs::path(current_directory()) / file;
+    std::string ps = p.lexically_normal().string();
+    if (include_chain_.count(ps)) throw Error(d.loc, "file \"" + file + "\" includes itself");
+    if (peeked_) throw Error(d.loc, "internal: include with pending token");
+    include_chain_.insert(ps);
+    push_file(Tokenizer::from_file(ps, d.loc));
+    return true;
   }
 };
 
