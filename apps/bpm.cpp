@@ -3,11 +3,11 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "base/error.h"
@@ -23,7 +23,9 @@ namespace {
 using namespace bpm;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 struct RenderArgs {
   std::string scene;
@@ -53,44 +55,50 @@ struct RenderArgs {
 // The bpm statistics a user wants to see at the end of a run (all of them are in the JSON).
 void print_bpm_summary(const nlohmann::json& d) {
   const auto &eye = d["eye"], &light = d["light"], &maps = d["maps"], &st = d["stages_s"];
-  std::fprintf(stderr,
-               "bpm: eye: %.3g rays, %.3g backward photons (%.3f per eye path), %.2f Mrays/s\n"
-               "bpm: maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s, sphere duplication %.2f\n"
-               "bpm: light: %.3g photons, %.3g rays, %.2f Mrays/s, %.3g queries (%.2f M/s), %.1f batches/iteration, "
-               "coverage %.2f\n"
-               "bpm: stages: eye %.2f s, trees %.2f s, light %.2f + %.2f s, accumulate %.2f s\n",
-               double(eye["camera_rays"].get<uint64_t>() + eye["bounce_rays"].get<uint64_t>() +
-                      eye["shadow_rays"].get<uint64_t>()),
-               double(eye["backward_photons"].get<uint64_t>()), eye["backward_photons_per_backward_ray"].get<double>(),
-               eye["rays_per_second"].get<double>() * 1e-6, maps["peak_photon_bytes"].get<double>() * 1e-6,
-               maps["peak_tree_bytes"].get<double>() * 1e-6, maps["tree_build_s"].get<double>(),
-               maps["mean_sphere_duplication"].get<double>(), double(light["photons"].get<uint64_t>()),
-               double(light["light_rays"].get<uint64_t>()), light["rays_per_second"].get<double>() * 1e-6,
-               double(light["queries"].get<uint64_t>()), light["queries_per_second"].get<double>() * 1e-6,
-               light["batches_per_iteration"].get<double>(), light["coverage_mean"].get<double>(),
-               st["eye"].get<double>(), st["tree_build"].get<double>(), st["light_trace"].get<double>(),
-               st["light_apply"].get<double>(), st["accumulate"].get<double>());
+  std::fprintf(
+      stderr,
+      "bpm: eye: %.3g rays, %.3g backward photons (%.3f per eye path), %.2f Mrays/s\n"
+      "bpm: maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s, sphere duplication %.2f\n"
+      "bpm: light: %.3g photons, %.3g rays, %.2f Mrays/s, %.3g queries (%.2f M/s), %.1f "
+      "batches/iteration, "
+      "coverage %.2f\n"
+      "bpm: stages: eye %.2f s, trees %.2f s, light %.2f + %.2f s, accumulate %.2f s\n",
+      double(eye["camera_rays"].get<uint64_t>() + eye["bounce_rays"].get<uint64_t>() +
+             eye["shadow_rays"].get<uint64_t>()),
+      double(eye["backward_photons"].get<uint64_t>()),
+      eye["backward_photons_per_backward_ray"].get<double>(),
+      eye["rays_per_second"].get<double>() * 1e-6, maps["peak_photon_bytes"].get<double>() * 1e-6,
+      maps["peak_tree_bytes"].get<double>() * 1e-6, maps["tree_build_s"].get<double>(),
+      maps["mean_sphere_duplication"].get<double>(), double(light["photons"].get<uint64_t>()),
+      double(light["light_rays"].get<uint64_t>()), light["rays_per_second"].get<double>() * 1e-6,
+      double(light["queries"].get<uint64_t>()), light["queries_per_second"].get<double>() * 1e-6,
+      light["batches_per_iteration"].get<double>(), light["coverage_mean"].get<double>(),
+      st["eye"].get<double>(), st["tree_build"].get<double>(), st["light_trace"].get<double>(),
+      st["light_apply"].get<double>(), st["accumulate"].get<double>());
 }
 
 void print_fpm_summary(const nlohmann::json& d) {
   const auto &light = d["light"], &maps = d["maps"], &st = d["stages_s"];
-  std::fprintf(stderr,
-               "bpm: fpm light: %.3g photons, %.3g rays, %.3g photons stored (%.3f per photon path, a forward ray), %.2f Mrays/s\n"
-               "bpm: fpm maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s\n"
-               "bpm: fpm stages: light %.2f s, trees %.2f s, eye %.2f s\n",
-               double(light["photons"].get<uint64_t>()), double(light["light_rays"].get<uint64_t>()),
-               double(light["photons_stored"].get<uint64_t>()), light["photons_per_forward_ray"].get<double>(),
-               light["rays_per_second"].get<double>() * 1e-6, maps["peak_photon_bytes"].get<double>() * 1e-6,
-               maps["peak_tree_bytes"].get<double>() * 1e-6, maps["tree_build_s"].get<double>(),
-               st["light"].get<double>(), st["tree_build"].get<double>(), st["eye"].get<double>());
+  std::fprintf(
+      stderr,
+      "bpm: fpm light: %.3g photons, %.3g rays, %.3g photons stored (%.3f per photon path, a "
+      "forward ray), %.2f Mrays/s\n"
+      "bpm: fpm maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s\n"
+      "bpm: fpm stages: light %.2f s, trees %.2f s, eye %.2f s\n",
+      double(light["photons"].get<uint64_t>()), double(light["light_rays"].get<uint64_t>()),
+      double(light["photons_stored"].get<uint64_t>()),
+      light["photons_per_forward_ray"].get<double>(), light["rays_per_second"].get<double>() * 1e-6,
+      maps["peak_photon_bytes"].get<double>() * 1e-6, maps["peak_tree_bytes"].get<double>() * 1e-6,
+      maps["tree_build_s"].get<double>(), st["light"].get<double>(), st["tree_build"].get<double>(),
+      st["eye"].get<double>());
 }
 
 // --resolution WxH replaces the Film's resolution.
 void set_resolution(const std::string& resolution, FilmSettings* film) {
   int w = 0, h = 0;
   char x = 0, extra = 0;
-  if (std::sscanf(resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 ||
-      h <= 0 || w > 65536 || h > 65536)
+  if (std::sscanf(resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
+      (x != 'x' && x != 'X') || w <= 0 || h <= 0 || w > 65536 || h > 65536)
     throw Error("--resolution must look like 640x480; got \"" + resolution + "\"");
   film->width = w;
   film->height = h;
@@ -107,7 +115,8 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls) {
   opt.max_depth = a.max_depth >= 0 ? a.max_depth : ls.render.max_depth;
   opt.progress = !a.quiet;
   if (a.iterations > 0) opt.spp = a.iterations;  // one eye sample per pixel per iteration
-  if (a.time > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // the time budget decides
+  if (a.time > 0 && a.spp <= 0 && a.iterations <= 0)
+    opt.spp = std::numeric_limits<int>::max();  // the time budget decides
   opt.bpm = bpm_settings_from_file(ls.render.integrator_directive);
   opt.fpm = fpm_settings_from_file(ls.render.integrator_directive);
   // Both photon methods read the same photon parameters from an Integrator line of either.
@@ -116,19 +125,22 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls) {
   if (a.coverage >= 0) opt.bpm.coverage = a.coverage;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
   if (a.max_batches > 0) opt.bpm.max_batches = a.max_batches;
-  for (PhotonSettings* p : {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
+  for (PhotonSettings* p :
+       {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
     if (a.k0 > 0) p->k0 = a.k0;
     if (a.k1 > 0) p->k1 = a.k1;
     if (a.alpha > 0) p->alpha = a.alpha;
     if (!a.radius_policy.empty())
-      p->radius_policy = a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
+      p->radius_policy =
+          a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
     if (a.photons_per_batch > 0) p->photons_per_batch = a.photons_per_batch;
   }
   if (a.final_gather) opt.fpm.final_gather = true;
   if (a.knn >= 0) opt.fpm.knn = a.knn;
 
   opt.accuracy = a.accuracy;
-  if (a.accuracy > 0 && a.spp <= 0 && a.iterations <= 0) opt.spp = std::numeric_limits<int>::max();  // delta decides
+  if (a.accuracy > 0 && a.spp <= 0 && a.iterations <= 0)
+    opt.spp = std::numeric_limits<int>::max();  // delta decides
   opt.adaptive = !a.no_adaptive;
   opt.adaptive_floor = a.adaptive_floor;
   opt.write_every_s = a.write_every;
@@ -140,8 +152,9 @@ struct StageSeconds {
 };
 
 // The JSON record of a finished render: how the image was made and what it cost.
-nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt, const RenderStats& st,
-                          const Film& film, const OutputPaths& paths, StageSeconds t) {
+nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt,
+                          const RenderStats& st, const Film& film, const OutputPaths& paths,
+                          StageSeconds t) {
   double t_parse = t.parse, t_build = t.build, t_write = t.write;
   struct rusage ru;
   getrusage(RUSAGE_SELF, &ru);
@@ -176,20 +189,25 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                    {"relative_error_delta", st.relative_error},
                    {"m_images", film.m_images()},
                    {"relative_error_delta_m_images", film.relative_error_m_images()}};
-  rec["rays"] = {{"camera", st.rays.camera_rays},
-                 {"bounce", st.rays.bounce_rays},
-                 {"shadow", st.rays.shadow_rays},
-                 {"light", st.light_rays},
-                 {"total", st.total_rays()},
-                 {"per_second", st.render_seconds > 0 ? double(st.total_rays()) / st.render_seconds : 0.0}};
+  rec["rays"] = {
+      {"camera", st.rays.camera_rays},
+      {"bounce", st.rays.bounce_rays},
+      {"shadow", st.rays.shadow_rays},
+      {"light", st.light_rays},
+      {"total", st.total_rays()},
+      {"per_second", st.render_seconds > 0 ? double(st.total_rays()) / st.render_seconds : 0.0}};
   rec["scene_stats"] = {{"objects", ls.scene.objects.size()},
                         {"triangles", ls.scene.triangle_count()},
                         {"lights", ls.scene.lights.size()},
                         {"materials", ls.scene.materials.size()},
                         {"warnings", warning_count()}};
   rec["peak_memory_bytes"] = uint64_t(ru.ru_maxrss) * 1024;
-  rec["outputs"] = {{"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
-  rec["stages_s"] = {{"parse", t_parse}, {"build", t_build}, {"render", st.render_seconds}, {"write_images", t_write}};
+  rec["outputs"] = {
+      {"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
+  rec["stages_s"] = {{"parse", t_parse},
+                     {"build", t_build},
+                     {"render", st.render_seconds},
+                     {"write_images", t_write}};
   return rec;
 }
 
@@ -213,9 +231,9 @@ int run_render(const RenderArgs& a) {
     throw Error("output folder \"" + dir.string() + "\" does not exist");
 
   if (!a.quiet)
-    std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n", a.scene.c_str(),
-                 ls.scene.objects.size(), ls.scene.triangle_count(), ls.scene.lights.size(), ls.film.width,
-                 ls.film.height, opt.integrator.c_str());
+    std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n",
+                 a.scene.c_str(), ls.scene.objects.size(), ls.scene.triangle_count(),
+                 ls.scene.lights.size(), ls.film.width, ls.film.height, opt.integrator.c_str());
   install_interrupt_handlers();
   Film film(ls.film.width, ls.film.height, a.m_images);
   // Intermediate outputs: the images so far and a JSON record that says the render is running.
@@ -223,8 +241,11 @@ int run_render(const RenderArgs& a) {
     write_images(paths, film, ls.film.imaging_ratio);
     nlohmann::json rec;
     rec["scene"] = a.scene;
-    rec["settings"] = {{"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
-    rec["result"] = {{"passes", passes}, {"stop_reason", "running"}, {"relative_error_delta", film.relative_error()}};
+    rec["settings"] = {
+        {"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
+    rec["result"] = {{"passes", passes},
+                     {"stop_reason", "running"},
+                     {"relative_error_delta", film.relative_error()}};
     write_text_atomic(paths.json, rec.dump(2) + "\n");
   };
   RenderStats st = render(ls, opt, &film);
@@ -238,9 +259,10 @@ int run_render(const RenderArgs& a) {
     if (opt.integrator == "bpm") print_bpm_summary(st.details);
     if (opt.integrator == "fpm") print_fpm_summary(st.details);
     std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f -> %s\n", st.passes,
-                 opt.integrator == "path" ? "spp" : "iterations", st.render_seconds, st.stop_reason.c_str(),
-                 st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0, st.relative_error,
-                 paths.exr.c_str());
+                 opt.integrator == "path" ? "spp" : "iterations", st.render_seconds,
+                 st.stop_reason.c_str(),
+                 st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0,
+                 st.relative_error, paths.exr.c_str());
   }
   return st.stop_reason == "interrupted" ? 130 : 0;
 }
@@ -248,14 +270,17 @@ int run_render(const RenderArgs& a) {
 int run_compare(const std::string& a_path, const std::string& b_path) {
   Image a = read_exr(a_path), b = read_exr(b_path);
   if (a.width != b.width || a.height != b.height)
-    throw Error("images differ in size: " + std::to_string(a.width) + "x" + std::to_string(a.height) + " vs " +
-                std::to_string(b.width) + "x" + std::to_string(b.height));
+    throw Error("images differ in size: " + std::to_string(a.width) + "x" +
+                std::to_string(a.height) + " vs " + std::to_string(b.width) + "x" +
+                std::to_string(b.height));
   ImageComparison c = compare_images(a, b);
   const auto &ma = c.mean_a, &mb = c.mean_b;
   std::printf("mean A      %.6f %.6f %.6f\n", ma[0], ma[1], ma[2]);
   std::printf("mean B      %.6f %.6f %.6f\n", mb[0], mb[1], mb[2]);
-  std::printf("mean A/B-1  %+.4f %+.4f %+.4f\n", ma[0] / mb[0] - 1, ma[1] / mb[1] - 1, ma[2] / mb[2] - 1);
-  std::printf("relMSE      %.6f   (mean over pixels and channels of (a-b)^2/(b^2+0.01))\n", c.rel_mse);
+  std::printf("mean A/B-1  %+.4f %+.4f %+.4f\n", ma[0] / mb[0] - 1, ma[1] / mb[1] - 1,
+              ma[2] / mb[2] - 1);
+  std::printf("relMSE      %.6f   (mean over pixels and channels of (a-b)^2/(b^2+0.01))\n",
+              c.rel_mse);
   return 0;
 }
 
@@ -265,66 +290,117 @@ int main(int argc, char** argv) {
   CLI::App app{"bpm: physically based rendering with backward photon maps; reads pbrt-v4 scenes"};
   app.require_subcommand(1);
   RenderArgs ra;
-  CLI::App* render = app.add_subcommand("render", "Render a pbrt-v4 scene to EXR, PNG, error PNG and JSON");
+  CLI::App* render =
+      app.add_subcommand("render", "Render a pbrt-v4 scene to EXR, PNG, error PNG and JSON");
   render->add_option("scene", ra.scene, "Scene file (.pbrt)")->required();
-  render->add_option("--integrator", ra.integrator, "Integrator: path, bpm or fpm; default: the scene file's")
+  render
+      ->add_option("--integrator", ra.integrator,
+                   "Integrator: path, bpm or fpm; default: the scene file's")
       ->check(CLI::IsMember({"path", "bpm", "fpm"}));
   render->add_option("--spp", ra.spp, "Samples per pixel; default: the scene file's pixelsamples")
       ->check(CLI::Range(1, 1 << 24));
-  render->add_option("--time", ra.time, "Time budget in seconds (stops after the pass that exceeds it)")
+  render
+      ->add_option("--time", ra.time,
+                   "Time budget in seconds (stops after the pass that exceeds it)")
       ->check(CLI::Range(0.0, 1e9));
   render->add_option("--resolution", ra.resolution, "Image size WxH; default: the scene file's");
-  render->add_option("--threads", ra.threads, "Worker threads; default: all cores")->check(CLI::Range(1, 4096));
-  render->add_option("--seed", ra.seed, "Random seed; default: the sampler's seed in the file, else 0")
+  render->add_option("--threads", ra.threads, "Worker threads; default: all cores")
+      ->check(CLI::Range(1, 4096));
+  render
+      ->add_option("--seed", ra.seed,
+                   "Random seed; default: the sampler's seed in the file, else 0")
       ->check(CLI::Range(int64_t(0), int64_t(1) << 62));
-  render->add_option("--maxdepth", ra.max_depth, "Maximum scattering events; default: the file's maxdepth (5)")
+  render
+      ->add_option("--maxdepth", ra.max_depth,
+                   "Maximum scattering events; default: the file's maxdepth (5)")
       ->check(CLI::Range(0, 100000));
-  render->add_option("-o,--output", ra.output, "Output EXR; PNG, .error.png and .json are written beside it");
+  render->add_option("-o,--output", ra.output,
+                     "Output EXR; PNG, .error.png and .json are written beside it");
   render->add_flag("-q,--quiet", ra.quiet, "No progress output");
-  render->add_option("--accuracy", ra.accuracy,
-                     "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
+  render
+      ->add_option(
+          "--accuracy", ra.accuracy,
+          "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
       ->check(CLI::Range(1e-6, 1.0));
   render->add_flag("--no-adaptive", ra.no_adaptive,
-                   "Sample every pixel in every pass (by default pixels with a larger relative error get more passes)");
-  render->add_option("--adaptive-floor", ra.adaptive_floor,
-                     "Lowest probability of sampling a pixel in a pass under adaptive sampling (default 0.1)")
+                   "Sample every pixel in every pass (by default pixels with a larger relative "
+                   "error get more passes)");
+  render
+      ->add_option(
+          "--adaptive-floor", ra.adaptive_floor,
+          "Lowest probability of sampling a pixel in a pass under adaptive sampling (default 0.1)")
       ->check(CLI::Range(0.01, 1.0));
-  render->add_option("--m-images", ra.m_images,
-                     "Also estimate the error from M intermediate images (pass j to image j mod M; 0: off; default 4)")
+  render
+      ->add_option("--m-images", ra.m_images,
+                   "Also estimate the error from M intermediate images (pass j to image j mod M; "
+                   "0: off; default 4)")
       ->check(CLI::Range(0, 64));
-  render->add_option("--write-every", ra.write_every, "Write the outputs so far every SECONDS (atomically)")
+  render
+      ->add_option("--write-every", ra.write_every,
+                   "Write the outputs so far every SECONDS (atomically)")
       ->check(CLI::Range(0.1, 1e9));
-  render->add_option("--iterations", ra.iterations,
-                     "Iterations (each one eye sample per pixel and a photon pass); same as --spp")
+  render
+      ->add_option("--iterations", ra.iterations,
+                   "Iterations (each one eye sample per pixel and a photon pass); same as --spp")
       ->check(CLI::Range(1, 1 << 24));
   const char* g = "Backward photon mapping (--integrator bpm)";
-  render->add_option("--diffuse-depth", ra.diffuse_depth, "Diffuse vertices before the last backward photon (0..3; default 1)")
-      ->check(CLI::Range(0, 3))->group(g);
-  render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")->check(CLI::Range(1e-4, 1e4))->group(g);
-  render->add_option("--k1", ra.k1, "Radius at the last diffuse vertex in pixel footprints (default 3)")
-      ->check(CLI::Range(1e-4, 1e4))->group(g);
-  render->add_option("--radius-policy", ra.radius_policy, "fixed, or progressive shrinking (default)")
-      ->check(CLI::IsMember({"fixed", "progressive"}))->group(g);
-  render->add_option("--alpha", ra.alpha, "Progressive radius alpha: r2 *= (i+alpha)/(i+1) (default 2/3)")
-      ->check(CLI::Range(1e-3, 0.999))->group(g);
-  render->add_option("--photons-per-batch", ra.photons_per_batch, "Photons per light-pass batch (default 100000)")
-      ->check(CLI::Range(1, 1 << 30))->group(g);
-  render->add_option("--coverage", ra.coverage,
-                     "Fraction of last-vertex backward photons hit that ends the photon phase (default 0.9)")
-      ->check(CLI::Range(0.0, 1.0))->group(g);
-  render->add_option("--max-batches", ra.max_batches, "Cap on photon batches per iteration (default 16)")
-      ->check(CLI::Range(1, 1 << 20))->group(g);
+  render
+      ->add_option("--diffuse-depth", ra.diffuse_depth,
+                   "Diffuse vertices before the last backward photon (0..3; default 1)")
+      ->check(CLI::Range(0, 3))
+      ->group(g);
+  render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")
+      ->check(CLI::Range(1e-4, 1e4))
+      ->group(g);
+  render
+      ->add_option("--k1", ra.k1,
+                   "Radius at the last diffuse vertex in pixel footprints (default 3)")
+      ->check(CLI::Range(1e-4, 1e4))
+      ->group(g);
+  render
+      ->add_option("--radius-policy", ra.radius_policy, "fixed, or progressive shrinking (default)")
+      ->check(CLI::IsMember({"fixed", "progressive"}))
+      ->group(g);
+  render
+      ->add_option("--alpha", ra.alpha,
+                   "Progressive radius alpha: r2 *= (i+alpha)/(i+1) (default 2/3)")
+      ->check(CLI::Range(1e-3, 0.999))
+      ->group(g);
+  render
+      ->add_option("--photons-per-batch", ra.photons_per_batch,
+                   "Photons per light-pass batch (default 100000)")
+      ->check(CLI::Range(1, 1 << 30))
+      ->group(g);
+  render
+      ->add_option(
+          "--coverage", ra.coverage,
+          "Fraction of last-vertex backward photons hit that ends the photon phase (default 0.9)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->group(g);
+  render
+      ->add_option("--max-batches", ra.max_batches,
+                   "Cap on photon batches per iteration (default 16)")
+      ->check(CLI::Range(1, 1 << 20))
+      ->group(g);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
-      ->check(CLI::IsMember({"spheres", "centres"}))->group(g);
-  const char* gf = "Forward photon mapping (--integrator fpm; also uses --k0, --k1, --radius-policy, --alpha, "
-                   "--photons-per-batch as photons per iteration)";
-  render->add_flag("--final-gather", ra.final_gather, "Read indirect light one diffuse bounce after the first hit")
+      ->check(CLI::IsMember({"spheres", "centres"}))
+      ->group(g);
+  const char* gf =
+      "Forward photon mapping (--integrator fpm; also uses --k0, --k1, --radius-policy, --alpha, "
+      "--photons-per-batch as photons per iteration)";
+  render
+      ->add_flag("--final-gather", ra.final_gather,
+                 "Read indirect light one diffuse bounce after the first hit")
       ->group(gf);
-  render->add_option("--knn", ra.knn, "Radius from the N nearest photons, capped by the k1 radius (0: off)")
-      ->check(CLI::Range(0, 100000))->group(gf);
+  render
+      ->add_option("--knn", ra.knn,
+                   "Radius from the N nearest photons, capped by the k1 radius (0: off)")
+      ->check(CLI::Range(0, 100000))
+      ->group(gf);
 
   std::string cmp_a, cmp_b;
-  CLI::App* compare = app.add_subcommand("compare", "Compare two EXR images (channel means, relative MSE)");
+  CLI::App* compare =
+      app.add_subcommand("compare", "Compare two EXR images (channel means, relative MSE)");
   compare->add_option("a", cmp_a, "Image to test")->required()->check(CLI::ExistingFile);
   compare->add_option("b", cmp_b, "Reference image")->required()->check(CLI::ExistingFile);
 

@@ -4,9 +4,9 @@
 //   accuracy [--res WxH] [--passes N] [--reference-passes N] [--target DELTA]
 //
 // The measured noise part comes from two renders with different seeds, a and b:
-// sum (a - b)^2 / 2 estimates sum Var, whatever the bias, so noise = sqrt(sum (a-b)^2 / 2 / sum ref^2).
-// The total error is measured against a path-traced reference with its own seed; the bias part is
-// what the total has beyond the noise of the render and of the reference.
+// sum (a - b)^2 / 2 estimates sum Var, whatever the bias, so noise = sqrt(sum (a-b)^2 / 2 / sum
+// ref^2). The total error is measured against a path-traced reference with its own seed; the bias
+// part is what the total has beyond the noise of the render and of the reference.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -32,8 +32,8 @@ struct Rendered {
   RenderStats stats;
 };
 
-Rendered run(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed, double accuracy = 0,
-             bool adaptive = false) {
+Rendered run(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed,
+             double accuracy = 0, bool adaptive = false) {
   Rendered r{Film(ls.film.width, ls.film.height, 4), {}};
   RenderOptions opt = quiet_options(ls, integrator, passes, seed);
   opt.accuracy = accuracy;
@@ -52,17 +52,22 @@ int main(int argc, char** argv) {
   double target = 0.05;
   for (int i = 1; i < argc; ++i) {
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (!std::strcmp(argv[i], "--res")) std::sscanf(next().c_str(), "%dx%d", &w, &h);
-    else if (!std::strcmp(argv[i], "--passes")) passes = std::atoi(next().c_str());
-    else if (!std::strcmp(argv[i], "--reference-passes")) ref_passes = std::atoi(next().c_str());
-    else if (!std::strcmp(argv[i], "--target")) target = std::atof(next().c_str());
+    if (!std::strcmp(argv[i], "--res"))
+      std::sscanf(next().c_str(), "%dx%d", &w, &h);
+    else if (!std::strcmp(argv[i], "--passes"))
+      passes = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--reference-passes"))
+      ref_passes = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--target"))
+      target = std::atof(next().c_str());
   }
-  std::printf("== predicted against measured error, %dx%d, %d passes, reference: path %d spp ==\n", w, h, passes,
-              ref_passes);
-  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5", "delta M=4", "noise", "ratio",
-              "total", "bias");
+  std::printf("== predicted against measured error, %dx%d, %d passes, reference: path %d spp ==\n",
+              w, h, passes, ref_passes);
+  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5", "delta M=4",
+              "noise", "ratio", "total", "bias");
   for (const char* name : {"cornell-box", "caustic-sphere"}) {
-    LoadedScene ls = flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/" + name + ".pbrt"));
+    LoadedScene ls =
+        flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/" + name + ".pbrt"));
     ls.film.width = w;
     ls.film.height = h;
     Rendered ref = run(ls, "path", ref_passes, 0x5eed);
@@ -80,26 +85,32 @@ int main(int argc, char** argv) {
         d_ar += (la[i] - lr[i]) * (la[i] - lr[i]);
       }
       double noise = std::sqrt(d_ab / 2 / ref_sum2), total = std::sqrt(d_ar / ref_sum2);
-      double bias = std::sqrt(std::fmax(0.0, total * total - noise * noise - ref_delta * ref_delta));
+      double bias =
+          std::sqrt(std::fmax(0.0, total * total - noise * noise - ref_delta * ref_delta));
       double pred = a.film.relative_error();
       std::printf("%-16s %-5s %10.4f %10.4f %10.4f %10.2f %10.4f %10.4f\n", name, integrator, pred,
                   a.film.relative_error_m_images(), noise, pred / noise, total, bias);
     }
   }
-  std::printf("(ratio: predicted delta over measured noise; total: against the reference; bias: total beyond\n"
-              " the noise of the render and of the reference, %s)\n\n",
-              "whose own delta is subtracted");
+  std::printf(
+      "(ratio: predicted delta over measured noise; total: against the reference; bias: total "
+      "beyond\n"
+      " the noise of the render and of the reference, %s)\n\n",
+      "whose own delta is subtracted");
 
   std::printf("== rays to reach delta %.3g on the caustic scene, %dx%d ==\n", target, w, h);
-  LoadedScene ls = flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/caustic-sphere.pbrt"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/caustic-sphere.pbrt"));
   ls.film.width = w;
   ls.film.height = h;
-  std::printf("%-6s %-9s %12s %10s %10s %10s\n", "", "adaptive", "rays", "passes", "seconds", "delta");
+  std::printf("%-6s %-9s %12s %10s %10s %10s\n", "", "adaptive", "rays", "passes", "seconds",
+              "delta");
   for (const char* integrator : {"path", "bpm"})
     for (bool adaptive : {false, true}) {
       Rendered r = run(ls, integrator, std::numeric_limits<int>::max(), 3, target, adaptive);
       std::printf("%-6s %-9s %12.4g %10d %10.2f %10.4f\n", integrator, adaptive ? "yes" : "no",
-                  double(r.stats.total_rays()), r.stats.passes, r.stats.render_seconds, r.stats.relative_error);
+                  double(r.stats.total_rays()), r.stats.passes, r.stats.render_seconds,
+                  r.stats.relative_error);
     }
   return 0;
 }

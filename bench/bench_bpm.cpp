@@ -31,10 +31,8 @@ using namespace bpm;
 
 namespace {
 
-
-
-RenderStats run(const LoadedScene& ls, const std::string& integrator, int iterations, double time_s, int threads,
-                const BpmSettings& bs, Film* film, uint64_t seed = 1) {
+RenderStats run(const LoadedScene& ls, const std::string& integrator, int iterations, double time_s,
+                int threads, const BpmSettings& bs, Film* film, uint64_t seed = 1) {
   RenderOptions opt = quiet_options(ls, integrator, iterations, seed);
   opt.time_limit_s = time_s;
   opt.threads = threads;
@@ -66,9 +64,10 @@ double global_rel_mse(const Image& a, const Image& ref) {
 }
 
 void trees(const LoadedScene& ls, int iterations, int threads, const BpmSettings& base) {
-  std::printf("\n== sphere tree vs centre tree: %d iterations, %d threads ==\n", iterations, threads);
-  std::printf("%-8s %10s %12s %12s %14s %12s %10s\n", "tree", "build s", "tree MB", "queries", "queries/s (M)",
-              "light s", "dup");
+  std::printf("\n== sphere tree vs centre tree: %d iterations, %d threads ==\n", iterations,
+              threads);
+  std::printf("%-8s %10s %12s %12s %14s %12s %10s\n", "tree", "build s", "tree MB", "queries",
+              "queries/s (M)", "light s", "dup");
   Image images[2];
   for (int centres = 0; centres < 2; ++centres) {
     BpmSettings bs = base;
@@ -77,11 +76,14 @@ void trees(const LoadedScene& ls, int iterations, int threads, const BpmSettings
     RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
     images[centres] = film.image();
     const auto& d = st.details;
-    double light_s = d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+    double light_s =
+        d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
     std::printf("%-8s %10.3f %12.2f %12.3g %14.2f %12.3f %10.2f\n", centres ? "centres" : "spheres",
-                d["maps"]["tree_build_s"].get<double>(), d["maps"]["peak_tree_bytes"].get<double>() * 1e-6,
-                double(d["light"]["queries"].get<uint64_t>()), d["light"]["queries_per_second"].get<double>() * 1e-6,
-                light_s, d["maps"]["mean_sphere_duplication"].get<double>());
+                d["maps"]["tree_build_s"].get<double>(),
+                d["maps"]["peak_tree_bytes"].get<double>() * 1e-6,
+                double(d["light"]["queries"].get<uint64_t>()),
+                d["light"]["queries_per_second"].get<double>() * 1e-6, light_s,
+                d["maps"]["mean_sphere_duplication"].get<double>());
   }
   std::printf("images identical: %s\n", images[0].rgb == images[1].rgb ? "yes" : "NO");
 }
@@ -111,34 +113,40 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     lc.observer = &light_log;
     for (int k = 0; k < bs.photons_per_batch; ++k) {
       Rng rng(stream_key(98, 0, k));
-      trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos, {}}, owner, rng, out, lc);
+      trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos, {}},
+                   owner, rng, out, lc);
     }
   }
-  std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n", eye_log.closest_rays.size(),
-              eye_log.shadow_rays.size(), light_log.closest_rays.size());
+  std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n",
+              eye_log.closest_rays.size(), eye_log.shadow_rays.size(),
+              light_log.closest_rays.size());
   for (int threads : {1, hw}) {
     Film film(w, h);
     RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
     const auto& d = st.details;
     double eye_rate = d["eye"]["rays_per_second"].get<double>();
-    double light_s = d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+    double light_s =
+        d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
     double light_rate = double(d["light"]["light_rays"].get<uint64_t>()) / light_s;
-    double eye_embree = embree_replay(ls.scene, eye_log, threads), light_embree = embree_replay(ls.scene, light_log, threads);
-    std::printf("threads %2d: eye %.2f Mrays/s vs Embree %.2f (%.0f%% slower); light %.2f Mrays/s vs Embree %.2f "
-                "(%.0f%% slower)\n",
-                threads, eye_rate * 1e-6, eye_embree * 1e-6, 100 * (1 - eye_rate / eye_embree), light_rate * 1e-6,
-                light_embree * 1e-6, 100 * (1 - light_rate / light_embree));
+    double eye_embree = embree_replay(ls.scene, eye_log, threads),
+           light_embree = embree_replay(ls.scene, light_log, threads);
+    std::printf(
+        "threads %2d: eye %.2f Mrays/s vs Embree %.2f (%.0f%% slower); light %.2f Mrays/s vs "
+        "Embree %.2f "
+        "(%.0f%% slower)\n",
+        threads, eye_rate * 1e-6, eye_embree * 1e-6, 100 * (1 - eye_rate / eye_embree),
+        light_rate * 1e-6, light_embree * 1e-6, 100 * (1 - light_rate / light_embree));
     if (hw == 1) break;
   }
 }
 
-void equal_time(const LoadedScene& ls, const std::string& scene_path, const std::vector<double>& times,
-                double reference_s, const BpmSettings& bs) {
+void equal_time(const LoadedScene& ls, const std::string& scene_path,
+                const std::vector<double>& times, double reference_s, const BpmSettings& bs) {
   int w = ls.film.width, h = ls.film.height;
   std::printf("\n== equal time, %dx%d, against path run for %.0f s ==\n", w, h, reference_s);
   std::ostringstream name;
-  name << "bench_bpm_reference_" << std::filesystem::path(scene_path).stem().string() << "_" << w << "x" << h << "_"
-       << int(reference_s) << "s_path.exr";
+  name << "bench_bpm_reference_" << std::filesystem::path(scene_path).stem().string() << "_" << w
+       << "x" << h << "_" << int(reference_s) << "s_path.exr";
   std::string ref_path = name.str();
   Image ref;
   if (std::filesystem::exists(ref_path)) {
@@ -147,23 +155,26 @@ void equal_time(const LoadedScene& ls, const std::string& scene_path, const std:
   } else {
     Film film(w, h);
     // Its own seed: the timed path renders must not share its first samples.
-    RenderStats st = run(ls, "path", std::numeric_limits<int>::max(), reference_s, 0, bs, &film, 0x5eed);
+    RenderStats st =
+        run(ls, "path", std::numeric_limits<int>::max(), reference_s, 0, bs, &film, 0x5eed);
     ref = film.image();
     write_exr(ref_path, ref);
-    std::printf("reference: %s, %d spp, delta %.4f\n", ref_path.c_str(), st.passes, st.relative_error);
+    std::printf("reference: %s, %d spp, delta %.4f\n", ref_path.c_str(), st.passes,
+                st.relative_error);
   }
   std::printf("relMSE: mean of (a-ref)^2/(ref^2+0.01); global: sum (a-ref)^2 / sum ref^2\n");
-  std::printf("%7s %12s %12s %9s %13s %13s %9s %8s %8s\n", "time s", "path relMSE", "bpm relMSE", "path/bpm",
-              "path global", "bpm global", "path/bpm", "path spp", "bpm its");
+  std::printf("%7s %12s %12s %9s %13s %13s %9s %8s %8s\n", "time s", "path relMSE", "bpm relMSE",
+              "path/bpm", "path global", "bpm global", "path/bpm", "path spp", "bpm its");
   for (double t : times) {
     if (t <= 0) continue;
     Film fp(w, h), fb(w, h);
     RenderStats sp = run(ls, "path", std::numeric_limits<int>::max(), t, 0, bs, &fp);
     RenderStats sb = run(ls, "bpm", std::numeric_limits<int>::max(), t, 0, bs, &fb);
     Image ip = fp.image(), ib = fb.image();
-    double ep = rel_mse(ip, ref), eb = rel_mse(ib, ref), gp = global_rel_mse(ip, ref), gb = global_rel_mse(ib, ref);
-    std::printf("%7.0f %12.3e %12.3e %9.2f %13.3e %13.3e %9.2f %8d %8d\n", t, ep, eb, ep / eb, gp, gb, gp / gb,
-                sp.passes, sb.passes);
+    double ep = rel_mse(ip, ref), eb = rel_mse(ib, ref), gp = global_rel_mse(ip, ref),
+           gb = global_rel_mse(ib, ref);
+    std::printf("%7.0f %12.3e %12.3e %9.2f %13.3e %13.3e %9.2f %8d %8d\n", t, ep, eb, ep / eb, gp,
+                gb, gp / gb, sp.passes, sb.passes);
   }
 }
 
@@ -176,23 +187,30 @@ int main(int argc, char** argv) {
   std::vector<double> times = {30, 60};
   for (int i = 1; i < argc; ++i) {
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (!std::strcmp(argv[i], "--res")) std::sscanf(next().c_str(), "%dx%d", &w, &h);
-    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::atoi(next().c_str());
-    else if (!std::strcmp(argv[i], "--reference-time")) reference_s = std::atof(next().c_str());
-    else if (!std::strcmp(argv[i], "--only")) only = next();
+    if (!std::strcmp(argv[i], "--res"))
+      std::sscanf(next().c_str(), "%dx%d", &w, &h);
+    else if (!std::strcmp(argv[i], "--iterations"))
+      iterations = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--reference-time"))
+      reference_s = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--only"))
+      only = next();
     else if (!std::strcmp(argv[i], "--times")) {
       times.clear();
       std::stringstream ss(next());
       for (std::string t; std::getline(ss, t, ',');) times.push_back(std::atof(t.c_str()));
-    } else scene_path = argv[i];
+    } else
+      scene_path = argv[i];
   }
   LoadedScene ls = flatten_scene(parse_scene_file(scene_path));
   ls.film.width = w;
   ls.film.height = h;
   int hw = int(std::thread::hardware_concurrency());
   BpmSettings bs = bpm_settings_from_file(ls.render.integrator_directive);
-  std::printf("scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per batch\n",
-              scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1, bs.photons_per_batch);
+  std::printf(
+      "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per batch\n",
+      scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1,
+      bs.photons_per_batch);
   if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
   if (only.empty() || only == "rays") rays(ls, iterations, bs, hw);
   if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);

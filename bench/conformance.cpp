@@ -5,10 +5,10 @@
 // cannot render prints the error it reports. Prints figures; never fails.
 //   conformance [--shared DIR] [--spp N] [--width W]
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -40,7 +40,8 @@ std::optional<Reference> find_reference(const fs::path& dir, const std::string& 
     r.path = e.path();
     std::string prefix = scene + "-path-";
     if (name.rfind(prefix, 0) != 0 || e.path().extension() != ".exr") continue;
-    if (std::sscanf(name.c_str() + prefix.size(), "%dx%d-%dspp", &r.width, &r.height, &r.spp) != 3) continue;
+    if (std::sscanf(name.c_str() + prefix.size(), "%dx%d-%dspp", &r.width, &r.height, &r.spp) != 3)
+      continue;
     if (!best || r.spp > best->spp) best = r;
   }
   return best;
@@ -53,9 +54,12 @@ int main(int argc, char** argv) {
   int spp = 64, max_width = 200;
   for (int i = 1; i < argc; ++i) {
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (!std::strcmp(argv[i], "--shared")) shared = next();
-    else if (!std::strcmp(argv[i], "--spp")) spp = std::atoi(next().c_str());
-    else if (!std::strcmp(argv[i], "--width")) max_width = std::atoi(next().c_str());
+    if (!std::strcmp(argv[i], "--shared"))
+      shared = next();
+    else if (!std::strcmp(argv[i], "--spp"))
+      spp = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--width"))
+      max_width = std::atoi(next().c_str());
   }
   fs::path scenes = fs::path(shared) / "scenes";
   if (!fs::is_directory(scenes)) {
@@ -69,8 +73,11 @@ int main(int argc, char** argv) {
         if (f.path().extension() == ".pbrt") files.push_back(f.path());
   std::sort(files.begin(), files.end());
 
-  std::printf("path integrator, %d spp; references: pbrt-v4 renders in %s/references\n\n", spp, shared.c_str());
-  std::printf("| scene file | resolution | seconds | mean R G B | bpm / pbrt-v4 per channel | relMSE to pbrt-v4 |\n");
+  std::printf("path integrator, %d spp; references: pbrt-v4 renders in %s/references\n\n", spp,
+              shared.c_str());
+  std::printf(
+      "| scene file | resolution | seconds | mean R G B | bpm / pbrt-v4 per channel | relMSE to "
+      "pbrt-v4 |\n");
   std::printf("| --- | --- | --- | --- | --- | --- |\n");
   for (const fs::path& file : files) {
     std::string scene = file.parent_path().filename().string();
@@ -95,11 +102,13 @@ int main(int argc, char** argv) {
       double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       Image img = film.image(ls.film.imaging_ratio);
       auto m = channel_means(img);
-      std::printf("| %s | %dx%d | %.1f | %.4f %.4f %.4f |", label.c_str(), w, h, secs, m[0], m[1], m[2]);
+      std::printf("| %s | %dx%d | %.1f | %.4f %.4f %.4f |", label.c_str(), w, h, secs, m[0], m[1],
+                  m[2]);
       if (ref) {
         ImageComparison c = compare_images(img, read_exr(ref->path.string()));
         const auto& mr = c.mean_b;
-        std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2], c.rel_mse);
+        std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2],
+                    c.rel_mse);
       } else {
         std::printf(" no reference | |\n");
       }

@@ -47,21 +47,26 @@ int main(int argc, char** argv) {
   std::vector<std::string> only;
   for (int i = 1; i < argc; ++i) {
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (!std::strcmp(argv[i], "--res")) std::sscanf(next().c_str(), "%dx%d", &w, &h);
-    else if (!std::strcmp(argv[i], "--photons")) photons = std::atoi(next().c_str());
-    else if (!std::strcmp(argv[i], "--fpm-iterations")) fpm_iterations = std::atoi(next().c_str());
+    if (!std::strcmp(argv[i], "--res"))
+      std::sscanf(next().c_str(), "%dx%d", &w, &h);
+    else if (!std::strcmp(argv[i], "--photons"))
+      photons = std::atoi(next().c_str());
+    else if (!std::strcmp(argv[i], "--fpm-iterations"))
+      fpm_iterations = std::atoi(next().c_str());
     else if (!std::strcmp(argv[i], "--scenes")) {
       std::stringstream ss(next());
       for (std::string t; std::getline(ss, t, ',');) only.push_back(t);
     }
   }
-  std::printf("Table 1 at %dx%d; fpm: %d iterations of %d photons; bpm (D = 1): iterations until it has traced as "
-              "many rays\n\n",
-              w, h, fpm_iterations, photons);
-  std::printf("%-40s | %21s | %21s | %21s | %17s | %15s\n", "", "photons/forward ray", "photons/backward ray",
-              "reduction", "map MB fpm / bpm", "time s fpm/bpm");
-  std::printf("%-40s | %10s %10s | %10s %10s | %10s %10s | %17s | %15s\n", "scene", "ours", "paper", "ours", "paper",
-              "ours", "paper", "", "");
+  std::printf(
+      "Table 1 at %dx%d; fpm: %d iterations of %d photons; bpm (D = 1): iterations until it has "
+      "traced as "
+      "many rays\n\n",
+      w, h, fpm_iterations, photons);
+  std::printf("%-40s | %21s | %21s | %21s | %17s | %15s\n", "", "photons/forward ray",
+              "photons/backward ray", "reduction", "map MB fpm / bpm", "time s fpm/bpm");
+  std::printf("%-40s | %10s %10s | %10s %10s | %10s %10s | %17s | %15s\n", "scene", "ours", "paper",
+              "ours", "paper", "ours", "paper", "", "");
   for (const PaperRow& row : kPaper) {
     if (!only.empty() && std::find(only.begin(), only.end(), row.scene) == only.end()) continue;
     std::string path = std::string(BPM_SOURCE_DIR) + "/scenes/" + row.scene + ".pbrt";
@@ -98,12 +103,15 @@ int main(int argc, char** argv) {
       b.seconds += st.render_seconds;
     }
     double fr = double(f.photons) / double(f.paths), br = double(b.photons) / double(b.paths);
-    std::printf("%-40s | %10.2f %10.2f | %10.2f %10.2f | %10.2f %10.2f | %8.1f / %6.1f | %7.1f / %5.1f\n", row.label,
-                fr, row.forward, br, row.backward, fr / br, row.reduction, f.map_bytes * 1e-6, b.map_bytes * 1e-6,
-                f.seconds, b.seconds);
+    std::printf(
+        "%-40s | %10.2f %10.2f | %10.2f %10.2f | %10.2f %10.2f | %8.1f / %6.1f | %7.1f / %5.1f\n",
+        row.label, fr, row.forward, br, row.backward, fr / br, row.reduction, f.map_bytes * 1e-6,
+        b.map_bytes * 1e-6, f.seconds, b.seconds);
     std::fflush(stdout);
   }
-  std::printf("\nrays traced per scene: as many for bpm as for fpm (to within one iteration); map MB: peak bytes of\n"
-              "one iteration's photons (fpm: forward photons; bpm: backward photons), trees excluded.\n");
+  std::printf(
+      "\nrays traced per scene: as many for bpm as for fpm (to within one iteration); map MB: peak "
+      "bytes of\n"
+      "one iteration's photons (fpm: forward photons; bpm: backward photons), trees excluded.\n");
   return 0;
 }

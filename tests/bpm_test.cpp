@@ -39,16 +39,18 @@ struct RenderRun {
 };
 
 // Options for a quiet render of `ls` with the file's maxdepth.
-RenderOptions test_options(const LoadedScene& ls, const std::string& integrator, int passes, uint64_t seed = 1,
-                           const BpmSettings& bpm = {}, const FpmSettings& fpm = {}) {
+RenderOptions test_options(const LoadedScene& ls, const std::string& integrator, int passes,
+                           uint64_t seed = 1, const BpmSettings& bpm = {},
+                           const FpmSettings& fpm = {}) {
   RenderOptions opt = quiet_options(ls, integrator, passes, seed);
   opt.bpm = bpm;
   opt.fpm = fpm;
   return opt;
 }
 
-RenderRun render_with(const LoadedScene& ls, const std::string& integrator, int passes, int threads = 0, uint64_t seed = 1,
-                      BpmSettings bpm = {}, FpmSettings fpm = {}) {
+RenderRun render_with(const LoadedScene& ls, const std::string& integrator, int passes,
+                      int threads = 0, uint64_t seed = 1, BpmSettings bpm = {},
+                      FpmSettings fpm = {}) {
   RenderRun r{Film(ls.film.width, ls.film.height), {}};
   RenderOptions opt = test_options(ls, integrator, passes, seed, bpm, fpm);
   opt.threads = threads;
@@ -129,8 +131,8 @@ struct Iterations {
   }
 };
 
-Iterations render_iterations(const LoadedScene& ls, const std::string& integrator, int n, uint64_t seed,
-                             const BpmSettings& bpm, const FpmSettings& fpm = {}) {
+Iterations render_iterations(const LoadedScene& ls, const std::string& integrator, int n,
+                             uint64_t seed, const BpmSettings& bpm, const FpmSettings& fpm = {}) {
   Iterations out;
   for (int i = 0; i < n; ++i) {
     Film film(ls.film.width, ls.film.height);
@@ -144,7 +146,8 @@ Iterations render_iterations(const LoadedScene& ls, const std::string& integrato
 
 // Every block of the iterations' average agrees with the reference within 4.5 sigma plus
 // bias * mean(reference).
-void expect_blocks_agree(const Iterations& a, const Film& ref, int block, double bias, const std::string& what) {
+void expect_blocks_agree(const Iterations& a, const Film& ref, int block, double bias,
+                         const std::string& what) {
   auto sa = a.blocks(block), sb = block_stats(ref, block);
   ASSERT_EQ(sa.size(), sb.size());
   int n_lit = 0;
@@ -152,8 +155,8 @@ void expect_blocks_agree(const Iterations& a, const Film& ref, int block, double
     double diff = std::fabs(sa[i].mean - sb[i].mean);
     double sigma = std::sqrt(sa[i].var + sb[i].var);
     double tol = 4.5 * sigma + bias * sb[i].mean;
-    EXPECT_LE(diff, tol) << what << ": block " << i << " mean " << sa[i].mean << " vs reference " << sb[i].mean
-                         << " (sigma " << sigma << ")";
+    EXPECT_LE(diff, tol) << what << ": block " << i << " mean " << sa[i].mean << " vs reference "
+                         << sb[i].mean << " (sigma " << sigma << ")";
     n_lit += sb[i].mean > 0;
   }
   EXPECT_GT(n_lit, int(sa.size()) / 2) << what << ": the scene is mostly dark";
@@ -179,50 +182,62 @@ std::string quad(float x0, float z0, float x1, float z1, float y, bool down) {
   std::ostringstream s;
   // pbrt-v4 orientation: the normal is cross(p0 - p2, p1 - p2).
   if (down)
-    s << "\"point3 P\" [" << x0 << " " << y << " " << z0 << "  " << x1 << " " << y << " " << z0 << "  " << x1 << " "
-      << y << " " << z1 << "  " << x0 << " " << y << " " << z1 << "]";
+    s << "\"point3 P\" [" << x0 << " " << y << " " << z0 << "  " << x1 << " " << y << " " << z0
+      << "  " << x1 << " " << y << " " << z1 << "  " << x0 << " " << y << " " << z1 << "]";
   else
-    s << "\"point3 P\" [" << x0 << " " << y << " " << z0 << "  " << x0 << " " << y << " " << z1 << "  " << x1 << " "
-      << y << " " << z1 << "  " << x1 << " " << y << " " << z0 << "]";
+    s << "\"point3 P\" [" << x0 << " " << y << " " << z0 << "  " << x0 << " " << y << " " << z1
+      << "  " << x1 << " " << y << " " << z1 << "  " << x1 << " " << y << " " << z0 << "]";
   return "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] " + s.str() + "\n";
 }
 
 std::string header(int res, int max_depth, const std::string& lookat, float fov = 40) {
-  return "LookAt " + lookat + "\nCamera \"perspective\" \"float fov\" " + std::to_string(fov) + "\n" +
-         "Film \"rgb\" \"integer xresolution\" " + std::to_string(res) + " \"integer yresolution\" " +
-         std::to_string(res) + " \"string filename\" \"t.exr\"\nPixelFilter \"box\"\n" +
+  return "LookAt " + lookat + "\nCamera \"perspective\" \"float fov\" " + std::to_string(fov) +
+         "\n" + "Film \"rgb\" \"integer xresolution\" " + std::to_string(res) +
+         " \"integer yresolution\" " + std::to_string(res) +
+         " \"string filename\" \"t.exr\"\nPixelFilter \"box\"\n" +
          "Integrator \"path\" \"integer maxdepth\" " + std::to_string(max_depth) + "\nWorldBegin\n";
 }
 
 // A closed-ish Cornell box (open toward the camera) with a ceiling light and a diffuse sphere;
 // `floor_material` lets a test swap the floor.
-std::string cornell(const std::string& floor_material = "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]") {
+std::string cornell(
+    const std::string& floor_material = "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]") {
   std::string s = header(32, 8, "0.5 0.5 -1.3  0.5 0.5 0  0 1 0");
-  s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [15 15 15]\n" + quad(0.35f, 0.35f, 0.65f, 0.65f, 0.999f, true) +
-       "AttributeEnd\n";
+  s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [15 15 15]\n" +
+       quad(0.35f, 0.35f, 0.65f, 0.65f, 0.999f, true) + "AttributeEnd\n";
   s += "AttributeBegin\n" + floor_material + "\n" + quad(0, 0, 1, 1, 0, false) + "AttributeEnd\n";
   s += "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]\n" + quad(0, 0, 1, 1, 1, true);
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 1  1 0 1  1 1 1  0 1 1]\n";
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 1  1 0 1  1 1 1 "
+       " 0 1 1]\n";
   s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.7 0.15 0.1]\n"
-       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 0  0 0 1  0 1 1  0 1 0]\nAttributeEnd\n";
+       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 0  0 0 1  0 1 1 "
+       " 0 1 0]\nAttributeEnd\n";
   s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.1 0.6 0.15]\n"
-       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [1 0 0  1 1 0  1 1 1  1 0 1]\nAttributeEnd\n";
-  s += "AttributeBegin\nTranslate 0.3 0.2 0.6\nShape \"sphere\" \"float radius\" 0.2\nAttributeEnd\n";
+       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [1 0 0  1 1 0  1 1 1 "
+       " 1 0 1]\nAttributeEnd\n";
+  s += "AttributeBegin\nTranslate 0.3 0.2 0.6\nShape \"sphere\" \"float radius\" "
+       "0.2\nAttributeEnd\n";
   return s;
 }
 
 // A glass sphere on a floor under a small light: the caustic is the test's subject.
 // absorbing: the glass is filled with a green absorbing medium (pbrt-v4 MediumInterface).
 std::string caustic_scene(bool absorbing = false) {
-  std::string s = absorbing ? "MakeNamedMedium \"green\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1.5 1.5 1.5] "
+  std::string s = absorbing ? "MakeNamedMedium \"green\" \"string type\" \"homogeneous\" \"rgb "
+                              "sigma_a\" [1.5 1.5 1.5] "
                               "\"rgb sigma_s\" [0 0 0]\n"
                             : "";
   s += header(32, 8, "0 2.0 -1.6  0 0 0.2  0 1 0");
-  // The absorbing variant moves the light aside, so that its caustic falls where the camera sees it.
+  // The absorbing variant moves the light aside, so that its caustic falls where the camera sees
+  // it.
   s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [60 60 60]\n" +
-       (absorbing ? quad(1.3f, 0.1f, 1.7f, 0.5f, 2.0f, true) : quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true)) + "AttributeEnd\n";
-  s += "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]\n" + quad(-1.5f, -1.5f, 1.5f, 2, 0, false);
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.5 0 2  1.5 0 2  1.5 2 2  -1.5 2 2]\n";
+       (absorbing ? quad(1.3f, 0.1f, 1.7f, 0.5f, 2.0f, true)
+                  : quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true)) +
+       "AttributeEnd\n";
+  s += "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]\n" +
+       quad(-1.5f, -1.5f, 1.5f, 2, 0, false);
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.5 0 2  1.5 0 2  "
+       "1.5 2 2  -1.5 2 2]\n";
   s += "AttributeBegin\nMaterial \"dielectric\" \"float eta\" 1.5\nTranslate 0 0.45 0.3\n";
   if (absorbing) s += "MediumInterface \"green\" \"\"\n";
   s += "Shape \"sphere\" \"float radius\" 0.45\nAttributeEnd\n";
@@ -251,8 +266,8 @@ LoadedScene sphere_furnace() {
 // The image mean of 40 iterations equals the exact radiance within 4.5 sigma (spread over
 // iterations) plus the tilt bias bound (r / R)^2 / 8, where the last gathering vertex is at most
 // `path_radii` sphere radii from the camera along the eye path.
-void expect_furnace(const std::string& integrator, const BpmSettings& s, const FpmSettings& f, int path_radii,
-                    const std::string& what) {
+void expect_furnace(const std::string& integrator, const BpmSettings& s, const FpmSettings& f,
+                    int path_radii, const std::string& what) {
   LoadedScene ls = sphere_furnace();
   double expected = 0;
   for (int k = 0; k <= ls.render.max_depth; ++k) expected += std::pow(0.8, k);
@@ -261,7 +276,8 @@ void expect_furnace(const std::string& integrator, const BpmSettings& s, const F
   float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
   double r_over_R = s.k1 * pixel_angle * path_radii;
   double bias = expected * r_over_R * r_over_R / 8;
-  EXPECT_NEAR(m.mean, expected, 4.5 * sigma + bias) << what << " sigma " << sigma << " bias bound " << bias;
+  EXPECT_NEAR(m.mean, expected, 4.5 * sigma + bias)
+      << what << " sigma " << sigma << " bias bound " << bias;
   EXPECT_LT(sigma, 0.01 * expected) << what;  // the test has power
 }
 
@@ -284,12 +300,13 @@ TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
 // rhobar the area mean of the albedo. Textured materials are resolved on eye and light paths.
 struct CheckerFurnace {
   static constexpr int kRes = 16, kDepth = 6;
-  LoadedScene ls = load(header(kRes, kDepth, "0 0 0  0 0 1  0 1 0") +
-                        "Texture \"checks\" \"spectrum\" \"checkerboard\" \"float uscale\" 8 \"float vscale\" 4\n"
-                        "  \"rgb tex1\" [0.3 0.3 0.3] \"rgb tex2\" [0.7 0.7 0.7]\n"
-                        "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
-                        "Material \"diffuse\" \"texture reflectance\" \"checks\"\n"
-                        "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+  LoadedScene ls = load(
+      header(kRes, kDepth, "0 0 0  0 0 1  0 1 0") +
+      "Texture \"checks\" \"spectrum\" \"checkerboard\" \"float uscale\" 8 \"float vscale\" 4\n"
+      "  \"rgb tex1\" [0.3 0.3 0.3] \"rgb tex2\" [0.7 0.7 0.7]\n"
+      "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+      "Material \"diffuse\" \"texture reflectance\" \"checks\"\n"
+      "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
   static float rho(Vec3 p) {
     double phi = std::atan2(double(p.y), double(p.x));
     if (phi < 0) phi += 2 * M_PI;
@@ -303,7 +320,8 @@ struct CheckerFurnace {
     const int n = 200000;
     for (int i = 0; i < n; ++i) {  // a Fibonacci lattice: nearly uniform over the sphere
       double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z), phi = 2.399963229728653 * i;
-      rho_bar += rho(Vec3(float(2 * r * std::cos(phi)), float(2 * r * std::sin(phi)), float(2 * z)));
+      rho_bar +=
+          rho(Vec3(float(2 * r * std::cos(phi)), float(2 * r * std::sin(phi)), float(2 * z)));
     }
     rho_bar /= n;
     double a = 1;  // A_0 = Le = 1 (unit luminance)
@@ -349,13 +367,16 @@ TEST(Textures, CheckerboardFurnaceMatchesAnalyticRadianceWithBpm) {
   Iterations its = render_iterations(f.ls, "bpm", 40, 13, s);
   const int block = CheckerFurnace::kRes / 2;
   std::vector<BlockStats> got = its.blocks(block);
-  float pixel_angle = std::sqrt(PerspectiveCamera(f.ls.camera, CheckerFurnace::kRes, CheckerFurnace::kRes).pixel_solid_angle());
+  float pixel_angle =
+      std::sqrt(PerspectiveCamera(f.ls.camera, CheckerFurnace::kRes, CheckerFurnace::kRes)
+                    .pixel_solid_angle());
   double r_over_R = s.k1 * pixel_angle * 3;
   ASSERT_EQ(got.size(), 4u);
   for (int b = 0; b < 4; ++b) {
     double e = 0;
     for (int y = 0; y < block; ++y)
-      for (int x = 0; x < block; ++x) e += want[size_t((b / 2 * block + y) * CheckerFurnace::kRes + b % 2 * block + x)];
+      for (int x = 0; x < block; ++x)
+        e += want[size_t((b / 2 * block + y) * CheckerFurnace::kRes + b % 2 * block + x)];
     e /= block * block;
     double sigma = std::sqrt(got[size_t(b)].var), bias = e * r_over_R * r_over_R / 8;
     EXPECT_NEAR(got[size_t(b)].mean, e, 4.5 * sigma + bias) << "block " << b << " sigma " << sigma;
@@ -371,7 +392,8 @@ void expect_bpm_converges(const LoadedScene& ls, const Film& ref, uint64_t seed)
     Iterations its = render_iterations(ls, "bpm", 160, seed, small_batches(d));
     std::string what = "D=" + std::to_string(d);
     expect_blocks_agree(its, ref, 8, edge_bias(small_batches(d), 160, 8), what);
-    double e_early = relative_difference(its.average(12), ref), e_late = relative_difference(its.average(), ref);
+    double e_early = relative_difference(its.average(12), ref),
+           e_late = relative_difference(its.average(), ref);
     EXPECT_LT(e_late, 0.7 * e_early) << what << ": the error does not fall with iterations";
     EXPECT_GT(its.last.details["light"]["entries"].get<uint64_t>(), 0u) << what;
   }
@@ -392,12 +414,13 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
 // A_k = Le + 0.35 A_{k-1}, for path (per pixel) and bpm (image mean over iterations).
 TEST(Materials, MixFurnaceMatchesAnalyticRadiance) {
   const int depth = 6;
-  LoadedScene ls = load(header(16, depth, "0 0 0  0 0 1  0 1 0") +
-                        "MakeNamedMaterial \"dark\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.2 0.2 0.2]\n"
-                        "MakeNamedMaterial \"light\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
-                        "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
-                        "Material \"mix\" \"string materials\" [\"dark\" \"light\"] \"float amount\" 0.25\n"
-                        "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+  LoadedScene ls = load(
+      header(16, depth, "0 0 0  0 0 1  0 1 0") +
+      "MakeNamedMaterial \"dark\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.2 0.2 0.2]\n"
+      "MakeNamedMaterial \"light\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
+      "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+      "Material \"mix\" \"string materials\" [\"dark\" \"light\"] \"float amount\" 0.25\n"
+      "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
   double a = 1;
   for (int k = 1; k < depth; ++k) a = 1 + 0.35 * a;
   const double want = 1 + 0.35 * a;
@@ -421,9 +444,9 @@ TEST(Materials, MixFurnaceMatchesAnalyticRadiance) {
   EXPECT_LT(sigma, 0.01 * want);
 }
 
-// The caustic of a glass sphere filled with a grey absorbing medium (grey, so that the comparison of
-// luminance sees it): photons lose exp(-sigma_a d) inside
-// as eye paths do, so bpm (D = 1) converges to the path tracer block by block.
+// The caustic of a glass sphere filled with a grey absorbing medium (grey, so that the comparison
+// of luminance sees it): photons lose exp(-sigma_a d) inside as eye paths do, so bpm (D = 1)
+// converges to the path tracer block by block.
 TEST(Bpm, AbsorbingGlassCausticConvergesToPath) {
   LoadedScene ls = load(caustic_scene(true));
   ASSERT_EQ(ls.scene.media.size(), 1u);
@@ -431,16 +454,15 @@ TEST(Bpm, AbsorbingGlassCausticConvergesToPath) {
   Iterations its = render_iterations(ls, "bpm", 160, 9, small_batches(1));
   expect_blocks_agree(its, ref, 8, edge_bias(small_batches(1), 160, 8), "D=1");
   EXPECT_GT(its.last.details["light"]["entries"].get<uint64_t>(), 0u);
-
 }
 
 // Light that reaches every visible point only directly: the photons add nothing (no entry is
 // made) and the image is the path tracer's, so nothing is counted twice.
 TEST(Bpm, DirectLightOnlyGivesThePathImageAndNoPhotonEntries) {
   std::string s = header(32, 5, "0 1.5 -1.5  0 0 0  0 1 0");
-  s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource \"diffuse\" \"rgb L\" [8 8 8]\n" +
-       quad(-0.3f, -0.3f, 0.3f, 0.3f, 1.2f, true) +
-       "AttributeEnd\n";
+  s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
+       "\"diffuse\" \"rgb L\" [8 8 8]\n" +
+       quad(-0.3f, -0.3f, 0.3f, 0.3f, 1.2f, true) + "AttributeEnd\n";
   s += "Material \"diffuse\" \"rgb reflectance\" [0.6 0.5 0.4]\n" + quad(-2, -2, 2, 2, 0, false);
   // The light's own surface reflects nothing, or it would light the floor indirectly.
   LoadedScene ls = load(s);
@@ -459,8 +481,8 @@ TEST(Bpm, DirectLightOnlyGivesThePathImageAndNoPhotonEntries) {
 // photons' transport, or a missing shading-normal correction, would change the image.
 TEST(Bpm, SmoothShadedFloorUnderGlassBlockMatchesPath) {
   std::string s = header(32, 8, "0 2.2 -1.9  0 0 0.1  0 1 0");
-  s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [20 20 20]\n" + quad(-0.3f, -0.3f, 0.3f, 0.3f, 2, true) +
-       "AttributeEnd\n";
+  s += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [20 20 20]\n" +
+       quad(-0.3f, -0.3f, 0.3f, 0.3f, 2, true) + "AttributeEnd\n";
   // Floor: a 6 x 6 grid with perturbed vertex normals.
   std::ostringstream p, n, idx;
   const int g = 6;
@@ -475,16 +497,23 @@ TEST(Bpm, SmoothShadedFloorUnderGlassBlockMatchesPath) {
       int a = j * (g + 1) + i, b = a + 1, c = a + g + 1, d = c + 1;
       idx << a << " " << c << " " << b << " " << b << " " << c << " " << d << " ";
     }
-  s += "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]\nShape \"trianglemesh\" \"point3 P\" [" + p.str() +
-       "] \"normal N\" [" + n.str() + "] \"integer indices\" [" + idx.str() + "]\n";
+  s += "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]\nShape \"trianglemesh\" \"point3 "
+       "P\" [" +
+       p.str() + "] \"normal N\" [" + n.str() + "] \"integer indices\" [" + idx.str() + "]\n";
   // A back wall lit mostly by the floor: its light has scattered off the shading normals.
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.5 0 1.5  1.5 0 1.5  1.5 2 1.5  -1.5 2 1.5]\n";
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.5 0 1.5  1.5 0 "
+       "1.5  1.5 2 1.5  -1.5 2 1.5]\n";
   // Glass block x, z in [-0.5, 0.5], y in [0, 0.4]: top and four sides, normals outward.
-  s += "AttributeBegin\nMaterial \"dielectric\" \"float eta\" 1.5\n" + quad(-0.5f, -0.5f, 0.5f, 0.5f, 0.4f, false);
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-0.5 0 -0.5  -0.5 0.4 -0.5  0.5 0.4 -0.5  0.5 0 -0.5]\n";
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-0.5 0 0.5  0.5 0 0.5  0.5 0.4 0.5  -0.5 0.4 0.5]\n";
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-0.5 0 -0.5  -0.5 0 0.5  -0.5 0.4 0.5  -0.5 0.4 -0.5]\n";
-  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0.5 0 -0.5  0.5 0.4 -0.5  0.5 0.4 0.5  0.5 0 0.5]\n";
+  s += "AttributeBegin\nMaterial \"dielectric\" \"float eta\" 1.5\n" +
+       quad(-0.5f, -0.5f, 0.5f, 0.5f, 0.4f, false);
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-0.5 0 -0.5  -0.5 "
+       "0.4 -0.5  0.5 0.4 -0.5  0.5 0 -0.5]\n";
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-0.5 0 0.5  0.5 0 "
+       "0.5  0.5 0.4 0.5  -0.5 0.4 0.5]\n";
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-0.5 0 -0.5  -0.5 0 "
+       "0.5  -0.5 0.4 0.5  -0.5 0.4 -0.5]\n";
+  s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0.5 0 -0.5  0.5 0.4 "
+       "-0.5  0.5 0.4 0.5  0.5 0 0.5]\n";
   s += "AttributeEnd\n";
   LoadedScene ls = load(s);
   // The block's faces must face outward for the dielectric to mean glass inside.
@@ -502,8 +531,8 @@ TEST(Bpm, SmoothShadedFloorUnderGlassBlockMatchesPath) {
     // edge bound.
     BpmSettings bs = small_batches(d);
     bs.k0 = bs.k1 = 1;
-    expect_blocks_agree(render_iterations(ls, "bpm", 160, 4, bs), ref.film, 8, edge_bias(bs, 160, 8),
-                        "D=" + std::to_string(d));
+    expect_blocks_agree(render_iterations(ls, "bpm", 160, 4, bs), ref.film, 8,
+                        edge_bias(bs, 160, 8), "D=" + std::to_string(d));
   }
 }
 
@@ -533,14 +562,18 @@ TEST(Bpm, SmoothShadedCornerMatchesPath) {
     for (int j = 0; j < g; ++j)
       for (int i = 0; i < g; ++i) {
         int a = wall * (g + 1) * (g + 1) + j * (g + 1) + i, b = a + 1, c = a + g + 1, d = c + 1;
-        if (wall == 0) idx << a << " " << c << " " << b << " " << b << " " << c << " " << d << " ";
-        else idx << a << " " << b << " " << c << " " << b << " " << d << " " << c << " ";
+        if (wall == 0)
+          idx << a << " " << c << " " << b << " " << b << " " << c << " " << d << " ";
+        else
+          idx << a << " " << b << " " << c << " " << b << " " << d << " " << c << " ";
       }
   std::string s = header(32, 8, "0 1.2 -2.2  0 0.6 0.5  0 1 0", 45);
-  s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource \"diffuse\" \"rgb L\" [20 20 20]\n" +
+  s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
+       "\"diffuse\" \"rgb L\" [20 20 20]\n" +
        quad(-0.2f, -0.2f, 0.2f, 0.2f, 1.9f, true) + "AttributeEnd\n";
-  s += "Material \"diffuse\" \"rgb reflectance\" [0.85 0.85 0.85]\nShape \"trianglemesh\" \"point3 P\" [" + p.str() +
-       "] \"normal N\" [" + n.str() + "] \"integer indices\" [" + idx.str() + "]\n";
+  s += "Material \"diffuse\" \"rgb reflectance\" [0.85 0.85 0.85]\nShape \"trianglemesh\" \"point3 "
+       "P\" [" +
+       p.str() + "] \"normal N\" [" + n.str() + "] \"integer indices\" [" + idx.str() + "]\n";
   LoadedScene ls = load(s);
   RenderRun ref = render_with(ls, "path", 2048);
   BpmSettings bs = small_batches(0);
@@ -558,7 +591,8 @@ TEST(Bpm, SmoothShadedCornerMatchesPath) {
 // Camera paths sample the light-direction lobe and carry the ratio of the BSDF values; photons
 // scatter with the lobe exactly; backward photons evaluate the radiance-direction value.
 TEST(Bpm, NonReciprocalFloorMatchesPath) {
-  LoadedScene ls = load(cornell("Material \"phong\" \"rgb reflectance\" [0.75 0.75 0.75] \"float exponent\" 6"));
+  LoadedScene ls =
+      load(cornell("Material \"phong\" \"rgb reflectance\" [0.75 0.75 0.75] \"float exponent\" 6"));
   ASSERT_TRUE(std::holds_alternative<PhongDesc>(ls.scene.materials[ls.scene.objects[1].material]));
   RenderRun ref = render_with(ls, "path", 2048);
   for (int d : {0, 1}) {
@@ -616,9 +650,11 @@ TEST(Fpm, CornellBoxAndCausticConvergeToPath) {
       FpmSettings f;
       f.final_gather = gather;
       Iterations its = render_iterations(ls, "fpm", 120, 3, s, f);
-      std::string what = std::string(gather ? "final gather" : "direct") + " on " + text.substr(0, 40);
+      std::string what =
+          std::string(gather ? "final gather" : "direct") + " on " + text.substr(0, 40);
       expect_blocks_agree(its, ref.film, 8, edge_bias(s, 120, 8), what);
-      EXPECT_LT(relative_difference(its.average(), ref.film), 0.7 * relative_difference(its.average(12), ref.film))
+      EXPECT_LT(relative_difference(its.average(), ref.film),
+                0.7 * relative_difference(its.average(12), ref.film))
           << what;
       EXPECT_GT(its.last.details["light"]["photons_stored"].get<uint64_t>(), 0u);
     }
@@ -669,7 +705,8 @@ TEST(Accuracy, RequestedAccuracyEndsTheRender) {
   LoadedScene ls = load(cornell());
   for (const char* integrator : {"path", "bpm"}) {
     Film film(ls.film.width, ls.film.height);
-    RenderOptions opt = test_options(ls, integrator, std::numeric_limits<int>::max(), 1, small_batches(1));
+    RenderOptions opt =
+        test_options(ls, integrator, std::numeric_limits<int>::max(), 1, small_batches(1));
     opt.accuracy = 0.08;
     RenderStats st = render(ls, opt, &film);
     EXPECT_EQ(st.stop_reason, "accuracy") << integrator;
@@ -689,11 +726,13 @@ TEST(Accuracy, AdaptiveSamplingKeepsPixelsUnbiased) {
   RenderStats st = render(ls, opt, &film);
   EXPECT_LT(st.mean_sampling_probability, 0.9);
   std::vector<float> counts = film.pass_counts();
-  EXPECT_LT(*std::min_element(counts.begin(), counts.end()), *std::max_element(counts.begin(), counts.end()));
+  EXPECT_LT(*std::min_element(counts.begin(), counts.end()),
+            *std::max_element(counts.begin(), counts.end()));
   // Path pixels are independent, so the per-pixel RMS gives the block errors of both films.
   auto sa = block_stats(film, 8), sb = block_stats(ref.film, 8);
   for (size_t i = 0; i < sa.size(); ++i)
-    EXPECT_LE(std::fabs(sa[i].mean - sb[i].mean), 4.5 * std::sqrt(sa[i].var + sb[i].var)) << "block " << i;
+    EXPECT_LE(std::fabs(sa[i].mean - sb[i].mean), 4.5 * std::sqrt(sa[i].var + sb[i].var))
+        << "block " << i;
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // End-to-end tests of the bpm program: outputs, bad input, interruption.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -27,8 +27,9 @@ struct CliRun {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("bpm_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() /
+           ("bpm_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -75,7 +76,8 @@ TEST_F(Cli, RendersAllOutputs) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r = run("render " + scene + " -q --spp 3 --seed 5 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* f : {"out.exr", "out.png", "out.error.png", "out.json"}) EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+  for (const char* f : {"out.exr", "out.png", "out.error.png", "out.json"})
+    EXPECT_TRUE(fs::exists(dir_ / f)) << f;
   Image img = read_exr((dir_ / "out.exr").string());
   EXPECT_EQ(img.width, 32);
   EXPECT_EQ(img.height, 24);
@@ -88,7 +90,8 @@ TEST_F(Cli, RendersAllOutputs) {
 
 TEST_F(Cli, ResolutionFlagOverridesTheFile) {
   std::string scene = write("s.pbrt", kTinyScene);
-  CliRun r = run("render " + scene + " -q --spp 1 --resolution 20x10 -o " + (dir_ / "out.exr").string());
+  CliRun r =
+      run("render " + scene + " -q --spp 1 --resolution 20x10 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   Image img = read_exr((dir_ / "out.exr").string());
   EXPECT_EQ(img.width, 20);
@@ -105,7 +108,8 @@ TEST_F(Cli, SceneErrorNamesFileLineAndWritesNothing) {
 }
 
 TEST_F(Cli, TruncatedFileIsAnError) {
-  std::string scene = write("cut.pbrt", "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0");
+  std::string scene =
+      write("cut.pbrt", "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0");
   CliRun r = run("render " + scene + " -q -o " + (dir_ / "out.exr").string());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("cut.pbrt:2:"), std::string::npos) << r.err;
@@ -132,8 +136,10 @@ TEST_F(Cli, BadFlagsAreErrors) {
 
 TEST_F(Cli, BpmWritesItsStatistics) {
   std::string scene = write("s.pbrt", kTinyScene);
-  CliRun r = run("render " + scene + " --integrator bpm --iterations 2 --photons-per-batch 2000 --diffuse-depth 0 "
-                 "--k1 2 --radius-policy fixed --tree centres -o " + (dir_ / "out.exr").string());
+  CliRun r = run("render " + scene +
+                 " --integrator bpm --iterations 2 --photons-per-batch 2000 --diffuse-depth 0 "
+                 "--k1 2 --radius-policy fixed --tree centres -o " +
+                 (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("backward photons"), std::string::npos) << r.err;
   auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
@@ -147,13 +153,16 @@ TEST_F(Cli, BpmWritesItsStatistics) {
   EXPECT_GT(b["eye"]["backward_photons"].get<uint64_t>(), 0u);
   EXPECT_GE(b["light"]["photons"].get<uint64_t>(), 4000u);
   EXPECT_GT(rec["rays"]["light"].get<uint64_t>(), 0u);
-  for (const char* f : {"out.exr", "out.png", "out.error.png"}) EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+  for (const char* f : {"out.exr", "out.png", "out.error.png"})
+    EXPECT_TRUE(fs::exists(dir_ / f)) << f;
 }
 
 TEST_F(Cli, FpmWritesItsStatistics) {
   std::string scene = write("s.pbrt", kTinyScene);
-  CliRun r = run("render " + scene + " --integrator fpm --iterations 2 --photons-per-batch 2000 --final-gather --knn 8 -o " +
-                 (dir_ / "out.exr").string());
+  CliRun r =
+      run("render " + scene +
+          " --integrator fpm --iterations 2 --photons-per-batch 2000 --final-gather --knn 8 -o " +
+          (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("per photon path"), std::string::npos) << r.err;
   auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
@@ -169,7 +178,8 @@ TEST_F(Cli, FpmWritesItsStatistics) {
 TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   std::string text = kTinyScene;
   text.replace(text.find("WorldBegin"), 0,
-               "Integrator \"bpm\" \"integer diffusedepth\" 2 \"float k0\" 0.5 \"integer photonsperbatch\" 1500\n");
+               "Integrator \"bpm\" \"integer diffusedepth\" 2 \"float k0\" 0.5 \"integer "
+               "photonsperbatch\" 1500\n");
   std::string scene = write("s.pbrt", text);
   CliRun r = run("render " + scene + " -q --spp 1 --k0 0.75 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -205,8 +215,8 @@ TEST_F(Cli, SigintAndSigtermStillWriteEveryOutput) {
     if (pid == 0) {
       int devnull = ::open("/dev/null", 1);
       dup2(devnull, 2);
-      execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", integrator, "--spp", "10000000",
-            "--photons-per-batch", "5000", "-o", out.c_str(), nullptr);
+      execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", integrator,
+            "--spp", "10000000", "--photons-per-batch", "5000", "-o", out.c_str(), nullptr);
       _exit(127);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -233,8 +243,9 @@ TEST_F(Cli, WriteEveryLeavesIntermediateOutputs) {
   if (pid == 0) {
     int devnull = ::open("/dev/null", 1);
     dup2(devnull, 2);
-    execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", "bpm", "--spp", "10000000",
-          "--photons-per-batch", "5000", "--write-every", "0.2", "-o", out.c_str(), nullptr);
+    execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", "bpm", "--spp",
+          "10000000", "--photons-per-batch", "5000", "--write-every", "0.2", "-o", out.c_str(),
+          nullptr);
     _exit(127);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(1200));

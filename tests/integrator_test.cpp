@@ -1,10 +1,9 @@
 // Analytic checks of the path integrator and of the render loop.
-#include <cmath>
-#include <functional>
-
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
+#include <functional>
 
 #include "camera/camera.h"
 #include "film/image_io.h"
@@ -108,7 +107,8 @@ TEST(PathIntegrator, PlaneUnderPointLight) {
       float d2 = length_squared(to_light);
       float expected = rho / kPi * I * (to_light.y / std::sqrt(d2)) / d2;
       float sigma = rms[y * 24 + x];
-      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 1e-4f * expected) << x << "," << y;
+      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 1e-4f * expected)
+          << x << "," << y;
       EXPECT_LT(sigma, 0.02f * expected);
       sum_ratio += img.at(x, y).luminance() / expected;
       sum_var += double(sigma) * sigma / (double(expected) * expected);
@@ -124,7 +124,8 @@ TEST(PathIntegrator, PlaneUnderPointLight) {
 // shows its texel's reflectance, which checks the image's orientation (t runs up the image).
 TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
   const float I = 3.0f, h = 2.0f;
-  std::filesystem::path png = std::filesystem::temp_directory_path() / ("bpm_plane_texture_" + std::to_string(::getpid()) + ".png");
+  std::filesystem::path png = std::filesystem::temp_directory_path() /
+                              ("bpm_plane_texture_" + std::to_string(::getpid()) + ".png");
   Image tex;
   tex.width = tex.height = 2;
   tex.rgb = {0.2f, 0.2f, 0.2f, 0.9f, 0.9f, 0.9f,   // top row
@@ -138,7 +139,8 @@ TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
     Integrator "path" "integer maxdepth" 1
     WorldBegin
     LightSource "point" "rgb I" [3 3 3] "point3 from" [0.5 2 0.3]
-    Texture "t" "spectrum" "imagemap" "string filename" ")" + png.string() + R"("
+    Texture "t" "spectrum" "imagemap" "string filename" ")" +
+                        png.string() + R"("
       "string encoding" "linear" "string filter" "point" "float uscale" 25 "float vscale" 25
     Material "diffuse" "texture reflectance" "t"
     Shape "trianglemesh" "point3 P" [-50 0 -50  50 0 -50  50 0 50  -50 0 50]
@@ -168,7 +170,8 @@ TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
       float expected = rho / kPi * I * (to_light.y / std::sqrt(d2)) / d2;
       float sigma = rms[y * 24 + x];
       // The grey texels become near-constant spectra through the coefficient table (within 0.002).
-      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 4e-3f * expected) << x << "," << y;
+      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 4e-3f * expected)
+          << x << "," << y;
       ++checked;
     }
   EXPECT_GT(checked, 100);
@@ -215,7 +218,8 @@ TEST(Integrators, AbsorbingMediumAttenuatesByBeerLambert) {
         if (disc > 0 && disc < 0.05f) continue;  // grazing: the chord changes fast across the pixel
         inside += chord > 0;
         // The only noise is that of the sampled wavelengths.
-        EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-sigma * chord), 5 * rms[size_t(y) * 16 + x] + 1e-3f)
+        EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-sigma * chord),
+                    5 * rms[size_t(y) * 16 + x] + 1e-3f)
             << integrator << " " << x << "," << y;
         EXPECT_LT(rms[size_t(y) * 16 + x], 0.01f);
       }
@@ -230,7 +234,8 @@ double pixel_mean(const PerspectiveCamera& cam, int x, int y, F&& f) {
   const int n = 12;
   double sum = 0;
   for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) sum += f(cam.generate_ray({x + (i + 0.5f) / n, y + (j + 0.5f) / n}, {0.5f, 0.5f}));
+    for (int i = 0; i < n; ++i)
+      sum += f(cam.generate_ray({x + (i + 0.5f) / n, y + (j + 0.5f) / n}, {0.5f, 0.5f}));
   return sum / (n * n);
 }
 
@@ -312,7 +317,8 @@ TEST(Integrators, AlphaMasksLetLightThrough) {
           // number of passes, bounds the noise from below.
           double blocked = c.name == std::string("sheet") ? 1 - expected : 0.5;
           double value = c.name == std::string("sheet") ? 1 : 2 * expected;
-          double sigma = std::max(double(rms[size_t(y) * 16 + x]), value * std::sqrt(blocked * (1 - blocked) / 64));
+          double sigma = std::max(double(rms[size_t(y) * 16 + x]),
+                                  value * std::sqrt(blocked * (1 - blocked) / 64));
           EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * sigma + 2e-3 * expected)
               << c.name << " " << integrator << " " << x << "," << y;
           sum_diff += img.at(x, y).luminance() - expected;
@@ -342,9 +348,11 @@ std::string write_environment_exr(const std::string& name, int width, int height
       for (int x = x0; x < x0 + 2; ++x)
         for (int c = 0; c < 3; ++c) env.rgb[(size_t(y) * width + x) * 3 + c] = v;
   };
-  patch(width / 2 + 1, height / 2 - 3, 30);  // upper hemisphere (near the square's centre, or the top rows)
-  patch(0, height - 2, 100);                 // lower hemisphere (a corner, or the bottom rows)
-  std::filesystem::path path = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".exr");
+  patch(width / 2 + 1, height / 2 - 3,
+        30);                  // upper hemisphere (near the square's centre, or the top rows)
+  patch(0, height - 2, 100);  // lower hemisphere (a corner, or the bottom rows)
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".exr");
   write_exr(path.string(), env);
   return path.string();
 }
@@ -364,7 +372,8 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
       PixelFilter "box" "float xradius" 0.5 "float yradius" 0.5
       Integrator "path" "integer maxdepth" 1
       WorldBegin
-      LightSource "infinite" "string filename" ")" + exr + R"(" "float illuminance" 2
+      LightSource "infinite" "string filename" ")" +
+                          exr + R"(" "float illuminance" 2
       Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
       Shape "trianglemesh" "point3 P" [-50 -50 0  50 -50 0  50 50 0  -50 50 0] "integer indices" [0 1 2 0 2 3]
     )");
@@ -380,11 +389,13 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
       double sum = 0, var = 0;
       for (int i = 0; i < 144; ++i) {
         double lum = img.at(i % 12, i / 12).luminance();
-        EXPECT_NEAR(lum, expected, 5 * rms[size_t(i)] + 1e-3) << integrator << " " << equal_area << " pixel " << i;
+        EXPECT_NEAR(lum, expected, 5 * rms[size_t(i)] + 1e-3)
+            << integrator << " " << equal_area << " pixel " << i;
         sum += lum;
         var += double(rms[size_t(i)]) * rms[size_t(i)];
       }
-      EXPECT_NEAR(sum / 144, expected, 4 * std::sqrt(var) / 144 + 1e-3) << integrator << " " << equal_area;
+      EXPECT_NEAR(sum / 144, expected, 4 * std::sqrt(var) / 144 + 1e-3)
+          << integrator << " " << equal_area;
     }
     // Looking up from below the plane's edge: the sky, texel by texel.
     LoadedScene sky = load(R"(
@@ -393,7 +404,8 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
       Film "rgb" "integer xresolution" 12 "integer yresolution" 12
       PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
       WorldBegin
-      LightSource "infinite" "string filename" ")" + exr + R"(" "float scale" 1.5
+      LightSource "infinite" "string filename" ")" +
+                           exr + R"(" "float scale" 1.5
     )");
     const auto& light = std::get<ImageInfiniteLight>(sky.scene.lights[0]);
     Film film(12, 12);
@@ -406,10 +418,12 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
         Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).d);
         Vec2 uv = image_light_uv(light, d);
         // pbrt-v4's image coordinates: (u, v) with v down the image's rows.
-        Rgb texel = light.image->texel(std::min(int(uv.x * light.image->width), light.image->width - 1),
-                                       std::min(int(uv.y * light.image->height), light.image->height - 1), TexWrap::kClamp);
+        Rgb texel = light.image->texel(
+            std::min(int(uv.x * light.image->width), light.image->width - 1),
+            std::min(int(uv.y * light.image->height), light.image->height - 1), TexWrap::kClamp);
         // The only noise is that of the sampled wavelengths (the sigmoid fit errs by < 0.2%).
-        EXPECT_NEAR(img.at(x, y).luminance(), 1.5f * texel.luminance(), 5 * sky_rms[size_t(y) * 12 + x] + 0.005f * texel.luminance())
+        EXPECT_NEAR(img.at(x, y).luminance(), 1.5f * texel.luminance(),
+                    5 * sky_rms[size_t(y) * 12 + x] + 0.005f * texel.luminance())
             << equal_area << " " << x << "," << y;
       }
     std::filesystem::remove(exr);
@@ -421,7 +435,8 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
 // constant white image pointing down lights the square its 90-degree frame cuts out of the plane
 // with intensity "scale", and nothing outside.
 TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("bpm_gonio_" + std::to_string(::getpid()));
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("bpm_gonio_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   Image flat;
   flat.width = flat.height = 8;
@@ -441,12 +456,14 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
   )";
   LoadedScene gonio = load(head + R"(
     Translate 0.5 2 0.3
-    LightSource "goniometric" "string filename" ")" + (dir / "half.exr").string() + R"(" "rgb I" [3 3 3]
+    LightSource "goniometric" "string filename" ")" +
+                           (dir / "half.exr").string() + R"(" "rgb I" [3 3 3]
   )");
   LoadedScene proj = load(head + R"(
     Translate 0 2 0
     Rotate 90 1 0 0
-    LightSource "projection" "string filename" ")" + (dir / "white.exr").string() + R"(" "float scale" 2
+    LightSource "projection" "string filename" ")" +
+                          (dir / "white.exr").string() + R"(" "float scale" 2
   )");
   for (bool is_gonio : {true, false}) {
     const LoadedScene& ls = is_gonio ? gonio : proj;
@@ -481,7 +498,8 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
           Vec3 to_light = light - p;
           float d2 = length_squared(to_light);
           expected = 0.6f / kPi * I * (to_light.y / std::sqrt(d2)) / d2;
-          EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 24 + x] + 2e-3f * expected)
+          EXPECT_NEAR(img.at(x, y).luminance(), expected,
+                      5 * rms[size_t(y) * 24 + x] + 2e-3f * expected)
               << (is_gonio ? "goniometric " : "projection ") << integrator << " " << x << "," << y;
           ++lit;
         }
@@ -498,7 +516,8 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
 // shows the image bilinearly filtered at (u, 1 - v), times scale, so the image appears upright on
 // a quad whose v runs up.
 TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
-  std::filesystem::path exr = std::filesystem::temp_directory_path() / ("bpm_area_image_" + std::to_string(::getpid()) + ".exr");
+  std::filesystem::path exr = std::filesystem::temp_directory_path() /
+                              ("bpm_area_image_" + std::to_string(::getpid()) + ".exr");
   Image img_in;
   img_in.width = 4;
   img_in.height = 3;
@@ -512,7 +531,8 @@ TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
     PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
     Integrator "path" "integer maxdepth" 1
     WorldBegin
-    AreaLightSource "diffuse" "string filename" ")" + exr.string() + R"(" "float scale" 2 "bool twosided" true
+    AreaLightSource "diffuse" "string filename" ")" +
+                        exr.string() + R"(" "float scale" 2 "bool twosided" true
     Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] "integer indices" [0 1 2 0 2 3]
       "point2 uv" [0 0  1 0  1 1  0 1]
   )");
@@ -531,8 +551,12 @@ TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
       if (std::fabs(p.x) > 1 || std::fabs(p.y) > 1) continue;
       Vec2 uv((p.x + 1) / 2, (p.y + 1) / 2);
       // The image's top row at the quad's top (v = 1).
-      float expected = 2 * light.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp).luminance();
-      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 16 + x] + 0.005f * expected) << x << "," << y;
+      float expected =
+          2 *
+          light.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp).luminance();
+      EXPECT_NEAR(img.at(x, y).luminance(), expected,
+                  5 * rms[size_t(y) * 16 + x] + 0.005f * expected)
+          << x << "," << y;
       ++inside;
     }
   EXPECT_GT(inside, 150);
@@ -582,7 +606,8 @@ TEST(PathIntegrator, OneSidedAreaLightEmitsOnItsNormalSide) {
     Shape "disk" "float radius" 5
   )";
   char a[1024], b[1024];
-  std::snprintf(a, sizeof a, tmpl, "Rotate 180 0 1 0");  // disk normal +z rotated to face the camera
+  std::snprintf(a, sizeof a, tmpl,
+                "Rotate 180 0 1 0");  // disk normal +z rotated to face the camera
   std::snprintf(b, sizeof b, tmpl, "");
   Film front = render_film(load(a), 64);
   EXPECT_NEAR(front.image().at(1, 1).luminance(), 2.0f, 4.5f * front.rms()[5] + 1e-5f);

@@ -48,14 +48,16 @@ TEST_P(Reference, MatchesPbrtV4) {
   // negligible at 2048 spp) no more than from another render of ours. E[relMSE(a, ref)] is
   // sigma^2 + bias^2 and E[relMSE(a, b)] is 2 sigma^2, so this fails once bias^2 ~ sigma^2.
   double to_ref = compare_images(a, ref).rel_mse, to_ours = compare_images(a, b).rel_mse;
-  std::printf("%s relMSE to pbrt-v4 %.5f, to an independent bpm render %.5f\n", c.scene, to_ref, to_ours);
+  std::printf("%s relMSE to pbrt-v4 %.5f, to an independent bpm render %.5f\n", c.scene, to_ref,
+              to_ours);
   EXPECT_LT(to_ref, to_ours);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Scenes, Reference,
-    ::testing::Values(Case{"cornell-box/scene-v4.pbrt", "cornell-box-path-256x256-2048spp.exr", 256, 256, 32},
-                      Case{"veach-mis/scene-v4.pbrt", "veach-mis-path-320x180-2048spp.exr", 320, 180, 32}),
+    ::testing::Values(
+        Case{"cornell-box/scene-v4.pbrt", "cornell-box-path-256x256-2048spp.exr", 256, 256, 32},
+        Case{"veach-mis/scene-v4.pbrt", "veach-mis-path-320x180-2048spp.exr", 320, 180, 32}),
     [](const auto& info) { return std::string(info.index == 0 ? "CornellBox" : "VeachMis"); });
 
 }  // namespace

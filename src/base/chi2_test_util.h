@@ -47,7 +47,8 @@ namespace bpm {
 struct MeanAccumulator {
   long long n = 0;
   double mean = 0, m2 = 0;
-  double min = std::numeric_limits<double>::infinity(), max = -std::numeric_limits<double>::infinity();
+  double min = std::numeric_limits<double>::infinity(),
+         max = -std::numeric_limits<double>::infinity();
   void add(double x) {
     ++n;
     double d = x - mean;
@@ -122,8 +123,8 @@ inline double sidak_alpha(double family_alpha, int n_tests) {
 }
 
 struct Options {
-  int n_cos = 10;             // cells in cos(theta), over [-1, 1]
-  int n_phi = 20;             // cells in phi, over [0, 2 pi)
+  int n_cos = 10;  // cells in cos(theta), over [-1, 1]
+  int n_phi = 20;  // cells in phi, over [0, 2 pi)
   long long n_samples = 200000;
   // pdf evaluations per cell side (even). The midpoint rule errs by O(h^2) where the pdf is
   // smooth but by O(h) across a discontinuity inside a cell (a rough dielectric's transmission
@@ -131,9 +132,9 @@ struct Options {
   // is not zero); 64 keeps the resulting systematic part of the statistic below ~1 for the BSDFs
   // tested here (about 5 with 32).
   int sub = 64;
-  double min_expected = 5;    // pooling threshold
-  double alpha = 0.01;        // family-wise significance level
-  int n_tests = 1;            // chi-square tests in the suite, for the Sidak correction
+  double min_expected = 5;  // pooling threshold
+  double alpha = 0.01;      // family-wise significance level
+  int n_tests = 1;          // chi-square tests in the suite, for the Sidak correction
 };
 
 struct Result {
@@ -226,7 +227,8 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
   // and 1e-5 for the float rounding of pdf values.
   r.sample_mass = double(r.n_valid) / n;
   double pm = std::clamp(r.pdf_mass, 0.0, 1.0);
-  r.mass_tolerance = 5 * std::sqrt(pm * (1 - pm) / n) + 2 * std::fabs(r.pdf_mass - mass_half) + 1e-5;
+  r.mass_tolerance =
+      5 * std::sqrt(pm * (1 - pm) / n) + 2 * std::fabs(r.pdf_mass - mass_half) + 1e-5;
   r.mass_mismatch = std::fabs(r.sample_mass - r.pdf_mass) > r.mass_tolerance;
 
   // Categories: cells plus "sampler failed".
@@ -265,7 +267,8 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
     ++k;
   }
   if (pool_e > 0 || pool_o > 0) {
-    stat += pool_e > 0 ? (pool_o - pool_e) * (pool_o - pool_e) / pool_e : std::numeric_limits<double>::infinity();
+    stat += pool_e > 0 ? (pool_o - pool_e) * (pool_o - pool_e) / pool_e
+                       : std::numeric_limits<double>::infinity();
     ++k;
   }
   r.statistic = stat;
@@ -278,17 +281,20 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
      << "; sample mass " << r.sample_mass << " vs pdf mass " << r.pdf_mass << " (tolerance "
      << r.mass_tolerance << (r.mass_mismatch ? ", MISMATCH" : "") << "); " << r.n_not_unit
      << " non-unit directions; " << r.n_in_zero_cells << " samples in cells of zero pdf\n";
-  std::sort(contributions.begin(), contributions.end(), [](auto& a, auto& b) { return a.first > b.first; });
+  std::sort(contributions.begin(), contributions.end(),
+            [](auto& a, auto& b) { return a.first > b.first; });
   for (size_t q = 0; q < std::min<size_t>(6, contributions.size()); ++q) {
     int c = contributions[q].second;
     if (c < 0) {
-      os << "  failures: observed " << (n - double(r.n_valid)) << ", expected " << (n - n * r.pdf_mass) << "\n";
+      os << "  failures: observed " << (n - double(r.n_valid)) << ", expected "
+         << (n - n * r.pdf_mass) << "\n";
       continue;
     }
     int i = c / o.n_phi, j = c % o.n_phi;
-    os << "  cell cos[" << (-1 + 2.0 * i / o.n_cos) << ", " << (-1 + 2.0 * (i + 1) / o.n_cos) << ") phi["
-       << (2 * M_PI * j / o.n_phi) << ", " << (2 * M_PI * (j + 1) / o.n_phi) << "): observed " << observed[c]
-       << ", expected " << expected[c] << ", contribution " << contributions[q].first << "\n";
+    os << "  cell cos[" << (-1 + 2.0 * i / o.n_cos) << ", " << (-1 + 2.0 * (i + 1) / o.n_cos)
+       << ") phi[" << (2 * M_PI * j / o.n_phi) << ", " << (2 * M_PI * (j + 1) / o.n_phi)
+       << "): observed " << observed[c] << ", expected " << expected[c] << ", contribution "
+       << contributions[q].first << "\n";
   }
   r.report = os.str();
   return r;

@@ -1,9 +1,9 @@
 #include "base/color.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <tbb/parallel_for.h>
 
 #include "base/vec.h"
 
@@ -19,12 +19,12 @@ double lobe(double l, double mu, double s1, double s2) {
 
 // CIE standard illuminant D65 (ISO 11664-2), 300 to 830 nm in 10 nm steps, 100 at 560 nm.
 constexpr float kD65[] = {
-    0.0341f,  3.2945f,  20.236f,  37.0535f, 39.9488f, 44.9117f, 46.6383f, 52.0891f, 49.9755f, 54.6482f,
-    82.7549f, 91.486f,  93.4318f, 86.6823f, 104.865f, 117.008f, 117.812f, 114.861f, 115.923f, 108.811f,
-    109.354f, 107.802f, 104.79f,  107.689f, 104.405f, 104.046f, 100.0f,   96.3342f, 95.788f,  88.6856f,
-    90.0062f, 89.5991f, 87.6987f, 83.2886f, 83.6992f, 80.0268f, 80.2146f, 82.2778f, 78.2842f, 69.7213f,
-    71.6091f, 74.349f,  61.604f,  69.8856f, 75.087f,  63.5927f, 46.4182f, 66.8054f, 63.3828f, 64.304f,
-    59.4519f, 51.959f,  57.4406f, 60.3125f};
+    0.0341f,  3.2945f,  20.236f,  37.0535f, 39.9488f, 44.9117f, 46.6383f, 52.0891f, 49.9755f,
+    54.6482f, 82.7549f, 91.486f,  93.4318f, 86.6823f, 104.865f, 117.008f, 117.812f, 114.861f,
+    115.923f, 108.811f, 109.354f, 107.802f, 104.79f,  107.689f, 104.405f, 104.046f, 100.0f,
+    96.3342f, 95.788f,  88.6856f, 90.0062f, 89.5991f, 87.6987f, 83.2886f, 83.6992f, 80.0268f,
+    80.2146f, 82.2778f, 78.2842f, 69.7213f, 71.6091f, 74.349f,  61.604f,  69.8856f, 75.087f,
+    63.5927f, 46.4182f, 66.8054f, 63.3828f, 64.304f,  59.4519f, 51.959f,  57.4406f, 60.3125f};
 
 double d65_raw(double l) {
   double x = (l - 300) / 10;
@@ -42,10 +42,10 @@ void xyz_to_srgb(const double xyz[3], double rgb[3]) {
 
 // Everything the conversions need, tabulated once at 1 nm.
 struct Tables {
-  double y_integral = 0;           // integral of ybar
-  double d65_scale = 0;            // D65 raw -> unit luminance
-  std::vector<float> d65;          // unit-luminance D65
-  std::vector<std::array<float, 3>> rgb_weight;      // sRGB of a unit spike at lambda, white balanced
+  double y_integral = 0;                         // integral of ybar
+  double d65_scale = 0;                          // D65 raw -> unit luminance
+  std::vector<float> d65;                        // unit-luminance D65
+  std::vector<std::array<float, 3>> rgb_weight;  // sRGB of a unit spike at lambda, white balanced
   std::vector<std::array<float, 3>> rgb_weight_d65;  // the same times D65: a reflectance's colour
   // rgb_weight_d65 gathered onto nodes every kNodeStep nm (each 1 nm weight split between its two
   // nodes linearly): the exact colour of the spectrum that is linear between the nodes.
@@ -74,7 +74,8 @@ struct Tables {
     xyz_to_srgb(white_xyz, white);
     for (int i = 0; i < kTableSize; ++i) {
       double l = kLambdaMin + i;
-      double xyz[3] = {cie_x(float(l)) / y_integral, cie_y(float(l)) / y_integral, cie_z(float(l)) / y_integral};
+      double xyz[3] = {cie_x(float(l)) / y_integral, cie_y(float(l)) / y_integral,
+                       cie_z(float(l)) / y_integral};
       double rgb[3];
       xyz_to_srgb(xyz, rgb);
       for (int c = 0; c < 3; ++c) {
@@ -103,7 +104,8 @@ T lerp_table(const std::vector<T>& table, float lambda, T (*mix)(const T&, const
   return mix(table[i], table[i + 1], x - float(i));
 }
 float mix_float(const float& a, const float& b, float t) { return a + (b - a) * t; }
-std::array<float, 3> mix_rgb(const std::array<float, 3>& a, const std::array<float, 3>& b, float t) {
+std::array<float, 3> mix_rgb(const std::array<float, 3>& a, const std::array<float, 3>& b,
+                             float t) {
   return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
 }
 
@@ -142,14 +144,16 @@ void sigmoid_rgb(const std::array<double, 3>& c, double rgb[3], double jac[3][3]
 }
 
 bool solve3(double a[3][3], const double b[3], double x[3]) {
-  double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+  double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+               a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
                a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
   if (!(std::fabs(det) > 1e-300)) return false;
   for (int col = 0; col < 3; ++col) {
     double m[3][3];
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) m[r][c] = c == col ? b[r] : a[r][c];
-    x[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+    x[col] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+              m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
               m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) /
              det;
   }
@@ -157,16 +161,22 @@ bool solve3(double a[3][3], const double b[3], double x[3]) {
 }
 
 double max_abs_residual(const double rgb[3], const double target[3]) {
-  return std::max({std::fabs(rgb[0] - target[0]), std::fabs(rgb[1] - target[1]), std::fabs(rgb[2] - target[2])});
+  return std::max({std::fabs(rgb[0] - target[0]), std::fabs(rgb[1] - target[1]),
+                   std::fabs(rgb[2] - target[2])});
 }
 
 }  // namespace
 
 float cie_x(float l) {
-  return float(1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) - 0.065 * lobe(l, 501.1, 20.4, 26.2));
+  return float(1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) -
+               0.065 * lobe(l, 501.1, 20.4, 26.2));
 }
-float cie_y(float l) { return float(0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1)); }
-float cie_z(float l) { return float(1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8)); }
+float cie_y(float l) {
+  return float(0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1));
+}
+float cie_z(float l) {
+  return float(1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8));
+}
 
 float d65_unit(float lambda) { return lerp_table(tables().d65, lambda, mix_float); }
 
@@ -210,7 +220,8 @@ namespace {
 
 // Gauss-Newton with backtracking from c toward the sigmoid whose colour is target; returns the
 // largest remaining channel error.
-double gauss_newton(std::array<double, 3>& c, const double target[3], int max_iterations, bool coarse) {
+double gauss_newton(std::array<double, 3>& c, const double target[3], int max_iterations,
+                    bool coarse) {
   double rgb_now[3], jac[3][3];
   sigmoid_rgb(c, rgb_now, jac, coarse);
   double residual = max_abs_residual(rgb_now, target);
@@ -323,7 +334,9 @@ class SigmoidTable {
   static std::array<float, 3> to_float(const std::array<double, 3>& c) {
     return {float(c[0]), float(c[1]), float(c[2])};
   }
-  static size_t index(int l, int zi, int yi, int xi) { return ((size_t(l) * kZ + zi) * kXY + yi) * kXY + xi; }
+  static size_t index(int l, int zi, int yi, int xi) {
+    return ((size_t(l) * kZ + zi) * kXY + yi) * kXY + xi;
+  }
   std::array<float, 3>& at(int l, int zi, int yi, int xi) { return coeff_[index(l, zi, yi, xi)]; }
 
   std::array<float, kZ> z_nodes_{};
@@ -348,7 +361,8 @@ std::array<float, 3> sigmoid_coefficients_lookup(Rgb rgb) {
 Spectrum rgb_texel_spectrum(Rgb rgb, SpectrumKind kind, const Wavelengths& wl) {
   Spectrum s;
   if (kind == SpectrumKind::kAlbedo)
-    for (int c = 0; c < 3; ++c) rgb[c] = std::clamp(rgb[c], 0.0f, 1.0f);  // as pbrt-v4's image textures
+    for (int c = 0; c < 3; ++c)
+      rgb[c] = std::clamp(rgb[c], 0.0f, 1.0f);  // as pbrt-v4's image textures
   float m = rgb.max_component();
   if (!(m > 0)) return s;
   // A reflectance is looked up as it is; other colours with their largest channel scaled to 0.5.
@@ -361,7 +375,8 @@ Spectrum rgb_texel_spectrum(Rgb rgb, SpectrumKind kind, const Wavelengths& wl) {
   return s;
 }
 
-SpectrumCurve::SpectrumCurve(float constant) : kind_(Kind::kConstant), scale_(constant), rgb_(constant) {}
+SpectrumCurve::SpectrumCurve(float constant)
+    : kind_(Kind::kConstant), scale_(constant), rgb_(constant) {}
 
 SpectrumCurve SpectrumCurve::from_rgb(Rgb rgb, SpectrumKind kind) {
   SpectrumCurve s;
@@ -418,7 +433,9 @@ SpectrumCurve SpectrumCurve::from_pairs(const std::vector<double>& pairs, Spectr
 
 SpectrumCurve SpectrumCurve::blackbody(float T) {
   const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
-  auto planck = [&](double l) { return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1)); };
+  auto planck = [&](double l) {
+    return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1));
+  };
   // Normalised to 1 at the peak of the curve (Wien's law), as pbrt-v4.
   const double peak = planck(2.8977721e-3 / T);
   std::vector<float> values(kTableSize);
@@ -428,10 +445,14 @@ SpectrumCurve SpectrumCurve::blackbody(float T) {
 
 float SpectrumCurve::raw(float lambda) const {
   switch (kind_) {
-    case Kind::kZero: return 0;
-    case Kind::kConstant: return 1;
-    case Kind::kSigmoid: return sigmoid_spectrum(coeff_, lambda);
-    case Kind::kTable: return lerp_table(*table_, lambda, mix_float);
+    case Kind::kZero:
+      return 0;
+    case Kind::kConstant:
+      return 1;
+    case Kind::kSigmoid:
+      return sigmoid_spectrum(coeff_, lambda);
+    case Kind::kTable:
+      return lerp_table(*table_, lambda, mix_float);
   }
   return 0;
 }

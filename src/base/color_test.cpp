@@ -17,7 +17,8 @@ namespace {
 struct ColourEstimate {
   MeanAccumulator c[3];
 };
-ColourEstimate estimate_colour(const SpectrumCurve& s, const SpectrumCurve* lit_by, int n, uint64_t seed) {
+ColourEstimate estimate_colour(const SpectrumCurve& s, const SpectrumCurve* lit_by, int n,
+                               uint64_t seed) {
   ColourEstimate e;
   Rng rng(seed);
   for (int i = 0; i < n; ++i) {
@@ -64,7 +65,8 @@ Rgb sigmoid_colour(const std::array<float, 3>& c) {
 }
 
 // The interpolated table that texels use reproduces colours all over the cube, between its nodes
-// too: measured worst 0.0017 and mean 0.0006 per channel over these colours (an 8-bit step is 0.004).
+// too: measured worst 0.0017 and mean 0.0006 per channel over these colours (an 8-bit step is
+// 0.004).
 TEST(Color, SigmoidTableReproducesColoursBetweenNodes) {
   Rng rng(7);
   double worst = 0, sum = 0;
@@ -129,7 +131,8 @@ TEST(Color, SampledConversionIsUnbiased) {
   for (const Case& c : cases) {
     ColourEstimate e = estimate_colour(c.s, c.lit, 200000, 11);
     for (int k = 0; k < 3; ++k)
-      EXPECT_NEAR(e.c[k].mean, c.expected[k], kMeanTestSigmas * e.c[k].standard_error() + 1e-4 * c.expected.max_component())
+      EXPECT_NEAR(e.c[k].mean, c.expected[k],
+                  kMeanTestSigmas * e.c[k].standard_error() + 1e-4 * c.expected.max_component())
           << c.name << " channel " << k;
   }
 }
@@ -155,9 +158,11 @@ TEST(Color, WavelengthSamplesFollowTheirDensity) {
   }
   double width = (kLambdaMax - kLambdaMin) / bins;
   for (int b = 0; b < bins; ++b)
-    for (int s = 0; s < 50; ++s) expected[b] += n * width / 50 * wavelength_pdf(kLambdaMin + width * (b + (s + 0.5f) / 50));
+    for (int s = 0; s < 50; ++s)
+      expected[b] += n * width / 50 * wavelength_pdf(kLambdaMin + width * (b + (s + 0.5f) / 50));
   double stat = 0;
-  for (int b = 0; b < bins; ++b) stat += (observed[b] - expected[b]) * (observed[b] - expected[b]) / expected[b];
+  for (int b = 0; b < bins; ++b)
+    stat += (observed[b] - expected[b]) * (observed[b] - expected[b]) / expected[b];
   EXPECT_GT(chi2::chi2_survival(stat, bins - 1), 0.01) << "statistic " << stat;
 }
 
@@ -179,7 +184,8 @@ TEST(Color, TwoBouncesDifferFromTheRgbProduct) {
   for (float l = kLambdaMin; l <= kLambdaMax; l += 1) squared.push_back(s.value(l) * s.value(l));
   Rgb spectral = SpectrumCurve::from_table(squared, SpectrumKind::kAlbedo).rgb();
   Rgb product = wall * wall;
-  EXPECT_GT(std::fabs(spectral[2] / product[2] - 1), 0.05f) << "blue " << spectral[2] << " vs " << product[2];
+  EXPECT_GT(std::fabs(spectral[2] / product[2] - 1), 0.05f)
+      << "blue " << spectral[2] << " vs " << product[2];
 }
 
 }  // namespace

@@ -35,5 +35,7 @@ int warning_count();
 }  // namespace bpm
 
 // Internal invariant, kept in release builds (use only where it is cheap).
-#define BPM_CHECK(expr) \
-  do { if (!(expr)) ::bpm::check_failed(#expr, __FILE__, __LINE__); } while (0)
+#define BPM_CHECK(expr)                                          \
+  do {                                                           \
+    if (!(expr)) ::bpm::check_failed(#expr, __FILE__, __LINE__); \
+  } while (0)

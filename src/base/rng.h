@@ -14,7 +14,8 @@ inline uint64_t mix64(uint64_t x) {
 }
 
 inline uint64_t stream_key(uint64_t seed, uint64_t a, uint64_t b = 0, uint64_t c = 0) {
-  return mix64(mix64(mix64(seed ^ 0x5851f42d4c957f2dull) ^ a) ^ mix64(b + 0x632be59bd9b4e019ull) ^ (c * 0x9e3779b97f4a7c15ull));
+  return mix64(mix64(mix64(seed ^ 0x5851f42d4c957f2dull) ^ a) ^ mix64(b + 0x632be59bd9b4e019ull) ^
+               (c * 0x9e3779b97f4a7c15ull));
 }
 
 // PCG32 (O'Neill 2014): XSH RR output over a 64-bit LCG.

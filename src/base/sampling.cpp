@@ -47,7 +47,8 @@ Distribution2D::Distribution2D(const std::vector<float>& weights, int w, int h) 
   std::vector<float> row_totals(static_cast<size_t>(h));
   rows_.reserve(size_t(h));
   for (int y = 0; y < h; ++y) {
-    std::vector<float> row(weights.begin() + ptrdiff_t(y) * w, weights.begin() + ptrdiff_t(y + 1) * w);
+    std::vector<float> row(weights.begin() + ptrdiff_t(y) * w,
+                           weights.begin() + ptrdiff_t(y + 1) * w);
     rows_.emplace_back(row);
     row_totals[size_t(y)] = float(rows_.back().total());
   }
@@ -63,7 +64,8 @@ Vec2 Distribution2D::sample(Vec2 u, float* pdf) const {
 }
 
 float Distribution2D::pdf(Vec2 p) const {
-  int x = std::clamp(int(p.x * float(w_)), 0, w_ - 1), y = std::clamp(int(p.y * float(h_)), 0, h_ - 1);
+  int x = std::clamp(int(p.x * float(w_)), 0, w_ - 1),
+      y = std::clamp(int(p.y * float(h_)), 0, h_ - 1);
   return marginal_.pmf(y) * rows_[size_t(y)].pmf(x) * float(w_) * float(h_);
 }
 

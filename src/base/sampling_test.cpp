@@ -1,12 +1,13 @@
 // Tests of the equal-area square-sphere map (orientation, inverse, equal solid angles) and of
 // the 2D piecewise-constant distribution (density against its own pdf and cell frequencies).
+#include "base/sampling.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "base/chi2_test_util.h"
 #include "base/rng.h"
-#include "base/sampling.h"
 
 namespace bpm {
 namespace {
@@ -14,7 +15,8 @@ namespace {
 TEST(EqualArea, CentreIsUpAndCornersAreDown) {
   Vec3 up = equal_area_square_to_sphere({0.5f, 0.5f});
   EXPECT_NEAR(up.z, 1.0f, 1e-6f);
-  for (Vec2 c : {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)}) EXPECT_NEAR(equal_area_square_to_sphere(c).z, -1.0f, 1e-6f);
+  for (Vec2 c : {Vec2(0, 0), Vec2(1, 0), Vec2(0, 1), Vec2(1, 1)})
+    EXPECT_NEAR(equal_area_square_to_sphere(c).z, -1.0f, 1e-6f);
   // The midpoints of the edges and the diamond's corners lie on the equator, +x at u = 1.
   Vec3 px = equal_area_square_to_sphere({1.0f, 0.5f});
   EXPECT_NEAR(px.x, 1.0f, 1e-6f);
@@ -59,9 +61,9 @@ TEST(EqualArea, EqualAreasOfTheSquareAreEqualSolidAngles) {
 
 TEST(Distribution2D, SamplesFollowTheWeights) {
   const int w = 5, h = 4;
-  std::vector<float> weights = {1, 0, 2, 3, 0.5f,  //
-                                0, 0, 0, 0, 0,     // an empty row is never drawn
-                                4, 1, 1, 1, 1,     //
+  std::vector<float> weights = {1,    0, 2, 3, 0.5f,  //
+                                0,    0, 0, 0, 0,     // an empty row is never drawn
+                                4,    1, 1, 1, 1,     //
                                 0.2f, 3, 0, 2, 1};
   Distribution2D d(weights, w, h);
   double total = 0;

@@ -15,17 +15,27 @@ struct Channels {
 
   constexpr Channels() = default;
   constexpr explicit Channels(float v) { c.fill(v); }
-  constexpr Channels(float r, float g, float b)
-    requires(N == 3)
-      : c{r, g, b} {}
+  constexpr Channels(float r, float g, float b) requires(N == 3) : c{r, g, b} {}
 
   float operator[](int i) const { return c[i]; }
   float& operator[](int i) { return c[i]; }
 
-  Channels& operator+=(const Channels& o) { for (int i = 0; i < N; ++i) c[i] += o.c[i]; return *this; }
-  Channels& operator-=(const Channels& o) { for (int i = 0; i < N; ++i) c[i] -= o.c[i]; return *this; }
-  Channels& operator*=(const Channels& o) { for (int i = 0; i < N; ++i) c[i] *= o.c[i]; return *this; }
-  Channels& operator*=(float s) { for (float& v : c) v *= s; return *this; }
+  Channels& operator+=(const Channels& o) {
+    for (int i = 0; i < N; ++i) c[i] += o.c[i];
+    return *this;
+  }
+  Channels& operator-=(const Channels& o) {
+    for (int i = 0; i < N; ++i) c[i] -= o.c[i];
+    return *this;
+  }
+  Channels& operator*=(const Channels& o) {
+    for (int i = 0; i < N; ++i) c[i] *= o.c[i];
+    return *this;
+  }
+  Channels& operator*=(float s) {
+    for (float& v : c) v *= s;
+    return *this;
+  }
   Channels& operator/=(float s) { return *this *= 1.0f / s; }
 
   bool is_black() const {
@@ -49,9 +59,7 @@ struct Channels {
     return s / N;
   }
   // Luminance Y of linear sRGB (Rec. 709 primaries, D65).
-  float luminance() const
-    requires(N == 3)
-  {
+  float luminance() const requires(N == 3) {
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
   }
   bool is_finite() const {
@@ -72,12 +80,30 @@ struct Channels {
   }
 };
 
-template <int N> Channels<N> operator+(Channels<N> a, const Channels<N>& b) { return a += b; }
-template <int N> Channels<N> operator-(Channels<N> a, const Channels<N>& b) { return a -= b; }
-template <int N> Channels<N> operator*(Channels<N> a, const Channels<N>& b) { return a *= b; }
-template <int N> Channels<N> operator*(Channels<N> a, float s) { return a *= s; }
-template <int N> Channels<N> operator*(float s, Channels<N> a) { return a *= s; }
-template <int N> Channels<N> operator/(Channels<N> a, float s) { return a /= s; }
+template <int N>
+Channels<N> operator+(Channels<N> a, const Channels<N>& b) {
+  return a += b;
+}
+template <int N>
+Channels<N> operator-(Channels<N> a, const Channels<N>& b) {
+  return a -= b;
+}
+template <int N>
+Channels<N> operator*(Channels<N> a, const Channels<N>& b) {
+  return a *= b;
+}
+template <int N>
+Channels<N> operator*(Channels<N> a, float s) {
+  return a *= s;
+}
+template <int N>
+Channels<N> operator*(float s, Channels<N> a) {
+  return a *= s;
+}
+template <int N>
+Channels<N> operator/(Channels<N> a, float s) {
+  return a /= s;
+}
 // Element-wise quotient; 0 where the divisor is 0.
 template <int N>
 Channels<N> operator/(Channels<N> a, const Channels<N>& b) {

@@ -125,7 +125,8 @@ Transform Transform::operator*(const Transform& o) const {
 Vec3 Transform::point(Vec3 p) const {
   double r[4];
   for (int i = 0; i < 4; ++i) r[i] = m_[i][0] * p.x + m_[i][1] * p.y + m_[i][2] * p.z + m_[i][3];
-  if (r[3] != 1 && r[3] != 0) return Vec3(float(r[0] / r[3]), float(r[1] / r[3]), float(r[2] / r[3]));
+  if (r[3] != 1 && r[3] != 0)
+    return Vec3(float(r[0] / r[3]), float(r[1] / r[3]), float(r[2] / r[3]));
   return Vec3(float(r[0]), float(r[1]), float(r[2]));
 }
 
@@ -150,8 +151,11 @@ bool Transform::swaps_handedness() const {
 
 bool Transform::is_similarity(float* s_out) const {
   double len[3], dots[3];
-  for (int c = 0; c < 3; ++c) len[c] = std::sqrt(m_[0][c] * m_[0][c] + m_[1][c] * m_[1][c] + m_[2][c] * m_[2][c]);
-  auto col_dot = [&](int a, int b) { return m_[0][a] * m_[0][b] + m_[1][a] * m_[1][b] + m_[2][a] * m_[2][b]; };
+  for (int c = 0; c < 3; ++c)
+    len[c] = std::sqrt(m_[0][c] * m_[0][c] + m_[1][c] * m_[1][c] + m_[2][c] * m_[2][c]);
+  auto col_dot = [&](int a, int b) {
+    return m_[0][a] * m_[0][b] + m_[1][a] * m_[1][b] + m_[2][a] * m_[2][b];
+  };
   dots[0] = col_dot(0, 1);
   dots[1] = col_dot(0, 2);
   dots[2] = col_dot(1, 2);

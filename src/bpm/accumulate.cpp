@@ -7,22 +7,25 @@
 
 namespace bpm {
 
-void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux, uint64_t emitted,
-                          const EyePixels& eye, const Wavelengths& wl, float max_component_value, Film* film) {
+void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
+                          uint64_t emitted, const EyePixels& eye, const Wavelengths& wl,
+                          float max_component_value, Film* film) {
   const int w = film->width(), h = film->height();
   std::vector<Spectrum> photon_L(size_t(w) * size_t(h));
   for (size_t g = 0; g < maps.photons.size(); ++g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (flux[g].is_black()) continue;
     // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
-    photon_L[bp.pixel] += bp.tau * flux[g] * float(1.0 / (kPi * double(bp.radius) * bp.radius * double(emitted)));
+    photon_L[bp.pixel] +=
+        bp.tau * flux[g] * float(1.0 / (kPi * double(bp.radius) * bp.radius * double(emitted)));
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y)
       for (int x = 0; x < w; ++x) {
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
-        record_pass(film, p, eye.radiance[p] + photon_L[p], wl, eye.filter_weight[p], max_component_value);
+        record_pass(film, p, eye.radiance[p] + photon_L[p], wl, eye.filter_weight[p],
+                    max_component_value);
       }
   });
 }

@@ -12,7 +12,8 @@
 namespace bpm {
 
 // flux[g]: the summed contributions backward photon g received from `emitted` photons.
-void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux, uint64_t emitted,
-                          const EyePixels& eye, const Wavelengths& wl, float max_component_value, Film* film);
+void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
+                          uint64_t emitted, const EyePixels& eye, const Wavelengths& wl,
+                          float max_component_value, Film* film);
 
 }  // namespace bpm

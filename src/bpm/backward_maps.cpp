@@ -17,8 +17,8 @@ size_t BackwardMaps::tree_bytes() const {
   return b;
 }
 
-void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t object_count, bool centre_tree,
-                         BackwardMaps* maps) {
+void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t object_count,
+                         bool centre_tree, BackwardMaps* maps) {
   maps->centre_tree = centre_tree;
   maps->object_begin.assign(object_count + 1, 0);
   for (size_t o = 0; o < object_count; ++o) {
@@ -30,14 +30,17 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
   maps->photons.resize(maps->object_begin[object_count]);
   maps->sphere_trees.clear();
   maps->centre_trees.clear();
-  if (centre_tree) maps->centre_trees.resize(object_count);
-  else maps->sphere_trees.resize(object_count);
+  if (centre_tree)
+    maps->centre_trees.resize(object_count);
+  else
+    maps->sphere_trees.resize(object_count);
 
   std::vector<uint32_t> order;
   for (uint32_t o = 0; o < object_count; ++o)
     if (maps->has_photons(int(o))) order.push_back(o);
   std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    return maps->object_begin[a + 1] - maps->object_begin[a] > maps->object_begin[b + 1] - maps->object_begin[b];
+    return maps->object_begin[a + 1] - maps->object_begin[a] >
+           maps->object_begin[b + 1] - maps->object_begin[b];
   });
   auto build_one = [&](uint32_t o) {
     BackwardPhoton* dst = maps->photons.data() + maps->object_begin[o];
@@ -49,11 +52,14 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
       n += src.size();
       std::vector<BackwardPhoton>().swap(src);
     }
-    std::sort(dst, dst + n, [](const BackwardPhoton& a, const BackwardPhoton& b) { return a.key() < b.key(); });
+    std::sort(dst, dst + n,
+              [](const BackwardPhoton& a, const BackwardPhoton& b) { return a.key() < b.key(); });
     std::vector<SphereRef> spheres(n);
     for (size_t k = 0; k < n; ++k) spheres[k] = {dst[k].p, dst[k].radius};
-    if (centre_tree) maps->centre_trees[o].build(spheres);
-    else maps->sphere_trees[o].build(spheres);
+    if (centre_tree)
+      maps->centre_trees[o].build(spheres);
+    else
+      maps->sphere_trees[o].build(spheres);
   };
   // The queue: each worker takes the largest object not yet taken.
   std::atomic<size_t> next{0};

@@ -13,7 +13,8 @@ namespace bpm {
 
 struct BackwardMaps {
   std::vector<BackwardPhoton> photons;  // object by object; within an object sorted by key()
-  std::vector<uint32_t> object_begin;   // photons of object o: [object_begin[o], object_begin[o + 1])
+  std::vector<uint32_t>
+      object_begin;  // photons of object o: [object_begin[o], object_begin[o + 1])
   bool centre_tree = false;
   std::vector<SphereKdTree> sphere_trees;  // per object (empty when centre_tree)
   std::vector<CentreKdTree> centre_trees;  // per object (empty unless centre_tree)
@@ -24,8 +25,10 @@ struct BackwardMaps {
   void query(int object, Vec3 p, F&& f) const {
     uint32_t base = object_begin[object];
     auto g = [&](uint32_t local) { f(base + local); };
-    if (centre_tree) centre_trees[object].query(p, g);
-    else sphere_trees[object].query(p, g);
+    if (centre_tree)
+      centre_trees[object].query(p, g);
+    else
+      sphere_trees[object].query(p, g);
   }
   size_t photon_bytes() const { return photons.size() * sizeof(BackwardPhoton); }
   size_t tree_bytes() const;
@@ -34,7 +37,7 @@ struct BackwardMaps {
 // Merges the threads' per-object lists (in an order that does not depend on the threads) and
 // builds the trees in parallel: objects sorted by photon count, largest first, taken from a
 // queue by free threads (section 3). The lists are emptied.
-void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t object_count, bool centre_tree,
-                         BackwardMaps* maps);
+void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t object_count,
+                         bool centre_tree, BackwardMaps* maps);
 
 }  // namespace bpm

@@ -10,7 +10,6 @@
 
 namespace bpm {
 
-
 enum AcceptMask : uint8_t { kAcceptsCaustic = 1, kAcceptsIndirect = 2 };
 
 struct BackwardPhoton {
@@ -22,9 +21,9 @@ struct BackwardPhoton {
   Spectrum tau;  // throughput from the camera (the paper's transmittance)
   uint32_t pixel;
   uint32_t material;
-  uint16_t eye_depth;      // scattering events on the eye path, this vertex included
-  uint8_t accepts;         // AcceptMask bits
-  uint8_t diffuse_index;   // j - 1 for the j-th diffuse vertex (0..3)
+  uint16_t eye_depth;     // scattering events on the eye path, this vertex included
+  uint8_t accepts;        // AcceptMask bits
+  uint8_t diffuse_index;  // j - 1 for the j-th diffuse vertex (0..3)
 
   bool accepts_class(PhotonClass c) const {
     return (c == PhotonClass::kCaustic && (accepts & kAcceptsCaustic)) ||

@@ -29,7 +29,8 @@ void check(const BpmSettings& s) {
 
 }  // namespace
 
-RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, const BpmSettings& s, Film* film) {
+RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, const BpmSettings& s,
+                       Film* film) {
   check(s);
   const RenderScene& scene = ls.scene;
   const size_t n_pixels = size_t(film->width()) * size_t(film->height());
@@ -53,8 +54,10 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
 
     // 1. Eye pass: backward photons, and the light the eye paths count themselves.
     auto t = Clock::now();
-    EyePassParams ep{&wm, s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale};
-    bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye, {thread_lists, eye_counters});
+    EyePassParams ep{&wm, s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale,
+                     s.k1 * pixel_angle * scale};
+    bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
+                                 {thread_lists, eye_counters});
     tot.eye_s += since(t);
     // An iteration without its light pass would be a wrong image: it is dropped.
     if (!complete) return PassResult{false};
@@ -75,7 +78,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
-    accumulate_iteration(maps, light_result.flux, light_result.emitted, eye, wm.wl, ls.film.max_component_value, film);
+    accumulate_iteration(maps, light_result.flux, light_result.emitted, eye, wm.wl,
+                         ls.film.max_component_value, film);
     tot.accumulate_s += since(t);
     masks.rebuild(eye.cost_ns);
 
@@ -83,8 +87,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     for (const EyeCounters& c : eye_counters) r.rays += c.rays.total();
     for (const LightCounters& c : light.counters) r.rays += c.light_rays;
     char progress[128];
-    std::snprintf(progress, sizeof progress, "  %zu backward photons  %d batches  coverage %.2f", maps.photons.size(),
-                  light_result.batches, light_result.coverage);
+    std::snprintf(progress, sizeof progress, "  %zu backward photons  %d batches  coverage %.2f",
+                  maps.photons.size(), light_result.batches, light_result.coverage);
     r.progress = progress;
     return r;
   };

@@ -11,7 +11,7 @@
 
 namespace bpm {
 
-RenderStats render_bpm(const LoadedScene& scene, const IntegratorOptions& options, const BpmSettings& settings,
-                       Film* film);
+RenderStats render_bpm(const LoadedScene& scene, const IntegratorOptions& options,
+                       const BpmSettings& settings, Film* film);
 
 }  // namespace bpm

@@ -49,7 +49,8 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    if (next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L) != StepEnd::kVertex) break;
+    if (next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L) != StepEnd::kVertex)
+      break;
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
     bool is_diffuse = !bsdf_is_specular(v.m());
@@ -58,8 +59,8 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       bool last = diffuse == prm.diffuse_depth + 1;
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local, !last, wl,
-                                        rng, counters.rays);
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                        v.wo_local, !last, wl, rng, counters.rays);
       BackwardPhoton bp = backward_photon_at(v, s, prm, pixel, depth, diffuse, last);
       if (bp.radius > 0 && !s.beta.is_black()) {
         out[size_t(v.object())].push_back(bp);
@@ -76,8 +77,9 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     if (!bs) break;
     s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (s.beta.is_black()) break;
-    emitter = diffuse == 0 ? EmitterWeight::full()
-                           : (is_diffuse ? EmitterWeight::mis(bs->mis_pdf, v.sp.p) : EmitterWeight::none());
+    emitter = diffuse == 0
+                  ? EmitterWeight::full()
+                  : (is_diffuse ? EmitterWeight::mis(bs->mis_pdf, v.sp.p) : EmitterWeight::none());
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++counters.rays.bounce_rays;
   }
@@ -89,25 +91,28 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
                   EyePixels* px, EyeThreadData threads) {
   using Clock = std::chrono::steady_clock;
   const int slots = masks.slots();
-  tbb::parallel_for(tbb::blocked_range<int>(0, masks.block_count() * slots, 1), [&](const tbb::blocked_range<int>& r) {
-    ObjectPhotonLists& lists = threads.lists.local();
-    EyeCounters& ec = threads.counters.local();
-    for (int task = r.begin(); task < r.end(); ++task) {
-      if (interrupted()) return;
-      for (uint32_t pixel : masks.pixels(task / slots, task % slots)) {
-        px->sampled[pixel] = control.sample_pixel(pass, pixel);
-        if (!px->sampled[pixel]) {
-          px->cost_ns[pixel] = 0;
-          continue;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, masks.block_count() * slots, 1),
+      [&](const tbb::blocked_range<int>& r) {
+        ObjectPhotonLists& lists = threads.lists.local();
+        EyeCounters& ec = threads.counters.local();
+        for (int task = r.begin(); task < r.end(); ++task) {
+          if (interrupted()) return;
+          for (uint32_t pixel : masks.pixels(task / slots, task % slots)) {
+            px->sampled[pixel] = control.sample_pixel(pass, pixel);
+            if (!px->sampled[pixel]) {
+              px->cost_ns[pixel] = 0;
+              continue;
+            }
+            auto t0 = Clock::now();
+            CameraSample cs = camera.sample(pass_index, pixel);
+            px->radiance[pixel] = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec);
+            px->filter_weight[pixel] = cs.filter_weight;
+            px->cost_ns[pixel] =
+                float(std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
+          }
         }
-        auto t0 = Clock::now();
-        CameraSample cs = camera.sample(pass_index, pixel);
-        px->radiance[pixel] = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec);
-        px->filter_weight[pixel] = cs.filter_weight;
-        px->cost_ns[pixel] = float(std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
-      }
-    }
-  });
+      });
   if (!interrupt_flag().load()) return true;
   for (ObjectPhotonLists& l : threads.lists)
     for (auto& v : l) v.clear();

@@ -40,8 +40,8 @@ using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
 // appends the path's backward photons to out[object].
-Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray, uint32_t pixel,
-                        Rng& rng, ObjectPhotonLists& out, EyeCounters& counters);
+Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
+                        uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
@@ -60,8 +60,9 @@ struct EyeThreadData {
 
 // Runs the eye pass of pass `pass` (random streams keyed by `pass_index`) over every pixel the
 // control samples. Returns false when interrupted: the backward photons are then dropped.
-bool run_eye_pass(const RenderScene& scene, const EyePassParams& params, const CameraSampler& camera,
-                  const PixelMasks& masks, const RenderControl& control, int pass, int pass_index,
-                  EyePixels* pixels, EyeThreadData threads);
+bool run_eye_pass(const RenderScene& scene, const EyePassParams& params,
+                  const CameraSampler& camera, const PixelMasks& masks,
+                  const RenderControl& control, int pass, int pass_index, EyePixels* pixels,
+                  EyeThreadData threads);
 
 }  // namespace bpm

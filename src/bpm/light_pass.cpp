@@ -23,17 +23,18 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`.
 void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                    const std::vector<uint16_t>& owner, int object, const SurfacePoint& sp, Vec3 wi,
-                   const Spectrum& flux, PhotonClass cls, int bounces, std::vector<std::vector<PhotonEntry>>& out,
-                   LightCounters& counters) {
+                   const Spectrum& flux, PhotonClass cls, int bounces,
+                   std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   ++counters.queries;
   maps.query(object, sp.p, [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (!bp.accepts_class(cls) || int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
     Material storage;
-    const Material& m = prm.photon_materials.empty()
-                            ? prm.materials->at(int(bp.material), TextureContext{bp.p, bp.uv}, storage)
-                            : prm.photon_materials[g];
+    const Material& m =
+        prm.photon_materials.empty()
+            ? prm.materials->at(int(bp.material), TextureContext{bp.p, bp.uv}, storage)
+            : prm.photon_materials[g];
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     out[owner[bp.pixel]].push_back({g, value});
@@ -56,13 +57,14 @@ void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
 }
 
 void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                  const std::vector<uint16_t>& owner, Rng& rng, std::vector<std::vector<PhotonEntry>>& out,
-                  LightCounters& counters) {
+                  const std::vector<uint16_t>& owner, Rng& rng,
+                  std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   // A backward photon adds at least one eye vertex; direct photons are never used (next-event
   // estimation counts direct light).
   trace_light_path(scene, *prm.materials, prm.max_depth, 1, rng, counters, [&](const PhotonHit& h) {
     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
-      gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out, counters);
+      gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out,
+                    counters);
   });
 }
 
@@ -70,28 +72,30 @@ namespace {
 
 // Phase one of a batch: every chunk traces its photons into its own lists.
 void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                 const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t photons_per_batch, int batch,
-                 LightPassBuffers* buf) {
+                 const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t photons_per_batch,
+                 int batch, LightPassBuffers* buf) {
   const int slots = masks.slots();
-  tbb::parallel_for(tbb::blocked_range<int>(0, int(buf->chunks.size()), 1), [&](const tbb::blocked_range<int>& r) {
-    LightCounters& lc = buf->counters.local();
-    for (int c = r.begin(); c < r.end(); ++c) {
-      std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
-      by_slot.resize(size_t(slots));
-      for (auto& v : by_slot) v.clear();
-      uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-      uint64_t last = std::min(first + kPhotonsPerChunk, photons_per_batch);
-      for (uint64_t k = first; k < last; ++k) {
-        uint64_t index = uint64_t(batch) * photons_per_batch + k;
-        Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
-        trace_photon(scene, maps, prm, masks.owner(), rng, by_slot, lc);
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<int>(0, int(buf->chunks.size()), 1),
+                    [&](const tbb::blocked_range<int>& r) {
+                      LightCounters& lc = buf->counters.local();
+                      for (int c = r.begin(); c < r.end(); ++c) {
+                        std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
+                        by_slot.resize(size_t(slots));
+                        for (auto& v : by_slot) v.clear();
+                        uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+                        uint64_t last = std::min(first + kPhotonsPerChunk, photons_per_batch);
+                        for (uint64_t k = first; k < last; ++k) {
+                          uint64_t index = uint64_t(batch) * photons_per_batch + k;
+                          Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
+                          trace_photon(scene, maps, prm, masks.owner(), rng, by_slot, lc);
+                        }
+                      }
+                    });
 }
 
 // Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
-void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* flux, std::vector<uint8_t>* hit) {
+void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* flux,
+                 std::vector<uint8_t>* hit) {
   tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
     for (int slot = r.begin(); slot < r.end(); ++slot)
       for (const auto& by_slot : buf.chunks)
@@ -104,8 +108,9 @@ void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* 
 
 }  // namespace
 
-LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                               const BpmSettings& s, const PixelMasks& masks, uint64_t seed, int pass_index,
+LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
+                               const LightPassParams& prm, const BpmSettings& s,
+                               const PixelMasks& masks, uint64_t seed, int pass_index,
                                LightPassBuffers* buf) {
   const uint64_t photons_per_batch = uint64_t(s.photons_per_batch);
   buf->chunks.resize(size_t((photons_per_batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
@@ -132,7 +137,8 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     res.apply_s += seconds_since(t);
     if (n_indirect) {
       size_t covered = 0;
-      for (size_t g = 0; g < n_bp; ++g) covered += hit[g] && (maps.photons[g].accepts & kAcceptsIndirect);
+      for (size_t g = 0; g < n_bp; ++g)
+        covered += hit[g] && (maps.photons[g].accepts & kAcceptsIndirect);
       res.coverage = double(covered) / double(n_indirect);
     }
     if (res.coverage >= s.coverage || interrupt_flag().load()) break;

@@ -39,8 +39,8 @@ void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm);
 
 // Traces one photon. owner[pixel] is the mask slot of the pixel; out has one list per slot.
 void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& params,
-                  const std::vector<uint16_t>& owner, Rng& rng, std::vector<std::vector<PhotonEntry>>& out,
-                  LightCounters& counters);
+                  const std::vector<uint16_t>& owner, Rng& rng,
+                  std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters);
 
 // What the light pass keeps between iterations: the entry lists of each chunk of a batch and the
 // per-thread counters.
@@ -60,8 +60,9 @@ struct LightPassResult {
 
 // Shoots batches of photons (streams keyed by seed, pass_index and photon index) until the
 // coverage target, the batch cap or an interrupt.
-LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& params,
-                               const BpmSettings& settings, const PixelMasks& masks, uint64_t seed, int pass_index,
+LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
+                               const LightPassParams& params, const BpmSettings& settings,
+                               const PixelMasks& masks, uint64_t seed, int pass_index,
                                LightPassBuffers* buffers);
 
 }  // namespace bpm

@@ -7,10 +7,15 @@
 
 namespace bpm {
 
-int PixelMasks::block_size_for(int threads) { return threads <= 4 ? 32 : (threads <= 16 ? 64 : 128); }
+int PixelMasks::block_size_for(int threads) {
+  return threads <= 4 ? 32 : (threads <= 16 ? 64 : 128);
+}
 
 PixelMasks::PixelMasks(int width, int height, int slots)
-    : width_(width), height_(height), slots_(std::clamp(slots, 1, 65535)), block_(block_size_for(slots)) {
+    : width_(width),
+      height_(height),
+      slots_(std::clamp(slots, 1, 65535)),
+      block_(block_size_for(slots)) {
   bx_ = (width_ + block_ - 1) / block_;
   by_ = (height_ + block_ - 1) / block_;
   owner_.assign(size_t(width_) * height_, 0);
@@ -41,7 +46,8 @@ void PixelMasks::assign_block(int b, const std::vector<float>* cost) {
     }
     return;
   }
-  std::stable_sort(pix.begin(), pix.end(), [&](uint32_t a, uint32_t c) { return (*cost)[a] > (*cost)[c]; });
+  std::stable_sort(pix.begin(), pix.end(),
+                   [&](uint32_t a, uint32_t c) { return (*cost)[a] > (*cost)[c]; });
   std::vector<double> load(slots_, 0.0);
   for (uint32_t p : pix) {
     int s = int(std::min_element(load.begin(), load.end()) - load.begin());

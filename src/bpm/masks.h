@@ -22,7 +22,9 @@ class PixelMasks {
   // Slot that owns each pixel (row-major pixel index).
   const std::vector<uint16_t>& owner() const { return owner_; }
   // Pixels of `block` owned by `slot`.
-  const std::vector<uint32_t>& pixels(int block, int slot) const { return lists_[size_t(block) * slots_ + slot]; }
+  const std::vector<uint32_t>& pixels(int block, int slot) const {
+    return lists_[size_t(block) * slots_ + slot];
+  }
   // Reassigns the pixels of every block to balance the summed cost per slot (longest processing
   // time first).
   void rebuild(const std::vector<float>& cost_per_pixel);

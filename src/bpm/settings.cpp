@@ -9,7 +9,8 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   if (in.name != "bpm" && in.name != "fpm") return b;
   const ParamSet& ps = in.params;
   b.diffuse_depth = ps.get_int("diffusedepth", b.diffuse_depth);
-  ps.require("diffusedepth", b.diffuse_depth >= 0 && b.diffuse_depth <= 3, "must be in 0..3", in.loc);
+  ps.require("diffusedepth", b.diffuse_depth >= 0 && b.diffuse_depth <= 3, "must be in 0..3",
+             in.loc);
   read_photon_settings(in, &b);
   b.coverage = ps.get_float("coverage", b.coverage);
   ps.require("coverage", b.coverage >= 0 && b.coverage <= 1, "must be in [0, 1]", in.loc);
@@ -17,7 +18,8 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("maxbatches", b.max_batches > 0, "must be positive", in.loc);
   std::string tree = ps.get_string("tree", "spheres");
   b.centre_tree = tree == "centres";
-  ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"", in.loc);
+  ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"",
+             in.loc);
   return b;
 }
 

@@ -41,9 +41,11 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
           {"backward_photons", t.eye.backward_photons},
           // The paper's Table 1 counts per ray traced from the camera with all its continuations
           // (an eye path); per segment counts every camera and bounce ray.
-          {"backward_photons_per_backward_ray", ratio(backward_photons, double(t.eye.rays.camera_rays))},
+          {"backward_photons_per_backward_ray",
+           ratio(backward_photons, double(t.eye.rays.camera_rays))},
           {"backward_photons_per_backward_segment", ratio(backward_photons, double(backward_rays))},
-          {"backward_photons_per_pixel_iteration", ratio(backward_photons, double(iterations) * double(pixels))},
+          {"backward_photons_per_pixel_iteration",
+           ratio(backward_photons, double(iterations) * double(pixels))},
           {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s)}};
 }
 

@@ -13,14 +13,16 @@ PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, int width, int hei
       width_(width),
       height_(height) {
   float aspect = float(width) / float(height);
-  if (s.screen_window[0] == 0 && s.screen_window[1] == 0 && s.screen_window[2] == 0 && s.screen_window[3] == 0) {
+  if (s.screen_window[0] == 0 && s.screen_window[1] == 0 && s.screen_window[2] == 0 &&
+      s.screen_window[3] == 0) {
     if (aspect > 1) {
       x0_ = -aspect, x1_ = aspect, y0_ = -1, y1_ = 1;
     } else {
       x0_ = -1, x1_ = 1, y0_ = -1 / aspect, y1_ = 1 / aspect;
     }
   } else {
-    x0_ = s.screen_window[0], x1_ = s.screen_window[1], y0_ = s.screen_window[2], y1_ = s.screen_window[3];
+    x0_ = s.screen_window[0], x1_ = s.screen_window[1], y0_ = s.screen_window[2],
+    y1_ = s.screen_window[3];
   }
   tan_half_ = std::tan(s.fov_degrees * kPi / 360);
   float px = (x1_ - x0_) / width * tan_half_, py = (y1_ - y0_) / height * tan_half_;

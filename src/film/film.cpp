@@ -5,7 +5,10 @@
 namespace bpm {
 
 Film::Film(int width, int height, int m_images)
-    : width_(width), height_(height), pixels_(size_t(width) * height), m_(m_images > 1 ? m_images : 0) {
+    : width_(width),
+      height_(height),
+      pixels_(size_t(width) * height),
+      m_(m_images > 1 ? m_images : 0) {
   m_sum_.assign(pixels_.size() * size_t(m_), 0.0);
   m_count_.assign(pixels_.size() * size_t(m_), 0);
 }
@@ -38,7 +41,8 @@ Image Film::image(float scale) const {
   img.rgb.resize(pixels_.size() * 3);
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const Pixel& p = pixels_[i];
-    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = p.sum_w != 0 ? float(scale * p.sum_wl[c] / p.sum_w) : 0.0f;
+    for (int c = 0; c < 3; ++c)
+      img.rgb[3 * i + c] = p.sum_w != 0 ? float(scale * p.sum_wl[c] / p.sum_w) : 0.0f;
   }
   return img;
 }

@@ -14,7 +14,9 @@ float mitchell_1d(float x, float b, float c) {
   if (x <= 1)
     return ((12 - 9 * b - 6 * c) * x * x * x + (-18 + 12 * b + 6 * c) * x * x + (6 - 2 * b)) / 6;
   if (x <= 2)
-    return ((-b - 6 * c) * x * x * x + (6 * b + 30 * c) * x * x + (-12 * b - 48 * c) * x + (8 * b + 24 * c)) / 6;
+    return ((-b - 6 * c) * x * x * x + (6 * b + 30 * c) * x * x + (-12 * b - 48 * c) * x +
+            (8 * b + 24 * c)) /
+           6;
   return 0;
 }
 float sinc(float x) { return std::fabs(x) < 1e-5f ? 1 : std::sin(kPi * x) / (kPi * x); }
@@ -45,7 +47,8 @@ Filter::Filter(const FilterSettings& s) : s_(s) {
   integral_ = 0;
   for (int y = 0; y < ny_; ++y)
     for (int x = 0; x < nx_; ++x) {
-      Vec2 p{-s_.radius.x + (x + 0.5f) * 2 * s_.radius.x / nx_, -s_.radius.y + (y + 0.5f) * 2 * s_.radius.y / ny_};
+      Vec2 p{-s_.radius.x + (x + 0.5f) * 2 * s_.radius.x / nx_,
+             -s_.radius.y + (y + 0.5f) * 2 * s_.radius.y / ny_};
       float f = evaluate(p);
       values_[y * nx_ + x] = f;
       w[y * nx_ + x] = std::fabs(f);
@@ -60,12 +63,14 @@ float Filter::evaluate(Vec2 p) const {
     case FilterType::kBox:
       return 1;
     case FilterType::kTriangle:
-      return std::fmax(0.0f, s_.radius.x - std::fabs(p.x)) * std::fmax(0.0f, s_.radius.y - std::fabs(p.y));
+      return std::fmax(0.0f, s_.radius.x - std::fabs(p.x)) *
+             std::fmax(0.0f, s_.radius.y - std::fabs(p.y));
     case FilterType::kGaussian:
       return std::fmax(0.0f, gaussian_1d(p.x, s_.sigma) - gaussian_1d(s_.radius.x, s_.sigma)) *
              std::fmax(0.0f, gaussian_1d(p.y, s_.sigma) - gaussian_1d(s_.radius.y, s_.sigma));
     case FilterType::kMitchell:
-      return mitchell_1d(2 * p.x / s_.radius.x, s_.b, s_.c) * mitchell_1d(2 * p.y / s_.radius.y, s_.b, s_.c);
+      return mitchell_1d(2 * p.x / s_.radius.x, s_.b, s_.c) *
+             mitchell_1d(2 * p.y / s_.radius.y, s_.b, s_.c);
     case FilterType::kLanczos:
       return windowed_sinc(p.x, s_.radius.x, s_.tau) * windowed_sinc(p.y, s_.radius.y, s_.tau);
   }
@@ -75,7 +80,8 @@ float Filter::evaluate(Vec2 p) const {
 FilterSample Filter::sample(Vec2 u) const {
   if (s_.type == FilterType::kBox)
     return {{(2 * u.x - 1) * s_.radius.x, (2 * u.y - 1) * s_.radius.y}, 1};
-  if (s_.type == FilterType::kTriangle) return {{sample_tent(u.x, s_.radius.x), sample_tent(u.y, s_.radius.y)}, 1};
+  if (s_.type == FilterType::kTriangle)
+    return {{sample_tent(u.x, s_.radius.x), sample_tent(u.y, s_.radius.y)}, 1};
   float ur;
   float pmf;
   int cell = cells_.sample(u.x, &pmf, &ur);
@@ -91,11 +97,16 @@ FilterSample Filter::sample(Vec2 u) const {
 
 std::string Filter::name() const {
   switch (s_.type) {
-    case FilterType::kBox: return "box";
-    case FilterType::kTriangle: return "triangle";
-    case FilterType::kGaussian: return "gaussian";
-    case FilterType::kMitchell: return "mitchell";
-    case FilterType::kLanczos: return "lanczos";
+    case FilterType::kBox:
+      return "box";
+    case FilterType::kTriangle:
+      return "triangle";
+    case FilterType::kGaussian:
+      return "gaussian";
+    case FilterType::kMitchell:
+      return "mitchell";
+    case FilterType::kLanczos:
+      return "lanczos";
   }
   return "?";
 }

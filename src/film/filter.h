@@ -15,9 +15,9 @@ enum class FilterType { kBox, kTriangle, kGaussian, kMitchell, kLanczos };
 struct FilterSettings {
   FilterType type = FilterType::kGaussian;
   Vec2 radius{1.5f, 1.5f};
-  float sigma = 0.5f;           // gaussian
+  float sigma = 0.5f;                // gaussian
   float b = 1.0f / 3, c = 1.0f / 3;  // mitchell
-  float tau = 3;                // lanczos
+  float tau = 3;                     // lanczos
 };
 
 struct FilterSample {

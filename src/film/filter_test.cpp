@@ -1,6 +1,8 @@
 // Tests of the pixel filters' importance sampling: a sample's weight times a test function, summed
 // and divided by the sum of weights (what the film does), converges to the filter-weighted average
 // of the test function, integral(f g) / integral(f).
+#include "film/filter.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 
 #include "base/chi2_test_util.h"
 #include "base/rng.h"
-#include "film/filter.h"
 
 namespace bpm {
 namespace {
@@ -61,7 +62,8 @@ TEST_P(FilterTest, WeightedSamplesAverageTheTestFunction) {
   double i_f = 0, i_abs_f = 0, i_fg = 0, d_f = 0, d_fg = 0;  // d_: f minus its cell-centre value
   for (int cy = 0; cy < ny; ++cy)
     for (int cx = 0; cx < nx; ++cx) {
-      double f_center = filter.evaluate({float(-rx + (cx + 0.5) * cw), float(-ry + (cy + 0.5) * ch)});
+      double f_center =
+          filter.evaluate({float(-rx + (cx + 0.5) * cw), float(-ry + (cy + 0.5) * ch)});
       for (int sy = 0; sy < k; ++sy)
         for (int sx = 0; sx < k; ++sx) {
           double x = -rx + cx * cw + (sx + 0.5) * cw / k, y = -ry + cy * ch + (sy + 0.5) * ch / k;
@@ -95,10 +97,12 @@ TEST_P(FilterTest, WeightedSamplesAverageTheTestFunction) {
   // E[w (g - mu)] = integral f (g - mu) = 0.
   EXPECT_NEAR(weighted_g.mean, 0.0,
               kMeanTestSigmas * weighted_g.standard_error() + std::fabs(bias_g) + 1e-6 * i_abs_f)
-      << fc.name << ": self-normalised estimate " << mu + weighted_g.mean / weight.mean << " vs " << mu;
+      << fc.name << ": self-normalised estimate " << mu + weighted_g.mean / weight.mean << " vs "
+      << mu;
   // E[w] = integral f (1 for the analytic samplers, whose densities are f / integral f).
   if (!fc.analytic) {
-    EXPECT_NEAR(weight.mean, i_f, kMeanTestSigmas * weight.standard_error() + std::fabs(bias_w) + 1e-5 * i_abs_f)
+    EXPECT_NEAR(weight.mean, i_f,
+                kMeanTestSigmas * weight.standard_error() + std::fabs(bias_w) + 1e-5 * i_abs_f)
         << fc.name;
   }
 }
@@ -122,7 +126,9 @@ TEST(FilterSampling, TriangleMoments) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Filters, FilterTest, ::testing::ValuesIn(filter_cases()),
-                         [](const ::testing::TestParamInfo<FilterCase>& info) { return info.param.name; });
+                         [](const ::testing::TestParamInfo<FilterCase>& info) {
+                           return info.param.name;
+                         });
 
 }  // namespace
 }  // namespace bpm

@@ -52,11 +52,12 @@ void write_png_bytes(const std::string& path, int w, int h, const std::vector<ui
     throw Error("cannot write PNG \"" + path + "\"");
   }
   png_init_io(png, f);
-  png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
   png_write_info(png, info);
-  for (int y = 0; y < h; ++y) png_write_row(png, const_cast<uint8_t*>(rgb8.data() + size_t(y) * w * 3));
+  for (int y = 0; y < h; ++y)
+    png_write_row(png, const_cast<uint8_t*>(rgb8.data() + size_t(y) * w * 3));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   if (std::fclose(f) != 0) {
@@ -81,7 +82,8 @@ void write_exr(const std::string& path, const Image& img, const std::vector<Extr
       fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(img.rgb.data() + c), 3 * sizeof(float),
                                      3 * sizeof(float) * img.width));
     for (const ExtraChannel& e : extra)
-      fb.insert(e.name, Imf::Slice(Imf::FLOAT, (char*)e.values->data(), sizeof(float), sizeof(float) * img.width));
+      fb.insert(e.name, Imf::Slice(Imf::FLOAT, (char*)e.values->data(), sizeof(float),
+                                   sizeof(float) * img.width));
     Imf::OutputFile file(tmp.c_str(), header);
     file.setFrameBuffer(fb);
     file.writePixels(img.height);
@@ -116,7 +118,8 @@ Image read_exr(const std::string& path) {
     img.rgb.assign(size_t(img.width) * img.height * 3, 0.0f);
     Imf::FrameBuffer fb;
     const char* names[3] = {"R", "G", "B"};
-    char* base = (char*)(img.rgb.data()) - (size_t(dw.min.x) + size_t(dw.min.y) * img.width) * 3 * sizeof(float);
+    char* base = (char*)(img.rgb.data()) -
+                 (size_t(dw.min.x) + size_t(dw.min.y) * img.width) * 3 * sizeof(float);
     for (int c = 0; c < 3; ++c)
       fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float),
                                      3 * sizeof(float) * img.width));

@@ -14,7 +14,8 @@ struct ExtraChannel {
 };
 
 // Linear float OpenEXR with R, G, B and optional extra channels. Throws Error on failure.
-void write_exr(const std::string& path, const Image& img, const std::vector<ExtraChannel>& extra = {});
+void write_exr(const std::string& path, const Image& img,
+               const std::vector<ExtraChannel>& extra = {});
 // 8-bit sRGB PNG of the image times exposure, clamped. Throws Error on failure.
 void write_png(const std::string& path, const Image& img, float exposure = 1);
 // 8-bit PNG of an RGB image already in display values [0,1].

@@ -43,8 +43,10 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   std::vector<float> passes = film.pass_counts();
   std::vector<float> rms_m = film.rms_m_images();
   for (float& r : rms_m) r *= imaging_ratio;
-  if (film.m_images() > 0) write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}, {"rms_m_images", &rms_m}});
-  else write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}});
+  if (film.m_images() > 0)
+    write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}, {"rms_m_images", &rms_m}});
+  else
+    write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}});
   write_png(paths.png, img);
   write_png_display(paths.error_png, error_false_colour(film));
 }

@@ -14,12 +14,13 @@ namespace {
 // sum f dPhi / (pi r^2 N). With knn > 0 the radius is the distance to the knn-th nearest
 // photon within `radius` (Jensen's estimate), else `radius`.
 template <class Accept>
-Spectrum estimate(const PhotonMap& map, const PathVertex& v, float radius, int eye_depth, const FpmEyeParams& prm,
-                  Accept&& accept, FpmEyeCounters& c) {
+Spectrum estimate(const PhotonMap& map, const PathVertex& v, float radius, int eye_depth,
+                  const FpmEyeParams& prm, Accept&& accept, FpmEyeCounters& c) {
   ++c.lookups;
   const SurfacePoint& sp = v.sp;
   auto usable = [&](const ForwardPhoton& ph) {
-    return accept(ph.cls) && eye_depth + int(ph.bounces) <= prm.max_depth && dot(ph.ng, sp.ng) >= prm.fpm->normal_cos;
+    return accept(ph.cls) && eye_depth + int(ph.bounces) <= prm.max_depth &&
+           dot(ph.ng, sp.ng) >= prm.fpm->normal_cos;
   };
   float r = radius;
   if (prm.fpm->knn > 0) {
@@ -48,8 +49,8 @@ bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
 
 }  // namespace
 
-Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps, const FpmEyeParams& prm, Ray ray,
-                          Rng& rng, FpmEyeCounters& c) {
+Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
+                          const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c) {
   const Wavelengths& wl = prm.materials->wl;
   PathState s{ray};
   Spectrum L;
@@ -73,9 +74,10 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps, con
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local, false, wl,
-                                        rng, c.rays);
-      L += s.beta * estimate(maps.caustic, v, s.length * prm.radius_per_length0, depth, prm, caustic_class, c);
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                        v.wo_local, false, wl, rng, c.rays);
+      L += s.beta * estimate(maps.caustic, v, s.length * prm.radius_per_length0, depth, prm,
+                             caustic_class, c);
       if (!prm.fpm->final_gather) {
         L += s.beta * estimate(maps.global, v, r1, depth, prm, indirect_class, c);
         break;

@@ -30,7 +30,7 @@ struct FpmEyeCounters {
 };
 
 // Radiance arriving along -ray.d at the camera.
-Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps, const FpmEyeParams& params, Ray ray,
-                          Rng& rng, FpmEyeCounters& counters);
+Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
+                          const FpmEyeParams& params, Ray ray, Rng& rng, FpmEyeCounters& counters);
 
 }  // namespace bpm

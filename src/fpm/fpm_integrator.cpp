@@ -65,7 +65,8 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
 
 }  // namespace
 
-RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, const FpmSettings& s, Film* film) {
+RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, const FpmSettings& s,
+                       Film* film) {
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: radius factors k0 and k1 must be positive");
   if (s.photons_per_batch <= 0) throw Error("fpm: photons per iteration must be positive");
   if (s.knn < 0) throw Error("fpm: knn must not be negative");
@@ -85,22 +86,30 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
     // 1. Light pass: a forward photon at every diffuse hit.
     auto t = Clock::now();
-    trace_forward_photons(scene, wm, opt.max_depth, min_eye_vertices, n_photons, opt.seed, it, light_counters, &maps);
+    trace_forward_photons(scene, wm, opt.max_depth, min_eye_vertices, n_photons, opt.seed, it,
+                          light_counters, &maps);
     tot.light_s += since(t);
 
     // 2. The maps, in chunk order (the same for any thread count), and their trees.
     t = Clock::now();
     build_forward_maps(&maps);
-    tot.stored += maps.global.photons.size();  // every photon once; the caustic map holds copies of some
+    tot.stored +=
+        maps.global.photons.size();  // every photon once; the caustic map holds copies of some
     tot.stored_caustic += maps.caustic.photons.size();
     tot.build_s += since(t);
-    tot.peak_map_bytes = std::max(tot.peak_map_bytes, maps.global.photon_bytes() + maps.caustic.photon_bytes());
-    tot.peak_tree_bytes = std::max(tot.peak_tree_bytes, maps.global.tree.bytes() + maps.caustic.tree.bytes());
+    tot.peak_map_bytes =
+        std::max(tot.peak_map_bytes, maps.global.photon_bytes() + maps.caustic.photon_bytes());
+    tot.peak_tree_bytes =
+        std::max(tot.peak_tree_bytes, maps.global.tree.bytes() + maps.caustic.tree.bytes());
 
     // 3. Eye pass.
     t = Clock::now();
     float scale = radius_scale(s, it);
-    FpmEyeParams ep{&wm, &s, opt.max_depth, s.k0 * pixel_angle * scale, s.k1 * pixel_angle * scale,
+    FpmEyeParams ep{&wm,
+                    &s,
+                    opt.max_depth,
+                    s.k0 * pixel_angle * scale,
+                    s.k1 * pixel_angle * scale,
                     double(n_photons)};
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(it, pixel);

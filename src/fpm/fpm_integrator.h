@@ -10,7 +10,7 @@
 
 namespace bpm {
 
-RenderStats render_fpm(const LoadedScene& scene, const IntegratorOptions& options, const FpmSettings& settings,
-                       Film* film);
+RenderStats render_fpm(const LoadedScene& scene, const IntegratorOptions& options,
+                       const FpmSettings& settings, Film* film);
 
 }  // namespace bpm

@@ -19,27 +19,33 @@ void PhotonMap::build() {
 
 void trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
                            int min_eye_vertices, uint64_t n_photons, uint64_t seed, int pass_index,
-                           tbb::enumerable_thread_specific<LightCounters>& counters, ForwardMaps* maps) {
+                           tbb::enumerable_thread_specific<LightCounters>& counters,
+                           ForwardMaps* maps) {
   maps->chunks.resize(size_t((n_photons + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
-  tbb::parallel_for(tbb::blocked_range<int>(0, int(maps->chunks.size()), 1), [&](const tbb::blocked_range<int>& r) {
-    LightCounters& lc = counters.local();
-    for (int c = r.begin(); c < r.end(); ++c) {
-      ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
-      ch.global.clear();
-      ch.caustic.clear();
-      uint64_t first = uint64_t(c) * kPhotonsPerChunk, last = std::min(first + kPhotonsPerChunk, n_photons);
-      for (uint64_t k = first; k < last; ++k) {
-        Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
-        trace_light_path(scene, wm, max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
-          if (hit.bounces + min_eye_vertices > max_depth) return;
-          ForwardPhoton ph{hit.sp.p, hit.wi, hit.sp.ng, hit.flux, uint16_t(hit.bounces), hit.cls};
-          ch.global.push_back(ph);
-          if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
-          ++lc.entries;
-        });
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, int(maps->chunks.size()), 1),
+      [&](const tbb::blocked_range<int>& r) {
+        LightCounters& lc = counters.local();
+        for (int c = r.begin(); c < r.end(); ++c) {
+          ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
+          ch.global.clear();
+          ch.caustic.clear();
+          uint64_t first = uint64_t(c) * kPhotonsPerChunk,
+                   last = std::min(first + kPhotonsPerChunk, n_photons);
+          for (uint64_t k = first; k < last; ++k) {
+            Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
+            trace_light_path(
+                scene, wm, max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
+                  if (hit.bounces + min_eye_vertices > max_depth) return;
+                  ForwardPhoton ph{hit.sp.p, hit.wi, hit.sp.ng, hit.flux, uint16_t(hit.bounces),
+                                   hit.cls};
+                  ch.global.push_back(ph);
+                  if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
+                  ++lc.entries;
+                });
+          }
+        }
+      });
 }
 
 void build_forward_maps(ForwardMaps* maps) {

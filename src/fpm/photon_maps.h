@@ -44,7 +44,8 @@ struct ForwardMaps {
 // gathering), so that no stored photon makes a path longer than max_depth.
 void trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
                            int min_eye_vertices, uint64_t n_photons, uint64_t seed, int pass_index,
-                           tbb::enumerable_thread_specific<LightCounters>& counters, ForwardMaps* maps);
+                           tbb::enumerable_thread_specific<LightCounters>& counters,
+                           ForwardMaps* maps);
 
 // Joins the chunks into the two maps and builds their trees.
 void build_forward_maps(ForwardMaps* maps);

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <limits>
 
-#include "base/rng.h"
 #include "base/interrupt.h"
+#include "base/rng.h"
 #include "integrator/options.h"
 
 namespace bpm {
@@ -56,7 +56,8 @@ void RenderControl::update_probabilities() {
     image_mean += lum[i] / double(n);
   }
   std::vector<float> rel(n);
-  for (size_t i = 0; i < n; ++i) rel[i] = float(rms[i] / (std::fabs(lum[i]) + 0.01 * image_mean + 1e-12));
+  for (size_t i = 0; i < n; ++i)
+    rel[i] = float(rms[i] / (std::fabs(lum[i]) + 0.01 * image_mean + 1e-12));
   // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
   std::vector<float> sorted = rel;
   size_t k = std::min(n - 1, size_t(0.9 * double(n)));
@@ -83,7 +84,8 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
   if (!print) return;
   last_progress_ = t;
   char budget[32] = "";
-  if (opt_.spp != std::numeric_limits<int>::max()) std::snprintf(budget, sizeof budget, "/%d", opt_.spp);
+  if (opt_.spp != std::numeric_limits<int>::max())
+    std::snprintf(budget, sizeof budget, "/%d", opt_.spp);
   std::string eta;
   if (opt_.accuracy > 0 && delta_ > opt_.accuracy && passes >= kWarmupPasses) {
     // delta falls as 1/sqrt(passes): the passes still needed, at the rate so far.
@@ -92,8 +94,9 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
     std::snprintf(buf, sizeof buf, "  %.0f s to delta %.3g", more * t / passes, opt_.accuracy);
     eta = buf;
   }
-  std::fprintf(stderr, "\rbpm: %s %d%s  %.1f s  delta %.4f  %.2f Mrays/s%s%s   ", unit_, passes, budget, t,
-               delta_, t > 0 ? double(rays) / t * 1e-6 : 0.0, extra.c_str(), eta.c_str());
+  std::fprintf(stderr, "\rbpm: %s %d%s  %.1f s  delta %.4f  %.2f Mrays/s%s%s   ", unit_, passes,
+               budget, t, delta_, t > 0 ? double(rays) / t * 1e-6 : 0.0, extra.c_str(),
+               eta.c_str());
   std::fflush(stderr);
 }
 

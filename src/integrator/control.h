@@ -20,7 +20,9 @@ namespace bpm {
 
 // Wall-clock time of the integrators' stages.
 using Clock = std::chrono::steady_clock;
-inline double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+inline double since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 struct IntegratorOptions;
 

@@ -15,8 +15,7 @@ namespace bpm {
 // ray in `medium`: the shadow ray's absorption is that of the medium on the light's side.
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
-                             bool use_mis, const Wavelengths& wl, Rng& rng,
-                             PathCounters& counters);
+                             bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters);
 
 // How emission found by the next ray of a path counts: in full (seen from the camera or through
 // specular vertices only), by the power heuristic against next-event estimation at the previous
@@ -47,11 +46,11 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
                                PathState& s, PathVertex& v, PathCounters& counters,
                                const EmitterWeight& emitter, Spectrum& L) {
   const Wavelengths& wl = materials.wl;
-  StepEnd end = next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
-                            [&](const Hit& hit, const SurfacePoint& sp) {
-                              L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta,
-                                                             emitter);
-                            });
+  StepEnd end =
+      next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
+                  [&](const Hit& hit, const SurfacePoint& sp) {
+                    L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
+                  });
   if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
   return end;
 }

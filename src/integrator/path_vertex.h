@@ -24,8 +24,8 @@ struct PathState {
 struct PathVertex {
   Hit hit;
   SurfacePoint sp;
-  Vec3 wo;                // toward where the path came from
-  int material_index;     // the object's material in RenderScene::materials
+  Vec3 wo;                   // toward where the path came from
+  int material_index;        // the object's material in RenderScene::materials
   const Material* material;  // resolved at sp (textures, mixes) at the path's wavelengths
   Material storage;          // holds the material when it had to be resolved at sp
   Frame frame;               // shading frame

@@ -2,8 +2,8 @@
 
 namespace bpm {
 
-void run_passes(const IntegratorOptions& opt, Film* film, const char* unit, const PassFunction& pass,
-                RenderStats* stats) {
+void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
+                const PassFunction& pass, RenderStats* stats) {
   RenderControl control(opt, *film, unit);
   for (int p = 0; control.keep_going(p); ++p) {
     PassResult r = pass(p, control);

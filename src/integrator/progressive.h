@@ -36,8 +36,8 @@ using PassFunction = std::function<PassResult(int pass, const RenderControl& con
 
 // Runs passes until a budget ends the render. `unit` names a pass in the progress line. Fills
 // the passes, stop reason, time, mean sampling probability and error delta of `stats`.
-void run_passes(const IntegratorOptions& opt, Film* film, const char* unit, const PassFunction& pass,
-                RenderStats* stats);
+void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
+                const PassFunction& pass, RenderStats* stats);
 
 // One pixel sample: its random stream, keyed by (seed, pass index, pixel), which has already
 // drawn the filter offset and the lens position; the camera ray; the filter weight.

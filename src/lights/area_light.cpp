@@ -9,7 +9,8 @@ namespace bpm {
 Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl) {
   if (!l.two_sided && dot(n, w) <= 0) return {};
   if (!l.image) return l.radiance.sample(wl);
-  return illuminant_texel(l.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp), l.image_scale, wl);
+  return illuminant_texel(l.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp),
+                          l.image_scale, wl);
 }
 
 float primitive_area(const Shape& shape, int prim) {
@@ -22,7 +23,8 @@ float primitive_area(const Shape& shape, int prim) {
     float scale = 1;
     s->world_from_object.is_similarity(&scale);
     float r = s->radius * scale;
-    return s->phi_max * r * (std::fmin(s->z_max, s->radius) - std::fmax(s->z_min, -s->radius)) * scale;
+    return s->phi_max * r * (std::fmin(s->z_max, s->radius) - std::fmax(s->z_min, -s->radius)) *
+           scale;
   }
   if (auto* c = std::get_if<Cylinder>(&shape)) {
     float scale = 1;
@@ -58,7 +60,8 @@ AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
   }
   if (auto* c = std::get_if<Cylinder>(&shape)) {
     float phi = u.y * c->phi_max;
-    Vec3 po(c->radius * std::cos(phi), c->radius * std::sin(phi), c->z_min + u.x * (c->z_max - c->z_min));
+    Vec3 po(c->radius * std::cos(phi), c->radius * std::sin(phi),
+            c->z_min + u.x * (c->z_max - c->z_min));
     SurfacePoint sp = surface_point(shape, 0, {}, c->world_from_object.point(po));
     return {sp.p, sp.ng, 1 / l.area, sp.uv};
   }
@@ -81,8 +84,8 @@ SphereWorld sphere_world(const Sphere& s) {
 
 }  // namespace
 
-std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec2 u,
-                                          const SceneBoundsInfo&, const Wavelengths& wl) {
+std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref,
+                                          Vec2 u, const SceneBoundsInfo&, const Wavelengths& wl) {
   LightLiSample ls;
   if (auto* s = std::get_if<Sphere>(shape)) {
     SphereWorld sw = sphere_world(*s);
@@ -125,7 +128,8 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
   return ls;
 }
 
-float pdf_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light) {
+float pdf_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
+                Vec3 n_light) {
   if (auto* s = std::get_if<Sphere>(shape)) {
     SphereWorld sw = sphere_world(*s);
     float dc2 = length_squared(sw.center - p_ref);
@@ -140,8 +144,9 @@ float pdf_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec
   return d2 / (cos_l * l.area);
 }
 
-std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
-                                          const SceneBoundsInfo&, const Wavelengths& wl) {
+std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape, Vec2 u_pos,
+                                          Vec2 u_dir, const SceneBoundsInfo&,
+                                          const Wavelengths& wl) {
   LightLeSample s;
   AreaSample as = sample_area(l, *shape, u_pos);
   // Cosine-weighted about the normal; a two-sided emitter picks its side with probability 1/2.
@@ -162,7 +167,8 @@ std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape
   s.direction = Frame::from_z(n).to_world(w_local);
   s.origin = as.p;
   s.n_light = as.n;
-  s.flux = area_light_radiance(l, as.n, as.uv, s.direction, wl) * (w_local.z / (as.pdf_area * pdf_dir));
+  s.flux =
+      area_light_radiance(l, as.n, as.uv, s.direction, wl) * (w_local.z / (as.pdf_area * pdf_dir));
   return s;
 }
 

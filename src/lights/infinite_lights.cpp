@@ -49,8 +49,9 @@ Rgb power_of(const DistantLight& l, const SceneBoundsInfo& bounds) {
 
 // ---- uniform infinite ----
 
-std::optional<LightLiSample> sample_li_of(const UniformInfiniteLight& l, const Shape*, Vec3 p_ref, Vec2 u,
-                                          const SceneBoundsInfo& bounds, const Wavelengths& wl) {
+std::optional<LightLiSample> sample_li_of(const UniformInfiniteLight& l, const Shape*, Vec3 p_ref,
+                                          Vec2 u, const SceneBoundsInfo& bounds,
+                                          const Wavelengths& wl) {
   LightLiSample ls;
   ls.wi = sample_uniform_sphere(u);
   ls.radiance = l.radiance.sample(wl);
@@ -64,8 +65,9 @@ float pdf_li_of(const UniformInfiniteLight&, const Shape*, Vec3, Vec3, Vec3, Vec
   return kUniformSpherePdfSolidAngle;
 }
 
-std::optional<LightLeSample> sample_le_of(const UniformInfiniteLight& l, const Shape*, Vec2 u_pos, Vec2 u_dir,
-                                          const SceneBoundsInfo& bounds, const Wavelengths& wl) {
+std::optional<LightLeSample> sample_le_of(const UniformInfiniteLight& l, const Shape*, Vec2 u_pos,
+                                          Vec2 u_dir, const SceneBoundsInfo& bounds,
+                                          const Wavelengths& wl) {
   LightLeSample s;
   s.direction = sample_uniform_sphere(u_dir);
   s.origin = disk_origin(s.direction, u_pos, bounds);
@@ -92,7 +94,8 @@ Spectrum image_radiance(const ImageInfiniteLight& l, Vec2 uv, const Wavelengths&
   if (l.equal_area) {
     rgb = l.image->lookup(uv, TexFilter::kPoint, TexWrap::kOctahedralSphere);
   } else {
-    rgb = l.image->lookup({uv.x, std::clamp(uv.y, 0.0f, kOneMinusEpsilon)}, TexFilter::kPoint, TexWrap::kRepeat);
+    rgb = l.image->lookup({uv.x, std::clamp(uv.y, 0.0f, kOneMinusEpsilon)}, TexFilter::kPoint,
+                          TexWrap::kRepeat);
   }
   return illuminant_texel(rgb, l.scale, wl);
 }
@@ -137,7 +140,8 @@ Vec2 image_light_sample(const ImageInfiniteLight& l, Vec2 u, float* pdf_solid_an
     return uv;
   }
   // Latitude-longitude: uniform in solid angle within the texel (uniform in cos theta across its
-  // row), so that the density is the texel's probability over its solid angle, bounded at the poles.
+  // row), so that the density is the texel's probability over its solid angle, bounded at the
+  // poles.
   int y = std::clamp(int(uv.y * float(im.height)), 0, im.height - 1);
   float frac = uv.y * float(im.height) - float(y);
   double c0 = std::cos(M_PI * y / im.height), c1 = std::cos(M_PI * (y + 1) / im.height);
@@ -192,8 +196,10 @@ double image_light_illuminance(const ImageInfiniteLight& l) {
             w = equal_area_square_to_sphere(uv);
           } else {  // rows of equal solid angle: uniform steps in cos theta
             double c0 = std::cos(M_PI * y / im.height), c1 = std::cos(M_PI * (y + 1) / im.height);
-            double ct = c0 + (j + 0.5) / sub * (c1 - c0), st = std::sqrt(std::fmax(0.0, 1 - ct * ct));
-            w = Vec3(float(st * std::cos(uv.x * 2 * M_PI)), float(st * std::sin(uv.x * 2 * M_PI)), float(ct));
+            double ct = c0 + (j + 0.5) / sub * (c1 - c0),
+                   st = std::sqrt(std::fmax(0.0, 1 - ct * ct));
+            w = Vec3(float(st * std::cos(uv.x * 2 * M_PI)), float(st * std::sin(uv.x * 2 * M_PI)),
+                     float(ct));
           }
           cos_sum += std::fmax(0.0f, w.z);
         }
@@ -206,8 +212,9 @@ Spectrum environment_radiance_of(const ImageInfiniteLight& l, Vec3 w, const Wave
   return image_radiance(l, image_light_uv(l, w), wl);
 }
 
-std::optional<LightLiSample> sample_li_of(const ImageInfiniteLight& l, const Shape*, Vec3 p_ref, Vec2 u,
-                                          const SceneBoundsInfo& bounds, const Wavelengths& wl) {
+std::optional<LightLiSample> sample_li_of(const ImageInfiniteLight& l, const Shape*, Vec3 p_ref,
+                                          Vec2 u, const SceneBoundsInfo& bounds,
+                                          const Wavelengths& wl) {
   LightLiSample ls;
   float pdf = 0;
   Vec2 uv = image_light_sample(l, u, &pdf);
@@ -225,8 +232,9 @@ float pdf_li_of(const ImageInfiniteLight& l, const Shape*, Vec3, Vec3 wi, Vec3, 
   return image_light_pdf(l, image_light_uv(l, wi));
 }
 
-std::optional<LightLeSample> sample_le_of(const ImageInfiniteLight& l, const Shape*, Vec2 u_pos, Vec2 u_dir,
-                                          const SceneBoundsInfo& bounds, const Wavelengths& wl) {
+std::optional<LightLeSample> sample_le_of(const ImageInfiniteLight& l, const Shape*, Vec2 u_pos,
+                                          Vec2 u_dir, const SceneBoundsInfo& bounds,
+                                          const Wavelengths& wl) {
   LightLeSample s;
   float pdf = 0;
   Vec2 uv = image_light_sample(l, u_dir, &pdf);

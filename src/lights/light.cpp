@@ -21,30 +21,39 @@ bool light_is_environment(const Light& l) {
 Spectrum environment_radiance(const Light& light, Vec3 w, const Wavelengths& wl) {
   return std::visit(
       [&](const auto& x) {
-        if constexpr (kEnvironmentLight<std::decay_t<decltype(x)>>) return environment_radiance_of(x, w, wl);
-        else return Spectrum();
+        if constexpr (kEnvironmentLight<std::decay_t<decltype(x)>>)
+          return environment_radiance_of(x, w, wl);
+        else
+          return Spectrum();
       },
       light);
 }
 
-std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec2 u,
-                                             const SceneBoundsInfo& bounds, const Wavelengths& wl) {
-  return std::visit([&](const auto& x) { return sample_li_of(x, shape, p_ref, u, bounds, wl); }, light);
+std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* shape, Vec3 p_ref,
+                                             Vec2 u, const SceneBoundsInfo& bounds,
+                                             const Wavelengths& wl) {
+  return std::visit([&](const auto& x) { return sample_li_of(x, shape, p_ref, u, bounds, wl); },
+                    light);
 }
 
 // Delta lights are never hit by a sampled direction.
-float light_pdf_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light) {
+float light_pdf_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
+                   Vec3 n_light) {
   return std::visit(
       [&](const auto& x) {
-        if constexpr (kDeltaLight<std::decay_t<decltype(x)>>) return 0.0f;
-        else return pdf_li_of(x, shape, p_ref, wi, p_light, n_light);
+        if constexpr (kDeltaLight<std::decay_t<decltype(x)>>)
+          return 0.0f;
+        else
+          return pdf_li_of(x, shape, p_ref, wi, p_light, n_light);
       },
       light);
 }
 
-std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
-                                             const SceneBoundsInfo& bounds, const Wavelengths& wl) {
-  return std::visit([&](const auto& x) { return sample_le_of(x, shape, u_pos, u_dir, bounds, wl); }, light);
+std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* shape, Vec2 u_pos,
+                                             Vec2 u_dir, const SceneBoundsInfo& bounds,
+                                             const Wavelengths& wl) {
+  return std::visit([&](const auto& x) { return sample_le_of(x, shape, u_pos, u_dir, bounds, wl); },
+                    light);
 }
 
 Rgb light_power(const Light& light, const SceneBoundsInfo& bounds) {

@@ -7,9 +7,9 @@
 #include <variant>
 
 #include "base/color.h"
+#include "base/sampling.h"
 #include "base/spectrum.h"
 #include "base/vec.h"
-#include "base/sampling.h"
 #include "scene/shapes.h"
 #include "textures/texture.h"
 
@@ -123,10 +123,10 @@ using Light = std::variant<PointLight, SpotLight, GoniometricLight, ProjectionLi
                            UniformInfiniteLight, ImageInfiniteLight, AreaLight>;
 
 struct LightLiSample {
-  Spectrum radiance;    // arriving at the reference point along -wi
-  Vec3 wi;              // unit, toward the light
-  Vec3 p_light;         // point on the light (for shadow rays); far away for distant lights
-  Vec3 n_light;         // surface normal there (zero for lights without a surface)
+  Spectrum radiance;          // arriving at the reference point along -wi
+  Vec3 wi;                    // unit, toward the light
+  Vec3 p_light;               // point on the light (for shadow rays); far away for distant lights
+  Vec3 n_light;               // surface normal there (zero for lights without a surface)
   float pdf_solid_angle = 0;  // 1 for delta lights
   bool is_delta = false;
   bool is_infinite = false;
@@ -159,13 +159,15 @@ std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape,
                                              const SceneBoundsInfo& bounds, const Wavelengths& wl);
 // Solid-angle density of light_sample_li choosing direction wi that reaches the light at
 // p_light (area lights) or escapes (infinite lights).
-float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light, Vec3 n_light);
+float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
+                   Vec3 n_light);
 // Radiance leaving an area light at a point with geometric normal n and surface coordinates uv
 // toward w.
 Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl);
 // Samples an emitted photon; u_pos picks the point, u_dir the direction.
-std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape, Vec2 u_pos, Vec2 u_dir,
-                                             const SceneBoundsInfo& bounds, const Wavelengths& wl);
+std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape, Vec2 u_pos,
+                                             Vec2 u_dir, const SceneBoundsInfo& bounds,
+                                             const Wavelengths& wl);
 // Total emitted power as a colour (the light's RGB times its geometric factor), used by the
 // power light sampler.
 Rgb light_power(const Light& l, const SceneBoundsInfo& bounds);

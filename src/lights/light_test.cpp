@@ -1,21 +1,22 @@
 // Tests of lights: emitted power against numerical integrals, the density of light_sample_li
 // (Monte Carlo estimates of solid-angle integrals, agreement with light_pdf_li, and a chi-square
 // test of the sampled directions), and the spot light falloff.
+#include "lights/light.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <tuple>
-#include <optional>
 
 #include "base/chi2_test_util.h"
 #include "base/rng.h"
 #include "base/sampling.h"
 #include "base/transform.h"
-#include "lights/light.h"
-#include "textures/texture.h"
 #include "scene/shapes.h"
+#include "textures/texture.h"
 
 namespace bpm {
 namespace {
@@ -26,7 +27,9 @@ const Wavelengths kWl = sample_wavelengths(0.37f);
 const SpectrumCurve kL = SpectrumCurve::from_rgb(Rgb(1.0f, 2.0f, 0.5f), SpectrumKind::kIlluminant);
 const Spectrum kLs = kL.sample(kWl);
 
-SpectrumCurve light_rgb(float r, float g, float b) { return SpectrumCurve::from_rgb(Rgb(r, g, b), SpectrumKind::kIlluminant); }
+SpectrumCurve light_rgb(float r, float g, float b) {
+  return SpectrumCurve::from_rgb(Rgb(r, g, b), SpectrumKind::kIlluminant);
+}
 
 // The emission curve of a light, and its power per unit of that curve (light_power / curve rgb).
 const SpectrumCurve& emission_curve(const Light& l) {
@@ -49,7 +52,9 @@ struct D3 {
 D3 d3(Vec3 v) { return {v.x, v.y, v.z}; }
 D3 sub(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 double ddot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-D3 dcross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+D3 dcross(D3 a, D3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 double dlen(D3 a) { return std::sqrt(ddot(a, a)); }
 
 TriangleMesh make_triangle(bool flip = false) {
@@ -70,7 +75,8 @@ Vec3 triangle_normal(const TriangleMesh& m) {
 }
 // Solid angle of the triangle seen from p (Van Oosterom and Strackee 1983).
 double triangle_solid_angle(const TriangleMesh& m, Vec3 p) {
-  D3 a = sub(d3(m.positions[0]), d3(p)), b = sub(d3(m.positions[1]), d3(p)), c = sub(d3(m.positions[2]), d3(p));
+  D3 a = sub(d3(m.positions[0]), d3(p)), b = sub(d3(m.positions[1]), d3(p)),
+     c = sub(d3(m.positions[2]), d3(p));
   double la = dlen(a), lb = dlen(b), lc = dlen(c);
   double num = std::fabs(ddot(a, dcross(b, c)));
   double den = la * lb * lc + ddot(a, b) * lc + ddot(a, c) * lb + ddot(b, c) * la;
@@ -87,7 +93,8 @@ Sphere make_sphere(Vec3 center, float radius) {
 // A partial cylinder under a similarity transform.
 Cylinder make_cylinder() {
   Cylinder c;
-  c.world_from_object = Transform::translate(Vec3(1, 2, 3)) * Transform::rotate(30, normalize(Vec3(1, 1, 0))) *
+  c.world_from_object = Transform::translate(Vec3(1, 2, 3)) *
+                        Transform::rotate(30, normalize(Vec3(1, 1, 0))) *
                         Transform::scale(Vec3(2, 2, 2));
   c.radius = 0.25f;
   c.z_min = -0.2f;
@@ -117,8 +124,8 @@ void expect_mean(const MeanAccumulator& a, double expected, double extra, const 
 // Power of a diffuse emitter = integral over its area and over the sphere of directions of
 // L(p, w) |cos|: estimated with uniform points (own barycentric sampling) and uniform directions.
 template <class PointSampler>
-void check_area_light_power(const Shape& shape, const AreaLight& l, double area, PointSampler&& sample_point,
-                            uint64_t seed) {
+void check_area_light_power(const Shape& shape, const AreaLight& l, double area,
+                            PointSampler&& sample_point, uint64_t seed) {
   Spectrum power = spectral_power(Light(l));
   Rgb power_rgb = light_power(Light(l), kBounds);
   Rng rng(seed);
@@ -130,10 +137,12 @@ void check_area_light_power(const Shape& shape, const AreaLight& l, double area,
     for (int c = 0; c < Spectrum::kChannels; ++c)
       est[c].add(double(le[c]) * std::fabs(dot(n, w)) * area / kUniformSpherePdfSolidAngle);
   }
-  for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], power[c], 0, l.two_sided ? "two-sided" : "one-sided");
+  for (int c = 0; c < Spectrum::kChannels; ++c)
+    expect_mean(est[c], power[c], 0, l.two_sided ? "two-sided" : "one-sided");
   // And the closed form: pi A L per emitting side.
   for (int c = 0; c < 3; ++c)
-    EXPECT_NEAR(power_rgb[c], kPi * area * kL.rgb()[c] * (l.two_sided ? 2 : 1), 1e-5 * power_rgb[c]);
+    EXPECT_NEAR(power_rgb[c], kPi * area * kL.rgb()[c] * (l.two_sided ? 2 : 1),
+                1e-5 * power_rgb[c]);
   (void)shape;
 }
 
@@ -186,7 +195,10 @@ TEST(LightPower, CylinderAreaLight) {
         shape, l, area,
         [&](Rng& rng) {
           float phi = rng.uniform() * c.phi_max, z = c.z_min + rng.uniform() * (c.z_max - c.z_min);
-          SurfacePoint sp = surface_point(shape, 0, {}, c.world_from_object.point(Vec3(c.radius * std::cos(phi), c.radius * std::sin(phi), z)));
+          SurfacePoint sp =
+              surface_point(shape, 0, {},
+                            c.world_from_object.point(
+                                Vec3(c.radius * std::cos(phi), c.radius * std::sin(phi), z)));
           return sp.ng;
         },
         5 + two_sided);
@@ -213,7 +225,8 @@ TEST(LightPower, PrimitiveAreaUnderScaleAndForPartialShapes) {
 TEST(LightPower, PointLight) {
   PointLight p{Vec3(1, 2, 3), light_rgb(2.0f, 3.0f, 4.0f)};
   Rgb power = light_power(Light(p), kBounds);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(power[c], 4 * M_PI * p.intensity.rgb()[c], 1e-5 * power[c]);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(power[c], 4 * M_PI * p.intensity.rgb()[c], 1e-5 * power[c]);
   auto s = light_sample_li(Light(p), nullptr, Vec3(1, 2, 5), {0.5f, 0.5f}, kBounds, kWl);
   ASSERT_TRUE(s.has_value());
   EXPECT_TRUE(s->is_delta);
@@ -234,7 +247,8 @@ SpotLight make_spot() {
 TEST(LightPower, SpotLightMatchesIntegralOfFalloff) {
   SpotLight l = make_spot();
   Rgb power = light_power(Light(l), kBounds);
-  // Power = I * integral over the sphere of falloff = I * 2 pi * integral_{-1}^{1} falloff(cos) dcos.
+  // Power = I * integral over the sphere of falloff = I * 2 pi * integral_{-1}^{1} falloff(cos)
+  // dcos.
   const int n = 200000;
   double integral = 0;
   for (int k = 0; k < n; ++k) {
@@ -242,7 +256,8 @@ TEST(LightPower, SpotLightMatchesIntegralOfFalloff) {
     integral += spot_falloff(l, Vec3(float(std::sqrt(1 - c * c)), 0, float(c)));
   }
   integral *= 2 * M_PI * 2.0 / n;
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(power[c], l.intensity.rgb()[c] * integral, 1e-3 * power[c]) << c;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(power[c], l.intensity.rgb()[c] * integral, 1e-3 * power[c]) << c;
 }
 
 // The intensity that light_sample_li delivers, integrated over all directions from the light.
@@ -267,7 +282,9 @@ TEST(LightPower, SpotLightMatchesSampledIntensity) {
 
 TEST(SpotLight, Falloff) {
   SpotLight l = make_spot();
-  auto f = [&](double c) { return spot_falloff(l, Vec3(float(std::sqrt(std::fmax(0.0, 1 - c * c))), 0, float(c))); };
+  auto f = [&](double c) {
+    return spot_falloff(l, Vec3(float(std::sqrt(std::fmax(0.0, 1 - c * c))), 0, float(c)));
+  };
   EXPECT_EQ(f(1.0), 1.0f);
   EXPECT_EQ(f(l.cos_falloff_start + 1e-4), 1.0f);
   EXPECT_EQ(f(l.cos_falloff_end - 1e-4), 0.0f);
@@ -288,7 +305,8 @@ TEST(SpotLight, Falloff) {
   auto s = light_sample_li(Light(l), nullptr, l.position + l.frame.n * 3, {}, kBounds, kWl);
   ASSERT_TRUE(s.has_value());
   EXPECT_NEAR(s->radiance[0], l.intensity.value(kWl.lambda[0]) / 9, 1e-5f);
-  EXPECT_FALSE(light_sample_li(Light(l), nullptr, l.position - l.frame.n * 3, {}, kBounds, kWl).has_value());
+  EXPECT_FALSE(
+      light_sample_li(Light(l), nullptr, l.position - l.frame.n * 3, {}, kBounds, kWl).has_value());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -302,7 +320,8 @@ struct LiCheck {
 };
 
 template <class PerSample>
-LiCheck run_li(const Light& light, const Shape& shape, Vec3 p_ref, uint64_t seed, int n, PerSample&& per_sample) {
+LiCheck run_li(const Light& light, const Shape& shape, Vec3 p_ref, uint64_t seed, int n,
+               PerSample&& per_sample) {
   LiCheck r;
   Rng rng(seed);
   for (int k = 0; k < n; ++k) {
@@ -318,7 +337,8 @@ LiCheck run_li(const Light& light, const Shape& shape, Vec3 p_ref, uint64_t seed
     EXPECT_GT(s->pdf_solid_angle, 0);
     float pdf = light_pdf_li(light, &shape, p_ref, s->wi, s->p_light, s->n_light);
     EXPECT_NEAR(pdf, s->pdf_solid_angle, 1e-3f * s->pdf_solid_angle);
-    for (int c = 0; c < Spectrum::kChannels; ++c) r.est[c].add(double(s->radiance[c]) / s->pdf_solid_angle);
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      r.est[c].add(double(s->radiance[c]) / s->pdf_solid_angle);
     per_sample(*s);
   }
   return r;
@@ -346,13 +366,15 @@ TEST(LightSampleLi, TriangleSolidAngle) {
           EXPECT_NEAR(dot(normalize(s.p_light - p_ref), s.wi), 1.0f, 1e-5f);
           EXPECT_NEAR(s.radiance[1], kLs[1], 1e-6f);
         };
-        LiCheck r = run_li(light, shape, p_ref, 100 + 10 * flip + 2 * two_sided + lit, 100000, check);
+        LiCheck r =
+            run_li(light, shape, p_ref, 100 + 10 * flip + 2 * two_sided + lit, 100000, check);
         if (!lit) {
           EXPECT_EQ(r.n_none, r.n_samples) << "the back of a one-sided emitter must be dark";
           continue;
         }
         EXPECT_EQ(r.n_none, 0);
-        for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(r.est[c], kLs[c] * omega, 0, "triangle");
+        for (int c = 0; c < Spectrum::kChannels; ++c)
+          expect_mean(r.est[c], kLs[c] * omega, 0, "triangle");
       }
     }
   }
@@ -381,8 +403,10 @@ TEST(LightSampleLi, SphereFromOutsideSamplesTheCone) {
     EXPECT_GE(dot(s.n_light, -s.wi), 0.0f);
   };
   LiCheck r = run_li(light, shape, p_ref, 200, 100000, check);
-  // Every sample returns L / pdf = L * omega: a zero-variance estimator; 1e-4 covers float rounding.
-  for (int ch = 0; ch < Spectrum::kChannels; ++ch) expect_mean(r.est[ch], kLs[ch] * omega, 1e-4 * kLs[ch] * omega, "sphere");
+  // Every sample returns L / pdf = L * omega: a zero-variance estimator; 1e-4 covers float
+  // rounding.
+  for (int ch = 0; ch < Spectrum::kChannels; ++ch)
+    expect_mean(r.est[ch], kLs[ch] * omega, 1e-4 * kLs[ch] * omega, "sphere");
 }
 
 // From inside, points are sampled by area; a two-sided sphere surrounds p_ref with radiance L.
@@ -414,7 +438,8 @@ TEST(LightSampleLi, CylinderMatchesCountedCrossings) {
     for (int ch = 0; ch < Spectrum::kChannels; ++ch) {
       double se = std::sqrt(r.est[ch].standard_error() * r.est[ch].standard_error() +
                             kLs[ch] * ref.standard_error() * kLs[ch] * ref.standard_error());
-      EXPECT_NEAR(r.est[ch].mean, kLs[ch] * ref.mean, kMeanTestSigmas * se) << "two-sided " << two_sided;
+      EXPECT_NEAR(r.est[ch].mean, kLs[ch] * ref.mean, kMeanTestSigmas * se)
+          << "two-sided " << two_sided;
     }
   }
 }
@@ -430,7 +455,8 @@ TEST(LightSampleLi, SphereFromInside) {
   EXPECT_EQ(dark.n_none, dark.n_samples) << "a one-sided sphere emits outward only";
   Light light = make_area_light(shape, true);
   LiCheck r = run_li(light, shape, p_ref, 301, 100000, none);
-  for (int ch = 0; ch < Spectrum::kChannels; ++ch) expect_mean(r.est[ch], kLs[ch] * 4 * M_PI, 0, "inside sphere");
+  for (int ch = 0; ch < Spectrum::kChannels; ++ch)
+    expect_mean(r.est[ch], kLs[ch] * 4 * M_PI, 0, "inside sphere");
 
   // The directions follow light_pdf_li (the chi-square harness of the BSDF tests; the image
   // lights' test runs two more, on their texels).
@@ -439,7 +465,8 @@ TEST(LightSampleLi, SphereFromInside) {
   o.sub = 32;  // this pdf is smooth (no discontinuity inside cells): O(h^2) integration suffices
   auto res = chi2::run(
       [&](Rng& rng) -> std::optional<Vec3> {
-        auto s = light_sample_li(light, &shape, p_ref, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+        auto s =
+            light_sample_li(light, &shape, p_ref, {rng.uniform(), rng.uniform()}, kBounds, kWl);
         if (!s) return std::nullopt;
         return s->wi;
       },
@@ -453,7 +480,6 @@ TEST(LightSampleLi, SphereFromInside) {
       302, o);
   EXPECT_TRUE(res.passed()) << res.report;
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // Environment image lights.
@@ -490,7 +516,8 @@ std::pair<int, int> texel_of(const ImageInfiniteLight& l, Vec3 w) {
           std::clamp(int(uv.y * l.image->height), 0, l.image->height - 1)};
 }
 Spectrum texel_radiance(const ImageInfiniteLight& l, int x, int y) {
-  return rgb_texel_spectrum(l.image->texel(x, y, TexWrap::kClamp), SpectrumKind::kIlluminant, kWl) * l.scale;
+  return rgb_texel_spectrum(l.image->texel(x, y, TexWrap::kClamp), SpectrumKind::kIlluminant, kWl) *
+         l.scale;
 }
 // The integral of the radiance over the sphere, texel by texel (each texel's solid angle from
 // the layout's geometry, independently of image_light_jacobian).
@@ -498,8 +525,10 @@ Spectrum integrated_radiance(const ImageInfiniteLight& l) {
   const TexImage& im = *l.image;
   Spectrum sum;
   for (int y = 0; y < im.height; ++y) {
-    double omega = l.equal_area ? 4 * M_PI / (im.width * im.height)
-                                : 2 * M_PI / im.width * (std::cos(M_PI * y / im.height) - std::cos(M_PI * (y + 1) / im.height));
+    double omega =
+        l.equal_area ? 4 * M_PI / (im.width * im.height)
+                     : 2 * M_PI / im.width *
+                           (std::cos(M_PI * y / im.height) - std::cos(M_PI * (y + 1) / im.height));
     for (int x = 0; x < im.width; ++x) sum += texel_radiance(l, x, y) * float(omega);
   }
   return sum;
@@ -522,7 +551,8 @@ TEST(ImageLight, OrientationAndRadiance) {
       auto [tx, ty] = texel_of(l, w);
       Spectrum L = environment_radiance(Light(l), w, kWl);
       Spectrum expected = texel_radiance(l, tx, ty);
-      for (int c = 0; c < Spectrum::kChannels; ++c) ASSERT_NEAR(L[c], expected[c], 1e-4f * expected[c] + 1e-6f);
+      for (int c = 0; c < Spectrum::kChannels; ++c)
+        ASSERT_NEAR(L[c], expected[c], 1e-4f * expected[c] + 1e-6f);
       // The mapping's inverse.
       EXPECT_NEAR(dot(image_light_direction(l, image_light_uv(l, w)), w), 1.0f, 1e-4f);
     }
@@ -536,12 +566,14 @@ TEST(ImageLight, SampledRadianceIntegratesToTheImageAndDensitiesAgree) {
     Light light = l;
     Shape none = Sphere{};  // unused by environment lights
     Spectrum expected = integrated_radiance(l);
-    LiCheck r = run_li(light, none, Vec3(0.3f, 0.1f, -0.2f), 500 + equal_area, 200000, [&](const LightLiSample& s) {
-      EXPECT_TRUE(s.is_infinite);
-      Spectrum L = environment_radiance(light, s.wi, kWl);
-      EXPECT_NEAR(s.radiance[0], L[0], 1e-4f * L[0]);
-    });
-    for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(r.est[c], expected[c], 0, equal_area ? "equal-area" : "lat-long");
+    LiCheck r = run_li(light, none, Vec3(0.3f, 0.1f, -0.2f), 500 + equal_area, 200000,
+                       [&](const LightLiSample& s) {
+                         EXPECT_TRUE(s.is_infinite);
+                         Spectrum L = environment_radiance(light, s.wi, kWl);
+                         EXPECT_NEAR(s.radiance[0], L[0], 1e-4f * L[0]);
+                       });
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      expect_mean(r.est[c], expected[c], 0, equal_area ? "equal-area" : "lat-long");
     // The power the light sampler uses: the mean radiance times 4 pi, times the disk pi r^2.
     Rgb power = light_power(light, kBounds);
     double disk = M_PI * kBounds.radius * kBounds.radius;
@@ -549,10 +581,13 @@ TEST(ImageLight, SampledRadianceIntegratesToTheImageAndDensitiesAgree) {
     for (int y = 0; y < l.image->height; ++y)
       for (int x = 0; x < l.image->width; ++x) {
         double omega = l.equal_area ? 4 * M_PI / (l.image->width * l.image->height)
-                                    : 2 * M_PI / l.image->width * (std::cos(M_PI * y / l.image->height) - std::cos(M_PI * (y + 1) / l.image->height));
+                                    : 2 * M_PI / l.image->width *
+                                          (std::cos(M_PI * y / l.image->height) -
+                                           std::cos(M_PI * (y + 1) / l.image->height));
         sum += l.image->texel(x, y, TexWrap::kClamp) * float(omega);
       }
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(power[c], sum[c] * l.scale * disk, 0.01 * power[c]) << c;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(power[c], sum[c] * l.scale * disk, 0.01 * power[c]) << c;
   }
 }
 
@@ -570,7 +605,8 @@ TEST(ImageLight, SampledDirectionsFollowThePdf) {
     std::vector<int> count(size_t(im.width) * im.height * 4, 0);
     Rng rng(600 + equal_area);
     for (int k = 0; k < n; ++k) {
-      auto s = light_sample_li(light, nullptr, Vec3(0, 0, 0), {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      auto s = light_sample_li(light, nullptr, Vec3(0, 0, 0), {rng.uniform(), rng.uniform()},
+                               kBounds, kWl);
       ASSERT_TRUE(s.has_value());
       Vec2 uv = image_light_uv(l, s->wi);
       auto [x, y] = texel_of(l, s->wi);
@@ -586,7 +622,8 @@ TEST(ImageLight, SampledDirectionsFollowThePdf) {
     }
     double chi2 = 0, mass = 0;
     for (int y = 0; y < im.height; ++y) {
-      double omega = equal_area ? 4 * M_PI / (im.width * im.height) : 2 * M_PI / im.width * (row_cos(y) - row_cos(y + 1));
+      double omega = equal_area ? 4 * M_PI / (im.width * im.height)
+                                : 2 * M_PI / im.width * (row_cos(y) - row_cos(y + 1));
       for (int x = 0; x < im.width; ++x) {
         Vec3 centre = image_light_direction(l, {(x + 0.5f) / im.width, (y + 0.5f) / im.height});
         double p = light_pdf_li(light, nullptr, Vec3(0, 0, 0), centre, {}, {}) * omega;
@@ -641,7 +678,8 @@ std::shared_ptr<TexImage> gradient_image(int w, int h) {
 
 GoniometricLight make_goniometric() {
   GoniometricLight l;
-  l.world_from_light = Transform::translate(Vec3(0.5f, 1, -1)) * Transform::rotate(30, normalize(Vec3(1, 1, 0)));
+  l.world_from_light =
+      Transform::translate(Vec3(0.5f, 1, -1)) * Transform::rotate(30, normalize(Vec3(1, 1, 0)));
   l.intensity = light_rgb(2.0f, 1.0f, 0.5f);
   l.image = gradient_image(8, 8);
   prepare_goniometric_light(&l);
@@ -650,7 +688,8 @@ GoniometricLight make_goniometric() {
 
 ProjectionLight make_projection(int w, int h, float fov_degrees) {
   ProjectionLight l;
-  l.world_from_light = Transform::translate(Vec3(0.5f, 1, -1)) * Transform::rotate(-20, normalize(Vec3(1, 0, 1)));
+  l.world_from_light =
+      Transform::translate(Vec3(0.5f, 1, -1)) * Transform::rotate(-20, normalize(Vec3(1, 0, 1)));
   l.image = gradient_image(w, h);
   l.scale = 1.5f;
   l.tan_half_fov = std::tan(fov_degrees * kPi / 360);
@@ -669,9 +708,12 @@ TEST(GoniometricLight, ImageCentreFacesTheLightsY) {
   };
   Vec3 up = l.world_from_light.vector(Vec3(0, 1, 0));
   float centre = goniometric_value(l, up);
-  EXPECT_TRUE(centre == mean(3, 3) || centre == mean(4, 4) || centre == mean(3, 4) || centre == mean(4, 3)) << centre;
+  EXPECT_TRUE(centre == mean(3, 3) || centre == mean(4, 4) || centre == mean(3, 4) ||
+              centre == mean(4, 3))
+      << centre;
   float pole = goniometric_value(l, -up);  // one of the four corners, by the signs of x and z there
-  EXPECT_TRUE(pole == mean(0, 0) || pole == mean(7, 0) || pole == mean(0, 7) || pole == mean(7, 7)) << pole;
+  EXPECT_TRUE(pole == mean(0, 0) || pole == mean(7, 0) || pole == mean(0, 7) || pole == mean(7, 7))
+      << pole;
   // Shading toward a point: I times the value over d^2, a delta light.
   Vec3 p = l.world_from_light.point(Vec3(0.3f, 2, 0.1f));
   auto s = light_sample_li(Light(l), nullptr, p, {0.5f, 0.5f}, kBounds, kWl);
@@ -718,7 +760,8 @@ TEST(ProjectionLight, FrameSolidAngle) {
     const int n = 400;
     double omega = 0;
     for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) omega += projection_solid_angle_per_area(l, {(i + 0.5f) / n, (j + 0.5f) / n});
+      for (int i = 0; i < n; ++i)
+        omega += projection_solid_angle_per_area(l, {(i + 0.5f) / n, (j + 0.5f) / n});
     omega /= double(n) * n;
     double a = 1.5 * l.tan_half_fov, b = l.tan_half_fov;
     double expected = 4 * std::atan(a * b / std::sqrt(1 + a * a + b * b));
@@ -737,26 +780,33 @@ TEST(GoniometricAndProjectionLights, MeanFluxIsTheIntegratedIntensity) {
     for (int i = 0; i < n; ++i) {
       Vec2 uv((i + 0.5f) / n, (j + 0.5f) / n);
       Vec3 w = equal_area_square_to_sphere(uv);
-      expected_g += light_intensity(g, g.world_from_light.vector(Vec3(w.x, w.z, w.y)), kWl) * float(4 * M_PI / (n * n));
+      expected_g += light_intensity(g, g.world_from_light.vector(Vec3(w.x, w.z, w.y)), kWl) *
+                    float(4 * M_PI / (n * n));
       Vec3 wp = p.world_from_light.vector(projection_direction_light(p, uv));
-      expected_p += light_intensity(p, wp, kWl) * (projection_solid_angle_per_area(p, uv) / float(n * n));
+      expected_p +=
+          light_intensity(p, wp, kWl) * (projection_solid_angle_per_area(p, uv) / float(n * n));
     }
   // The goniometric light's power as the light sampler sees it.
   Spectrum power_g = spectral_power(Light(g));
-  for (int c = 0; c < Spectrum::kChannels; ++c) EXPECT_NEAR(power_g[c], expected_g[c], 2e-3f * expected_g[c]);
-  for (auto [light, expected, name] : {std::tuple{Light(g), expected_g, "goniometric"}, std::tuple{Light(p), expected_p, "projection"}}) {
+  for (int c = 0; c < Spectrum::kChannels; ++c)
+    EXPECT_NEAR(power_g[c], expected_g[c], 2e-3f * expected_g[c]);
+  for (auto [light, expected, name] : {std::tuple{Light(g), expected_g, "goniometric"},
+                                       std::tuple{Light(p), expected_p, "projection"}}) {
     Rng rng(77);
     MeanAccumulator est[Spectrum::kChannels];
-    Vec3 origin = std::holds_alternative<GoniometricLight>(light) ? g.world_from_light.point(Vec3(0, 0, 0))
-                                                                  : p.world_from_light.point(Vec3(0, 0, 0));
+    Vec3 origin = std::holds_alternative<GoniometricLight>(light)
+                      ? g.world_from_light.point(Vec3(0, 0, 0))
+                      : p.world_from_light.point(Vec3(0, 0, 0));
     for (int k = 0; k < 200000; ++k) {
-      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()},
+                               {rng.uniform(), rng.uniform()}, kBounds, kWl);
       for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
       if (s) {
         ASSERT_LT(length(s->origin - origin), 1e-5f);
       }
     }
-    for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], expected[c], 2e-3 * expected[c], name);
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      expect_mean(est[c], expected[c], 2e-3 * expected[c], name);
   }
   // The projection light's RGB power, which "power" normalises, is the same integral.
   Rgb prgb = light_power(Light(p), kBounds);
@@ -771,20 +821,21 @@ void check_emission(const char* name, const Light& light, const Shape* shape,
   Rng rng(stream_key(41, std::string(name).size()));
   MeanAccumulator est[Spectrum::kChannels];
   for (int k = 0; k < 200000; ++k) {
-    auto s = light_sample_le(light, shape, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+    auto s = light_sample_le(light, shape, {rng.uniform(), rng.uniform()},
+                             {rng.uniform(), rng.uniform()}, kBounds, kWl);
     for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
     if (!s) continue;
     ASSERT_NEAR(length(s->direction), 1.0f, 1e-4f) << name;
     check_sample(*s);
   }
   for (int c = 0; c < Spectrum::kChannels; ++c)
-    EXPECT_NEAR(est[c].mean, power[c], 4 * est[c].standard_error() + 1e-6 * power[c]) << name << " channel " << c;
+    EXPECT_NEAR(est[c].mean, power[c], 4 * est[c].standard_error() + 1e-6 * power[c])
+        << name << " channel " << c;
 }
 
 TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
-  check_emission("point", Light(PointLight{Vec3(1, 2, 3), kL}), nullptr, [](const LightLeSample& s) {
-    EXPECT_EQ(length(s.origin - Vec3(1, 2, 3)), 0.0f);
-  });
+  check_emission("point", Light(PointLight{Vec3(1, 2, 3), kL}), nullptr,
+                 [](const LightLeSample& s) { EXPECT_EQ(length(s.origin - Vec3(1, 2, 3)), 0.0f); });
   SpotLight spot = make_spot();
   check_emission("spot", Light(spot), nullptr, [&](const LightLeSample& s) {
     EXPECT_GE(dot(s.direction, spot.frame.n), spot.cos_falloff_end - 1e-5f);
@@ -797,22 +848,26 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     EXPECT_GE(length(oc), kBounds.radius * 0.999f);
     EXPECT_LE(length(oc - s.direction * along), kBounds.radius * 1.0001f);
   };
-  check_emission("distant", Light(DistantLight{to_light, kL}), nullptr, [&](const LightLeSample& s) {
-    EXPECT_NEAR(dot(s.direction, to_light), -1.0f, 1e-5f);
-    crosses_scene(s);
-  });
+  check_emission("distant", Light(DistantLight{to_light, kL}), nullptr,
+                 [&](const LightLeSample& s) {
+                   EXPECT_NEAR(dot(s.direction, to_light), -1.0f, 1e-5f);
+                   crosses_scene(s);
+                 });
   check_emission("uniform infinite", Light(UniformInfiniteLight{kL}), nullptr, crosses_scene);
   for (bool two_sided : {false, true}) {
     Shape tri = make_triangle();
     AreaLight l = make_area_light(tri, two_sided);
     Vec3 n = triangle_normal(std::get<TriangleMesh>(tri));
     int back = 0;
-    check_emission(two_sided ? "triangle two-sided" : "triangle", Light(l), &tri, [&](const LightLeSample& s) {
-      EXPECT_NEAR(dot(s.origin - std::get<TriangleMesh>(tri).positions[0], n), 0.0f, 1e-4f);
-      if (dot(s.direction, n) < 0) ++back;
-    });
-    if (two_sided) EXPECT_NEAR(back, 100000, 1500);
-    else EXPECT_EQ(back, 0);
+    check_emission(
+        two_sided ? "triangle two-sided" : "triangle", Light(l), &tri, [&](const LightLeSample& s) {
+          EXPECT_NEAR(dot(s.origin - std::get<TriangleMesh>(tri).positions[0], n), 0.0f, 1e-4f);
+          if (dot(s.direction, n) < 0) ++back;
+        });
+    if (two_sided)
+      EXPECT_NEAR(back, 100000, 1500);
+    else
+      EXPECT_EQ(back, 0);
   }
   for (bool equal_area : {true, false}) {
     ImageInfiniteLight im = make_image_light(equal_area);
@@ -822,7 +877,8 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     Rng rng(43 + equal_area);
     MeanAccumulator est[Spectrum::kChannels];
     for (int k = 0; k < 200000; ++k) {
-      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()},
+                               {rng.uniform(), rng.uniform()}, kBounds, kWl);
       for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
       if (!s) continue;
       crosses_scene(*s);
@@ -831,7 +887,8 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
       EXPECT_GT(L[0], 0.0f);
     }
     Spectrum expected = integrated_radiance(im) * float(M_PI * kBounds.radius * kBounds.radius);
-    for (int c = 0; c < Spectrum::kChannels; ++c) expect_mean(est[c], expected[c], 0, equal_area ? "image equal-area" : "image lat-long");
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      expect_mean(est[c], expected[c], 0, equal_area ? "image equal-area" : "image lat-long");
   }
   {
     // An image area light: the flux is pi A times the mean texel radiance.
@@ -846,7 +903,8 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     Rng rng(91);
     MeanAccumulator est[Spectrum::kChannels], radiance[Spectrum::kChannels];
     for (int k = 0; k < 200000; ++k) {
-      auto s = light_sample_le(Light(l), &tri, {rng.uniform(), rng.uniform()}, {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      auto s = light_sample_le(Light(l), &tri, {rng.uniform(), rng.uniform()},
+                               {rng.uniform(), rng.uniform()}, kBounds, kWl);
       for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
     }
     // The mean radiance over the triangle by uniform points, against the flux over pi A.
@@ -858,23 +916,27 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     }
     for (int c = 0; c < Spectrum::kChannels; ++c) {
       double flux_over = est[c].mean / (M_PI * l.area);
-      EXPECT_NEAR(flux_over, radiance[c].mean, 4 * (est[c].standard_error() / (M_PI * l.area) + radiance[c].standard_error()));
+      EXPECT_NEAR(flux_over, radiance[c].mean,
+                  4 * (est[c].standard_error() / (M_PI * l.area) + radiance[c].standard_error()));
     }
     Rgb power = light_power(Light(l), kBounds);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(power[c], l.image_mean[c] * 1.5f * kPi * l.area, 1e-4f * power[c]);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(power[c], l.image_mean[c] * 1.5f * kPi * l.area, 1e-4f * power[c]);
   }
   Shape sphere = make_sphere(Vec3(1, 2, 3), 0.5f);
-  check_emission("sphere", Light(make_area_light(sphere, false)), &sphere, [&](const LightLeSample& s) {
-    EXPECT_NEAR(length(s.origin - Vec3(1, 2, 3)), 0.5f, 1e-4f);
-    EXPECT_GT(dot(s.direction, s.origin - Vec3(1, 2, 3)), 0.0f);
-  });
+  check_emission("sphere", Light(make_area_light(sphere, false)), &sphere,
+                 [&](const LightLeSample& s) {
+                   EXPECT_NEAR(length(s.origin - Vec3(1, 2, 3)), 0.5f, 1e-4f);
+                   EXPECT_GT(dot(s.direction, s.origin - Vec3(1, 2, 3)), 0.0f);
+                 });
   Cylinder cyl = make_cylinder();
   Shape cyl_shape = cyl;
-  check_emission("cylinder", Light(make_area_light(cyl_shape, false)), &cyl_shape, [&](const LightLeSample& s) {
-    Vec3 po = cyl.world_from_object.inverse().point(s.origin);
-    EXPECT_NEAR(std::hypot(po.x, po.y), cyl.radius, 1e-4f);
-    EXPECT_GT(dot(s.direction, s.n_light), 0.0f);
-  });
+  check_emission("cylinder", Light(make_area_light(cyl_shape, false)), &cyl_shape,
+                 [&](const LightLeSample& s) {
+                   Vec3 po = cyl.world_from_object.inverse().point(s.origin);
+                   EXPECT_NEAR(std::hypot(po.x, po.y), cyl.radius, 1e-4f);
+                   EXPECT_GT(dot(s.direction, s.n_light), 0.0f);
+                 });
 }
 
 }  // namespace

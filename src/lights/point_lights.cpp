@@ -10,8 +10,8 @@ namespace bpm {
 
 // ---- point ----
 
-std::optional<LightLiSample> sample_li_of(const PointLight& l, const Shape*, Vec3 p_ref, Vec2, const SceneBoundsInfo&,
-                                          const Wavelengths& wl) {
+std::optional<LightLiSample> sample_li_of(const PointLight& l, const Shape*, Vec3 p_ref, Vec2,
+                                          const SceneBoundsInfo&, const Wavelengths& wl) {
   LightLiSample ls;
   Vec3 d = l.position - p_ref;
   float d2 = length_squared(d);
@@ -24,8 +24,8 @@ std::optional<LightLiSample> sample_li_of(const PointLight& l, const Shape*, Vec
   return ls;
 }
 
-std::optional<LightLeSample> sample_le_of(const PointLight& l, const Shape*, Vec2, Vec2 u_dir, const SceneBoundsInfo&,
-                                          const Wavelengths& wl) {
+std::optional<LightLeSample> sample_le_of(const PointLight& l, const Shape*, Vec2, Vec2 u_dir,
+                                          const SceneBoundsInfo&, const Wavelengths& wl) {
   LightLeSample s;
   s.origin = l.position;
   s.direction = sample_uniform_sphere(u_dir);
@@ -45,8 +45,8 @@ float spot_falloff(const SpotLight& l, Vec3 w) {
   return t * t * (3 - 2 * t);
 }
 
-std::optional<LightLiSample> sample_li_of(const SpotLight& l, const Shape*, Vec3 p_ref, Vec2, const SceneBoundsInfo&,
-                                          const Wavelengths& wl) {
+std::optional<LightLiSample> sample_li_of(const SpotLight& l, const Shape*, Vec3 p_ref, Vec2,
+                                          const SceneBoundsInfo&, const Wavelengths& wl) {
   LightLiSample ls;
   Vec3 d = l.position - p_ref;
   float d2 = length_squared(d);
@@ -61,8 +61,8 @@ std::optional<LightLiSample> sample_li_of(const SpotLight& l, const Shape*, Vec3
   return ls;
 }
 
-std::optional<LightLeSample> sample_le_of(const SpotLight& l, const Shape*, Vec2, Vec2 u_dir, const SceneBoundsInfo&,
-                                          const Wavelengths& wl) {
+std::optional<LightLeSample> sample_le_of(const SpotLight& l, const Shape*, Vec2, Vec2 u_dir,
+                                          const SceneBoundsInfo&, const Wavelengths& wl) {
   LightLeSample s;
   Vec3 w = sample_uniform_cone(u_dir, l.cos_falloff_end);
   float fall = spot_falloff(l, w);
@@ -74,7 +74,8 @@ std::optional<LightLeSample> sample_le_of(const SpotLight& l, const Shape*, Vec2
 }
 
 Rgb power_of(const SpotLight& l, const SceneBoundsInfo&) {
-  return l.intensity.rgb() * (2 * kPi * ((1 - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2));
+  return l.intensity.rgb() *
+         (2 * kPi * ((1 - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2));
 }
 
 // Goniometric and projection lights are points whose intensity depends on the direction.
@@ -82,7 +83,8 @@ Rgb power_of(const SpotLight& l, const SceneBoundsInfo&) {
 namespace {
 // L is a GoniometricLight or a ProjectionLight (light_intensity of either).
 template <class L>
-std::optional<LightLiSample> sample_li_directional_point(const L& l, Vec3 p_ref, const Wavelengths& wl) {
+std::optional<LightLiSample> sample_li_directional_point(const L& l, Vec3 p_ref,
+                                                         const Wavelengths& wl) {
   LightLiSample ls;
   Vec3 position = l.world_from_light.point(Vec3(0, 0, 0));
   Vec3 d = position - p_ref;
@@ -136,7 +138,8 @@ Spectrum light_intensity(const GoniometricLight& l, Vec3 w, const Wavelengths& w
 // projection): image coordinates drawn by the light's distribution, direction_light(uv) their
 // direction in the light's frame, flux(uv, direction, pdf_uv) the photon's flux.
 template <class L, class Direction, class Flux>
-std::optional<LightLeSample> sample_le_image_point(const L& l, Vec2 u_dir, Direction&& direction_light, Flux&& flux) {
+std::optional<LightLeSample> sample_le_image_point(const L& l, Vec2 u_dir,
+                                                   Direction&& direction_light, Flux&& flux) {
   LightLeSample s;
   float pdf_uv = 0;
   Vec2 uv = l.distribution.sample(u_dir, &pdf_uv);
@@ -157,10 +160,14 @@ std::optional<LightLeSample> sample_le_of(const GoniometricLight& l, const Shape
                                           const SceneBoundsInfo&, const Wavelengths& wl) {
   return sample_le_image_point(
       l, u_dir, [&](Vec2 uv) { return swap_yz(equal_area_square_to_sphere(uv)); },
-      [&](Vec2, Vec3 direction, float pdf_uv) { return light_intensity(l, direction, wl) * (4 * kPi / pdf_uv); });
+      [&](Vec2, Vec3 direction, float pdf_uv) {
+        return light_intensity(l, direction, wl) * (4 * kPi / pdf_uv);
+      });
 }
 
-Rgb power_of(const GoniometricLight& l, const SceneBoundsInfo&) { return l.intensity.rgb() * (4 * kPi * l.mean_value); }
+Rgb power_of(const GoniometricLight& l, const SceneBoundsInfo&) {
+  return l.intensity.rgb() * (4 * kPi * l.mean_value);
+}
 
 // ---- projection ----
 
@@ -228,7 +235,8 @@ std::optional<LightLeSample> sample_le_of(const ProjectionLight& l, const Shape*
   return sample_le_image_point(
       l, u_dir, [&](Vec2 uv) { return projection_direction_light(l, uv); },
       [&](Vec2 uv, Vec3, float pdf_uv) {
-        return illuminant_texel(projection_texel(l, uv), l.scale, wl) * (projection_solid_angle_per_area(l, uv) / pdf_uv);
+        return illuminant_texel(projection_texel(l, uv), l.scale, wl) *
+               (projection_solid_angle_per_area(l, uv) / pdf_uv);
       });
 }
 

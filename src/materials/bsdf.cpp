@@ -71,7 +71,8 @@ Spectrum f_of(const DiffuseMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
 float pdf_of(const DiffuseMaterial&, Vec3 wo, Vec3 wi, TransportMode) {
   return same_hemisphere(wo, wi) ? cosine_hemisphere_pdf_solid_angle(std::fabs(wi.z)) : 0;
 }
-std::optional<BsdfSample> sample_of(const DiffuseMaterial& m, Vec3 wo, float, Vec2 u, TransportMode) {
+std::optional<BsdfSample> sample_of(const DiffuseMaterial& m, Vec3 wo, float, Vec2 u,
+                                    TransportMode) {
   Vec3 wi = sample_cosine_hemisphere(u);
   if (wo.z < 0) wi.z = -wi.z;
   float pdf = cosine_hemisphere_pdf_solid_angle(std::fabs(wi.z));
@@ -99,7 +100,8 @@ float pdf_of(const ConductorMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
   TrowbridgeReitz d(m.roughness.alpha_x, m.roughness.alpha_y);
   return d.d_visible(wo, wm) / (4 * absdot(wo, wm));
 }
-std::optional<BsdfSample> sample_of(const ConductorMaterial& m, Vec3 wo, float, Vec2 u, TransportMode) {
+std::optional<BsdfSample> sample_of(const ConductorMaterial& m, Vec3 wo, float, Vec2 u,
+                                    TransportMode) {
   if (m.roughness.effectively_smooth()) {
     Vec3 wi(-wo.x, -wo.y, wo.z);
     float c = std::fabs(wi.z);
@@ -147,13 +149,16 @@ Spectrum f_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode)
   if (h->reflect) return Spectrum(d.d(h->wm) * d.g(wo, wi) * F / std::fabs(4 * wi.z * wo.z));
   float denom = dot(wi, h->wm) + dot(wo, h->wm) / h->etap;
   denom = denom * denom * wi.z * wo.z;
-  float ft = d.d(h->wm) * (1 - F) * d.g(wo, wi) * std::fabs(dot(wi, h->wm) * dot(wo, h->wm) / denom);
+  float ft =
+      d.d(h->wm) * (1 - F) * d.g(wo, wi) * std::fabs(dot(wi, h->wm) * dot(wo, h->wm) / denom);
   if (mode == TransportMode::kRadiance) ft /= h->etap * h->etap;
   return Spectrum(ft);
 }
 }  // namespace
 
-Spectrum dielectric_f(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) { return f_of(m, wo, wi, mode); }
+Spectrum dielectric_f(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  return f_of(m, wo, wi, mode);
+}
 
 // With `lobes` restricting the choice, reflection and transmission are picked in proportion to
 // the Fresnel terms of the lobes allowed (pbrt-v4's BxDFReflTransFlags).
@@ -172,8 +177,8 @@ float dielectric_pdf(const DielectricMaterial& m, Vec3 wo, Vec3 wi, unsigned lob
   return dvis * dwm_dwi * pt / (pr + pt);
 }
 
-std::optional<BsdfSample> dielectric_sample(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode,
-                                            unsigned lobes) {
+std::optional<BsdfSample> dielectric_sample(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u,
+                                            TransportMode mode, unsigned lobes) {
   if (m.eta == 1 || m.roughness.effectively_smooth()) {
     float R = fresnel_dielectric(wo.z, m.eta), T = 1 - R;
     float pr = (lobes & kReflection) ? R : 0, pt = (lobes & kTransmission) ? T : 0;
@@ -206,12 +211,14 @@ std::optional<BsdfSample> dielectric_sample(const DielectricMaterial& m, Vec3 wo
   }
   Vec3 wi;
   float etap;
-  if (!refract(wo, wm, m.eta, &etap, &wi) || same_hemisphere(wo, wi) || wi.z == 0) return std::nullopt;
+  if (!refract(wo, wm, m.eta, &etap, &wi) || same_hemisphere(wo, wi) || wi.z == 0)
+    return std::nullopt;
   float denom = dot(wi, wm) + dot(wo, wm) / etap;
   denom *= denom;
   float dwm_dwi = absdot(wi, wm) / denom;
   float pdf = dvis * dwm_dwi * pt / (pr + pt);
-  float ft = T * d.d(wm) * d.g(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
+  float ft =
+      T * d.d(wm) * d.g(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
   if (mode == TransportMode::kRadiance) ft /= etap * etap;
   return BsdfSample{Spectrum(ft), wi, pdf, kTransmission | kGlossy, etap};
 }
@@ -221,14 +228,16 @@ namespace {
 float pdf_of(const DielectricMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
   return dielectric_pdf(m, wo, wi, kReflection | kTransmission);
 }
-std::optional<BsdfSample> sample_of(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+std::optional<BsdfSample> sample_of(const DielectricMaterial& m, Vec3 wo, float uc, Vec2 u,
+                                    TransportMode mode) {
   return dielectric_sample(m, wo, uc, u, mode, kReflection | kTransmission);
 }
 
 // ---- thin dielectric ----
 Spectrum f_of(const ThinDielectricMaterial&, Vec3, Vec3, TransportMode) { return {}; }
 float pdf_of(const ThinDielectricMaterial&, Vec3, Vec3, TransportMode) { return 0; }
-std::optional<BsdfSample> sample_of(const ThinDielectricMaterial& m, Vec3 wo, float uc, Vec2, TransportMode) {
+std::optional<BsdfSample> sample_of(const ThinDielectricMaterial& m, Vec3 wo, float uc, Vec2,
+                                    TransportMode) {
   float R = fresnel_dielectric(std::fabs(wo.z), m.eta), T = 1 - R;
   // Sum of the geometric series of inter-reflections inside the slab.
   if (R < 1) {
@@ -254,7 +263,8 @@ float pdf_of(const DiffuseTransmissionMaterial& m, Vec3 wo, Vec3 wi, TransportMo
   float c = cosine_hemisphere_pdf_solid_angle(std::fabs(wi.z));
   return (same_hemisphere(wo, wi) ? pr : pt) / (pr + pt) * c;
 }
-std::optional<BsdfSample> sample_of(const DiffuseTransmissionMaterial& m, Vec3 wo, float uc, Vec2 u, TransportMode) {
+std::optional<BsdfSample> sample_of(const DiffuseTransmissionMaterial& m, Vec3 wo, float uc, Vec2 u,
+                                    TransportMode) {
   float pr = m.reflectance.max_component(), pt = m.transmittance.max_component();
   if (pr + pt == 0) return std::nullopt;
   Vec3 wi = sample_cosine_hemisphere(u);
@@ -284,8 +294,11 @@ Spectrum f_of(const PhongMaterial& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   float cos_out = std::fabs(mode == TransportMode::kRadiance ? wo.z : wi.z);
   return m.reflectance * (lobe / cos_out);
 }
-float pdf_of(const PhongMaterial& m, Vec3 wo, Vec3 wi, TransportMode) { return phong_lobe(m, wo, wi); }
-std::optional<BsdfSample> sample_of(const PhongMaterial& m, Vec3 wo, float, Vec2 u, TransportMode mode) {
+float pdf_of(const PhongMaterial& m, Vec3 wo, Vec3 wi, TransportMode) {
+  return phong_lobe(m, wo, wi);
+}
+std::optional<BsdfSample> sample_of(const PhongMaterial& m, Vec3 wo, float, Vec2 u,
+                                    TransportMode mode) {
   if (wo.z == 0) return std::nullopt;
   // cos^n lobe about the mirror direction (pdf (n+1)/(2 pi) cos^n).
   float cos_a = std::pow(u.x, 1 / (m.exponent + 1));
@@ -301,7 +314,9 @@ std::optional<BsdfSample> sample_of(const PhongMaterial& m, Vec3 wo, float, Vec2
 // ---- interface: no scattering; the integrators skip such surfaces ----
 Spectrum f_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return {}; }
 float pdf_of(const InterfaceMaterial&, Vec3, Vec3, TransportMode) { return 0; }
-std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2, TransportMode) { return std::nullopt; }
+std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2, TransportMode) {
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -309,27 +324,35 @@ std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2,
 Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   return std::visit(
       [&](const auto& x) {
-        if constexpr (kLayered<std::decay_t<decltype(x)>>) return layered_f(m, wo, wi, mode);
-        else return f_of(x, wo, wi, mode);
+        if constexpr (kLayered<std::decay_t<decltype(x)>>)
+          return layered_f(m, wo, wi, mode);
+        else
+          return f_of(x, wo, wi, mode);
       },
       m);
 }
 float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   return std::visit(
       [&](const auto& x) {
-        if constexpr (kLayered<std::decay_t<decltype(x)>>) return layered_pdf(m, wo, wi, mode);
-        else return pdf_of(x, wo, wi, mode);
+        if constexpr (kLayered<std::decay_t<decltype(x)>>)
+          return layered_pdf(m, wo, wi, mode);
+        else
+          return pdf_of(x, wo, wi, mode);
       },
       m);
 }
-std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
+                                      TransportMode mode) {
   auto s = std::visit(
       [&](const auto& x) {
-        if constexpr (kLayered<std::decay_t<decltype(x)>>) return layered_sample(m, wo, uc, u, mode);
-        else return sample_of(x, wo, uc, u, mode);
+        if constexpr (kLayered<std::decay_t<decltype(x)>>)
+          return layered_sample(m, wo, uc, u, mode);
+        else
+          return sample_of(x, wo, uc, u, mode);
       },
       m);
-  if (s && (s->pdf_solid_angle <= 0 || !s->f.is_finite() || !std::isfinite(s->pdf_solid_angle))) return std::nullopt;
+  if (s && (s->pdf_solid_angle <= 0 || !s->f.is_finite() || !std::isfinite(s->pdf_solid_angle)))
+    return std::nullopt;
   if (s) {
     // A layered material's walk gives an exact weight but no density; MIS takes its estimate.
     bool layered = std::visit([](const auto& x) { return kLayered<std::decay_t<decltype(x)>>; }, m);
@@ -342,7 +365,9 @@ bool bsdf_is_specular(const Material& m) {
   struct V {
     bool operator()(const DiffuseMaterial&) const { return false; }
     bool operator()(const ConductorMaterial& c) const { return c.roughness.effectively_smooth(); }
-    bool operator()(const DielectricMaterial& d) const { return d.eta == 1 || d.roughness.effectively_smooth(); }
+    bool operator()(const DielectricMaterial& d) const {
+      return d.eta == 1 || d.roughness.effectively_smooth();
+    }
     bool operator()(const ThinDielectricMaterial&) const { return true; }
     bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
     bool operator()(const PhongMaterial&) const { return false; }

@@ -21,7 +21,8 @@ namespace bpm {
 namespace {
 
 constexpr float kEta = 1.5f;
-constexpr float kPhiO = 0.6f;  // azimuth of wo: off the axes, so anisotropic lobes are not symmetric
+constexpr float kPhiO =
+    0.6f;  // azimuth of wo: off the axes, so anisotropic lobes are not symmetric
 
 Vec3 spherical(float cos_theta, float phi) {
   float s = std::sqrt(std::fmax(0.0f, 1 - cos_theta * cos_theta));
@@ -97,14 +98,22 @@ void PrintTo(const BsdfCase& c, std::ostream* os) { *os << c.name; }
 
 std::vector<BsdfCase> bsdf_cases() {
   std::vector<BsdfCase> v;
-  auto add = [&](const std::string& name, const Material& m, std::vector<std::pair<const char*, float>> wos) {
+  auto add = [&](const std::string& name, const Material& m,
+                 std::vector<std::pair<const char*, float>> wos) {
     for (auto& [label, c] : wos) v.push_back({name + "_" + label, m, c, 1000 + v.size()});
   };
-  add("Diffuse", diffuse(), {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}, {"CosMinus0p5", -0.5f}});
-  add("ConductorIso0p3", rough_conductor(0.3f, 0.3f), {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}});
-  add("ConductorAniso0p1x0p4", rough_conductor(0.1f, 0.4f), {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}});
+  add("Diffuse", diffuse(),
+      {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}, {"CosMinus0p5", -0.5f}});
+  add("ConductorIso0p3", rough_conductor(0.3f, 0.3f),
+      {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}});
+  add("ConductorAniso0p1x0p4", rough_conductor(0.1f, 0.4f),
+      {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}});
   add("DielectricRough0p3", rough_dielectric(0.3f),
-      {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}, {"CosMinus0p9", -0.9f}, {"CosMinus0p6", -0.6f},
+      {{"Cos0p9", 0.9f},
+       {"Cos0p5", 0.5f},
+       {"Cos0p1", 0.1f},
+       {"CosMinus0p9", -0.9f},
+       {"CosMinus0p6", -0.6f},
        {"CosMinus0p3", -0.3f}});
   add("DiffuseTransmission", diffuse_transmission(),
       {{"Cos0p9", 0.9f}, {"Cos0p5", 0.5f}, {"Cos0p1", 0.1f}, {"CosMinus0p6", -0.6f}});
@@ -139,13 +148,16 @@ TEST(Chi2Harness, SurvivalFunctionMatchesClosedForms) {
     EXPECT_NEAR(chi2::chi2_survival(x, 2), std::exp(-x / 2), 1e-12 + 1e-10 * std::exp(-x / 2)) << x;
   // dof = 1: erfc(sqrt(x/2)); 3.841458820694124 is the 95% quantile.
   for (double x : {0.5, 3.841458820694124, 10.0, 30.0})
-    EXPECT_NEAR(chi2::chi2_survival(x, 1), std::erfc(std::sqrt(x / 2)), 1e-9 * std::erfc(std::sqrt(x / 2))) << x;
+    EXPECT_NEAR(chi2::chi2_survival(x, 1), std::erfc(std::sqrt(x / 2)),
+                1e-9 * std::erfc(std::sqrt(x / 2)))
+        << x;
   EXPECT_NEAR(chi2::chi2_survival(3.841458820694124, 1), 0.05, 1e-9);
   // Even dof = 2m: exp(-x/2) sum_{k<m} (x/2)^k / k!, here m = 100 (both the series and the
   // continued-fraction branches are exercised).
   for (double x : {150.0, 200.0, 260.0, 320.0}) {
     double s = 0;
-    for (int k = 0; k < 100; ++k) s += std::exp(-x / 2 + k * std::log(x / 2) - std::lgamma(k + 1.0));
+    for (int k = 0; k < 100; ++k)
+      s += std::exp(-x / 2 + k * std::log(x / 2) - std::lgamma(k + 1.0));
     EXPECT_NEAR(chi2::chi2_survival(x, 200), s, 1e-9 * s + 1e-300) << x;
   }
   EXPECT_EQ(chi2::chi2_survival(0, 5), 1.0);
@@ -172,16 +184,19 @@ TEST(Chi2Harness, AcceptsCorrectSamplers) {
 TEST(Chi2Harness, RejectsWrongPdfs) {
   // Cosine-weighted samples against the uniform hemisphere density.
   auto r = chi2::run(
-      [](Rng& rng) -> std::optional<Vec3> { return sample_cosine_hemisphere({rng.uniform(), rng.uniform()}); },
+      [](Rng& rng) -> std::optional<Vec3> {
+        return sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
+      },
       [](Vec3 w) { return w.z > 0 ? 1 / (2 * M_PI) : 0.0; }, 13, chi2_options());
   EXPECT_FALSE(r.passed()) << r.report;
   EXPECT_LT(r.p_value, 1e-12);
   // A GGX lobe of roughness 0.3 against the density of roughness 0.33.
   Material a = rough_conductor(0.3f, 0.3f), b = rough_conductor(0.33f, 0.33f);
   Vec3 wo = spherical(0.5f, kPhiO);
-  auto r2 = chi2::run([&](Rng& rng) { return sample_direction(a, wo, rng, TransportMode::kRadiance); },
-                      [&](Vec3 wi) { return double(bsdf_pdf(b, wo, wi, TransportMode::kRadiance)); }, 14,
-                      chi2_options());
+  auto r2 =
+      chi2::run([&](Rng& rng) { return sample_direction(a, wo, rng, TransportMode::kRadiance); },
+                [&](Vec3 wi) { return double(bsdf_pdf(b, wo, wi, TransportMode::kRadiance)); }, 14,
+                chi2_options());
   EXPECT_FALSE(r2.passed()) << r2.report;
   // Failing samples that the pdf does not account for: a mass mismatch.
   auto r3 = chi2::run(
@@ -202,9 +217,10 @@ class BsdfCaseTest : public ::testing::TestWithParam<BsdfCase> {};
 TEST_P(BsdfCaseTest, Chi2SampledDirectionsFollowPdf) {
   const BsdfCase& c = GetParam();
   Vec3 wo = c.wo();
-  auto r = chi2::run([&](Rng& rng) { return sample_direction(c.material, wo, rng, TransportMode::kRadiance); },
-                     [&](Vec3 wi) { return double(bsdf_pdf(c.material, wo, wi, TransportMode::kRadiance)); },
-                     stream_key(c.seed, 1), chi2_options());
+  auto r = chi2::run(
+      [&](Rng& rng) { return sample_direction(c.material, wo, rng, TransportMode::kRadiance); },
+      [&](Vec3 wi) { return double(bsdf_pdf(c.material, wo, wi, TransportMode::kRadiance)); },
+      stream_key(c.seed, 1), chi2_options());
   EXPECT_TRUE(r.passed()) << c.name << ": " << r.report;
 }
 
@@ -240,8 +256,8 @@ TEST_P(BsdfCaseTest, SampleAgreesWithEvaluation) {
       for (int ch = 0; ch < Spectrum::kChannels; ++ch) ok = ok && near_rel(s->f[ch], f[ch], 1e-3);
       if (!ok && n_bad++ == 0) {
         std::ostringstream os;
-        os << "wi = (" << s->wi.x << ", " << s->wi.y << ", " << s->wi.z << "): sample f " << s->f[0] << " pdf "
-           << s->pdf_solid_angle << ", evaluated f " << f[0] << " pdf " << pdf;
+        os << "wi = (" << s->wi.x << ", " << s->wi.y << ", " << s->wi.z << "): sample f " << s->f[0]
+           << " pdf " << s->pdf_solid_angle << ", evaluated f " << f[0] << " pdf " << pdf;
         first_bad = os.str();
       }
     }
@@ -261,7 +277,8 @@ TEST_P(BsdfCaseTest, AlbedoAtMostOne) {
   Vec3 wo = c.wo();
   for (TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
     float bound = 1;
-    if (mode == TransportMode::kRadiance && is_dielectric(c.material) && wo.z < 0) bound = kEta * kEta;
+    if (mode == TransportMode::kRadiance && is_dielectric(c.material) && wo.z < 0)
+      bound = kEta * kEta;
     // The non-reciprocal lobe conserves energy in the direction light flows (importance); camera
     // paths carry |cos theta_i| / |cos theta_o|, which is not bounded by one.
     if (mode == TransportMode::kRadiance && is_phong(c.material)) continue;
@@ -275,15 +292,19 @@ TEST_P(BsdfCaseTest, AlbedoAtMostOne) {
         albedo[ch].add(s ? double(s->f[ch]) * std::fabs(s->wi.z) / s->pdf_solid_angle : 0.0);
     }
     for (int ch = 0; ch < Spectrum::kChannels; ++ch) {
-      EXPECT_LE(albedo[ch].mean, bound + 3 * albedo[ch].standard_error()) << c.name << " channel " << ch;
-      EXPECT_LE(albedo[ch].max, bound * (1 + 1e-4)) << c.name << " channel " << ch << " mode " << int(mode);
+      EXPECT_LE(albedo[ch].mean, bound + 3 * albedo[ch].standard_error())
+          << c.name << " channel " << ch;
+      EXPECT_LE(albedo[ch].max, bound * (1 + 1e-4))
+          << c.name << " channel " << ch << " mode " << int(mode);
       EXPECT_GE(albedo[ch].min, 0.0) << c.name;
     }
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(Materials, BsdfCaseTest, ::testing::ValuesIn(bsdf_cases()),
-                         [](const ::testing::TestParamInfo<BsdfCase>& info) { return info.param.name; });
+                         [](const ::testing::TestParamInfo<BsdfCase>& info) {
+                           return info.param.name;
+                         });
 
 // ---------------------------------------------------------------------------------------------
 // Exact albedos and white furnaces.
@@ -362,7 +383,8 @@ TEST(BsdfEnergy, RoughPerfectConductorLosesLittleEnergyAtLowRoughness) {
   Rng rng(24);
   MeanAccumulator a;
   for (int k = 0; k < 100000; ++k) {
-    auto s = bsdf_sample(m, Vec3(0, 0, 1), rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kRadiance);
+    auto s = bsdf_sample(m, Vec3(0, 0, 1), rng.uniform(), {rng.uniform(), rng.uniform()},
+                         TransportMode::kRadiance);
     a.add(s ? s->f[0] * std::fabs(s->wi.z) / s->pdf_solid_angle : 0.0);
   }
   EXPECT_GT(a.mean, 0.95);
@@ -384,7 +406,8 @@ TEST(BsdfReciprocity, PhongIsNotReciprocalButHasAnAdjoint) {
     wi.z = std::copysign(wi.z, wo.z);
     Spectrum rad = bsdf_f(m, wo, wi, TransportMode::kRadiance);
     Spectrum imp = bsdf_f(m, wi, wo, TransportMode::kImportance);
-    for (int ch = 0; ch < Spectrum::kChannels; ++ch) ASSERT_TRUE(near_rel(rad[ch], imp[ch], 1e-5, 1e-9));
+    for (int ch = 0; ch < Spectrum::kChannels; ++ch)
+      ASSERT_TRUE(near_rel(rad[ch], imp[ch], 1e-5, 1e-9));
     if (rad.is_black()) continue;
     ++n_pairs;
     Spectrum swapped = bsdf_f(m, wi, wo, TransportMode::kRadiance);
@@ -395,7 +418,8 @@ TEST(BsdfReciprocity, PhongIsNotReciprocalButHasAnAdjoint) {
   for (float cos_o : {0.95f, 0.5f}) {
     Vec3 wo = spherical(cos_o, 0.3f);
     for (int k = 0; k < 2000; ++k) {
-      auto s = bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kImportance);
+      auto s = bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()},
+                           TransportMode::kImportance);
       if (!s) continue;
       Spectrum w = s->f * (std::fabs(s->wi.z) / s->pdf_solid_angle);
       for (int ch = 0; ch < Spectrum::kChannels; ++ch)
@@ -418,7 +442,8 @@ TEST(BsdfReciprocity, ReflectionIsSymmetric) {
     for (int k = 0; k < 20000; ++k) {
       Vec3 wo = random_direction(rng), wi = random_direction(rng);
       if (k % 2) wi.z = std::copysign(wi.z, wo.z);  // half of the pairs in the same hemisphere
-      if (!same_hemisphere(wo, wi) && !std::holds_alternative<DiffuseTransmissionMaterial>(m)) continue;
+      if (!same_hemisphere(wo, wi) && !std::holds_alternative<DiffuseTransmissionMaterial>(m))
+        continue;
       for (TransportMode mode : {TransportMode::kRadiance, TransportMode::kImportance}) {
         Spectrum a = bsdf_f(m, wo, wi, mode), b = bsdf_f(m, wi, wo, mode);
         for (int ch = 0; ch < Spectrum::kChannels; ++ch)
@@ -445,7 +470,8 @@ TEST(BsdfReciprocity, RoughDielectricTransmission) {
   int n_checked = 0;
   for (int k = 0; k < 40000; ++k) {
     Vec3 wo = random_direction(rng);
-    auto s = bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kRadiance);
+    auto s =
+        bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kRadiance);
     if (!s) continue;
     Vec3 wi = s->wi;
     if (near_grazing_microfacet(wo, wi)) continue;
@@ -453,10 +479,12 @@ TEST(BsdfReciprocity, RoughDielectricTransmission) {
     float f_rad_rev = bsdf_f(m, wi, wo, TransportMode::kRadiance)[0];
     float f_imp = bsdf_f(m, wo, wi, TransportMode::kImportance)[0];
     ASSERT_TRUE(near_rel(f_imp, f_rad_rev, 1e-3, 1e-6))
-        << "adjoint: f_imp(wo, wi) = " << f_imp << ", f_rad(wi, wo) = " << f_rad_rev << ", wo.z " << wo.z;
+        << "adjoint: f_imp(wo, wi) = " << f_imp << ", f_rad(wi, wo) = " << f_rad_rev << ", wo.z "
+        << wo.z;
     float eo = eta_of(wo), ei = eta_of(wi);
     ASSERT_TRUE(near_rel(f_rad * ei * ei, f_rad_rev * eo * eo, 1e-3, 1e-6))
-        << "f(wo, wi) = " << f_rad << ", f(wi, wo) = " << f_rad_rev << ", eta_o " << eo << ", eta_i " << ei;
+        << "f(wo, wi) = " << f_rad << ", f(wi, wo) = " << f_rad_rev << ", eta_o " << eo
+        << ", eta_i " << ei;
     if (s->is_transmission()) ++n_checked;
   }
   EXPECT_GT(n_checked, 5000);
@@ -601,7 +629,8 @@ TEST(SmoothDielectric, LobeProbabilitiesAreFresnel) {
     Rng rng(stream_key(41, int(co * 100)));
     int n = 100000, n_refl = 0;
     for (int k = 0; k < n; ++k) {
-      auto s = bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kRadiance);
+      auto s = bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()},
+                           TransportMode::kRadiance);
       ASSERT_TRUE(s.has_value());
       if (!s->is_transmission()) {
         ++n_refl;

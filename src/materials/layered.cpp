@@ -11,7 +11,6 @@
 namespace bpm {
 namespace {
 
-
 TransportMode adjoint(TransportMode mode) {
   return mode == TransportMode::kRadiance ? TransportMode::kImportance : TransportMode::kRadiance;
 }
@@ -23,7 +22,8 @@ float layer_transmittance(float thickness, Vec3 w) {
 
 uint64_t bits(float x) { return std::bit_cast<uint32_t>(x); }
 uint64_t key_of(Vec3 a, Vec3 b) {
-  return stream_key(0x6c6179657265ull, bits(a.x) | bits(a.y) << 32, bits(a.z) | bits(b.x) << 32, bits(b.y) | bits(b.z) << 32);
+  return stream_key(0x6c6179657265ull, bits(a.x) | bits(a.y) << 32, bits(a.z) | bits(b.x) << 32,
+                    bits(b.y) | bits(b.z) << 32);
 }
 
 // A sample that can be used: it exists, carries value and has a density.
@@ -51,7 +51,10 @@ struct Layer {
   float thickness;
   int max_depth, samples;
   Layer(const CoatLayer& c, Material base_material)
-      : top{c.eta, c.roughness}, base(std::move(base_material)), thickness(c.thickness), max_depth(c.max_depth),
+      : top{c.eta, c.roughness},
+        base(std::move(base_material)),
+        thickness(c.thickness),
+        max_depth(c.max_depth),
         samples(c.samples) {}
 };
 
@@ -70,9 +73,11 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   Rng rng(key_of(wo, wi));
   for (int s = 0; s < L.samples; ++s) {
     // Into the layer along wo, and the way out toward wi traced backwards (adjoint transport).
-    auto in = dielectric_sample(top, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, mode, kTransmission);
+    auto in = dielectric_sample(top, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, mode,
+                                kTransmission);
     if (!usable(in)) continue;
-    auto out = dielectric_sample(top, wi, rng.uniform(), {rng.uniform(), rng.uniform()}, adjoint(mode), kTransmission);
+    auto out = dielectric_sample(top, wi, rng.uniform(), {rng.uniform(), rng.uniform()},
+                                 adjoint(mode), kTransmission);
     if (!usable(out)) continue;
     Spectrum beta = in->f * (std::fabs(in->wi.z) / in->pdf_solid_angle);
     Vec3 w = in->wi;  // direction of travel inside the layer
@@ -87,7 +92,8 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
       at_top = !at_top;
       if (at_top) {
         // Reflected back into the layer by the coating, from inside.
-        auto r = dielectric_sample(top, -w, rng.uniform(), {rng.uniform(), rng.uniform()}, mode, kReflection);
+        auto r = dielectric_sample(top, -w, rng.uniform(), {rng.uniform(), rng.uniform()}, mode,
+                                   kReflection);
         if (!usable(r)) break;
         beta *= r->f * (std::fabs(r->wi.z) / r->pdf_solid_angle);
         w = r->wi;
@@ -98,9 +104,12 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
       // heuristic) unless the coating is smooth, where only this strategy can find it.
       Vec3 wb = -w, to_exit = -out->wi;
       if (!L.base.specular) {
-        float wt = top_smooth ? 1 : power_heuristic(out->pdf_solid_angle, L.base.pdf(wb, to_exit, mode));
+        float wt =
+            top_smooth ? 1 : power_heuristic(out->pdf_solid_angle, L.base.pdf(wb, to_exit, mode));
         f += beta * L.base.f(wb, to_exit, mode) *
-             (std::fabs(out->wi.z) * wt * layer_transmittance(L.thickness, out->wi) / out->pdf_solid_angle) * out->f;
+             (std::fabs(out->wi.z) * wt * layer_transmittance(L.thickness, out->wi) /
+              out->pdf_solid_angle) *
+             out->f;
       }
       auto b = L.base.sample(wb, rng, mode);
       if (!usable(b)) break;
@@ -111,7 +120,10 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
         if (!f_exit.is_black()) {
           // Both strategies' densities over the same variable, the direction leaving the base:
           // the other strategy would have drawn it by refracting wi into the layer.
-          float wt_exit = L.base.specular ? 1 : power_heuristic(b->pdf_solid_angle, dielectric_pdf(top, wi, -w, kTransmission));
+          float wt_exit =
+              L.base.specular
+                  ? 1
+                  : power_heuristic(b->pdf_solid_angle, dielectric_pdf(top, wi, -w, kTransmission));
           f += beta * f_exit * (layer_transmittance(L.thickness, w) * wt_exit);
         }
       }
@@ -133,8 +145,10 @@ float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
     Rng rng(key_of(wi, wo));
     for (int s = 0; s < L.samples; ++s) {
       // Transmission, base reflection, transmission: the dominant path.
-      auto in = dielectric_sample(top, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, mode, kTransmission);
-      auto out = dielectric_sample(top, wi, rng.uniform(), {rng.uniform(), rng.uniform()}, adjoint(mode), kTransmission);
+      auto in = dielectric_sample(top, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, mode,
+                                  kTransmission);
+      auto out = dielectric_sample(top, wi, rng.uniform(), {rng.uniform(), rng.uniform()},
+                                   adjoint(mode), kTransmission);
       if (!usable(in) || !usable(out)) continue;
       if (top_smooth) {
         sum += L.base.pdf(-in->wi, -out->wi, mode);
@@ -155,7 +169,8 @@ float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   return 0.1f / (4 * kPi) + 0.9f * sum / float(L.samples);
 }
 
-std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2 u,
+                                         TransportMode mode) {
   const bool flip = wo.z < 0;
   if (flip) wo = -wo;
   const DielectricMaterial& top = L.top;
@@ -185,7 +200,8 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
       t = L.base.sample(-w, rng, mode);
     } else {
       float uc2 = rng.uniform();
-      t = dielectric_sample(top, -w, uc2, {rng.uniform(), rng.uniform()}, mode, kReflection | kTransmission);
+      t = dielectric_sample(top, -w, uc2, {rng.uniform(), rng.uniform()}, mode,
+                            kReflection | kTransmission);
     }
     if (!usable(t)) return std::nullopt;
     f *= t->f;
@@ -202,9 +218,9 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
   return std::nullopt;
 }
 
-
 Layer layer_of(const Material& m) {
-  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) return Layer(d->layer, DiffuseMaterial{d->reflectance});
+  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m))
+    return Layer(d->layer, DiffuseMaterial{d->reflectance});
   const auto& c = std::get<CoatedConductorMaterial>(m);
   return Layer(c.layer, c.conductor);
 }
@@ -217,9 +233,9 @@ Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
 float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   return layered_pdf(layer_of(m), wo, wi, mode);
 }
-std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode) {
+std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
+                                         TransportMode mode) {
   return layered_sample(layer_of(m), wo, uc, u, mode);
 }
 
 }  // namespace bpm
-

@@ -1,8 +1,8 @@
+#include "materials/material.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include "materials/material.h"
 
 namespace bpm {
 
@@ -43,7 +43,9 @@ struct Resolver {
   Material operator()(const DiffuseTransmissionDesc& d) const {
     return DiffuseTransmissionMaterial{eval(d.reflectance), eval(d.transmittance)};
   }
-  Material operator()(const PhongDesc& d) const { return PhongMaterial{eval(d.reflectance), d.exponent}; }
+  Material operator()(const PhongDesc& d) const {
+    return PhongMaterial{eval(d.reflectance), d.exponent};
+  }
   Material operator()(const InterfaceMaterial& d) const { return d; }
   Material operator()(const CoatedConductorDesc& d) const {
     CoatLayer layer = d.layer;
@@ -63,7 +65,8 @@ struct Resolver {
 
 }  // namespace
 
-Roughness RoughnessTextures::eval(const Roughness& constant, const TextureSet& ts, const TextureContext& ctx) const {
+Roughness RoughnessTextures::eval(const Roughness& constant, const TextureSet& ts,
+                                  const TextureContext& ctx) const {
   auto alpha = [&](int tex, float fallback) {
     if (tex < 0) return fallback;
     float r = std::max(0.0f, ts.value(tex, ctx));
@@ -76,8 +79,8 @@ Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl) {
   return std::visit(Resolver{wl, nullptr, nullptr}, desc);
 }
 
-Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl, const TextureSet& textures,
-                          const TextureContext& ctx) {
+Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl,
+                          const TextureSet& textures, const TextureContext& ctx) {
   return std::visit(Resolver{wl, &textures, &ctx}, desc);
 }
 
@@ -85,12 +88,19 @@ bool material_is_textured(const MaterialDesc& desc) {
   struct V {
     bool operator()(const DiffuseDesc& d) const { return d.reflectance.textured(); }
     bool operator()(const ConductorDesc& d) const {
-      return d.eta.textured() || d.k.textured() || (d.reflectance && d.reflectance->textured()) || d.roughness_tex.any();
+      return d.eta.textured() || d.k.textured() || (d.reflectance && d.reflectance->textured()) ||
+             d.roughness_tex.any();
     }
-    bool operator()(const DiffuseTransmissionDesc& d) const { return d.reflectance.textured() || d.transmittance.textured(); }
+    bool operator()(const DiffuseTransmissionDesc& d) const {
+      return d.reflectance.textured() || d.transmittance.textured();
+    }
     bool operator()(const PhongDesc& d) const { return d.reflectance.textured(); }
-    bool operator()(const CoatedDiffuseDesc& d) const { return d.reflectance.textured() || d.roughness_tex.any(); }
-    bool operator()(const CoatedConductorDesc& d) const { return (*this)(d.conductor) || d.roughness_tex.any(); }
+    bool operator()(const CoatedDiffuseDesc& d) const {
+      return d.reflectance.textured() || d.roughness_tex.any();
+    }
+    bool operator()(const CoatedConductorDesc& d) const {
+      return (*this)(d.conductor) || d.roughness_tex.any();
+    }
     bool operator()(const DielectricMaterial&) const { return false; }
     bool operator()(const ThinDielectricMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return false; }

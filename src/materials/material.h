@@ -136,15 +136,16 @@ struct MixDesc {
   int materials[2] = {0, 0};
   FloatParam amount{0.5f, -1};
 };
-using MaterialDesc = std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
-                                  DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc,
-                                  CoatedConductorDesc, MixDesc>;
+using MaterialDesc =
+    std::variant<DiffuseDesc, ConductorDesc, DielectricMaterial, ThinDielectricMaterial,
+                 DiffuseTransmissionDesc, PhongDesc, InterfaceMaterial, CoatedDiffuseDesc,
+                 CoatedConductorDesc, MixDesc>;
 
 // A material without textures at the wavelengths.
 Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl);
 // Any material, at the wavelengths and the surface point.
-Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl, const TextureSet& textures,
-                          const TextureContext& ctx);
+Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl,
+                          const TextureSet& textures, const TextureContext& ctx);
 // True when a parameter of the material is a texture, or it is a mix (it must be resolved per
 // surface point).
 bool material_is_textured(const MaterialDesc& desc);
@@ -176,7 +177,8 @@ Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
 // Density with which bsdf_sample returns wi; zero for delta lobes.
 float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
 // uc picks among lobes, u picks the direction.
-std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u, TransportMode mode);
+std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
+                                      TransportMode mode);
 // All lobes of the material are delta lobes (no use in next-event estimation).
 bool bsdf_is_specular(const Material& m);
 // True when the material has a non-delta lobe (a diffuse vertex in DESIGN.md's sense).

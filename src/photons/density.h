@@ -9,7 +9,8 @@
 
 namespace bpm {
 
-inline Spectrum photon_contribution(const Material& m, Vec3 ng, Vec3 ns, Vec3 wo, Vec3 wi, const Spectrum& flux) {
+inline Spectrum photon_contribution(const Material& m, Vec3 ng, Vec3 ns, Vec3 wo, Vec3 wi,
+                                    const Spectrum& flux) {
   Frame frame = Frame::from_z(ns);
   Vec3 wo_local = frame.to_local(wo), wi_local = frame.to_local(wi);
   Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance);

@@ -34,7 +34,7 @@ struct LightCounters {
   uint64_t light_rays = 0;    // emitted and bounce rays
   uint64_t diffuse_hits = 0;  // photon hits on diffuse surfaces
   uint64_t queries = 0;       // map lookups (bpm)
-  uint64_t entries = 0;       // accepted (backward photon, photon) pairs (bpm); photons stored (fpm)
+  uint64_t entries = 0;  // accepted (backward photon, photon) pairs (bpm); photons stored (fpm)
   RayObserver* observer = nullptr;
   void add(const LightCounters& o) {
     photons += o.photons;
@@ -56,19 +56,20 @@ struct PhotonHit {
   int bounces;
 };
 
-// Traces one photon at the wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface. The path stops
-// once a further bounce could not make a path of at most max_depth scattering events with the
-// `min_eye_vertices` the estimator adds on the camera side.
+// Traces one photon at the wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse
+// surface. The path stops once a further bounce could not make a path of at most max_depth
+// scattering events with the `min_eye_vertices` the estimator adds on the camera side.
 template <class OnHit>
-void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth, int min_eye_vertices,
-                      Rng& rng, LightCounters& counters, OnHit&& on_hit) {
+void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
+                      int min_eye_vertices, Rng& rng, LightCounters& counters, OnHit&& on_hit) {
   ++counters.photons;
   if (scene.lights.empty() || max_depth < min_eye_vertices) return;
   float pmf;
   int li = scene.light_distribution.sample(rng.uniform(), &pmf);
   const Light& light = scene.lights[li];
   Vec2 u_pos{rng.uniform(), rng.uniform()}, u_dir{rng.uniform(), rng.uniform()};
-  auto le = light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info, wm.wl);
+  auto le =
+      light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info, wm.wl);
   if (!le || le->flux.is_black() || pmf == 0) return;
   bool has_surface = length_squared(le->n_light) > 0;
   PathState s{Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin,
@@ -83,11 +84,13 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
   ++counters.light_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    if (next_vertex(scene, wm, s, v, counters.light_rays, counters.observer) != StepEnd::kVertex) break;
+    if (next_vertex(scene, wm, s, v, counters.light_rays, counters.observer) != StepEnd::kVertex)
+      break;
     if (!bsdf_is_specular(v.m())) {
       ++counters.diffuse_hits;
-      PhotonClass cls = bounces == 0 ? PhotonClass::kDirect
-                                     : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
+      PhotonClass cls = bounces == 0
+                            ? PhotonClass::kDirect
+                            : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
       on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces});
     }
     if (bounces + 1 + min_eye_vertices > max_depth) break;
@@ -101,8 +104,9 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     // times the usual f |wi.ns| / pdf.
     float cos_o_g = std::fabs(dot(v.wo, v.sp.ng));
     if (cos_o_g == 0) break;
-    Spectrum bnew = s.beta * bs->f *
-                    (std::fabs(v.wo_local.z) * std::fabs(dot(wi, v.sp.ng)) / (cos_o_g * bs->pdf_solid_angle));
+    Spectrum bnew =
+        s.beta * bs->f *
+        (std::fabs(v.wo_local.z) * std::fabs(dot(wi, v.sp.ng)) / (cos_o_g * bs->pdf_solid_angle));
     // Russian roulette on the change of power (pbrt-v4's SPPM photon pass).
     float q = std::fmax(0.0f, 1 - bnew.max_component() / s.beta.max_component());
     if (rng.uniform() < q) break;

@@ -133,8 +133,9 @@ void CentreKdTree::build_node(uint32_t begin, uint32_t end, int depth) {
   // Keep items_ and spheres_ in step: sort an index permutation, then apply it.
   std::vector<uint32_t> perm(end - begin);
   for (uint32_t k = 0; k < perm.size(); ++k) perm[k] = begin + k;
-  std::nth_element(perm.begin(), perm.begin() + (mid - begin), perm.end(),
-                   [&](uint32_t x, uint32_t y) { return spheres_[x].c[axis] < spheres_[y].c[axis]; });
+  std::nth_element(
+      perm.begin(), perm.begin() + (mid - begin), perm.end(),
+      [&](uint32_t x, uint32_t y) { return spheres_[x].c[axis] < spheres_[y].c[axis]; });
   std::vector<SphereRef> s(perm.size());
   std::vector<uint32_t> it(perm.size());
   for (uint32_t k = 0; k < perm.size(); ++k) {

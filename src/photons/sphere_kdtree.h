@@ -46,9 +46,10 @@ class SphereKdTree {
     uint32_t a;     // inner: right child (the left child follows the node); leaf: first item
     uint32_t b;     // leaf: item count
   };
-  void build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth, const std::vector<SphereRef>& spheres);
+  void build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth,
+                  const std::vector<SphereRef>& spheres);
   std::vector<Node> nodes_;
-  std::vector<uint32_t> items_;   // sphere index per leaf slot
+  std::vector<uint32_t> items_;     // sphere index per leaf slot
   std::vector<SphereRef> spheres_;  // copy per leaf slot, for locality
   size_t input_count_ = 0;
 };

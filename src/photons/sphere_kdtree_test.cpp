@@ -48,11 +48,13 @@ void check_against_brute_force(const char* name, int n) {
 }
 
 TEST(SphereKdTree, MatchesBruteForce) {
-  for (int n : {0, 1, 3, 50, 1000, 20000}) check_against_brute_force<SphereKdTree>("sphere tree", n);
+  for (int n : {0, 1, 3, 50, 1000, 20000})
+    check_against_brute_force<SphereKdTree>("sphere tree", n);
 }
 
 TEST(CentreKdTree, MatchesBruteForce) {
-  for (int n : {0, 1, 3, 50, 1000, 20000}) check_against_brute_force<CentreKdTree>("centre tree", n);
+  for (int n : {0, 1, 3, 50, 1000, 20000})
+    check_against_brute_force<CentreKdTree>("centre tree", n);
 }
 
 TEST(CentreKdTree, PointQueriesWithinARadiusMatchBruteForce) {

@@ -35,11 +35,14 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
   const auto* us = static_cast<const UserShape*>(args->geometryUserPtr);
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    Vec3 o(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i), RTCRayN_org_z(args->ray, args->N, i));
-    Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i));
+    Vec3 o(RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+           RTCRayN_org_z(args->ray, args->N, i));
+    Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+           RTCRayN_dir_z(args->ray, args->N, i));
     float t = RTCRayN_tfar(args->ray, args->N, i);
     Vec2 bary(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
-    if (alpha_rejects(us, int(RTCHitN_primID(args->hit, args->N, i)), bary, o, d, t)) args->valid[i] = 0;
+    if (alpha_rejects(us, int(RTCHitN_primID(args->hit, args->N, i)), bary, o, d, t))
+      args->valid[i] = 0;
   }
 }
 
@@ -102,7 +105,9 @@ class Accel {
  public:
   Accel(const std::vector<Object>& objects, const TextureSet& textures) : textures_(textures) {
     device_ = rtcNewDevice(nullptr);
-    if (!device_) throw Error("cannot create the Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    if (!device_)
+      throw Error("cannot create the Embree device (error " +
+                  std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
     scene_ = rtcNewScene(device_);
     rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
@@ -113,10 +118,10 @@ class Accel {
       RTCGeometry g;
       if (auto* m = std::get_if<TriangleMesh>(&obj.shape)) {
         g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m->positions.data(), 0,
-                                   sizeof(Vec3), m->positions.size());
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->indices.data(), 0,
-                                   3 * sizeof(uint32_t), m->indices.size() / 3);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   m->positions.data(), 0, sizeof(Vec3), m->positions.size());
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->indices.data(),
+                                   0, 3 * sizeof(uint32_t), m->indices.size() / 3);
         triangles_ += m->indices.size() / 3;
         if (obj.has_alpha()) {
           user_shapes_.push_back(UserShape{&obj.shape, &obj, &textures_});
@@ -140,7 +145,8 @@ class Accel {
     }
     rtcCommitScene(scene_);
     RTCError err = rtcGetDeviceError(device_);
-    if (err != RTC_ERROR_NONE) throw Error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
+    if (err != RTC_ERROR_NONE)
+      throw Error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
   }
   ~Accel() {
     rtcReleaseScene(scene_);

@@ -27,6 +27,8 @@ LoadedScene Flattener::run() {
 
 }  // namespace flatten_internal
 
-LoadedScene flatten_scene(const ParsedScene& parsed) { return flatten_internal::Flattener(parsed).run(); }
+LoadedScene flatten_scene(const ParsedScene& parsed) {
+  return flatten_internal::Flattener(parsed).run();
+}
 
 }  // namespace bpm

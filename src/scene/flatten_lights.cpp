@@ -21,11 +21,14 @@ SpectrumCurve Flattener::light_spectrum(const ParamSet& ps, const std::string& n
 
 // The image a light's "filename" names (8-bit images decoded as sRGB, as pbrt-v4 does); errors
 // name the parameter.
-std::shared_ptr<const TexImage> Flattener::light_image(const ParamSet& ps, const std::string& light) {
+std::shared_ptr<const TexImage> Flattener::light_image(const ParamSet& ps,
+                                                       const std::string& light) {
   const Param* f = ps.find_any("filename");
   std::string file = ps.get_string("filename", "");
-  if (!f || file.empty()) throw Error(f ? f->loc : FileLoc{}, light + " light needs \"string filename\"");
-  fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+  if (!f || file.empty())
+    throw Error(f ? f->loc : FileLoc{}, light + " light needs \"string filename\"");
+  fs::path path =
+      fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
   std::shared_ptr<const TexImage> image;
   try {
     image = load_texture_image(path.string(), TexEncoding{});
@@ -33,13 +36,16 @@ std::shared_ptr<const TexImage> Flattener::light_image(const ParamSet& ps, const
     throw Error(f->loc, err.what());
   }
   for (float v : image->texels)
-    if (!std::isfinite(v)) throw Error(f->loc, "\"" + file + "\" has infinite or not-a-number texels and cannot be a light");
+    if (!std::isfinite(v))
+      throw Error(f->loc,
+                  "\"" + file + "\" has infinite or not-a-number texels and cannot be a light");
   return image;
 }
 
 // An environment image light; scale comes in with the light's "scale" and leaves with the
 // "illuminance" normalisation applied.
-ImageInfiniteLight Flattener::image_light(const LightEntity& e, const Param& file_param, float* scale) {
+ImageInfiniteLight Flattener::image_light(const LightEntity& e, const Param& file_param,
+                                          float* scale) {
   const ParamSet& ps = e.params;
   std::string file = ps.get_string("filename", "");
   ImageInfiniteLight l;
@@ -49,21 +55,27 @@ ImageInfiniteLight Flattener::image_light(const LightEntity& e, const Param& fil
     l.equal_area = true;
   } else if (im.width == 2 * im.height) {
     l.equal_area = false;
-    warning(file_param.loc, "\"" + file + "\" is " + std::to_string(im.width) + "x" + std::to_string(im.height) +
-                                ": read as a latitude-longitude map (pbrt-v3's layout); pbrt-v4 takes only square "
-                                "equal-area images");
+    warning(file_param.loc,
+            "\"" + file + "\" is " + std::to_string(im.width) + "x" + std::to_string(im.height) +
+                ": read as a latitude-longitude map (pbrt-v3's layout); pbrt-v4 takes only square "
+                "equal-area images");
   } else {
-    throw Error(file_param.loc, "environment image \"" + file + "\" is " + std::to_string(im.width) + "x" +
-                                    std::to_string(im.height) + ": it must be square (equal-area) or twice as wide as high (latitude-longitude)");
+    throw Error(
+        file_param.loc,
+        "environment image \"" + file + "\" is " + std::to_string(im.width) + "x" +
+            std::to_string(im.height) +
+            ": it must be square (equal-area) or twice as wide as high (latitude-longitude)");
   }
   if (!e.world_from_light.is_similarity())
-    throw Error(e.loc, "the transform of an environment light must be a rotation (no non-uniform scale)");
+    throw Error(e.loc,
+                "the transform of an environment light must be a rotation (no non-uniform scale)");
   l.world_from_light = e.world_from_light;
   float E = ps.get_float("illuminance", -1);
   if (E > 0) {
     double e_image = image_light_illuminance(l);
     if (!(e_image > 0))
-      throw Error(ps.find_any("illuminance")->loc, "\"illuminance\" is given but the image sends no light to the upper hemisphere");
+      throw Error(ps.find_any("illuminance")->loc,
+                  "\"illuminance\" is given but the image sends no light to the upper hemisphere");
     *scale *= float(E / e_image);
   }
   l.scale = *scale;
@@ -76,7 +88,8 @@ ImageInfiniteLight Flattener::image_light(const LightEntity& e, const Param& fil
 void Flattener::add_light(const LightEntity& e, RenderScene* rs) {
   const ParamSet& ps = e.params;
   if (!e.medium.outside.empty() && medium_id(e.medium.outside, e.medium.loc) >= 0)
-    throw Error(e.loc, "light \"" + e.name + "\" inside a medium (\"" + e.medium.outside + "\") is not supported");
+    throw Error(e.loc, "light \"" + e.name + "\" inside a medium (\"" + e.medium.outside +
+                           "\") is not supported");
   float scale = ps.get_float("scale", 1);
   if (e.name == "point") {
     add_point_light(e, &scale, rs);
@@ -93,7 +106,8 @@ void Flattener::add_light(const LightEntity& e, RenderScene* rs) {
   } else {
     throw Error(e.loc, "light \"" + e.name + "\" is not supported");
   }
-  if (!(scale >= 0) || !std::isfinite(scale)) throw Error(e.loc, "light scale must be a non-negative number");
+  if (!(scale >= 0) || !std::isfinite(scale))
+    throw Error(e.loc, "light scale must be a non-negative number");
   ps.warn_unused("light \"" + e.name + "\"");
 }
 
@@ -103,25 +117,31 @@ void Flattener::add_point_light(const LightEntity& e, float* scale, RenderScene*
   SpectrumCurve I = light_spectrum(ps, "I");
   float power = ps.get_float("power", -1);
   if (power > 0) *scale *= power / (4 * kPi);
-  rs->lights.push_back(PointLight{xf.point(ps.get_point3("from", Vec3(0, 0, 0))), I.scaled(*scale)});
+  rs->lights.push_back(
+      PointLight{xf.point(ps.get_point3("from", Vec3(0, 0, 0))), I.scaled(*scale)});
 }
 
 void Flattener::add_goniometric_light(const LightEntity& e, float* scale, RenderScene* rs) {
   const ParamSet& ps = e.params;
   const Transform& xf = e.world_from_light;
-  if (!ps.find_any("filename")) throw Error(e.loc, "goniometric light needs \"string filename\" (its intensity image)");
+  if (!ps.find_any("filename"))
+    throw Error(e.loc, "goniometric light needs \"string filename\" (its intensity image)");
   GoniometricLight l;
   l.image = light_image(ps, "goniometric");
   if (l.image->width != l.image->height)
-    throw Error(ps.find_any("filename")->loc, "goniometric image \"" + ps.get_string("filename", "") + "\" is " +
-                                                  std::to_string(l.image->width) + "x" + std::to_string(l.image->height) +
-                                                  ": it must be square (pbrt-v4's equal-area layout)");
-  if (!xf.is_similarity()) throw Error(e.loc, "the transform of a goniometric light must not scale non-uniformly");
+    throw Error(ps.find_any("filename")->loc,
+                "goniometric image \"" + ps.get_string("filename", "") + "\" is " +
+                    std::to_string(l.image->width) + "x" + std::to_string(l.image->height) +
+                    ": it must be square (pbrt-v4's equal-area layout)");
+  if (!xf.is_similarity())
+    throw Error(e.loc, "the transform of a goniometric light must not scale non-uniformly");
   l.world_from_light = xf;
   prepare_goniometric_light(&l);
   float power = ps.get_float("power", -1);
   if (power > 0) {
-    if (!(l.mean_value > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the goniometric image is black");
+    if (!(l.mean_value > 0))
+      throw Error(ps.find_any("power")->loc,
+                  "\"power\" is given but the goniometric image is black");
     *scale *= power / (4 * kPi * l.mean_value);
   }
   l.intensity = light_spectrum(ps, "I").scaled(*scale);
@@ -131,13 +151,16 @@ void Flattener::add_goniometric_light(const LightEntity& e, float* scale, Render
 void Flattener::add_projection_light(const LightEntity& e, float* scale, RenderScene* rs) {
   const ParamSet& ps = e.params;
   const Transform& xf = e.world_from_light;
-  if (!ps.find_any("filename")) throw Error(e.loc, "projection light needs \"string filename\" (the projected image)");
+  if (!ps.find_any("filename"))
+    throw Error(e.loc, "projection light needs \"string filename\" (the projected image)");
   ProjectionLight l;
   l.image = light_image(ps, "projection");
   float fov = ps.get_float("fov", 90);
-  if (!(fov > 0 && fov < 180)) throw Error(ps.find_any("fov")->loc, "projection fov must be in (0, 180) degrees");
+  if (!(fov > 0 && fov < 180))
+    throw Error(ps.find_any("fov")->loc, "projection fov must be in (0, 180) degrees");
   l.tan_half_fov = std::tan(radians(fov) / 2);
-  if (!xf.is_similarity()) throw Error(e.loc, "the transform of a projection light must not scale non-uniformly");
+  if (!xf.is_similarity())
+    throw Error(e.loc, "the transform of a projection light must not scale non-uniformly");
   l.world_from_light = xf;
   l.scale = 1;
   prepare_projection_light(&l);  // power_rgb at scale 1; the distribution does not depend on it
@@ -145,7 +168,8 @@ void Flattener::add_projection_light(const LightEntity& e, float* scale, RenderS
   if (power > 0) {
     // pbrt-v4 normalises the luminance-weighted power of the image.
     float phi = l.power_rgb.luminance();
-    if (!(phi > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the projected image is black");
+    if (!(phi > 0))
+      throw Error(ps.find_any("power")->loc, "\"power\" is given but the projected image is black");
     *scale *= power / phi;
   }
   l.scale = *scale;
@@ -167,7 +191,8 @@ void Flattener::add_spot_light(const LightEntity& e, float* scale, RenderScene* 
   l.cos_falloff_start = std::cos(radians(cone - delta));
   float power = ps.get_float("power", -1);
   if (power > 0)
-    *scale *= power / (2 * kPi * ((1 - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2));
+    *scale *= power / (2 * kPi *
+                       ((1 - l.cos_falloff_start) + (l.cos_falloff_start - l.cos_falloff_end) / 2));
   l.intensity = I.scaled(*scale);
   rs->lights.push_back(l);
 }
@@ -187,7 +212,8 @@ void Flattener::add_infinite_light(const LightEntity& e, float* scale, RenderSce
   const ParamSet& ps = e.params;
   if (auto* p = ps.find_any("portal")) throw Error(p->loc, "light portals are not supported");
   if (const Param* f = ps.find_any("filename")) {
-    if (const Param* l = ps.find_any("L")) throw Error(l->loc, "an infinite light takes \"L\" or \"filename\", not both");
+    if (const Param* l = ps.find_any("L"))
+      throw Error(l->loc, "an infinite light takes \"L\" or \"filename\", not both");
     rs->lights.push_back(image_light(e, *f, scale));
     return;  // add_light checks the scale and the unused parameters
   }

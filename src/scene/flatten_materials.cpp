@@ -10,14 +10,16 @@
 namespace bpm::flatten_internal {
 
 // A spectral material parameter: a constant (a constant texture included) or a texture node.
-std::optional<SpectrumParam> Flattener::spectrum_param(const ParamSet& ps, const std::string& name, SpectrumKind kind) {
+std::optional<SpectrumParam> Flattener::spectrum_param(const ParamSet& ps, const std::string& name,
+                                                       SpectrumKind kind) {
   const Param* p = ps.find_any(name);
   if (p && p->type == "texture") {
     const TextureEntity& t = texture_entity(*p);
     if (t.name == "constant" && t.value_type == "float") {
       float v = t.params.get_float("value", 1);
       if (v < 0 || (kind == SpectrumKind::kAlbedo && v > 1))
-        throw Error(t.loc, "constant texture \"" + t.texture_name + "\" used as a reflectance must lie in [0, 1]");
+        throw Error(t.loc, "constant texture \"" + t.texture_name +
+                               "\" used as a reflectance must lie in [0, 1]");
       return SpectrumParam(SpectrumCurve(v));
     }
     if (t.name == "constant") {
@@ -37,7 +39,8 @@ float Flattener::float_param(const ParamSet& ps, const std::string& name, float 
   if (p && p->type == "texture") {
     const TextureEntity& t = texture_entity(*p);
     if (t.name != "constant" || t.value_type != "float")
-      throw Error(p->loc, "\"" + name + "\" must be a float or a constant float texture; \"" + p->strings[0] + "\" is not");
+      throw Error(p->loc, "\"" + name + "\" must be a float or a constant float texture; \"" +
+                              p->strings[0] + "\" is not");
     return t.params.get_float("value", 1);
   }
   return ps.get_float(name, def);
@@ -47,7 +50,8 @@ FloatParam Flattener::float_or_texture(const ParamSet& ps, const std::string& na
   const Param* p = ps.find_any(name);
   if (p && p->type == "texture") {
     const TextureEntity& t = texture_entity(*p);
-    if (!(t.name == "constant" && t.value_type == "float")) return FloatParam{0, texture_node(t, true, SpectrumKind::kAlbedo)};
+    if (!(t.name == "constant" && t.value_type == "float"))
+      return FloatParam{0, texture_node(t, true, SpectrumKind::kAlbedo)};
   }
   return FloatParam{float_param(ps, name, def), -1};
 }
@@ -57,8 +61,10 @@ FloatParam Flattener::float_or_texture(const ParamSet& ps, const std::string& na
 Roughness Flattener::roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix,
                                RoughnessTextures* tex) {
   FloatParam r = float_or_texture(ps, prefix + "roughness", 0);
-  FloatParam u = ps.find_any(prefix + "uroughness") ? float_or_texture(ps, prefix + "uroughness", 0) : r;
-  FloatParam v = ps.find_any(prefix + "vroughness") ? float_or_texture(ps, prefix + "vroughness", 0) : r;
+  FloatParam u =
+      ps.find_any(prefix + "uroughness") ? float_or_texture(ps, prefix + "uroughness", 0) : r;
+  FloatParam v =
+      ps.find_any(prefix + "vroughness") ? float_or_texture(ps, prefix + "vroughness", 0) : r;
   bool remap = ps.get_bool("remaproughness", true);
   if (u.textured() || v.textured()) {
     if (!tex) throw Error(loc, "textured roughness is not supported for this material");
@@ -85,7 +91,8 @@ float Flattener::dielectric_eta(const ParamSet& ps, const FileLoc& loc, const st
     if (sp.textured()) throw Error(p->loc, "a textured eta is not supported");
     const SpectrumCurve& s = sp.curve;
     if (s.max_value() - s.min_value() > 1e-4f)
-      warning(p->loc, "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
+      warning(p->loc,
+              "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
     eta = s.value(550);
   }
   if (!(eta > 0)) throw Error(p ? p->loc : loc, "eta must be positive");
@@ -94,7 +101,8 @@ float Flattener::dielectric_eta(const ParamSet& ps, const FileLoc& loc, const st
 
 // A conductor from eta and k (copper by default) or from a reflectance; prefix names the
 // parameters ("conductor." inside coatedconductor).
-ConductorDesc Flattener::conductor_desc(const ParamSet& ps, const FileLoc& loc, const std::string& prefix) {
+ConductorDesc Flattener::conductor_desc(const ParamSet& ps, const FileLoc& loc,
+                                        const std::string& prefix) {
   ConductorDesc c;
   // pbrt-v4's coatedconductor calls the base's reflectance plain "reflectance".
   if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) {
@@ -114,7 +122,8 @@ ConductorDesc Flattener::conductor_desc(const ParamSet& ps, const FileLoc& loc, 
 // The coat of pbrt-v4's coated materials; prefix names the coat's roughness and eta
 // ("interface." in coatedconductor). A scattering medium inside the layer (albedo > 0) is not
 // modelled.
-CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix, RoughnessTextures* tex) {
+CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
+                                RoughnessTextures* tex) {
   CoatLayer c;
   c.roughness = roughness(ps, e.loc, prefix, tex);
   c.eta = dielectric_eta(ps, e.loc, prefix + "eta");
@@ -123,21 +132,26 @@ CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const 
     throw Error(ps.find_any("thickness")->loc, "thickness must be positive");
   auto count = [&](const char* name, int def) {
     int v = ps.get_int(name, def);
-    if (v < 1 || v > 1000) throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
+    if (v < 1 || v > 1000)
+      throw Error(ps.find_any(name)->loc, std::string(name) + " must be in [1, 1000]");
     return v;
   };
   c.max_depth = count("maxdepth", 10);
   c.samples = count("nsamples", 1);
-  if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo); a && (a->textured() || !a->curve.is_black()))
-    throw Error(ps.find_any("albedo")->loc, e.name + " with a scattering layer (albedo > 0) is not supported");
-  if (ps.find_any("g")) float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
+  if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo);
+      a && (a->textured() || !a->curve.is_black()))
+    throw Error(ps.find_any("albedo")->loc,
+                e.name + " with a scattering layer (albedo > 0) is not supported");
+  if (ps.find_any("g"))
+    float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
   return c;
 }
 
 MaterialDesc Flattener::make_material(const SceneEntity& e) {
   const ParamSet& ps = e.params;
   for (const char* unsupported : {"displacement", "normalmap"})
-    if (auto* p = ps.find_any(unsupported)) throw Error(p->loc, std::string(unsupported) + " is not supported");
+    if (auto* p = ps.find_any(unsupported))
+      throw Error(p->loc, std::string(unsupported) + " is not supported");
   MaterialDesc m;
   if (e.name == "diffuse") {
     DiffuseDesc d;
@@ -147,15 +161,19 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
     m = conductor_desc(ps, e.loc, "");
   } else if (e.name == "dielectric" || e.name == "thindielectric") {
     float eta = dielectric_eta(ps, e.loc);
-    if (e.name == "dielectric") m = DielectricMaterial{eta, roughness(ps, e.loc)};
-    else m = ThinDielectricMaterial{eta};
+    if (e.name == "dielectric")
+      m = DielectricMaterial{eta, roughness(ps, e.loc)};
+    else
+      m = ThinDielectricMaterial{eta};
   } else if (e.name == "diffusetransmission") {
     DiffuseTransmissionDesc d;
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;
     if (auto t = spectrum_param(ps, "transmittance", SpectrumKind::kAlbedo)) d.transmittance = *t;
     float s = ps.get_float("scale", 1);
     if (d.reflectance.textured() || d.transmittance.textured()) {
-      if (s != 1) throw Error(ps.find_any("scale")->loc, "diffusetransmission scale with textures is not supported");
+      if (s != 1)
+        throw Error(ps.find_any("scale")->loc,
+                    "diffusetransmission scale with textures is not supported");
     } else {
       d.reflectance.curve = d.reflectance.curve.scaled(s);
       d.transmittance.curve = d.transmittance.curve.scaled(s);
@@ -179,16 +197,19 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) ph.reflectance = *r;
     if (const Param* p = ps.find_any("exponent")) {
       ph.exponent = ps.get_float("exponent", 20);
-      if (!(ph.exponent >= 0 && ph.exponent <= 1e5f)) throw Error(p->loc, "phong exponent must be in [0, 1e5]");
+      if (!(ph.exponent >= 0 && ph.exponent <= 1e5f))
+        throw Error(p->loc, "phong exponent must be in [0, 1e5]");
     }
     m = ph;
   } else if (e.name == "mix") {
     MixDesc mix;
     const Param* names = ps.find("materials", "string");
     if (!names || names->strings.size() != 2)
-      throw Error(names ? names->loc : e.loc, "mix needs \"string materials\" with two named materials");
+      throw Error(names ? names->loc : e.loc,
+                  "mix needs \"string materials\" with two named materials");
     names->used = true;
-    for (int i = 0; i < 2; ++i) mix.materials[i] = material_id(MaterialRef{-1, names->strings[size_t(i)], names->loc});
+    for (int i = 0; i < 2; ++i)
+      mix.materials[i] = material_id(MaterialRef{-1, names->strings[size_t(i)], names->loc});
     mix.amount = float_or_texture(ps, "amount", 0.5f);
     m = mix;
   } else if (e.name == "interface" || e.name == "" || e.name == "none") {
@@ -211,16 +232,19 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   const SceneEntity& m = e->second;
   const ParamSet& ps = m.params;
   auto unsupported = [&](const std::string& why) {
-    return Error(loc, "participating media are not supported (medium \"" + name + "\" defined at " + m.loc.str() +
-                          ": " + why + "); only absorbing homogeneous media (sigma_s = 0) are");
+    return Error(loc, "participating media are not supported (medium \"" + name + "\" defined at " +
+                          m.loc.str() + ": " + why +
+                          "); only absorbing homogeneous media (sigma_s = 0) are");
   };
   if (m.name != "homogeneous") throw unsupported("type \"" + m.name + "\"");
   if (const Param* p = ps.find_any("preset")) {
     p->used = true;
-    throw unsupported("preset \"" + (p->strings.empty() ? std::string() : p->strings[0]) + "\" scatters");
+    throw unsupported("preset \"" + (p->strings.empty() ? std::string() : p->strings[0]) +
+                      "\" scatters");
   }
   float scale = ps.get_float("scale", 1);
-  if (!(scale >= 0) || !std::isfinite(scale)) throw Error(m.loc, "medium scale must be a non-negative number");
+  if (!(scale >= 0) || !std::isfinite(scale))
+    throw Error(m.loc, "medium scale must be a non-negative number");
   // pbrt-v4's defaults scatter: sigma_s must be stated, and zero.
   auto sigma_s = get_spectrum(ps, "sigma_s", SpectrumKind::kUnbounded, parsed_.base_directory);
   if (!sigma_s || sigma_s->max_value() * scale > 0) throw unsupported("it scatters (sigma_s > 0)");
@@ -229,7 +253,8 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
   ps.get_float("g", 0);
   auto sigma_a = get_spectrum(ps, "sigma_a", SpectrumKind::kUnbounded, parsed_.base_directory)
-                     .value_or(SpectrumCurve::from_rgb(Rgb(0.0011f, 0.0024f, 0.014f), SpectrumKind::kUnbounded));
+                     .value_or(SpectrumCurve::from_rgb(Rgb(0.0011f, 0.0024f, 0.014f),
+                                                       SpectrumKind::kUnbounded));
   if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
   ps.warn_unused("medium \"" + name + "\"");
   scene().media.push_back(AbsorbingMedium{name, sigma_a.scaled(scale)});
@@ -243,7 +268,8 @@ int Flattener::material_id(const MaterialRef& ref) {
     auto it = named_material_ids_.find(ref.named);
     if (it != named_material_ids_.end()) return it->second;
     auto e = parsed_.named_materials.find(ref.named);
-    if (e == parsed_.named_materials.end()) throw Error(ref.loc, "unknown named material \"" + ref.named + "\"");
+    if (e == parsed_.named_materials.end())
+      throw Error(ref.loc, "unknown named material \"" + ref.named + "\"");
     if (!building_materials_.insert(ref.named).second)
       throw Error(ref.loc, "named material \"" + ref.named + "\" contains itself (through mix)");
     MaterialDesc made = make_material(e->second);

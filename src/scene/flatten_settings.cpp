@@ -14,7 +14,8 @@ void Flattener::read_camera(LoadedScene* out) {
   }
   const CameraEntity& c = *parsed_.camera;
   if (!c.medium.outside.empty())
-    throw Error(c.medium.loc, "a camera inside a medium (\"" + c.medium.outside + "\") is not supported");
+    throw Error(c.medium.loc,
+                "a camera inside a medium (\"" + c.medium.outside + "\") is not supported");
   if (c.name != "perspective")
     throw Error(c.loc, "camera \"" + c.name + "\" is not supported (only perspective)");
   out->camera.world_from_camera = c.camera_from_world.inverse();
@@ -27,7 +28,8 @@ void Flattener::read_camera(LoadedScene* out) {
   if (!(out->camera.focal_distance > 0)) throw Error(c.loc, "focaldistance must be positive");
   auto sw = c.params.get_floats("screenwindow");
   if (!sw.empty()) {
-    if (sw.size() != 4) throw Error(c.params.find_any("screenwindow")->loc, "screenwindow needs 4 values");
+    if (sw.size() != 4)
+      throw Error(c.params.find_any("screenwindow")->loc, "screenwindow needs 4 values");
     for (int i = 0; i < 4; ++i) out->camera.screen_window[i] = sw[i];
   }
   float open = c.params.get_float("shutteropen", 0), close = c.params.get_float("shutterclose", 1);
@@ -41,19 +43,24 @@ void Flattener::read_film(LoadedScene* out) {
   if (f.name != "rgb") throw Error(f.loc, "film \"" + f.name + "\" is not supported (only rgb)");
   out->film.width = f.params.get_int("xresolution", 1280);
   out->film.height = f.params.get_int("yresolution", 720);
-  if (out->film.width <= 0 || out->film.height <= 0 || out->film.width > 65536 || out->film.height > 65536)
+  if (out->film.width <= 0 || out->film.height <= 0 || out->film.width > 65536 ||
+      out->film.height > 65536)
     throw Error(f.loc, "film resolution must be between 1 and 65536 pixels per axis");
   out->film.filename = f.params.get_string("filename", "pbrt.exr");
   float iso = f.params.get_float("iso", 100);
   if (!(iso > 0)) throw Error(f.loc, "iso must be positive");
   out->film.imaging_ratio *= iso / 100;
   std::string sensor = f.params.get_string("sensor", "cie1931");
-  if (sensor != "cie1931") throw Error(f.params.find_any("sensor")->loc, "sensor \"" + sensor + "\" is not supported (only cie1931)");
+  if (sensor != "cie1931")
+    throw Error(f.params.find_any("sensor")->loc,
+                "sensor \"" + sensor + "\" is not supported (only cie1931)");
   if (f.params.get_float("whitebalance", 0) != 0)
     throw Error(f.params.find_any("whitebalance")->loc, "white balancing is not supported");
   out->film.max_component_value = f.params.get_float("maxcomponentvalue", kInf);
-  if (auto* cw = f.params.find_any("cropwindow")) throw Error(cw->loc, "cropwindow is not supported");
-  if (auto* pb = f.params.find_any("pixelbounds")) throw Error(pb->loc, "pixelbounds is not supported");
+  if (auto* cw = f.params.find_any("cropwindow"))
+    throw Error(cw->loc, "cropwindow is not supported");
+  if (auto* pb = f.params.find_any("pixelbounds"))
+    throw Error(pb->loc, "pixelbounds is not supported");
   f.params.get_bool("savefp16", true);  // bpm always writes 32-bit float EXR
   f.params.warn_unused("film");
 }
@@ -62,12 +69,18 @@ void Flattener::read_filter(LoadedScene* out) {
   const SceneEntity& f = parsed_.filter;
   FilterSettings& s = out->filter;
   float def = 0.5f;
-  if (f.name == "box") s.type = FilterType::kBox, def = 0.5f;
-  else if (f.name == "triangle") s.type = FilterType::kTriangle, def = 2;
-  else if (f.name == "gaussian") s.type = FilterType::kGaussian, def = 1.5f;
-  else if (f.name == "mitchell") s.type = FilterType::kMitchell, def = 2;
-  else if (f.name == "sinc") s.type = FilterType::kLanczos, def = 4;
-  else throw Error(f.loc, "pixel filter \"" + f.name + "\" is unknown");
+  if (f.name == "box")
+    s.type = FilterType::kBox, def = 0.5f;
+  else if (f.name == "triangle")
+    s.type = FilterType::kTriangle, def = 2;
+  else if (f.name == "gaussian")
+    s.type = FilterType::kGaussian, def = 1.5f;
+  else if (f.name == "mitchell")
+    s.type = FilterType::kMitchell, def = 2;
+  else if (f.name == "sinc")
+    s.type = FilterType::kLanczos, def = 4;
+  else
+    throw Error(f.loc, "pixel filter \"" + f.name + "\" is unknown");
   s.radius = {f.params.get_float("xradius", def), f.params.get_float("yradius", def)};
   if (!(s.radius.x > 0 && s.radius.y > 0)) throw Error(f.loc, "filter radius must be positive");
   s.sigma = f.params.get_float("sigma", 0.5f);
@@ -79,7 +92,8 @@ void Flattener::read_filter(LoadedScene* out) {
 
 void Flattener::read_sampler_and_integrator(LoadedScene* out) {
   const SceneEntity& s = parsed_.sampler;
-  static const char* samplers[] = {"zsobol", "sobol", "paddedsobol", "halton", "independent", "pmj02bn", "stratified"};
+  static const char* samplers[] = {"zsobol",      "sobol",   "paddedsobol", "halton",
+                                   "independent", "pmj02bn", "stratified"};
   bool known = false;
   for (const char* n : samplers) known = known || s.name == n;
   if (!known) throw Error(s.loc, "sampler \"" + s.name + "\" is unknown");
@@ -104,7 +118,9 @@ void Flattener::read_sampler_and_integrator(LoadedScene* out) {
     // These estimate the same image for scenes without media; bpm's reference for them is path.
     out->render.integrator = "path";
     if (parsed_.integrator_given)
-      warning(in.loc, "integrator \"" + in.name + "\" is rendered with bpm's \"path\" integrator (same image for surfaces)");
+      warning(in.loc,
+              "integrator \"" + in.name +
+                  "\" is rendered with bpm's \"path\" integrator (same image for surfaces)");
   } else {
     throw Error(in.loc, "integrator \"" + in.name + "\" is not supported");
   }

@@ -19,11 +19,13 @@ namespace fs = std::filesystem;
 void Flattener::check_indices(const std::vector<int>& idx, size_t n, const FileLoc& loc) {
   for (int i : idx)
     if (i < 0 || size_t(i) >= n)
-      throw Error(loc, "vertex index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
+      throw Error(loc, "vertex index " + std::to_string(i) + " out of range (" + std::to_string(n) +
+                           " vertices)");
 }
 
-TriangleMesh Flattener::mesh_from(const Transform& xf, bool flip, std::vector<Vec3> P, std::vector<Vec3> N,
-                                  std::vector<Vec2> uv, const std::vector<int>& idx) {
+TriangleMesh Flattener::mesh_from(const Transform& xf, bool flip, std::vector<Vec3> P,
+                                  std::vector<Vec3> N, std::vector<Vec2> uv,
+                                  const std::vector<int>& idx) {
   TriangleMesh m;
   m.positions.reserve(P.size() + 2);  // Embree reads vertex buffers in 16-byte chunks
   for (Vec3 p : P) m.positions.push_back(xf.point(p));
@@ -46,7 +48,8 @@ void Flattener::add_shape(const ShapeEntity& s, RenderScene* rs) {
     if (!obj.alpha.textured() && !(obj.alpha.value >= 0 && obj.alpha.value <= 1))
       throw Error(a->loc, "alpha must be in [0, 1]");
     if (obj.has_alpha() && s.area_light)
-      throw Error(a->loc, "alpha on an emitting shape is not supported (the area light at " + s.area_light->loc.str() + ")");
+      throw Error(a->loc, "alpha on an emitting shape is not supported (the area light at " +
+                              s.area_light->loc.str() + ")");
   }
   if (s.name == "trianglemesh" || s.name == "bilinearmesh") {
     obj.shape = mesh_shape(s, flip);
@@ -86,15 +89,18 @@ TriangleMesh Flattener::mesh_shape(const ShapeEntity& s, bool flip) {
   }
   const FileLoc& iloc = ps.find_any("indices") ? ps.find_any("indices")->loc : s.loc;
   if (idx.size() % per != 0)
-    throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of " + std::to_string(per));
+    throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) +
+                          " values, not a multiple of " + std::to_string(per));
   check_indices(idx, P.size(), iloc);
   auto N = ps.get_normals("N");
   auto uv = ps.get_point2s("uv");
   if (uv.empty()) uv = ps.get_point2s("st");
   if (!N.empty() && N.size() != P.size())
-    throw Error(ps.find_any("N")->loc, "\"N\" has " + std::to_string(N.size()) + " normals for " + std::to_string(P.size()) + " vertices");
+    throw Error(ps.find_any("N")->loc, "\"N\" has " + std::to_string(N.size()) + " normals for " +
+                                           std::to_string(P.size()) + " vertices");
   if (!uv.empty() && uv.size() != P.size())
-    throw Error(ps.find_any("uv") ? ps.find_any("uv")->loc : s.loc, "\"uv\" count differs from the vertex count");
+    throw Error(ps.find_any("uv") ? ps.find_any("uv")->loc : s.loc,
+                "\"uv\" count differs from the vertex count");
   if (auto* S = ps.find_any("S")) {
     S->used = true;
     warning(S->loc, "per-vertex tangents \"S\" are ignored");
@@ -108,20 +114,24 @@ TriangleMesh Flattener::loopsubdiv_shape(const ShapeEntity& s, bool flip) {
   const ParamSet& ps = s.params;
   auto P = ps.get_point3s("P");
   auto idx = ps.get_ints("indices");
-  if (P.empty() || idx.empty()) throw Error(s.loc, "loopsubdiv needs \"point3 P\" and \"integer indices\"");
+  if (P.empty() || idx.empty())
+    throw Error(s.loc, "loopsubdiv needs \"point3 P\" and \"integer indices\"");
   const FileLoc& iloc = ps.find_any("indices")->loc;
   if (idx.size() % 3 != 0)
-    throw Error(iloc, "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of 3");
+    throw Error(iloc,
+                "\"indices\" has " + std::to_string(idx.size()) + " values, not a multiple of 3");
   check_indices(idx, P.size(), iloc);
   int levels = ps.get_int("levels", 3);
-  if (levels < 0 || levels > 8) throw Error(ps.find_any("levels")->loc, "loopsubdiv levels must be in [0, 8]");
+  if (levels < 0 || levels > 8)
+    throw Error(ps.find_any("levels")->loc, "loopsubdiv levels must be in [0, 8]");
   SubdividedMesh sub;
   try {
     sub = loop_subdivide(P, idx, levels);
   } catch (const std::invalid_argument& e) {
     throw Error(s.loc, std::string("loopsubdiv: ") + e.what());
   }
-  return mesh_from(s.world_from_object, flip, std::move(sub.positions), std::move(sub.normals), {}, sub.indices);
+  return mesh_from(s.world_from_object, flip, std::move(sub.positions), std::move(sub.normals), {},
+                   sub.indices);
 }
 
 // A "plymesh", read from its file (relative paths from the file that names it).
@@ -180,7 +190,8 @@ Cylinder Flattener::cylinder_shape(const ShapeEntity& s, bool flip) {
   return c;
 }
 
-std::vector<int> Flattener::bilinear_to_triangles(const std::vector<Vec3>& P, const std::vector<int>& idx, const FileLoc& loc) {
+std::vector<int> Flattener::bilinear_to_triangles(const std::vector<Vec3>& P,
+                                                  const std::vector<int>& idx, const FileLoc& loc) {
   std::vector<int> tris;
   for (size_t i = 0; i < idx.size(); i += 4) {
     int a = idx[i], b = idx[i + 1], c = idx[i + 2], d = idx[i + 3];  // p00 p10 p01 p11
@@ -188,7 +199,8 @@ std::vector<int> Flattener::bilinear_to_triangles(const std::vector<Vec3>& P, co
     float size = std::fmax(length(P[b] - P[a]), length(P[c] - P[a]));
     float ln = length(n);
     if (ln > 0 && std::fabs(dot(P[d] - P[a], n / ln)) > 1e-4f * size)
-      throw Error(loc, "non-planar bilinear patches are not supported (patch " + std::to_string(i / 4) + ")");
+      throw Error(loc, "non-planar bilinear patches are not supported (patch " +
+                           std::to_string(i / 4) + ")");
     int t[6] = {a, b, d, a, d, c};
     tris.insert(tris.end(), t, t + 6);
   }
@@ -201,7 +213,8 @@ void Flattener::add_area_light(const SceneEntity& a, Object* obj, int id, Render
   std::shared_ptr<const TexImage> image;
   Rgb image_mean(0.0f);
   if (ps.find_any("filename")) {
-    if (const Param* l = ps.find_any("L")) throw Error(l->loc, "an area light takes \"L\" or \"filename\", not both");
+    if (const Param* l = ps.find_any("L"))
+      throw Error(l->loc, "an area light takes \"L\" or \"filename\", not both");
     image = light_image(ps, "an image area");
     for (int y = 0; y < image->height; ++y)
       for (int x = 0; x < image->width; ++x) {
@@ -216,13 +229,15 @@ void Flattener::add_area_light(const SceneEntity& a, Object* obj, int id, Render
   float power = ps.get_float("power", -1);
   if (image && power > 0) {
     // pbrt-v4 normalises by the image's mean luminance.
-    if (!(image_mean.luminance() > 0)) throw Error(ps.find_any("power")->loc, "\"power\" is given but the image is black");
+    if (!(image_mean.luminance() > 0))
+      throw Error(ps.find_any("power")->loc, "\"power\" is given but the image is black");
     scale /= image_mean.luminance();
   }
   ps.warn_unused("area light");
   if (std::holds_alternative<Sphere>(obj->shape) || std::holds_alternative<Disk>(obj->shape)) {
-    const Transform& xf = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).world_from_object
-                                                                      : std::get<Disk>(obj->shape).world_from_object;
+    const Transform& xf = std::holds_alternative<Sphere>(obj->shape)
+                              ? std::get<Sphere>(obj->shape).world_from_object
+                              : std::get<Disk>(obj->shape).world_from_object;
     bool full = std::holds_alternative<Sphere>(obj->shape) ? std::get<Sphere>(obj->shape).is_full()
                                                            : std::get<Disk>(obj->shape).is_full();
     if (!xf.is_similarity() || !full)

@@ -34,16 +34,19 @@ int Flattener::texture_node(const TextureEntity& t, bool as_float, SpectrumKind 
 }
 
 // A texture's parameter that may itself be a texture: its node, or a constant node.
-int Flattener::spectrum_node(const ParamSet& ps, const std::string& name, SpectrumKind kind, float def) {
+int Flattener::spectrum_node(const ParamSet& ps, const std::string& name, SpectrumKind kind,
+                             float def) {
   const Param* p = ps.find_any(name);
   if (p && p->type == "texture") return texture_node(texture_entity(*p), false, kind);
-  if (p && p->type == "float") return scene().textures.add(ConstantTexture{SpectrumCurve(ps.get_float(name, def)), 0});
+  if (p && p->type == "float")
+    return scene().textures.add(ConstantTexture{SpectrumCurve(ps.get_float(name, def)), 0});
   auto v = get_spectrum(ps, name, kind, parsed_.base_directory);
   return scene().textures.add(ConstantTexture{v.value_or(SpectrumCurve(def)), 0});
 }
 int Flattener::float_node(const ParamSet& ps, const std::string& name, float def) {
   const Param* p = ps.find_any(name);
-  if (p && p->type == "texture") return texture_node(texture_entity(*p), true, SpectrumKind::kAlbedo);
+  if (p && p->type == "texture")
+    return texture_node(texture_entity(*p), true, SpectrumKind::kAlbedo);
   return scene().textures.add(ConstantTexture{SpectrumCurve(), ps.get_float(name, def)});
 }
 
@@ -70,7 +73,8 @@ TexMapping Flattener::texture_mapping(const TextureEntity& t) {
     m.ds = ps.get_float("udelta", 0);
     m.dt = ps.get_float("vdelta", 0);
   } else {
-    throw Error(ps.find_any("mapping")->loc, "texture mapping \"" + kind + "\" is unknown (uv, spherical, cylindrical, planar)");
+    throw Error(ps.find_any("mapping")->loc,
+                "texture mapping \"" + kind + "\" is unknown (uv, spherical, cylindrical, planar)");
   }
   return m;
 }
@@ -83,8 +87,11 @@ int Flattener::build_texture(const TextureEntity& t, bool as_float, SpectrumKind
   TextureNode node;
   if (t.name == "constant") {
     ConstantTexture c;
-    if (as_float) c.value = ps.get_float("value", 1);
-    else c.spectrum = get_spectrum(ps, "value", kind, parsed_.base_directory).value_or(SpectrumCurve(1.0f));
+    if (as_float)
+      c.value = ps.get_float("value", 1);
+    else
+      c.spectrum =
+          get_spectrum(ps, "value", kind, parsed_.base_directory).value_or(SpectrumCurve(1.0f));
     node = c;
   } else if (t.name == "imagemap") {
     node = image_texture(t, kind);
@@ -111,7 +118,8 @@ int Flattener::build_texture(const TextureEntity& t, bool as_float, SpectrumKind
     m.amount = float_node(ps, "amount", 0.5f);
     node = m;
   } else {
-    throw Error(t.loc, "texture class \"" + t.name + "\" is not supported (constant, imagemap, checkerboard, scale, mix)");
+    throw Error(t.loc, "texture class \"" + t.name +
+                           "\" is not supported (constant, imagemap, checkerboard, scale, mix)");
   }
   ps.warn_unused("texture \"" + t.texture_name + "\"");
   return scene().textures.add(std::move(node));
@@ -123,8 +131,10 @@ ImageTexture Flattener::image_texture(const TextureEntity& t, SpectrumKind kind)
   const ParamSet& ps = t.params;
   ImageTexture im;
   std::string file = ps.get_string("filename", "");
-  if (file.empty()) throw Error(t.loc, "imagemap texture \"" + t.texture_name + "\" has no \"string filename\"");
-  fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+  if (file.empty())
+    throw Error(t.loc, "imagemap texture \"" + t.texture_name + "\" has no \"string filename\"");
+  fs::path path =
+      fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
   TexEncoding enc;
   std::string encoding = ps.get_string("encoding", "sRGB");
   if (encoding == "sRGB") {
@@ -138,9 +148,11 @@ ImageTexture Flattener::image_texture(const TextureEntity& t, SpectrumKind kind)
     } catch (const std::exception&) {
       enc.gamma = -1;
     }
-    if (!(enc.gamma > 0)) throw Error(ps.find_any("encoding")->loc, "bad gamma in encoding \"" + encoding + "\"");
+    if (!(enc.gamma > 0))
+      throw Error(ps.find_any("encoding")->loc, "bad gamma in encoding \"" + encoding + "\"");
   } else {
-    throw Error(ps.find_any("encoding")->loc, "encoding \"" + encoding + "\" is unknown (sRGB, linear, \"gamma g\")");
+    throw Error(ps.find_any("encoding")->loc,
+                "encoding \"" + encoding + "\" is unknown (sRGB, linear, \"gamma g\")");
   }
   try {
     im.image = load_texture_image(path.string(), enc);
@@ -153,15 +165,22 @@ ImageTexture Flattener::image_texture(const TextureEntity& t, SpectrumKind kind)
   } else if (filter == "bilinear" || filter == "trilinear" || filter == "ewa" || filter == "EWA") {
     im.filter = TexFilter::kBilinear;  // without ray differentials, the finest level (texture.h)
   } else {
-    throw Error(ps.find_any("filter")->loc, "texture filter \"" + filter + "\" is unknown (point, bilinear, trilinear, ewa)");
+    throw Error(ps.find_any("filter")->loc,
+                "texture filter \"" + filter + "\" is unknown (point, bilinear, trilinear, ewa)");
   }
   ps.get_float("maxanisotropy", 8);
   std::string wrap = ps.get_string("wrap", "repeat");
-  if (wrap == "repeat") im.wrap = TexWrap::kRepeat;
-  else if (wrap == "clamp") im.wrap = TexWrap::kClamp;
-  else if (wrap == "black") im.wrap = TexWrap::kBlack;
-  else if (wrap == "octahedralsphere") im.wrap = TexWrap::kOctahedralSphere;
-  else throw Error(ps.find_any("wrap")->loc, "wrap mode \"" + wrap + "\" is unknown (repeat, clamp, black, octahedralsphere)");
+  if (wrap == "repeat")
+    im.wrap = TexWrap::kRepeat;
+  else if (wrap == "clamp")
+    im.wrap = TexWrap::kClamp;
+  else if (wrap == "black")
+    im.wrap = TexWrap::kBlack;
+  else if (wrap == "octahedralsphere")
+    im.wrap = TexWrap::kOctahedralSphere;
+  else
+    throw Error(ps.find_any("wrap")->loc,
+                "wrap mode \"" + wrap + "\" is unknown (repeat, clamp, black, octahedralsphere)");
   im.scale = ps.get_float("scale", 1);
   im.invert = ps.get_bool("invert", false);
   im.kind = kind;

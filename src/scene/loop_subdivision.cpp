@@ -24,14 +24,16 @@ struct Topology {
   std::vector<std::vector<int>> neighbours;  // distinct vertices sharing an edge
   std::vector<std::vector<int>> boundary;    // neighbours along boundary edges
 
-  Topology(size_t n_vertices, const std::vector<int>& idx) : neighbours(n_vertices), boundary(n_vertices) {
+  Topology(size_t n_vertices, const std::vector<int>& idx)
+      : neighbours(n_vertices), boundary(n_vertices) {
     for (size_t f = 0; f + 2 < idx.size(); f += 3)
       for (int k = 0; k < 3; ++k) {
         int a = idx[f + k], b = idx[f + (k + 1) % 3], c = idx[f + (k + 2) % 3];
         auto [it, fresh] = edge_of.emplace(edge_key(a, b), int(edges.size()));
         if (fresh) edges.push_back(Edge{a, b});
         Edge& e = edges[it->second];
-        if (e.faces == 2) throw std::invalid_argument("an edge is shared by more than two triangles");
+        if (e.faces == 2)
+          throw std::invalid_argument("an edge is shared by more than two triangles");
         e.opposite[e.faces++] = c;
       }
     for (const Edge& e : edges) {
@@ -64,7 +66,9 @@ void subdivide_once(std::vector<Vec3>& p, std::vector<int>& idx) {
     if (nb.empty()) {
       q[v] = p[v];
     } else if (t.on_boundary(int(v))) {
-      q[v] = t.boundary[v].size() == 2 ? p[v] * 0.75f + (p[t.boundary[v][0]] + p[t.boundary[v][1]]) * 0.125f : p[v];
+      q[v] = t.boundary[v].size() == 2
+                 ? p[v] * 0.75f + (p[t.boundary[v][0]] + p[t.boundary[v][1]]) * 0.125f
+                 : p[v];
     } else {
       float b = beta(nb.size());
       q[v] = p[v] * (1 - float(nb.size()) * b) + sum_of(p, nb) * b;
@@ -95,7 +99,8 @@ void subdivide_once(std::vector<Vec3>& p, std::vector<int>& idx) {
 
 }  // namespace
 
-SubdividedMesh loop_subdivide(const std::vector<Vec3>& positions, const std::vector<int>& indices, int levels) {
+SubdividedMesh loop_subdivide(const std::vector<Vec3>& positions, const std::vector<int>& indices,
+                              int levels) {
   SubdividedMesh m;
   m.positions = positions;
   m.indices = indices;
@@ -109,9 +114,10 @@ SubdividedMesh loop_subdivide(const std::vector<Vec3>& positions, const std::vec
     if (nb.empty()) {
       limit[v] = p;
     } else if (t.on_boundary(int(v))) {
-      limit[v] = t.boundary[v].size() == 2
-                     ? p * 0.6f + (m.positions[t.boundary[v][0]] + m.positions[t.boundary[v][1]]) * 0.2f
-                     : p;
+      limit[v] =
+          t.boundary[v].size() == 2
+              ? p * 0.6f + (m.positions[t.boundary[v][0]] + m.positions[t.boundary[v][1]]) * 0.2f
+              : p;
     } else {
       float g = 1 / (float(nb.size()) + 3 / (8 * beta(nb.size())));
       limit[v] = p * (1 - float(nb.size()) * g) + sum_of(m.positions, nb) * g;

@@ -17,6 +17,7 @@ struct SubdividedMesh {
 
 // indices: triangles into positions (checked by the caller). Throws std::invalid_argument for an
 // edge shared by more than two triangles (the scheme needs a manifold mesh).
-SubdividedMesh loop_subdivide(const std::vector<Vec3>& positions, const std::vector<int>& indices, int levels);
+SubdividedMesh loop_subdivide(const std::vector<Vec3>& positions, const std::vector<int>& indices,
+                              int levels);
 
 }  // namespace bpm

@@ -14,7 +14,8 @@ namespace {
 
 // Octahedron, outward winding.
 void octahedron(std::vector<Vec3>* p, std::vector<int>* idx) {
-  *p = {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1)};
+  *p = {Vec3(1, 0, 0),  Vec3(-1, 0, 0), Vec3(0, 1, 0),
+        Vec3(0, -1, 0), Vec3(0, 0, 1),  Vec3(0, 0, -1)};
   *idx = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
 }
 
@@ -27,7 +28,9 @@ void grid(int n, std::vector<Vec3>* p, std::vector<int>* idx) {
   auto id = [n](int x, int y) { return y * (n + 1) + x; };
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x)
-      for (int v : {id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y), id(x + 1, y + 1), id(x, y + 1)}) idx->push_back(v);
+      for (int v :
+           {id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y), id(x + 1, y + 1), id(x, y + 1)})
+        idx->push_back(v);
 }
 
 TEST(LoopSubdivision, CountsAndClosedness) {
@@ -92,7 +95,8 @@ TEST(LoopSubdivision, FlatGridStaysFlatAndRegularVerticesStay) {
 }
 
 TEST(LoopSubdivision, RejectsNonManifoldEdges) {
-  std::vector<Vec3> p = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1)};
+  std::vector<Vec3> p = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0),
+                         Vec3(0, 0, 1)};
   std::vector<int> idx = {0, 1, 2, 1, 0, 3, 0, 1, 4};
   EXPECT_THROW(loop_subdivide(p, idx, 1), std::invalid_argument);
 }

@@ -42,12 +42,14 @@ namespace {
 const Param* find_one(const ParamSet& ps, const std::string& name, const std::string& type) {
   const Param* p = ps.find(name, type);
   if (p && p->count() != 1)
-    throw Error(p->loc, "parameter \"" + name + "\" takes one value; got " + std::to_string(p->count()));
+    throw Error(p->loc,
+                "parameter \"" + name + "\" takes one value; got " + std::to_string(p->count()));
   return p;
 }
 void check_finite(const Param& p) {
   for (double v : p.numbers)
-    if (!std::isfinite(v)) throw Error(p.loc, "parameter \"" + p.name + "\" has a non-finite value");
+    if (!std::isfinite(v))
+      throw Error(p.loc, "parameter \"" + p.name + "\" has a non-finite value");
 }
 }  // namespace
 
@@ -102,14 +104,21 @@ std::vector<Vec3> triples(const Param* p) {
                             std::to_string(p->numbers.size()));
   std::vector<Vec3> out(p->numbers.size() / 3);
   for (size_t i = 0; i < out.size(); ++i)
-    out[i] = Vec3(float(p->numbers[3 * i]), float(p->numbers[3 * i + 1]), float(p->numbers[3 * i + 2]));
+    out[i] =
+        Vec3(float(p->numbers[3 * i]), float(p->numbers[3 * i + 1]), float(p->numbers[3 * i + 2]));
   return out;
 }
 }  // namespace
 
-std::vector<Vec3> ParamSet::get_point3s(const std::string& name) const { return triples(find(name, "point3")); }
-std::vector<Vec3> ParamSet::get_normals(const std::string& name) const { return triples(find(name, "normal")); }
-std::vector<Vec3> ParamSet::get_vector3s(const std::string& name) const { return triples(find(name, "vector3")); }
+std::vector<Vec3> ParamSet::get_point3s(const std::string& name) const {
+  return triples(find(name, "point3"));
+}
+std::vector<Vec3> ParamSet::get_normals(const std::string& name) const {
+  return triples(find(name, "normal"));
+}
+std::vector<Vec3> ParamSet::get_vector3s(const std::string& name) const {
+  return triples(find(name, "vector3"));
+}
 
 std::vector<Vec2> ParamSet::get_point2s(const std::string& name) const {
   const Param* p = find(name, "point2");
@@ -118,16 +127,20 @@ std::vector<Vec2> ParamSet::get_point2s(const std::string& name) const {
   if (p->numbers.size() % 2 != 0)
     throw Error(p->loc, "parameter \"" + name + "\" needs an even number of values");
   std::vector<Vec2> out(p->numbers.size() / 2);
-  for (size_t i = 0; i < out.size(); ++i) out[i] = {float(p->numbers[2 * i]), float(p->numbers[2 * i + 1])};
+  for (size_t i = 0; i < out.size(); ++i)
+    out[i] = {float(p->numbers[2 * i]), float(p->numbers[2 * i + 1])};
   return out;
 }
 
 void ParamSet::warn_unused(const std::string& what) const {
   for (const Param& p : params_)
-    if (!p.used) warning(p.loc, "parameter \"" + p.type + " " + p.name + "\" of " + what + " is not supported and was ignored");
+    if (!p.used)
+      warning(p.loc, "parameter \"" + p.type + " " + p.name + "\" of " + what +
+                         " is not supported and was ignored");
 }
 
-void ParamSet::require(const std::string& name, bool ok, const std::string& what, const FileLoc& fallback) const {
+void ParamSet::require(const std::string& name, bool ok, const std::string& what,
+                       const FileLoc& fallback) const {
   if (ok) return;
   const Param* p = find_any(name);
   throw Error(p ? p->loc : fallback, name + " " + what);

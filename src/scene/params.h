@@ -45,7 +45,8 @@ class ParamSet {
   std::vector<Vec2> get_point2s(const std::string& name) const;   // point2
 
   // Throws "NAME WHAT" at the parameter's place (or at `fallback` when it is absent) unless ok.
-  void require(const std::string& name, bool ok, const std::string& what, const FileLoc& fallback) const;
+  void require(const std::string& name, bool ok, const std::string& what,
+               const FileLoc& fallback) const;
 
   // Warns, naming file:line, for each parameter no getter asked for.
   void warn_unused(const std::string& what) const;

@@ -31,8 +31,8 @@ struct CameraEntity : SceneEntity {
 };
 
 struct MaterialRef {
-  int index = -1;          // into ParsedScene::materials, or -1
-  std::string named;       // or a NamedMaterial name
+  int index = -1;     // into ParsedScene::materials, or -1
+  std::string named;  // or a NamedMaterial name
   FileLoc loc;
 };
 
@@ -63,7 +63,7 @@ struct ParsedScene {
   SceneEntity filter{"gaussian", {}, {}};
   SceneEntity integrator{"volpath", {}, {}};
   bool integrator_given = false;
-  std::vector<SceneEntity> materials;                // anonymous Material directives
+  std::vector<SceneEntity> materials;                  // anonymous Material directives
   std::map<std::string, SceneEntity> named_materials;  // MakeNamedMaterial
   std::vector<TextureEntity> textures;
   std::map<std::string, SceneEntity> media;  // MakeNamedMedium; name is the "type" parameter

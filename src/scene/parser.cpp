@@ -30,8 +30,10 @@ class Parser {
   void run(std::unique_ptr<Tokenizer> top) {
     push_file(std::move(top));
     while (auto tok = next_token()) directive(*tok);
-    if (object_name_) throw Error(object_loc_, "ObjectBegin \"" + *object_name_ + "\" without ObjectEnd");
-    if (!stack_.empty()) throw Error(stack_.back().loc, "AttributeBegin without a matching AttributeEnd");
+    if (object_name_)
+      throw Error(object_loc_, "ObjectBegin \"" + *object_name_ + "\" without ObjectEnd");
+    if (!stack_.empty())
+      throw Error(stack_.back().loc, "AttributeBegin without a matching AttributeEnd");
     if (!world_begun_) throw Error(last_loc_, "the scene has no WorldBegin");
   }
 
@@ -107,7 +109,9 @@ class Parser {
       throw Error(t.loc, "expected a number; got '" + std::string(t.text) + "'");
     return v;
   }
-  double expect_number(const Token& directive) { return to_number(expect_token(directive.loc, "a number")); }
+  double expect_number(const Token& directive) {
+    return to_number(expect_token(directive.loc, "a number"));
+  }
   std::vector<double> numbers(const Token& d, int n) {
     std::vector<double> v;
     bool bracket = false;
@@ -118,7 +122,8 @@ class Parser {
     for (int i = 0; i < n; ++i) v.push_back(expect_number(d));
     if (bracket) {
       Token t = expect_token(d.loc, "]");
-      if (!t.is("]")) throw Error(t.loc, std::string(d.text) + " takes " + std::to_string(n) + " numbers");
+      if (!t.is("]"))
+        throw Error(t.loc, std::string(d.text) + " takes " + std::to_string(n) + " numbers");
     }
     for (double x : v)
       if (!std::isfinite(x)) throw Error(d.loc, std::string(d.text) + " has a non-finite value");
@@ -175,35 +180,45 @@ class Parser {
     const std::string& ty = p->type;
     if (ty == "string" || ty == "texture") {
       for (const Token& v : values) {
-        if (!v.is_string()) throw Error(v.loc, "parameter \"" + p->name + "\" expects strings; got '" + std::string(v.text) + "'");
+        if (!v.is_string())
+          throw Error(v.loc, "parameter \"" + p->name + "\" expects strings; got '" +
+                                 std::string(v.text) + "'");
         p->strings.push_back(v.unquoted());
       }
     } else if (ty == "bool") {
       for (const Token& v : values) {
         std::string s = v.is_string() ? v.unquoted() : std::string(v.text);
         if (s != "true" && s != "false")
-          throw Error(v.loc, "parameter \"" + p->name + "\" expects true or false; got '" + std::string(v.text) + "'");
+          throw Error(v.loc, "parameter \"" + p->name + "\" expects true or false; got '" +
+                                 std::string(v.text) + "'");
         p->bools.push_back(s == "true");
       }
     } else if (ty == "spectrum" && values.size() == 1 && values[0].is_string()) {
       p->strings.push_back(values[0].unquoted());
     } else {
       for (const Token& v : values) {
-        if (v.is_string()) throw Error(v.loc, "parameter \"" + p->name + "\" expects numbers; got a string");
+        if (v.is_string())
+          throw Error(v.loc, "parameter \"" + p->name + "\" expects numbers; got a string");
         p->numbers.push_back(to_number(v));
       }
       size_t n = p->numbers.size();
       auto need = [&](size_t k, const char* what) {
-        if (n % k != 0) throw Error(p->loc, "parameter \"" + p->name + "\" of type " + ty + " needs " + what + "; got " + std::to_string(n) + " values");
+        if (n % k != 0)
+          throw Error(p->loc, "parameter \"" + p->name + "\" of type " + ty + " needs " + what +
+                                  "; got " + std::to_string(n) + " values");
       };
       if (ty == "integer") {
         for (double x : p->numbers)
           if (x != std::floor(x) || std::fabs(x) > 2147483647.0)
             throw Error(p->loc, "parameter \"" + p->name + "\" expects integers");
       } else if (ty == "rgb") {
-        if (n != 3) throw Error(p->loc, "parameter \"" + p->name + "\" of type rgb needs 3 values; got " + std::to_string(n));
+        if (n != 3)
+          throw Error(p->loc, "parameter \"" + p->name + "\" of type rgb needs 3 values; got " +
+                                  std::to_string(n));
       } else if (ty == "blackbody") {
-        if (n != 1 && n != 2) throw Error(p->loc, "parameter \"" + p->name + "\" of type blackbody needs a temperature");
+        if (n != 1 && n != 2)
+          throw Error(p->loc,
+                      "parameter \"" + p->name + "\" of type blackbody needs a temperature");
       } else if (ty == "spectrum") {
         need(2, "wavelength/value pairs");
       } else if (ty == "point2" || ty == "vector2") {
@@ -252,7 +267,8 @@ class Parser {
       apply_transform(Transform::translate(Vec3(v[0], v[1], v[2])), true);
     } else if (k == "Scale") {
       auto v = numbers(d, 3);
-      if (v[0] == 0 || v[1] == 0 || v[2] == 0) throw Error(d.loc, "Scale by zero makes the transform singular");
+      if (v[0] == 0 || v[1] == 0 || v[2] == 0)
+        throw Error(d.loc, "Scale by zero makes the transform singular");
       apply_transform(Transform::scale(Vec3(v[0], v[1], v[2])), true);
     } else if (k == "Rotate") {
       auto v = numbers(d, 4);
@@ -260,8 +276,11 @@ class Parser {
       apply_transform(Transform::rotate(v[0], Vec3(v[1], v[2], v[3])), true);
     } else if (k == "LookAt") {
       auto v = numbers(d, 9);
-      auto t = Transform::look_at(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), Vec3(v[6], v[7], v[8]));
-      if (!t) throw Error(d.loc, "LookAt with coincident eye and target, or up parallel to the view direction");
+      auto t = Transform::look_at(Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]),
+                                  Vec3(v[6], v[7], v[8]));
+      if (!t)
+        throw Error(d.loc,
+                    "LookAt with coincident eye and target, or up parallel to the view direction");
       apply_transform(*t, true);
     } else if (k == "Transform" || k == "ConcatTransform") {
       auto v = numbers(d, 16);
@@ -279,14 +298,20 @@ class Parser {
     } else if (k == "CoordSysTransform") {
       std::string name = expect_string(d, "a name");
       auto it = coord_systems_.find(name);
-      if (it == coord_systems_.end()) throw Error(d.loc, "unknown coordinate system \"" + name + "\"");
+      if (it == coord_systems_.end())
+        throw Error(d.loc, "unknown coordinate system \"" + name + "\"");
       gs_.ctm = it->second;
     } else if (k == "ActiveTransform") {
       Token t = expect_token(d.loc, "StartTime, EndTime or All");
-      if (t.is("StartTime")) active_start_ = true, active_end_ = false;
-      else if (t.is("EndTime")) active_start_ = false, active_end_ = true;
-      else if (t.is("All")) active_start_ = active_end_ = true;
-      else throw Error(t.loc, "ActiveTransform takes StartTime, EndTime or All; got '" + std::string(t.text) + "'");
+      if (t.is("StartTime"))
+        active_start_ = true, active_end_ = false;
+      else if (t.is("EndTime"))
+        active_start_ = false, active_end_ = true;
+      else if (t.is("All"))
+        active_start_ = active_end_ = true;
+      else
+        throw Error(t.loc, "ActiveTransform takes StartTime, EndTime or All; got '" +
+                               std::string(t.text) + "'");
     } else if (k == "TransformTimes") {
       numbers(d, 2);
     } else if (k == "ReverseOrientation") {
@@ -304,14 +329,17 @@ class Parser {
       stack_.push_back({gs_, d.loc, k == "TransformBegin"});
     } else if (k == "AttributeEnd" || k == "TransformEnd") {
       if (stack_.empty()) throw Error(d.loc, std::string(k) + " without a matching begin");
-      if (stack_.back().transform_only) gs_.ctm = stack_.back().state.ctm;
-      else gs_ = stack_.back().state;
+      if (stack_.back().transform_only)
+        gs_.ctm = stack_.back().state.ctm;
+      else
+        gs_ = stack_.back().state;
       stack_.pop_back();
     } else if (k == "Attribute") {
       std::string target = expect_string(d, "a target");
       ParamSet ps = params();
       for (const Param& p : ps.all())
-        warning(p.loc, "Attribute \"" + target + "\" defaults are not supported; \"" + p.name + "\" was ignored");
+        warning(p.loc, "Attribute \"" + target + "\" defaults are not supported; \"" + p.name +
+                           "\" was ignored");
     } else if (k == "Material") {
       require_world(d, true);
       SceneEntity m{expect_string(d, "a material type"), {}, d.loc};
@@ -324,7 +352,8 @@ class Parser {
       ParamSet ps = params();
       const Param* type = ps.find("type", "string");
       if (!type) throw Error(d.loc, "MakeNamedMaterial \"" + name + "\" has no \"string type\"");
-      if (scene_->named_materials.count(name)) throw Error(d.loc, "named material \"" + name + "\" defined twice");
+      if (scene_->named_materials.count(name))
+        throw Error(d.loc, "named material \"" + name + "\" defined twice");
       scene_->named_materials[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
     } else if (k == "NamedMaterial") {
       require_world(d, true);
@@ -333,7 +362,8 @@ class Parser {
       std::string name = expect_string(d, "a medium name");
       ParamSet ps = params();
       const Param* type = ps.find("type", "string");
-      if (!type || type->strings.size() != 1) throw Error(d.loc, "medium \"" + name + "\" has no \"string type\"");
+      if (!type || type->strings.size() != 1)
+        throw Error(d.loc, "medium \"" + name + "\" has no \"string type\"");
       type->used = true;
       scene_->media[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
     } else if (k == "MediumInterface") {
@@ -358,21 +388,28 @@ class Parser {
       c.medium = gs_.medium;
       coord_systems_["camera"] = gs_.ctm.inverse();
       scene_->camera = std::move(c);
-    } else if (k == "Film" || k == "Sampler" || k == "PixelFilter" || k == "Integrator" || k == "Accelerator") {
+    } else if (k == "Film" || k == "Sampler" || k == "PixelFilter" || k == "Integrator" ||
+               k == "Accelerator") {
       require_world(d, false);
       SceneEntity e{expect_string(d, "a type name"), {}, d.loc};
       e.params = params();
-      if (k == "Film") scene_->film = std::move(e);
-      else if (k == "Sampler") scene_->sampler = std::move(e);
-      else if (k == "PixelFilter") scene_->filter = std::move(e);
-      else if (k == "Integrator") scene_->integrator = std::move(e), scene_->integrator_given = true;
+      if (k == "Film")
+        scene_->film = std::move(e);
+      else if (k == "Sampler")
+        scene_->sampler = std::move(e);
+      else if (k == "PixelFilter")
+        scene_->filter = std::move(e);
+      else if (k == "Integrator")
+        scene_->integrator = std::move(e), scene_->integrator_given = true;
       // Accelerator: Embree builds its own BVH, so the choice has no effect.
     } else if (k == "ColorSpace") {
       std::string cs = expect_string(d, "a color space");
-      if (cs != "srgb") throw Error(d.loc, "color space \"" + cs + "\" is not supported (only srgb)");
+      if (cs != "srgb")
+        throw Error(d.loc, "color space \"" + cs + "\" is not supported (only srgb)");
     } else if (k == "Option") {
       ParamSet ps = params();
-      for (const Param& p : ps.all()) warning(p.loc, "Option \"" + p.name + "\" is not supported and was ignored");
+      for (const Param& p : ps.all())
+        warning(p.loc, "Option \"" + p.name + "\" is not supported and was ignored");
     } else if (k == "WorldBegin") {
       require_world(d, false);
       world_begun_ = true;
@@ -396,7 +433,8 @@ class Parser {
       t.value_type = expect_string(d, "a texture type");
       if (t.value_type == "color") t.value_type = "spectrum";
       if (t.value_type != "float" && t.value_type != "spectrum")
-        throw Error(d.loc, "texture type must be \"float\" or \"spectrum\"; got \"" + t.value_type + "\"");
+        throw Error(d.loc,
+                    "texture type must be \"float\" or \"spectrum\"; got \"" + t.value_type + "\"");
       read_entity(d, "a texture class", &t);
       t.world_from_texture = gs_.ctm;
       scene_->textures.push_back(std::move(t));
@@ -422,8 +460,10 @@ class Parser {
       s.area_light = gs_.area_light;
       s.directory = current_directory();
       s.medium = gs_.medium;
-      if (object_name_) objects_[*object_name_].push_back(std::move(s));
-      else scene_->shapes.push_back(std::move(s));
+      if (object_name_)
+        objects_[*object_name_].push_back(std::move(s));
+      else
+        scene_->shapes.push_back(std::move(s));
     } else {
       return false;
     }
@@ -439,7 +479,8 @@ class Parser {
       if (object_name_) throw Error(d.loc, "ObjectBegin inside another ObjectBegin");
       object_name_ = expect_string(d, "an object name");
       object_loc_ = d.loc;
-      if (objects_.count(*object_name_)) throw Error(d.loc, "object \"" + *object_name_ + "\" defined twice");
+      if (objects_.count(*object_name_))
+        throw Error(d.loc, "object \"" + *object_name_ + "\" defined twice");
       objects_[*object_name_];
       stack_.push_back({gs_, d.loc, false});
     } else if (k == "ObjectEnd") {
@@ -470,7 +511,8 @@ class Parser {
     const std::string_view k = d.text;
     if (k != "Include" && k != "Import") return false;
     std::string file = expect_string(d, "a file name");
-    fs::path p = fs::path(file).is_absolute() ? fs::path(file) : fs::path(current_directory()) / file;
+    fs::path p =
+        fs::path(file).is_absolute() ? fs::path(file) : fs::path(current_directory()) / file;
     std::string ps = p.lexically_normal().string();
     if (include_chain_.count(ps)) throw Error(d.loc, "file \"" + file + "\" includes itself");
     if (peeked_) throw Error(d.loc, "internal: include with pending token");

@@ -64,17 +64,21 @@ int col(const std::string& line, const std::string& needle) {
 ::testing::AssertionResult IsError(const std::string& message, const std::string& where,
                                    const std::string& phrase) {
   if (message.empty())
-    return ::testing::AssertionFailure() << "no error; expected \"" << where << ": ..." << phrase << "...\"";
+    return ::testing::AssertionFailure()
+           << "no error; expected \"" << where << ": ..." << phrase << "...\"";
   if (!message.starts_with(where + ": "))
-    return ::testing::AssertionFailure() << "error \"" << message << "\" is not located at " << where;
+    return ::testing::AssertionFailure()
+           << "error \"" << message << "\" is not located at " << where;
   if (message.find(phrase) == std::string::npos)
-    return ::testing::AssertionFailure() << "error \"" << message << "\" does not contain \"" << phrase << "\"";
+    return ::testing::AssertionFailure()
+           << "error \"" << message << "\" does not contain \"" << phrase << "\"";
   return ::testing::AssertionSuccess();
 }
 
 ::testing::AssertionResult Contains(const std::string& haystack, const std::string& needle) {
   if (haystack.find(needle) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "\"" << haystack << "\" does not contain \"" << needle << "\"";
+  return ::testing::AssertionFailure()
+         << "\"" << haystack << "\" does not contain \"" << needle << "\"";
 }
 
 void expect_vec_near(Vec3 a, Vec3 b, float eps = 1e-5f) {
@@ -89,7 +93,8 @@ void expect_spectrum_near(const SpectrumCurve& a, const Rgb& b, float eps = 1e-4
 }
 // Two curves, wavelength by wavelength.
 void expect_spectrum_near(const SpectrumCurve& a, const SpectrumCurve& b, float eps = 1e-5f) {
-  for (float l = kLambdaMin; l <= kLambdaMax; l += 10) EXPECT_NEAR(a.value(l), b.value(l), eps) << l << " nm";
+  for (float l = kLambdaMin; l <= kLambdaMax; l += 10)
+    EXPECT_NEAR(a.value(l), b.value(l), eps) << l << " nm";
 }
 
 // A material parameter that must be a constant curve.
@@ -194,7 +199,8 @@ TEST(SceneParse, MinimalSceneFlattens) {
 }
 
 TEST(SceneParse, CommentsAndLocations) {
-  ParsedScene p = parse_scene_string("# a comment\nWorldBegin # trailing\n\n   Shape \"sphere\" # x\n");
+  ParsedScene p =
+      parse_scene_string("# a comment\nWorldBegin # trailing\n\n   Shape \"sphere\" # x\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   EXPECT_EQ(p.shapes[0].loc.file, "<string>");
   EXPECT_EQ(p.shapes[0].loc.line, 4);
@@ -209,7 +215,8 @@ TEST(SceneParse, TranslateMovesShape) {
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<Sphere>(ls.scene.objects[0].shape));
-  expect_vec_near(origin_of(std::get<Sphere>(ls.scene.objects[0].shape).world_from_object), Vec3(1, 2, 3));
+  expect_vec_near(origin_of(std::get<Sphere>(ls.scene.objects[0].shape).world_from_object),
+                  Vec3(1, 2, 3));
 }
 
 TEST(SceneParse, BracketedTranslate) {
@@ -220,7 +227,8 @@ TEST(SceneParse, BracketedTranslate) {
 
 TEST(SceneParse, TransformsConcatenateInOrder) {
   // Translate then Scale: the scale applies first to object points.
-  ParsedScene p = parse_scene_string("WorldBegin\nTranslate 1 0 0\nScale 2 3 4\nShape \"sphere\"\n");
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nTranslate 1 0 0\nScale 2 3 4\nShape \"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   expect_vec_near(p.shapes[0].world_from_object.point(Vec3(1, 1, 1)), Vec3(3, 3, 4));
 }
@@ -255,7 +263,8 @@ TEST(SceneParse, LookAtMapsEyeToCameraOrigin) {
 
 TEST(SceneParse, TransformReadsColumnByColumn) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nTranslate 100 0 0\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape \"sphere\"\n");
+      "WorldBegin\nTranslate 100 0 0\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape "
+      "\"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   // Transform replaces the current transform (the Translate is gone).
   expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(5, 6, 7));
@@ -272,7 +281,8 @@ TEST(SceneParse, TransformNonTranslationPart) {
 
 TEST(SceneParse, ConcatTransformMultiplies) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nTranslate 1 0 0\nConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape \"sphere\"\n");
+      "WorldBegin\nTranslate 1 0 0\nConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape "
+      "\"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(6, 6, 7));
 }
@@ -300,7 +310,8 @@ TEST(SceneParse, CoordinateSystemAndCoordSysTransform) {
 
 TEST(SceneParse, CameraCoordinateSystem) {
   ParsedScene p = parse_scene_string(
-      "LookAt 1 2 3  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nCoordSysTransform \"camera\"\n"
+      "LookAt 1 2 3  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nCoordSysTransform "
+      "\"camera\"\n"
       "Shape \"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 2, 3));
@@ -308,7 +319,8 @@ TEST(SceneParse, CameraCoordinateSystem) {
 
 TEST(SceneParse, ReverseOrientationIsPartOfAttributes) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nAttributeBegin\nReverseOrientation\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n");
+      "WorldBegin\nAttributeBegin\nReverseOrientation\nShape \"sphere\"\nAttributeEnd\nShape "
+      "\"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 2u);
   EXPECT_TRUE(p.shapes[0].reverse_orientation);
   EXPECT_FALSE(p.shapes[1].reverse_orientation);
@@ -319,7 +331,8 @@ TEST(SceneParse, ReverseOrientationIsPartOfAttributes) {
 }
 
 TEST(SceneParse, ReverseOrientationAndMirrorCancel) {
-  ParsedScene p = parse_scene_string("WorldBegin\nScale -1 1 1\nReverseOrientation\nShape \"sphere\"\n");
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nScale -1 1 1\nReverseOrientation\nShape \"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   EXPECT_TRUE(p.shapes[0].world_from_object.swaps_handedness());
   LoadedScene ls = flatten_scene(p);
@@ -337,7 +350,8 @@ TEST(SceneParse, AttributeBeginEndRestoresTransformAndMaterial) {
   EXPECT_EQ(p.shapes[1].material.index, -1);
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 2u);
-  EXPECT_TRUE(std::holds_alternative<ConductorDesc>(ls.scene.materials[ls.scene.objects[0].material]));
+  EXPECT_TRUE(
+      std::holds_alternative<ConductorDesc>(ls.scene.materials[ls.scene.objects[0].material]));
   EXPECT_EQ(ls.scene.objects[1].material, 0);  // the default diffuse material
 }
 
@@ -353,7 +367,8 @@ TEST(SceneParse, TransformBeginEndRestoresOnlyTransform) {
 
 TEST(SceneParse, NestedAttributes) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nAttributeBegin\nTranslate 1 0 0\nAttributeBegin\nTranslate 0 1 0\nShape \"sphere\"\n"
+      "WorldBegin\nAttributeBegin\nTranslate 1 0 0\nAttributeBegin\nTranslate 0 1 0\nShape "
+      "\"sphere\"\n"
       "AttributeEnd\nShape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 3u);
   expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 1, 0));
@@ -363,7 +378,8 @@ TEST(SceneParse, NestedAttributes) {
 
 TEST(SceneParse, CameraParameters) {
   ParsedScene p = parse_scene_string(
-      "Camera \"perspective\" \"float fov\" 30 \"float lensradius\" 0.1 \"float focaldistance\" 4\nWorldBegin\n");
+      "Camera \"perspective\" \"float fov\" 30 \"float lensradius\" 0.1 \"float focaldistance\" "
+      "4\nWorldBegin\n");
   ASSERT_TRUE(p.camera.has_value());
   EXPECT_EQ(p.camera->loc.line, 1);
   LoadedScene ls = flatten_scene(p);
@@ -375,7 +391,8 @@ TEST(SceneParse, CameraParameters) {
 
 TEST(SceneParse, Film) {
   ParsedScene p = parse_scene_string(
-      "Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" [32] \"string filename\" \"out.exr\"\n"
+      "Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" [32] \"string filename\" "
+      "\"out.exr\"\n"
       "WorldBegin\n");
   EXPECT_EQ(p.film.name, "rgb");
   LoadedScene ls = flatten_scene(p);
@@ -398,7 +415,8 @@ TEST(SceneParse, PixelFilter) {
   LoadedScene box = flatten_scene(parse_scene_string("PixelFilter \"box\"\nWorldBegin\n"));
   EXPECT_EQ(box.filter.type, FilterType::kBox);
   EXPECT_FLOAT_EQ(box.filter.radius.x, 0.5f);
-  LoadedScene tri = flatten_scene(parse_scene_string("PixelFilter \"triangle\" \"float xradius\" 1\nWorldBegin\n"));
+  LoadedScene tri = flatten_scene(
+      parse_scene_string("PixelFilter \"triangle\" \"float xradius\" 1\nWorldBegin\n"));
   EXPECT_EQ(tri.filter.type, FilterType::kTriangle);
   EXPECT_FLOAT_EQ(tri.filter.radius.x, 1);
   EXPECT_FLOAT_EQ(tri.filter.radius.y, 2);
@@ -431,7 +449,8 @@ TEST(SceneParse, VolpathIntegratorIsRenderedAsPathWithWarning) {
 
 TEST(SceneParse, AcceleratorIsAcceptedAndIgnored) {
   int before = warning_count();
-  ParsedScene p = parse_scene_string("Accelerator \"bvh\" \"integer maxnodeprims\" 4\nWorldBegin\n");
+  ParsedScene p =
+      parse_scene_string("Accelerator \"bvh\" \"integer maxnodeprims\" 4\nWorldBegin\n");
   (void)flatten_scene(p);
   EXPECT_EQ(warning_count(), before);
   EXPECT_EQ(p.film.name, "rgb");
@@ -447,7 +466,8 @@ TEST(SceneParse, ColorSpaceSrgbAccepted) {
 
 TEST(SceneParse, OptionWarns) {
   int before = warning_count();
-  ParsedScene p = parse_scene_string("Option \"bool disablepixeljitter\" true\nWorldBegin\nShape \"sphere\"\n");
+  ParsedScene p =
+      parse_scene_string("Option \"bool disablepixeljitter\" true\nWorldBegin\nShape \"sphere\"\n");
   EXPECT_EQ(warning_count() - before, 1);
   EXPECT_EQ(p.shapes.size(), 1u);
 }
@@ -469,7 +489,8 @@ TEST(SceneParse, AttributeDirectiveWarnsAndIsIgnored) {
 
 TEST(SceneParse, MaterialAppliesToFollowingShapes) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.3]\nShape \"sphere\"\nShape \"disk\"\n"
+      "WorldBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.3]\nShape \"sphere\"\nShape "
+      "\"disk\"\n"
       "Material \"dielectric\" \"float eta\" 1.33\nShape \"sphere\"\n");
   ASSERT_EQ(p.materials.size(), 2u);
   EXPECT_EQ(p.materials[0].name, "diffuse");
@@ -491,7 +512,8 @@ TEST(SceneParse, MaterialAppliesToFollowingShapes) {
 
 TEST(SceneParse, NamedMaterialResolvesAtFlatten) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nMakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" "
+      "WorldBegin\nMakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" "
+      "\"metal-Au-eta\" "
       "\"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.04\n"
       "NamedMaterial \"gold\"\nShape \"sphere\"\nShape \"disk\"\n");
   ASSERT_EQ(p.named_materials.count("gold"), 1u);
@@ -512,9 +534,10 @@ TEST(SceneParse, NamedMaterialResolvesAtFlatten) {
 }
 
 TEST(SceneParse, NamedMaterialMayBeDefinedAfterUse) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nNamedMaterial \"glass\"\nShape \"sphere\"\n"
-      "MakeNamedMaterial \"glass\" \"string type\" \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nNamedMaterial \"glass\"\nShape \"sphere\"\n"
+                                       "MakeNamedMaterial \"glass\" \"string type\" \"dielectric\" "
+                                       "\"spectrum eta\" \"glass-BK7\"\n"));
   ASSERT_EQ(ls.scene.objects.size(), 1u);
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<DielectricMaterial>(m));
@@ -522,11 +545,14 @@ TEST(SceneParse, NamedMaterialMayBeDefinedAfterUse) {
 }
 
 TEST(SceneParse, ConductorDefaultsToCopper) {
-  LoadedScene ls = flatten_scene(parse_scene_string("WorldBegin\nMaterial \"conductor\"\nShape \"sphere\"\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nMaterial \"conductor\"\nShape \"sphere\"\n"));
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m));
-  expect_spectrum_near(std::get<ConductorDesc>(m).eta, *named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
-  expect_spectrum_near(std::get<ConductorDesc>(m).k, *named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
+  expect_spectrum_near(std::get<ConductorDesc>(m).eta,
+                       *named_spectrum("metal-Cu-eta", SpectrumKind::kUnbounded));
+  expect_spectrum_near(std::get<ConductorDesc>(m).k,
+                       *named_spectrum("metal-Cu-k", SpectrumKind::kUnbounded));
 }
 
 TEST(SceneParse, ConstantTextures) {
@@ -538,7 +564,8 @@ TEST(SceneParse, ConstantTextures) {
       "Texture \"old\" \"color\" \"constant\" \"rgb value\" [0.5 0.5 0.5]\n"
       "Material \"diffuse\" \"texture reflectance\" \"tex\"\nShape \"sphere\"\n"
       "Material \"diffuse\" \"texture reflectance\" \"grey\"\nShape \"sphere\"\n"
-      "Material \"conductor\" \"texture roughness\" \"rough\" \"bool remaproughness\" false\nShape \"sphere\"\n");
+      "Material \"conductor\" \"texture roughness\" \"rough\" \"bool remaproughness\" false\nShape "
+      "\"sphere\"\n");
   ASSERT_EQ(p.textures.size(), 4u);
   EXPECT_EQ(p.textures[0].texture_name, "tex");
   EXPECT_EQ(p.textures[0].value_type, "spectrum");
@@ -561,7 +588,8 @@ TEST(SceneParse, ConstantTextures) {
 
 TEST(SceneParse, PointLight) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nTranslate 1 0 0\nLightSource \"point\" \"rgb I\" [1 2 3] \"point3 from\" [1 2 3]\n");
+      "WorldBegin\nTranslate 1 0 0\nLightSource \"point\" \"rgb I\" [1 2 3] \"point3 from\" [1 2 "
+      "3]\n");
   ASSERT_EQ(p.lights.size(), 1u);
   EXPECT_EQ(p.lights[0].name, "point");
   expect_vec_near(origin_of(p.lights[0].world_from_light), Vec3(1, 0, 0));
@@ -574,22 +602,25 @@ TEST(SceneParse, PointLight) {
 }
 
 TEST(SceneParse, DistantAndInfiniteLights) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nLightSource \"distant\" \"point3 from\" [0 10 0] \"point3 to\" [0 0 0] \"rgb L\" [1 1 1]\n"
-      "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3] \"float scale\" 2\n"));
+  LoadedScene ls = flatten_scene(
+      parse_scene_string("WorldBegin\nLightSource \"distant\" \"point3 from\" [0 10 0] \"point3 "
+                         "to\" [0 0 0] \"rgb L\" [1 1 1]\n"
+                         "LightSource \"infinite\" \"rgb L\" [0.1 0.2 0.3] \"float scale\" 2\n"));
   ASSERT_EQ(ls.scene.lights.size(), 2u);
   ASSERT_TRUE(std::holds_alternative<DistantLight>(ls.scene.lights[0]));
   expect_vec_near(std::get<DistantLight>(ls.scene.lights[0]).direction_to_light, Vec3(0, 1, 0));
   ASSERT_TRUE(std::holds_alternative<UniformInfiniteLight>(ls.scene.lights[1]));
-  expect_spectrum_near(std::get<UniformInfiniteLight>(ls.scene.lights[1]).radiance, Rgb(0.2f, 0.4f, 0.6f));
+  expect_spectrum_near(std::get<UniformInfiniteLight>(ls.scene.lights[1]).radiance,
+                       Rgb(0.2f, 0.4f, 0.6f));
   ASSERT_EQ(ls.scene.infinite_lights.size(), 1u);
   EXPECT_EQ(ls.scene.infinite_lights[0], 1);
 }
 
 TEST(SceneParse, SpotLight) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nLightSource \"spot\" \"point3 from\" [0 0 5] \"point3 to\" [0 0 0] \"float coneangle\" 60 "
-      "\"float conedelta\" 10\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nLightSource \"spot\" \"point3 from\" [0 0 5] "
+                                       "\"point3 to\" [0 0 0] \"float coneangle\" 60 "
+                                       "\"float conedelta\" 10\n"));
   ASSERT_EQ(ls.scene.lights.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<SpotLight>(ls.scene.lights[0]));
   const SpotLight& s = std::get<SpotLight>(ls.scene.lights[0]);
@@ -601,8 +632,10 @@ TEST(SceneParse, SpotLight) {
 
 TEST(SceneParse, AreaLightOnMesh) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 3] \"bool twosided\" true\n"
-      "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  1 1 0  0 1 0] \"integer indices\" [0 1 2  0 2 3]\n"
+      "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 3] \"bool twosided\" "
+      "true\n"
+      "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  1 1 0  0 1 0] \"integer indices\" [0 1 2 "
+      " 0 2 3]\n"
       "AttributeEnd\nShape \"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 2u);
   ASSERT_TRUE(p.shapes[0].area_light.has_value());
@@ -625,8 +658,9 @@ TEST(SceneParse, AreaLightOnMesh) {
 }
 
 TEST(SceneParse, AreaLightOnWholeSphere) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4] \"float scale\" 0.5\nShape \"sphere\" \"float radius\" 2\n"));
+  LoadedScene ls = flatten_scene(
+      parse_scene_string("WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4] \"float "
+                         "scale\" 0.5\nShape \"sphere\" \"float radius\" 2\n"));
   ASSERT_EQ(ls.scene.lights.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<AreaLight>(ls.scene.lights[0]));
   const AreaLight& a = std::get<AreaLight>(ls.scene.lights[0]);
@@ -638,11 +672,13 @@ TEST(SceneParse, AreaLightOnWholeSphere) {
 TEST(SceneParse, Shapes) {
   LoadedScene ls = flatten_scene(parse_scene_string(
       "WorldBegin\n"
-      "Shape \"sphere\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 1.5 \"float phimax\" 180\n"
+      "Shape \"sphere\" \"float radius\" 2 \"float zmin\" -1 \"float zmax\" 1.5 \"float phimax\" "
+      "180\n"
       "Shape \"disk\" \"float radius\" 3 \"float innerradius\" 1 \"float height\" 0.5\n"
       "Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0] \"point2 uv\" [0 0 1 0 0 1]\n"
       "Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n"
-      "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 2 \"float zmax\" -1 \"float phimax\" 90\n"
+      "Shape \"cylinder\" \"float radius\" 0.5 \"float zmin\" 2 \"float zmax\" -1 \"float phimax\" "
+      "90\n"
       "ReverseOrientation\nShape \"cylinder\"\n"));
   ASSERT_EQ(ls.scene.objects.size(), 6u);
   const Sphere& s = std::get<Sphere>(ls.scene.objects[0].shape);
@@ -707,7 +743,8 @@ TEST(SceneParse, ObjectInstancesCopyShapesWithInstanceTransform) {
   expect_vec_near(origin_of(p.shapes[3].world_from_object), Vec3(1, 10, 100));
   LoadedScene ls = flatten_scene(p);
   ASSERT_EQ(ls.scene.objects.size(), 4u);
-  expect_vec_near(origin_of(std::get<Sphere>(ls.scene.objects[2].shape).world_from_object), Vec3(1, 10, 100));
+  expect_vec_near(origin_of(std::get<Sphere>(ls.scene.objects[2].shape).world_from_object),
+                  Vec3(1, 10, 100));
 }
 
 TEST(SceneParse, IncludeAndImport) {
@@ -715,7 +752,8 @@ TEST(SceneParse, IncludeAndImport) {
   dir.write("inc.pbrt", "# included\nShape \"sphere\" \"float radius\" 3\n");
   dir.write("imp.pbrt", "Shape \"disk\"\n");
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nTranslate 1 0 0\nInclude \"inc.pbrt\"\nImport \"imp.pbrt\"\nShape \"sphere\"\n", dir.str());
+      "WorldBegin\nTranslate 1 0 0\nInclude \"inc.pbrt\"\nImport \"imp.pbrt\"\nShape \"sphere\"\n",
+      dir.str());
   ASSERT_EQ(p.shapes.size(), 3u);
   EXPECT_EQ(p.shapes[0].name, "sphere");
   EXPECT_TRUE(Contains(p.shapes[0].loc.file, "inc.pbrt"));
@@ -733,7 +771,8 @@ TEST(SceneParse, IncludeAndImport) {
 TEST(SceneParse, IncludedFileMayChangeGraphicsState) {
   TempDir dir;
   dir.write("state.pbrt", "Translate 0 2 0\nMaterial \"conductor\"\n");
-  ParsedScene p = parse_scene_string("WorldBegin\nInclude \"state.pbrt\"\nShape \"sphere\"\n", dir.str());
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nInclude \"state.pbrt\"\nShape \"sphere\"\n", dir.str());
   ASSERT_EQ(p.shapes.size(), 1u);
   expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(0, 2, 0));
   EXPECT_EQ(p.shapes[0].material.index, 0);
@@ -750,7 +789,8 @@ TEST(SceneParse, IncludedFileEndingWithParameterlessDirectives) {
             "Sampler \"halton\"\n");
   dir.write("geometry.pbrt", "# geometry\nShape \"sphere\"\n");
   ParsedScene p = parse_scene_string(
-      "Include \"settings.pbrt\"\nWorldBegin\nInclude \"geometry.pbrt\"\nShape \"disk\"\n", dir.str());
+      "Include \"settings.pbrt\"\nWorldBegin\nInclude \"geometry.pbrt\"\nShape \"disk\"\n",
+      dir.str());
   EXPECT_EQ(p.sampler.name, "halton");
   EXPECT_EQ(p.film.name, "rgb");
   ASSERT_EQ(p.shapes.size(), 2u);
@@ -780,15 +820,17 @@ TEST(SceneParse, ShapesOfAnIncludedFileResolveAgainstTheMainDirectory) {
 TEST(SceneParse, SameFileIncludedTwiceIsNotACycle) {
   TempDir dir;
   dir.write("one.pbrt", "Shape \"sphere\"\n");
-  ParsedScene p = parse_scene_string("WorldBegin\nInclude \"one.pbrt\"\nInclude \"one.pbrt\"\n", dir.str());
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nInclude \"one.pbrt\"\nInclude \"one.pbrt\"\n", dir.str());
   EXPECT_EQ(p.shapes.size(), 2u);
 }
 
 TEST(SceneParse, ParseSceneFileResolvesRelativeToItsDirectory) {
   TempDir dir;
   dir.write("quad.ply", kAsciiQuadPly);
-  fs::path main = dir.write("main.pbrt",
-                            "WorldBegin\nTranslate 0 0 2\nShape \"plymesh\" \"string filename\" \"quad.ply\"\n");
+  fs::path main = dir.write(
+      "main.pbrt",
+      "WorldBegin\nTranslate 0 0 2\nShape \"plymesh\" \"string filename\" \"quad.ply\"\n");
   ParsedScene p = parse_scene_file(main.string());
   EXPECT_TRUE(fs::equivalent(p.base_directory, dir.path()));
   ASSERT_EQ(p.shapes.size(), 1u);
@@ -808,7 +850,8 @@ TEST(SceneParse, MediaAreReadAndAbsorbingOnesAttachToShapes) {
       "MakeNamedMedium \"ink\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.2 0.4]\n"
       "  \"rgb sigma_s\" [0 0 0] \"float scale\" 2\nWorldBegin\n"
       "AttributeBegin\nMediumInterface \"ink\" \"\"\nShape \"sphere\"\nAttributeEnd\n"
-      "MediumInterface \"\" \"ink\"\nShape \"sphere\"\nMediumInterface \"ink\"\nShape \"sphere\"\n");
+      "MediumInterface \"\" \"ink\"\nShape \"sphere\"\nMediumInterface \"ink\"\nShape "
+      "\"sphere\"\n");
   ASSERT_EQ(p.media.size(), 2u);
   EXPECT_EQ(p.media.at("fog").name, "homogeneous");
   ASSERT_EQ(p.shapes.size(), 3u);
@@ -844,7 +887,8 @@ TEST(SceneParse, ActiveTransformEndTimeIsIgnored) {
 }
 
 TEST(SceneParse, TransformTimesAccepted) {
-  ParsedScene p = parse_scene_string("TransformTimes 0 1\nWorldBegin\nTranslate 1 0 0\nShape \"sphere\"\n");
+  ParsedScene p =
+      parse_scene_string("TransformTimes 0 1\nWorldBegin\nTranslate 1 0 0\nShape \"sphere\"\n");
   ASSERT_EQ(p.shapes.size(), 1u);
   expect_vec_near(origin_of(p.shapes[0].world_from_object), Vec3(1, 0, 0));
 }
@@ -943,7 +987,8 @@ TEST(SceneParams, CanonicalTypeNames) {
 }
 
 TEST(SceneParams, GetterMarksUsed) {
-  ParsedScene p = parse_scene_string("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float other\" 1\n");
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float other\" 1\n");
   const ParamSet& ps = p.shapes[0].params;
   EXPECT_FALSE(ps.find_any("radius")->used);
   EXPECT_FLOAT_EQ(ps.get_float("radius", 1), 2);
@@ -952,8 +997,9 @@ TEST(SceneParams, GetterMarksUsed) {
 }
 
 TEST(SceneParams, RgbReflectance) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMaterial \"diffuse\" \"color reflectance\" [0.25 0.5 0.75]\nShape \"sphere\"\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nMaterial \"diffuse\" \"color reflectance\" "
+                                       "[0.25 0.5 0.75]\nShape \"sphere\"\n"));
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m));
   expect_spectrum_near(std::get<DiffuseDesc>(m).reflectance, Rgb(0.25f, 0.5f, 0.75f));
@@ -961,8 +1007,9 @@ TEST(SceneParams, RgbReflectance) {
 
 TEST(SceneParams, InlineSpectrumReflectance) {
   // Constant over the whole visible range: a grey reflectance of that value.
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" [360 0.5 830 0.5]\nShape \"sphere\"\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" "
+                                       "[360 0.5 830 0.5]\nShape \"sphere\"\n"));
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m));
   expect_spectrum_near(std::get<DiffuseDesc>(m).reflectance, Rgb(0.5f), 1e-4f);
@@ -972,16 +1019,18 @@ TEST(SceneParams, SpectrumFile) {
   TempDir dir;
   dir.write("grey.spd", "# wavelength value\n360 0.25\n600 0.25 # middle\n830 0.25\n");
   LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"grey.spd\"\nShape \"sphere\"\n", dir.str()));
+      "WorldBegin\nMaterial \"diffuse\" \"spectrum reflectance\" \"grey.spd\"\nShape \"sphere\"\n",
+      dir.str()));
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<DiffuseDesc>(m));
   expect_spectrum_near(std::get<DiffuseDesc>(m).reflectance, Rgb(0.25f), 1e-4f);
 }
 
 TEST(SceneParams, NamedSpectrumEta) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMaterial \"conductor\" \"spectrum eta\" \"metal-Ag-eta\" \"spectrum k\" \"metal-Ag-k\"\n"
-      "Shape \"sphere\"\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nMaterial \"conductor\" \"spectrum eta\" "
+                                       "\"metal-Ag-eta\" \"spectrum k\" \"metal-Ag-k\"\n"
+                                       "Shape \"sphere\"\n"));
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
   ASSERT_TRUE(std::holds_alternative<ConductorDesc>(m));
   // Through the measured values at 650, 550 and 450 nm.
@@ -995,9 +1044,10 @@ TEST(SceneParams, NamedSpectrumEta) {
 }
 
 TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nLightSource \"point\" \"blackbody I\" 6500\nLightSource \"point\" \"blackbody I\" 3000 "
-      "\"float scale\" 2\n"));
+  LoadedScene ls =
+      flatten_scene(parse_scene_string("WorldBegin\nLightSource \"point\" \"blackbody I\" "
+                                       "6500\nLightSource \"point\" \"blackbody I\" 3000 "
+                                       "\"float scale\" 2\n"));
   ASSERT_EQ(ls.scene.lights.size(), 2u);
   const PointLight& a = std::get<PointLight>(ls.scene.lights[0]);
   SpectrumCurve bb = SpectrumCurve::blackbody(6500);
@@ -1012,7 +1062,8 @@ TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
 // Parse errors
 
 TEST(SceneParseError, UnknownDirective) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n  Bogus 1 2\n"), at(2, 3), "unknown directive 'Bogus'"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\n  Bogus 1 2\n"), at(2, 3), "unknown directive 'Bogus'"));
 }
 
 TEST(SceneParseError, StringWhereDirectiveExpected) {
@@ -1020,11 +1071,13 @@ TEST(SceneParseError, StringWhereDirectiveExpected) {
 }
 
 TEST(SceneParseError, UnterminatedStringAtEndOfFile) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sphere"), at(2, 7), "unterminated string at end of file"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sphere"), at(2, 7),
+                      "unterminated string at end of file"));
 }
 
 TEST(SceneParseError, UnterminatedStringAtNewline) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"sph\nere\"\n"), at(2, 7), "unterminated string"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nShape \"sph\nere\"\n"), at(2, 7), "unterminated string"));
 }
 
 TEST(SceneParseError, ParameterValueMissingAtEndOfFile) {
@@ -1123,16 +1176,19 @@ TEST(SceneParseError, DuplicateParameter) {
 }
 
 TEST(SceneParseError, DirectiveNumberMissing) {
-  EXPECT_TRUE(IsError(error_of("Translate 1 2\nWorldBegin\n"), at(2, 1), "expected a number; got 'WorldBegin'"));
+  EXPECT_TRUE(IsError(error_of("Translate 1 2\nWorldBegin\n"), at(2, 1),
+                      "expected a number; got 'WorldBegin'"));
 }
 
 TEST(SceneParseError, DirectiveNumbersAtEndOfFile) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTranslate 1"), at(2, 1), "unexpected end of file: expected a number"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTranslate 1"), at(2, 1),
+                      "unexpected end of file: expected a number"));
 }
 
 TEST(SceneParseError, BracketedDirectiveWithTooManyNumbers) {
   const std::string l2 = "Translate [1 2 3 4]";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "4")), "Translate takes 3 numbers"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "4")),
+                      "Translate takes 3 numbers"));
 }
 
 TEST(SceneParseError, AttributeEndWithoutBegin) {
@@ -1141,12 +1197,14 @@ TEST(SceneParseError, AttributeEndWithoutBegin) {
 }
 
 TEST(SceneParseError, TransformEndWithoutBegin) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTransformEnd\n"), at(2, 1), "TransformEnd without a matching begin"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTransformEnd\n"), at(2, 1),
+                      "TransformEnd without a matching begin"));
 }
 
 TEST(SceneParseError, AttributeBeginWithoutEndReportedAtEnd) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nAttributeBegin\nAttributeBegin\nAttributeEnd\nShape \"sphere\"\n"),
-                      at(2, 1), "AttributeBegin without a matching AttributeEnd"));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\nAttributeBegin\nAttributeBegin\nAttributeEnd\nShape \"sphere\"\n"),
+      at(2, 1), "AttributeBegin without a matching AttributeEnd"));
 }
 
 TEST(SceneParseError, CameraAfterWorldBegin) {
@@ -1155,7 +1213,8 @@ TEST(SceneParseError, CameraAfterWorldBegin) {
 }
 
 TEST(SceneParseError, WorldBeginTwice) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nWorldBegin\n"), at(2, 1), "WorldBegin is not allowed after WorldBegin"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nWorldBegin\n"), at(2, 1),
+                      "WorldBegin is not allowed after WorldBegin"));
 }
 
 TEST(SceneParseError, ShapeBeforeWorldBegin) {
@@ -1170,7 +1229,8 @@ TEST(SceneParseError, MaterialBeforeWorldBegin) {
 
 TEST(SceneParseError, NoWorldBegin) {
   // Reported at the last token read.
-  EXPECT_TRUE(IsError(error_of("Camera \"perspective\"\nFilm \"rgb\"\n"), at(2, 6), "the scene has no WorldBegin"));
+  EXPECT_TRUE(IsError(error_of("Camera \"perspective\"\nFilm \"rgb\"\n"), at(2, 6),
+                      "the scene has no WorldBegin"));
 }
 
 TEST(SceneParseError, UnknownCoordinateSystem) {
@@ -1179,16 +1239,19 @@ TEST(SceneParseError, UnknownCoordinateSystem) {
 }
 
 TEST(SceneParseError, UnknownObjectInstance) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectInstance \"thing\"\n"), at(2, 1), "unknown object \"thing\""));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectInstance \"thing\"\n"), at(2, 1),
+                      "unknown object \"thing\""));
 }
 
 TEST(SceneParseError, ObjectEndWithoutObjectBegin) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectEnd\n"), at(2, 1), "ObjectEnd without ObjectBegin"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nObjectEnd\n"), at(2, 1), "ObjectEnd without ObjectBegin"));
 }
 
 TEST(SceneParseError, ObjectDefinedTwice) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectEnd\nObjectBegin \"a\"\nObjectEnd\n"), at(4, 1),
-                      "object \"a\" defined twice"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectEnd\nObjectBegin \"a\"\nObjectEnd\n"),
+              at(4, 1), "object \"a\" defined twice"));
 }
 
 TEST(SceneParseError, NestedObjectBegin) {
@@ -1197,12 +1260,13 @@ TEST(SceneParseError, NestedObjectBegin) {
 }
 
 TEST(SceneParseError, ObjectInstanceInsideObject) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectInstance \"a\"\nObjectEnd\n"), at(3, 1),
-                      "ObjectInstance inside ObjectBegin"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nObjectInstance \"a\"\nObjectEnd\n"),
+                      at(3, 1), "ObjectInstance inside ObjectBegin"));
 }
 
 TEST(SceneParseError, ObjectBeginWithoutEnd) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nObjectBegin \"a\"\nShape \"sphere\"\n"), at(2, 1), "without"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nObjectBegin \"a\"\nShape \"sphere\"\n"), at(2, 1), "without"));
 }
 
 TEST(SceneParseError, IncludeMissingFile) {
@@ -1241,21 +1305,23 @@ TEST(SceneParseError, MissingSceneFile) {
 }
 
 TEST(SceneParseError, SingularTransform) {
-  EXPECT_TRUE(IsError(error_of("Transform [1 0 0 0  0 1 0 0  0 0 0 0  0 0 0 1]\nWorldBegin\n"), at(1, 1),
-                      "Transform matrix is singular"));
+  EXPECT_TRUE(IsError(error_of("Transform [1 0 0 0  0 1 0 0  0 0 0 0  0 0 0 1]\nWorldBegin\n"),
+                      at(1, 1), "Transform matrix is singular"));
 }
 
 TEST(SceneParseError, SingularConcatTransform) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nConcatTransform [0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0]\n"), at(2, 1),
-                      "ConcatTransform matrix is singular"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nConcatTransform [0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0]\n"),
+                      at(2, 1), "ConcatTransform matrix is singular"));
 }
 
 TEST(SceneParseError, ScaleByZero) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 0 1\n"), at(2, 1), "Scale by zero makes the transform singular"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 0 1\n"), at(2, 1),
+                      "Scale by zero makes the transform singular"));
 }
 
 TEST(SceneParseError, RotateAboutZeroAxis) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nRotate 30 0 0 0\n"), at(2, 1), "Rotate about a zero axis"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nRotate 30 0 0 0\n"), at(2, 1), "Rotate about a zero axis"));
 }
 
 TEST(SceneParseError, LookAtCoincidentEyeAndTarget) {
@@ -1280,8 +1346,9 @@ TEST(SceneParseError, TextureBadValueType) {
 }
 
 TEST(SceneParseError, MakeNamedMaterialWithoutType) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nMakeNamedMaterial \"m\" \"rgb reflectance\" [0.5 0.5 0.5]\n"), at(2, 1),
-                      "MakeNamedMaterial \"m\" has no \"string type\""));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nMakeNamedMaterial \"m\" \"rgb reflectance\" [0.5 0.5 0.5]\n"),
+              at(2, 1), "MakeNamedMaterial \"m\" has no \"string type\""));
 }
 
 TEST(SceneParseError, NamedMaterialDefinedTwice) {
@@ -1291,28 +1358,36 @@ TEST(SceneParseError, NamedMaterialDefinedTwice) {
 }
 
 TEST(SceneParseError, MediaThatScatterOrAreUnknownAreErrors) {
-  auto scene = [](const std::string& medium_params, const std::string& interface = "MediumInterface \"m\" \"\"") {
-    return "MakeNamedMedium \"m\" " + medium_params + "\nWorldBegin\n" + interface + "\nShape \"sphere\"\n";
+  auto scene = [](const std::string& medium_params,
+                  const std::string& interface = "MediumInterface \"m\" \"\"") {
+    return "MakeNamedMedium \"m\" " + medium_params + "\nWorldBegin\n" + interface +
+           "\nShape \"sphere\"\n";
   };
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\"", "MediumInterface \"nope\" \"\"")), at(3, 1),
-                      "unknown medium \"nope\""));
+  EXPECT_TRUE(
+      IsError(error_of(scene("\"string type\" \"homogeneous\"", "MediumInterface \"nope\" \"\"")),
+              at(3, 1), "unknown medium \"nope\""));
   // pbrt-v4's default sigma_s scatters; so does a stated one.
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\"")), at(3, 1),
-                      "participating media are not supported (medium \"m\" defined at <string>:1:1: it scatters"));
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0.1 0]")), at(3, 1),
-                      "it scatters (sigma_s > 0)"));
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"rgb sigma_s\" [0 0 0]")), at(3, 1),
-                      "type \"uniformgrid\""));
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] \"rgb Le\" [1 1 1]")),
-                      at(3, 1), "it emits (Le)"));
+  EXPECT_TRUE(IsError(
+      error_of(scene("\"string type\" \"homogeneous\"")), at(3, 1),
+      "participating media are not supported (medium \"m\" defined at <string>:1:1: it scatters"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0.1 0]")),
+                      at(3, 1), "it scatters (sigma_s > 0)"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"rgb sigma_s\" [0 0 0]")),
+                      at(3, 1), "type \"uniformgrid\""));
+  EXPECT_TRUE(IsError(
+      error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] \"rgb Le\" [1 1 1]")),
+      at(3, 1), "it emits (Le)"));
   EXPECT_TRUE(IsError(error_of("MakeNamedMedium \"m\" \"float scale\" 1\nWorldBegin\n"), at(1, 1),
                       "medium \"m\" has no \"string type\""));
   // The camera or a light inside a medium.
-  const std::string absorbing = "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0]\n";
-  EXPECT_TRUE(IsError(error_of(absorbing + "MediumInterface \"\" \"m\"\nCamera \"perspective\"\nWorldBegin\n"), at(2, 1),
-                      "a camera inside a medium (\"m\") is not supported"));
-  EXPECT_TRUE(IsError(error_of(absorbing + "WorldBegin\nMediumInterface \"m\"\nLightSource \"point\"\n"), at(4, 1),
-                      "light \"point\" inside a medium (\"m\") is not supported"));
+  const std::string absorbing =
+      "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0]\n";
+  EXPECT_TRUE(IsError(
+      error_of(absorbing + "MediumInterface \"\" \"m\"\nCamera \"perspective\"\nWorldBegin\n"),
+      at(2, 1), "a camera inside a medium (\"m\") is not supported"));
+  EXPECT_TRUE(
+      IsError(error_of(absorbing + "WorldBegin\nMediumInterface \"m\"\nLightSource \"point\"\n"),
+              at(4, 1), "light \"point\" inside a medium (\"m\") is not supported"));
 }
 
 TEST(SceneParseError, ColorSpaceOtherThanSrgb) {
@@ -1322,7 +1397,8 @@ TEST(SceneParseError, ColorSpaceOtherThanSrgb) {
 
 TEST(SceneParseError, NanInDirective) {
   // std::from_chars reads "nan" as a number, so the error is the non-finite check.
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTranslate nan 0 0\n"), at(2, 1), "Translate has a non-finite value"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTranslate nan 0 0\n"), at(2, 1),
+                      "Translate has a non-finite value"));
 }
 
 TEST(SceneParseError, MalformedNumber) {
@@ -1341,52 +1417,60 @@ TEST(SceneFlattenError, UnknownNamedMaterial) {
 }
 
 TEST(SceneFlattenError, TriangleMeshWithoutP) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"trianglemesh\" \"integer indices\" [0 1 2]\n"), at(2, 1),
-                      "trianglemesh has no \"point3 P\""));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"trianglemesh\" \"integer indices\" [0 1 2]\n"),
+                      at(2, 1), "trianglemesh has no \"point3 P\""));
 }
 
 TEST(SceneFlattenError, TriangleMeshWithoutIndices) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"), at(2, 1),
-                      "trianglemesh has no \"integer indices\""));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"),
+      at(2, 1), "trianglemesh has no \"integer indices\""));
 }
 
 TEST(SceneFlattenError, IndicesNotMultipleOfThree) {
-  const std::string l2 = R"(Shape "trianglemesh" "integer indices" [0 1 2 3] "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0])";
+  const std::string l2 =
+      R"(Shape "trianglemesh" "integer indices" [0 1 2 3] "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
                       "\"indices\" has 4 values, not a multiple of 3"));
 }
 
 TEST(SceneFlattenError, IndexOutOfRange) {
-  const std::string l2 = std::string(R"(Shape "trianglemesh" "integer indices" [0 1 5] )") + kTriangleP;
+  const std::string l2 =
+      std::string(R"(Shape "trianglemesh" "integer indices" [0 1 5] )") + kTriangleP;
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
                       "vertex index 5 out of range (3 vertices)"));
 }
 
 TEST(SceneFlattenError, NegativeIndex) {
-  const std::string l2 = std::string(R"(Shape "trianglemesh" "integer indices" [0 -1 2] )") + kTriangleP;
+  const std::string l2 =
+      std::string(R"(Shape "trianglemesh" "integer indices" [0 -1 2] )") + kTriangleP;
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"integer")),
                       "vertex index -1 out of range"));
 }
 
 TEST(SceneFlattenError, NormalCountMismatch) {
-  const std::string l2 = std::string(R"(Shape "trianglemesh" )") + kTriangleP + R"( "normal N" [0 0 1 0 0 1])";
+  const std::string l2 =
+      std::string(R"(Shape "trianglemesh" )") + kTriangleP + R"( "normal N" [0 0 1 0 0 1])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"normal N")),
                       "\"N\" has 2 normals for 3 vertices"));
 }
 
 TEST(SceneFlattenError, UvCountMismatch) {
-  const std::string l2 = std::string(R"(Shape "trianglemesh" )") + kTriangleP + R"( "point2 uv" [0 0 1 0])";
+  const std::string l2 =
+      std::string(R"(Shape "trianglemesh" )") + kTriangleP + R"( "point2 uv" [0 0 1 0])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"point2")),
                       "\"uv\" count differs from the vertex count"));
 }
 
 TEST(SceneFlattenError, NonPlanarBilinearPatch) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 1]\n"),
-                      at(2, 1), "non-planar bilinear patches are not supported"));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 1]\n"),
+      at(2, 1), "non-planar bilinear patches are not supported"));
 }
 
 TEST(SceneFlattenError, PlymeshWithoutFilename) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"plymesh\"\n"), at(2, 1), "plymesh has no \"string filename\""));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"plymesh\"\n"), at(2, 1),
+                      "plymesh has no \"string filename\""));
 }
 
 TEST(SceneFlattenError, PlymeshMissingFile) {
@@ -1413,12 +1497,14 @@ TEST(SceneFlattenError, PlymeshTruncatedBinary) {
 TEST(SceneFlattenError, PlymeshAsciiIndexOutOfRange) {
   TempDir dir;
   dir.write("bad.ply",
-            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+            "float z\n"
             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
             "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
   const std::string l2 = R"(Shape "plymesh" "string filename" "bad.ply")";
   std::string msg = error_of("WorldBegin\n" + l2 + "\n", dir.str());
-  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"string")), "vertex index 7 out of range (the file has 3 vertices)"));
+  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"string")),
+                      "vertex index 7 out of range (the file has 3 vertices)"));
   EXPECT_TRUE(Contains(msg, "bad.ply\""));
 }
 
@@ -1428,24 +1514,28 @@ TEST(SceneFlattenError, SphereNegativeRadius) {
 }
 
 TEST(SceneFlattenError, DiskInnerRadiusNotBelowRadius) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"disk\" \"float radius\" 1 \"float innerradius\" 2\n"), at(2, 1),
-                      "disk needs 0 <= innerradius < radius"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nShape \"disk\" \"float radius\" 1 \"float innerradius\" 2\n"),
+              at(2, 1), "disk needs 0 <= innerradius < radius"));
 }
 
 TEST(SceneFlattenError, CylinderErrors) {
   EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"cylinder\" \"float radius\" 0\n"), at(2, 1),
                       "cylinder radius must be positive"));
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"cylinder\" \"float zmin\" 1 \"float zmax\" 1\n"), at(2, 1),
-                      "cylinder needs zmin != zmax"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nShape \"cylinder\" \"float zmin\" 1 \"float zmax\" 1\n"),
+              at(2, 1), "cylinder needs zmin != zmax"));
   EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"cylinder\" \"float phimax\" 0\n"), at(2, 1),
                       "cylinder phimax must be positive"));
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 1 3\nAreaLightSource \"diffuse\"\nShape \"cylinder\"\n"),
-                      at(3, 1), "emitting cylinders must not be non-uniformly scaled"));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\nScale 1 1 3\nAreaLightSource \"diffuse\"\nShape \"cylinder\"\n"),
+      at(3, 1), "emitting cylinders must not be non-uniformly scaled"));
 }
 
 TEST(SceneFlattenError, UnsupportedShape) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n"), at(2, 1),
-                      "shape \"curve\" is not supported"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n"),
+              at(2, 1), "shape \"curve\" is not supported"));
 }
 
 TEST(SceneParse, AlphaConstantOrTexture) {
@@ -1461,7 +1551,8 @@ TEST(SceneParse, AlphaConstantOrTexture) {
   EXPECT_FLOAT_EQ(ls.scene.objects[0].alpha.value, 0.25f);
   EXPECT_TRUE(ls.scene.objects[0].has_alpha());
   ASSERT_TRUE(ls.scene.objects[1].alpha.textured());
-  EXPECT_TRUE(std::holds_alternative<CheckerboardTexture>(ls.scene.textures.node(ls.scene.objects[1].alpha.texture)));
+  EXPECT_TRUE(std::holds_alternative<CheckerboardTexture>(
+      ls.scene.textures.node(ls.scene.objects[1].alpha.texture)));
   EXPECT_FLOAT_EQ(ls.scene.objects[2].alpha.value, 0.5f);  // a constant texture is a constant
   EXPECT_FALSE(ls.scene.objects[2].alpha.textured());
   EXPECT_FALSE(ls.scene.objects[3].has_alpha());
@@ -1469,12 +1560,17 @@ TEST(SceneParse, AlphaConstantOrTexture) {
 
 TEST(SceneFlattenError, AlphaErrors) {
   const std::string l2 = R"(Shape "sphere" "float alpha" 1.5)";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")), "alpha must be in [0, 1]"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, col(l2, "\"float")),
+                      "alpha must be in [0, 1]"));
   const std::string l3 = R"(Shape "sphere" "float alpha" 0.5)";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"diffuse\"\n" + l3 + "\n"), at(3, col(l3, "\"float")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"diffuse\"\n" + l3 + "\n"),
+                      at(3, col(l3, "\"float")),
                       "alpha on an emitting shape is not supported (the area light at"));
   const std::string l4 = R"(Shape "sphere" "texture alpha" "colour")";
-  EXPECT_FALSE(error_of("WorldBegin\nTexture \"colour\" \"spectrum\" \"constant\" \"rgb value\" [1 1 1]\n" + l4 + "\n").empty());
+  EXPECT_FALSE(
+      error_of("WorldBegin\nTexture \"colour\" \"spectrum\" \"constant\" \"rgb value\" [1 1 1]\n" +
+               l4 + "\n")
+          .empty());
 }
 
 TEST(SceneFlattenError, UnsupportedMaterial) {
@@ -1483,18 +1579,21 @@ TEST(SceneFlattenError, UnsupportedMaterial) {
 }
 
 TEST(SceneFlattenError, UnsupportedLight) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"laser\"\n"), at(2, 1), "light \"laser\" is not supported"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"laser\"\n"), at(2, 1),
+                      "light \"laser\" is not supported"));
 }
 
 TEST(SceneFlattenError, NegativeReflectance) {
   const std::string l2 = R"(Material "diffuse" "rgb reflectance" [-0.1 0.5 0.5])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"rgb")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
+                      at(2, col(l2, "\"rgb")),
                       "parameter \"reflectance\" has a negative or non-finite value"));
 }
 
 TEST(SceneFlattenError, ReflectanceAboveOne) {
   const std::string l2 = R"(Material "diffuse" "rgb reflectance" [1.5 0.5 0.5])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"rgb")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
+                      at(2, col(l2, "\"rgb")),
                       "parameter \"reflectance\" is a reflectance and must not exceed 1"));
 }
 
@@ -1503,7 +1602,8 @@ TEST(SceneFlattenError, NanParameter) {
   const std::string l2 = R"(Shape "sphere" "float radius" nan)";
   std::string msg = error_of("WorldBegin\n" + l2 + "\n");
   EXPECT_FALSE(msg.empty());
-  EXPECT_TRUE(IsError(msg, at(2, col(l2, "\"float")), "parameter \"radius\" has a non-finite value"));
+  EXPECT_TRUE(
+      IsError(msg, at(2, col(l2, "\"float")), "parameter \"radius\" has a non-finite value"));
 }
 
 // A PFM image of one colour (PFM: header, then little-endian floats, rows from the bottom).
@@ -1545,7 +1645,8 @@ TEST(SceneFlattenError, InfiniteLightImageErrors) {
   dir.write("odd.pfm", constant_pfm(12, 8, Rgb(1.0f)));
   const std::string odd = R"(LightSource "infinite" "string filename" "odd.pfm")";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + odd + "\n", dir.str()), at(2, col(odd, "\"string")),
-                      "environment image \"odd.pfm\" is 12x8: it must be square (equal-area) or twice as wide as high"));
+                      "environment image \"odd.pfm\" is 12x8: it must be square (equal-area) or "
+                      "twice as wide as high"));
   const std::string both = R"(LightSource "infinite" "string filename" "sky.pfm" "rgb L" [1 1 1])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + both + "\n", dir.str()), at(2, col(both, "\"rgb")),
                       "an infinite light takes \"L\" or \"filename\", not both"));
@@ -1553,11 +1654,15 @@ TEST(SceneFlattenError, InfiniteLightImageErrors) {
   std::string msg = error_of("WorldBegin\n" + missing + "\n", dir.str());
   EXPECT_TRUE(IsError(msg, at(2, col(missing, "\"string")), ""));
   EXPECT_TRUE(Contains(msg, "none.exr"));
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 2 1\nLightSource \"infinite\" \"string filename\" \"sky.pfm\"\n", dir.str()),
-                      at(3, 1), "the transform of an environment light must be a rotation"));
-  const std::string portal = R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 1 0 0 1 0])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + portal + "\n", dir.str()), at(2, col(portal, "\"point3")),
-                      "light portals are not supported"));
+  EXPECT_TRUE(IsError(
+      error_of(
+          "WorldBegin\nScale 1 2 1\nLightSource \"infinite\" \"string filename\" \"sky.pfm\"\n",
+          dir.str()),
+      at(3, 1), "the transform of an environment light must be a rotation"));
+  const std::string portal =
+      R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 1 0 0 1 0])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + portal + "\n", dir.str()),
+                      at(2, col(portal, "\"point3")), "light portals are not supported"));
 }
 
 TEST(SceneParse, GoniometricAndProjectionLights) {
@@ -1567,7 +1672,8 @@ TEST(SceneParse, GoniometricAndProjectionLights) {
   LoadedScene ls = flatten_scene(parse_scene_string(
       "WorldBegin\nTranslate 1 2 3\n"
       "LightSource \"goniometric\" \"string filename\" \"gonio.pfm\" \"float power\" 10\n"
-      "LightSource \"projection\" \"string filename\" \"slide.pfm\" \"float fov\" 40 \"float scale\" 3\n"
+      "LightSource \"projection\" \"string filename\" \"slide.pfm\" \"float fov\" 40 \"float "
+      "scale\" 3\n"
       "LightSource \"projection\" \"string filename\" \"slide.pfm\" \"float power\" 7\n",
       dir.str()));
   ASSERT_EQ(ls.scene.lights.size(), 3u);
@@ -1590,13 +1696,16 @@ TEST(SceneFlattenError, GoniometricAndProjectionErrors) {
   TempDir dir;
   dir.write("wide.pfm", constant_pfm(8, 4, Rgb(1.0f)));
   const std::string wide = R"(LightSource "goniometric" "string filename" "wide.pfm")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + wide + "\n", dir.str()), at(2, col(wide, "\"string")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + wide + "\n", dir.str()),
+                      at(2, col(wide, "\"string")),
                       "goniometric image \"wide.pfm\" is 8x4: it must be square"));
   EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"goniometric\"\n", dir.str()), at(2, 1),
                       "goniometric light needs \"string filename\""));
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"projection\" \"float fov\" 30\n", dir.str()), at(2, 1),
-                      "projection light needs \"string filename\""));
-  const std::string fov = R"(LightSource "projection" "string filename" "wide.pfm" "float fov" 180)";
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nLightSource \"projection\" \"float fov\" 30\n", dir.str()),
+              at(2, 1), "projection light needs \"string filename\""));
+  const std::string fov =
+      R"(LightSource "projection" "string filename" "wide.pfm" "float fov" 180)";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + fov + "\n", dir.str()), at(2, col(fov, "\"float")),
                       "projection fov must be in (0, 180) degrees"));
 }
@@ -1608,15 +1717,17 @@ TEST(SceneFlattenError, AreaLightOnPartialSphere) {
 }
 
 TEST(SceneFlattenError, AreaLightOnNonUniformlyScaledDisk) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nScale 1 2 1\nAreaLightSource \"diffuse\"\nShape \"disk\"\n"),
-                      at(3, 1), "not non-uniformly scaled"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nScale 1 2 1\nAreaLightSource \"diffuse\"\nShape \"disk\"\n"),
+              at(3, 1), "not non-uniformly scaled"));
 }
 
 TEST(SceneParse, ImageAreaLight) {
   TempDir dir;
   dir.write("glow.pfm", constant_pfm(4, 2, Rgb(0.5f, 1.0f, 2.0f)));
   LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" \"float scale\" 3\n"
+      "WorldBegin\nAttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" "
+      "\"float scale\" 3\n"
       "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\nAttributeEnd\n"
       "AreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" \"float power\" 5\n"
       "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n",
@@ -1629,14 +1740,16 @@ TEST(SceneParse, ImageAreaLight) {
   // "power": pi A times the image's mean luminance times the scale.
   const auto& b = std::get<AreaLight>(ls.scene.lights[1]);
   EXPECT_NEAR(b.image_scale * b.image_mean.luminance() * kPi * 0.5f, 5.0f, 1e-3f);
-  const std::string both = R"(AreaLightSource "diffuse" "string filename" "glow.pfm" "rgb L" [1 1 1])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + both + "\nShape \"sphere\"\n", dir.str()), at(2, col(both, "\"rgb")),
+  const std::string both =
+      R"(AreaLightSource "diffuse" "string filename" "glow.pfm" "rgb L" [1 1 1])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + both + "\nShape \"sphere\"\n", dir.str()),
+                      at(2, col(both, "\"rgb")),
                       "an area light takes \"L\" or \"filename\", not both"));
 }
 
 TEST(SceneFlattenError, UnsupportedAreaLight) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"projection\"\nShape \"sphere\"\n"), at(2, 1),
-                      "area light \"projection\" is not supported"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"projection\"\nShape \"sphere\"\n"),
+                      at(2, 1), "area light \"projection\" is not supported"));
 }
 
 TEST(SceneFlattenError, UnknownCameraType) {
@@ -1655,7 +1768,8 @@ TEST(SceneFlattenError, FilmResolutionZero) {
 }
 
 TEST(SceneFlattenError, UnsupportedFilm) {
-  EXPECT_TRUE(IsError(error_of("Film \"gbuffer\"\nWorldBegin\n"), at(1, 1), "film \"gbuffer\" is not supported"));
+  EXPECT_TRUE(IsError(error_of("Film \"gbuffer\"\nWorldBegin\n"), at(1, 1),
+                      "film \"gbuffer\" is not supported"));
 }
 
 TEST(SceneFlattenError, UnknownPixelFilter) {
@@ -1687,7 +1801,8 @@ TEST(SceneFlattenError, ParameterTakesOneValue) {
 
 TEST(SceneParams, CoatedDiffuse) {
   LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMaterial \"coateddiffuse\" \"rgb reflectance\" [0.2 0.4 0.6] \"float roughness\" 0.04 "
+      "WorldBegin\nMaterial \"coateddiffuse\" \"rgb reflectance\" [0.2 0.4 0.6] \"float "
+      "roughness\" 0.04 "
       "\"float thickness\" 0.05 \"float eta\" 1.33 \"integer maxdepth\" 5 \"integer nsamples\" 2\n"
       "Shape \"sphere\"\nMaterial \"coateddiffuse\"\nShape \"sphere\"\n"));
   const MaterialDesc& m = ls.scene.materials[ls.scene.objects[0].material];
@@ -1700,7 +1815,8 @@ TEST(SceneParams, CoatedDiffuse) {
   EXPECT_EQ(c.layer.max_depth, 5);
   EXPECT_EQ(c.layer.samples, 2);
   // pbrt-v4's defaults.
-  const CoatedDiffuseDesc& d = std::get<CoatedDiffuseDesc>(ls.scene.materials[ls.scene.objects[1].material]);
+  const CoatedDiffuseDesc& d =
+      std::get<CoatedDiffuseDesc>(ls.scene.materials[ls.scene.objects[1].material]);
   expect_spectrum_near(d.reflectance, Rgb(0.5f));
   EXPECT_FLOAT_EQ(d.layer.thickness, 0.01f);
   EXPECT_FLOAT_EQ(d.layer.eta, 1.5f);
@@ -1711,7 +1827,8 @@ TEST(SceneParams, CoatedDiffuse) {
 
 TEST(SceneParams, CoatedConductor) {
   LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMaterial \"coatedconductor\" \"float interface.roughness\" 0.09 \"float interface.eta\" 1.4 "
+      "WorldBegin\nMaterial \"coatedconductor\" \"float interface.roughness\" 0.09 \"float "
+      "interface.eta\" 1.4 "
       "\"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\" "
       "\"float conductor.roughness\" 0.16 \"float thickness\" 0.02\nShape \"sphere\"\n"
       "Material \"coatedconductor\" \"rgb reflectance\" [0.9 0.5 0.2]\nShape \"sphere\"\n"));
@@ -1730,19 +1847,21 @@ TEST(SceneParams, CoatedConductor) {
 
 TEST(SceneFlattenError, CoatedDiffuseBadValues) {
   const std::string l1 = R"(Material "coateddiffuse" "float thickness" -1)";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\nShape \"sphere\"\n"), at(2, col(l1, "\"float thickness")),
-                      "thickness must be positive"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\nShape \"sphere\"\n"),
+                      at(2, col(l1, "\"float thickness")), "thickness must be positive"));
   const std::string l2 = R"(Material "coateddiffuse" "rgb albedo" [0.5 0.5 0.5])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"rgb albedo")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
+                      at(2, col(l2, "\"rgb albedo")),
                       "coateddiffuse with a scattering layer (albedo > 0) is not supported"));
   const std::string l3 = R"(Material "coateddiffuse" "integer maxdepth" 0)";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l3 + "\nShape \"sphere\"\n"), at(2, col(l3, "\"integer maxdepth")),
-                      "maxdepth must be in [1, 1000]"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l3 + "\nShape \"sphere\"\n"),
+                      at(2, col(l3, "\"integer maxdepth")), "maxdepth must be in [1, 1000]"));
 }
 
 TEST(SceneParams, LoopSubdivisionMesh) {
   LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nShape \"loopsubdiv\" \"integer levels\" 2 \"point3 P\" [1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1] "
+      "WorldBegin\nShape \"loopsubdiv\" \"integer levels\" 2 \"point3 P\" [1 0 0 -1 0 0 0 1 0 0 -1 "
+      "0 0 0 1 0 0 -1] "
       "\"integer indices\" [0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5]\n"));
   ASSERT_EQ(ls.scene.objects.size(), 1u);
   const auto& m = std::get<TriangleMesh>(ls.scene.objects[0].shape);
@@ -1752,14 +1871,16 @@ TEST(SceneParams, LoopSubdivisionMesh) {
 }
 
 TEST(SceneFlattenError, LoopSubdivisionBadInput) {
-  const std::string l1 = R"(Shape "loopsubdiv" "integer levels" -1 "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 2])";
+  const std::string l1 =
+      R"(Shape "loopsubdiv" "integer levels" -1 "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 2])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\n"), at(2, col(l1, "\"integer levels")),
                       "loopsubdiv levels must be in [0, 8]"));
   const std::string l2 =
       R"(Shape "loopsubdiv" "point3 P" [0 0 0 1 0 0 0 1 0 0 -1 0 0 0 1] "integer indices" [0 1 2 1 0 3 0 1 4])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\n"), at(2, 1),
                       "loopsubdiv: an edge is shared by more than two triangles"));
-  const std::string l3 = R"(Shape "loopsubdiv" "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 5])";
+  const std::string l3 =
+      R"(Shape "loopsubdiv" "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 5])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l3 + "\n"), at(2, col(l3, "\"integer indices")),
                       "vertex index 5 out of range (3 vertices)"));
 }
@@ -1767,22 +1888,25 @@ TEST(SceneFlattenError, LoopSubdivisionBadInput) {
 TEST(SceneFlattenError, UnknownNamedSpectrum) {
   TempDir dir;
   const std::string l2 = R"(Material "conductor" "spectrum eta" "metal-Unobtainium")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n", dir.str()), at(2, col(l2, "\"spectrum")),
-                      "\"metal-Unobtainium\" is neither a known named spectrum nor a readable spectrum file"));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n", dir.str()),
+      at(2, col(l2, "\"spectrum")),
+      "\"metal-Unobtainium\" is neither a known named spectrum nor a readable spectrum file"));
 }
 
 TEST(SceneFlattenError, SpectrumFileWithText) {
   TempDir dir;
   dir.write("bad.spd", "400 0.5\n500 half\n");
   const std::string l2 = R"(Material "diffuse" "spectrum reflectance" "bad.spd")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n", dir.str()), at(2, col(l2, "\"spectrum")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n", dir.str()),
+                      at(2, col(l2, "\"spectrum")),
                       "spectrum file \"bad.spd\" holds something other than numbers"));
 }
 
 TEST(SceneFlattenError, SpectrumWavelengthsMustIncrease) {
   const std::string l2 = R"(Material "diffuse" "spectrum reflectance" [500 0.5 400 0.5])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"spectrum")),
-                      "spectrum wavelengths must increase"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
+                      at(2, col(l2, "\"spectrum")), "spectrum wavelengths must increase"));
 }
 
 TEST(SceneFlattenError, BlackbodyNonPositive) {
@@ -1793,48 +1917,56 @@ TEST(SceneFlattenError, BlackbodyNonPositive) {
 
 TEST(SceneFlattenError, UnknownTexture) {
   const std::string l2 = R"(Material "diffuse" "texture reflectance" "nope")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"texture")),
-                      "unknown texture \"nope\""));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
+                      at(2, col(l2, "\"texture")), "unknown texture \"nope\""));
 }
 
 TEST(SceneFlattenError, TextureErrorsNameTheDirective) {
-  const std::string tex = "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"missing.png\"";
+  const std::string tex =
+      "Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"missing.png\"";
   const std::string use = R"(Material "diffuse" "texture reflectance" "img")";
   // A missing image: at its filename, naming the file.
   std::string e = error_of("WorldBegin\n" + tex + "\n" + use + "\nShape \"sphere\"\n");
   EXPECT_TRUE(IsError(e, at(2, col(tex, "\"string filename")), "missing.png"));
   // Unknown class, a float texture where a spectrum is needed, and the reverse.
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"n\" \"spectrum\" \"fbm\"\n" + use.substr(0, use.size() - 5) +
-                               "\"n\"\nShape \"sphere\"\n"),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"n\" \"spectrum\" \"fbm\"\n" +
+                               use.substr(0, use.size() - 5) + "\"n\"\nShape \"sphere\"\n"),
                       at(2, 1), "texture class \"fbm\" is not supported"));
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"c\" \"float\" \"checkerboard\"\n"
-                               "Material \"diffuse\" \"texture reflectance\" \"c\"\nShape \"sphere\"\n"),
-                      at(2, 1), "is a float texture; a spectrum texture is needed here"));
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\n"
-                               "Material \"conductor\" \"texture roughness\" \"c\"\nShape \"sphere\"\n"),
-                      at(2, 1), "is a spectrum texture; a float texture is needed here"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nTexture \"c\" \"float\" \"checkerboard\"\n"
+                       "Material \"diffuse\" \"texture reflectance\" \"c\"\nShape \"sphere\"\n"),
+              at(2, 1), "is a float texture; a spectrum texture is needed here"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nTexture \"c\" \"spectrum\" \"checkerboard\"\n"
+                       "Material \"conductor\" \"texture roughness\" \"c\"\nShape \"sphere\"\n"),
+              at(2, 1), "is a spectrum texture; a float texture is needed here"));
   // Unknown names and modes.
   const std::string l3 = R"(Material "diffuse" "texture reflectance" "nope")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n\n" + l3 + "\nShape \"sphere\"\n"), at(3, col(l3, "\"texture")),
-                      "unknown texture \"nope\""));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n\n" + l3 + "\nShape \"sphere\"\n"),
+                      at(3, col(l3, "\"texture")), "unknown texture \"nope\""));
   const std::string wrap = R"(Texture "c" "spectrum" "checkerboard" "string mapping" "cubic")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + wrap + "\nMaterial \"diffuse\" \"texture reflectance\" \"c\"\n"
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + wrap +
+                               "\nMaterial \"diffuse\" \"texture reflectance\" \"c\"\n"
                                "Shape \"sphere\"\n"),
-                      at(2, col(wrap, "\"string mapping")), "texture mapping \"cubic\" is unknown"));
+                      at(2, col(wrap, "\"string mapping")),
+                      "texture mapping \"cubic\" is unknown"));
   // A textured roughness where bpm takes none.
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nTexture \"r\" \"float\" \"checkerboard\"\n"
-                               "Material \"dielectric\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"),
-                      at(3, 1), "textured roughness is not supported"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nTexture \"r\" \"float\" \"checkerboard\"\n"
+                       "Material \"dielectric\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"),
+              at(3, 1), "textured roughness is not supported"));
 }
 
 TEST(SceneParse, MixMaterialNamesTwoMaterials) {
-  LoadedScene ls = flatten_scene(parse_scene_string(
-      "WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n"
-      "MakeNamedMaterial \"b\" \"string type\" \"conductor\"\n"
-      "Texture \"t\" \"float\" \"checkerboard\"\n"
-      "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"a\" \"b\"] \"texture amount\" \"t\"\n"
-      "NamedMaterial \"m\"\nShape \"sphere\"\n"
-      "Material \"mix\" \"string materials\" [\"b\" \"m\"] \"float amount\" 0.3\nShape \"sphere\"\n"));
+  LoadedScene ls = flatten_scene(
+      parse_scene_string("WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n"
+                         "MakeNamedMaterial \"b\" \"string type\" \"conductor\"\n"
+                         "Texture \"t\" \"float\" \"checkerboard\"\n"
+                         "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" "
+                         "[\"a\" \"b\"] \"texture amount\" \"t\"\n"
+                         "NamedMaterial \"m\"\nShape \"sphere\"\n"
+                         "Material \"mix\" \"string materials\" [\"b\" \"m\"] \"float amount\" "
+                         "0.3\nShape \"sphere\"\n"));
   const auto* m = std::get_if<MixDesc>(&ls.scene.materials[size_t(ls.scene.objects[0].material)]);
   ASSERT_TRUE(m);
   EXPECT_TRUE(std::holds_alternative<DiffuseDesc>(ls.scene.materials[size_t(m->materials[0])]));
@@ -1856,38 +1988,44 @@ TEST(SceneParse, MixMaterialNamesTwoMaterials) {
     int chosen = choose_mix(ls.scene, ls.scene.objects[1].material, c);
     EXPECT_FALSE(std::holds_alternative<MixDesc>(ls.scene.materials[size_t(chosen)]));
     hits_b += chosen == n->materials[0];
-    EXPECT_EQ(chosen, choose_mix(ls.scene, ls.scene.objects[1].material, c));  // the same every time
+    EXPECT_EQ(chosen,
+              choose_mix(ls.scene, ls.scene.objects[1].material, c));  // the same every time
   }
   EXPECT_NEAR(hits_b / 1000.0, 0.7, 0.05);  // "b" directly with 1 - 0.3, "a" through "m" otherwise
 }
 
 TEST(SceneFlattenError, MixMaterialErrors) {
   const std::string one = R"(Material "mix" "string materials" "a")";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + one + "\nShape \"sphere\"\n"), at(2, col(one, "\"string materials")),
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + one + "\nShape \"sphere\"\n"),
+                      at(2, col(one, "\"string materials")),
                       "mix needs \"string materials\" with two named materials"));
   const std::string unknown = R"(Material "mix" "string materials" ["a" "b"])";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + unknown + "\nShape \"sphere\"\n"), at(2, col(unknown, "\"string materials")),
-                      "unknown named material \"a\""));
-  const std::string self = R"(MakeNamedMaterial "a" "string type" "mix" "string materials" ["a" "a"])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + unknown + "\nShape \"sphere\"\n"),
+                      at(2, col(unknown, "\"string materials")), "unknown named material \"a\""));
+  const std::string self =
+      R"(MakeNamedMaterial "a" "string type" "mix" "string materials" ["a" "a"])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + self + "\nNamedMaterial \"a\"\nShape \"sphere\"\n"),
-                      at(2, col(self, "\"string materials")), "named material \"a\" contains itself"));
+                      at(2, col(self, "\"string materials")),
+                      "named material \"a\" contains itself"));
 }
 
 TEST(SceneFlattenError, ConductorWithReflectanceAndEta) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nMaterial \"conductor\" \"rgb reflectance\" [0.5 0.5 0.5] "
-                               "\"spectrum eta\" \"metal-Au-eta\"\nShape \"sphere\"\n"),
-                      at(2, 1), "conductor has both reflectance and eta/k"));
+  EXPECT_TRUE(
+      IsError(error_of("WorldBegin\nMaterial \"conductor\" \"rgb reflectance\" [0.5 0.5 0.5] "
+                       "\"spectrum eta\" \"metal-Au-eta\"\nShape \"sphere\"\n"),
+              at(2, 1), "conductor has both reflectance and eta/k"));
 }
 
 TEST(SceneFlattenError, DielectricNegativeEta) {
   const std::string l2 = R"(Material "dielectric" "float eta" -1.5)";
-  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"), at(2, col(l2, "\"float")),
-                      "eta must be positive"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
+                      at(2, col(l2, "\"float")), "eta must be positive"));
 }
 
 TEST(SceneFlattenError, SpotLightFromEqualsTo) {
-  EXPECT_TRUE(IsError(error_of("WorldBegin\nLightSource \"spot\" \"point3 from\" [1 1 1] \"point3 to\" [1 1 1]\n"),
-                      at(2, 1), "spot light with from == to"));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\nLightSource \"spot\" \"point3 from\" [1 1 1] \"point3 to\" [1 1 1]\n"),
+      at(2, 1), "spot light with from == to"));
 }
 
 TEST(SceneFlattenError, NegativeLightScale) {
@@ -1899,7 +2037,8 @@ TEST(SceneFlattenError, NegativeLightScale) {
 // Warnings
 
 TEST(SceneWarnings, UnusedParameterWarns) {
-  ParsedScene p = parse_scene_string("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float bogus\" 1\n");
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nShape \"sphere\" \"float radius\" 2 \"float bogus\" 1\n");
   int before = warning_count();
   (void)flatten_scene(p);
   EXPECT_EQ(warning_count() - before, 1);
@@ -1909,15 +2048,16 @@ TEST(SceneWarnings, UnusedParameterWarns) {
 
 TEST(SceneWarnings, NoWarningWhenAllParametersAreUsed) {
   ParsedScene p = parse_scene_string(
-      "WorldBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\nShape \"sphere\" \"float radius\" 2\n");
+      "WorldBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\nShape \"sphere\" "
+      "\"float radius\" 2\n");
   int before = warning_count();
   (void)flatten_scene(p);
   EXPECT_EQ(warning_count(), before);
 }
 
 TEST(SceneWarnings, UnusedMaterialParameterWarns) {
-  ParsedScene p = parse_scene_string(
-      "WorldBegin\nMaterial \"diffuse\" \"float sigma\" 20\nShape \"sphere\"\n");
+  ParsedScene p =
+      parse_scene_string("WorldBegin\nMaterial \"diffuse\" \"float sigma\" 20\nShape \"sphere\"\n");
   int before = warning_count();
   (void)flatten_scene(p);
   EXPECT_EQ(warning_count() - before, 1);
@@ -1980,7 +2120,8 @@ TEST(PlyReader, BinaryBigEndianWithDoublesAndExtraProperties) {
       "ply\nformat binary_big_endian 1.0\n"
       "element vertex 3\n"
       "property double x\nproperty double y\nproperty double z\nproperty uchar red\n"
-      "element face 1\nproperty uchar flags\nproperty list ushort uint vertex_indices\nend_header\n";
+      "element face 1\nproperty uchar flags\nproperty list ushort uint "
+      "vertex_indices\nend_header\n";
   const double verts[3][3] = {{0, 0, 0}, {2, 0, 0}, {0, 3, -1}};
   for (const auto& v : verts) {
     for (double x : v) put_be(&ply, x);
@@ -2023,10 +2164,11 @@ TEST(PlyReader, NotAPlyFile) {
 
 TEST(PlyReader, FaceWithFiveVertices) {
   TempDir dir;
-  fs::path path = dir.write("penta.ply",
-                            "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
-                            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                            "0 0 0\n1 0 0\n1 1 0\n0 1 0\n-1 0.5 0\n5 0 1 2 3 4\n");
+  fs::path path = dir.write(
+      "penta.ply",
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n-1 0.5 0\n5 0 1 2 3 4\n");
   try {
     (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
     ADD_FAILURE() << "no error";
@@ -2037,10 +2179,11 @@ TEST(PlyReader, FaceWithFiveVertices) {
 
 TEST(PlyReader, TruncatedAscii) {
   TempDir dir;
-  fs::path path = dir.write("short.ply",
-                            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                            "0 0 0\n1 0 0\n");
+  fs::path path = dir.write(
+      "short.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n");
   try {
     (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
     ADD_FAILURE() << "no error";

@@ -25,7 +25,8 @@ struct Element {
 int type_size(const std::string& t) {
   if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
   if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32")
+    return 4;
   if (t == "double" || t == "float64") return 8;
   return 0;
 }
@@ -47,16 +48,38 @@ class Reader {
     if (swap) std::reverse(buf, buf + n);
     if (t == "char" || t == "int8") return double(int8_t(buf[0]));
     if (t == "uchar" || t == "uint8") return double(buf[0]);
-    if (t == "short" || t == "int16") { int16_t v; std::memcpy(&v, buf, 2); return v; }
-    if (t == "ushort" || t == "uint16") { uint16_t v; std::memcpy(&v, buf, 2); return v; }
-    if (t == "int" || t == "int32") { int32_t v; std::memcpy(&v, buf, 4); return v; }
-    if (t == "uint" || t == "uint32") { uint32_t v; std::memcpy(&v, buf, 4); return v; }
-    if (t == "float" || t == "float32") { float v; std::memcpy(&v, buf, 4); return v; }
+    if (t == "short" || t == "int16") {
+      int16_t v;
+      std::memcpy(&v, buf, 2);
+      return v;
+    }
+    if (t == "ushort" || t == "uint16") {
+      uint16_t v;
+      std::memcpy(&v, buf, 2);
+      return v;
+    }
+    if (t == "int" || t == "int32") {
+      int32_t v;
+      std::memcpy(&v, buf, 4);
+      return v;
+    }
+    if (t == "uint" || t == "uint32") {
+      uint32_t v;
+      std::memcpy(&v, buf, 4);
+      return v;
+    }
+    if (t == "float" || t == "float32") {
+      float v;
+      std::memcpy(&v, buf, 4);
+      return v;
+    }
     double v;
     std::memcpy(&v, buf, 8);
     return v;
   }
-  [[noreturn]] void fail(const std::string& what) { throw Error("PLY file \"" + path_ + "\": " + what); }
+  [[noreturn]] void fail(const std::string& what) {
+    throw Error("PLY file \"" + path_ + "\": " + what);
+  }
 
  private:
   std::istream& in_;
@@ -72,7 +95,8 @@ struct Header {
 // Every failure it reports names the PLY file and `from`, the scene line that asked for it.
 class PlyParser {
  public:
-  PlyParser(std::istream& in, const std::string& path, const FileLoc& from) : in_(in), path_(path), from_(from) {}
+  PlyParser(std::istream& in, const std::string& path, const FileLoc& from)
+      : in_(in), path_(path), from_(from) {}
 
   // Leaves the stream at the first byte of the body.
   Header read_header() {
@@ -89,10 +113,14 @@ class PlyParser {
       if (word == "format") {
         std::string f;
         ls >> f;
-        if (f == "ascii") h.format = Format::kAscii;
-        else if (f == "binary_little_endian") h.format = Format::kBinaryLE;
-        else if (f == "binary_big_endian") h.format = Format::kBinaryBE;
-        else fail("unknown format '" + f + "'");
+        if (f == "ascii")
+          h.format = Format::kAscii;
+        else if (f == "binary_little_endian")
+          h.format = Format::kBinaryLE;
+        else if (f == "binary_big_endian")
+          h.format = Format::kBinaryBE;
+        else
+          fail("unknown format '" + f + "'");
       } else if (word == "element") {
         Element e;
         long long count = -1;
@@ -107,7 +135,8 @@ class PlyParser {
         ls >> t;
         if (t == "list") {
           ls >> p.count_type >> p.type >> p.name;
-          if (!type_size(p.count_type) || !type_size(p.type)) fail("bad list property '" + line + "'");
+          if (!type_size(p.count_type) || !type_size(p.type))
+            fail("bad list property '" + line + "'");
         } else {
           p.type = t;
           ls >> p.name;
@@ -130,11 +159,24 @@ class PlyParser {
     int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, iu = -1, iv = -1, iidx = -1;
     for (int k = 0; k < int(e.props.size()); ++k) {
       const std::string& n = e.props[k].name;
-      if (n == "x") ix = k; else if (n == "y") iy = k; else if (n == "z") iz = k;
-      else if (n == "nx") inx = k; else if (n == "ny") iny = k; else if (n == "nz") inz = k;
-      else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s") iu = k;
-      else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t") iv = k;
-      else if (n == "vertex_indices" || n == "vertex_index") iidx = k;
+      if (n == "x")
+        ix = k;
+      else if (n == "y")
+        iy = k;
+      else if (n == "z")
+        iz = k;
+      else if (n == "nx")
+        inx = k;
+      else if (n == "ny")
+        iny = k;
+      else if (n == "nz")
+        inz = k;
+      else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s")
+        iu = k;
+      else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t")
+        iv = k;
+      else if (n == "vertex_indices" || n == "vertex_index")
+        iidx = k;
     }
     if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) fail("vertex element lacks x, y or z");
     if (is_face && iidx < 0) fail("face element lacks vertex_indices");
@@ -158,7 +200,8 @@ class PlyParser {
       }
       if (is_vertex) {
         mesh->positions.push_back(Vec3(float(vals[ix]), float(vals[iy]), float(vals[iz])));
-        if (has_n) mesh->normals.push_back(Vec3(float(vals[inx]), float(vals[iny]), float(vals[inz])));
+        if (has_n)
+          mesh->normals.push_back(Vec3(float(vals[inx]), float(vals[iny]), float(vals[inz])));
         if (has_uv) mesh->uvs.push_back({float(vals[iu]), float(vals[iv])});
       } else if (is_face) {
         add_face(face, mesh);
@@ -175,7 +218,8 @@ class PlyParser {
       mesh->indices.insert(mesh->indices.end(), q, q + 6);
       ++mesh->quads;
     } else {
-      fail("face with " + std::to_string(face.size()) + " vertices (only triangles and quads are supported)");
+      fail("face with " + std::to_string(face.size()) +
+           " vertices (only triangles and quads are supported)");
     }
   }
 
@@ -193,7 +237,9 @@ class PlyParser {
   std::string path_;
   FileLoc from_;
 
-  [[noreturn]] void fail(const std::string& what) const { throw Error(from_, "PLY file \"" + path_ + "\": " + what); }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw Error(from_, "PLY file \"" + path_ + "\": " + what);
+  }
 };
 
 }  // namespace

@@ -1,11 +1,13 @@
+#include "scene/render_scene.h"
+
 #include <bit>
 
 #include "base/rng.h"
-#include "scene/render_scene.h"
 
 namespace bpm {
 
-bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const SurfacePoint& sp, Vec3 o, Vec3 d) {
+bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const SurfacePoint& sp,
+                  Vec3 o, Vec3 d) {
   float a = alpha.textured() ? textures.value(alpha.texture, texture_context(sp)) : alpha.value;
   if (a >= 1) return false;
   if (!(a > 0)) return true;
@@ -23,7 +25,8 @@ int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx
   for (int depth = 0; depth < 64; ++depth) {
     const auto* mix = std::get_if<MixDesc>(&scene.materials[size_t(material)]);
     if (!mix) return material;
-    float amount = mix->amount.textured() ? scene.textures.value(mix->amount.texture, ctx) : mix->amount.value;
+    float amount =
+        mix->amount.textured() ? scene.textures.value(mix->amount.texture, ctx) : mix->amount.value;
     int chosen;
     if (amount <= 0) {
       chosen = mix->materials[0];

@@ -33,7 +33,7 @@ struct Object {
   // 1 - alpha (a cut-out where it is 0).
   FloatParam alpha{1, -1};
   bool has_alpha() const { return alpha.textured() || alpha.value < 1; }
-  std::string source;    // file:line of the Shape directive, for statistics and messages
+  std::string source;  // file:line of the Shape directive, for statistics and messages
 };
 
 class Accel;
@@ -50,7 +50,7 @@ class RenderScene {
   TextureSet textures;  // the nodes textured materials read
   std::vector<AbsorbingMedium> media;
   std::vector<Light> lights;
-  std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
+  std::vector<int> infinite_lights;   // lights a ray that escapes the scene sees
   Distribution1D light_distribution;  // in proportion to power
   Bounds3 bounds;
   SceneBoundsInfo bounds_info;
@@ -63,7 +63,8 @@ class RenderScene {
   bool occluded(Vec3 a, Vec3 b) const;
   bool occluded_ray(const Ray& ray) const;
   SurfacePoint surface(const Ray& ray, const Hit& hit) const {
-    return surface_point(objects[hit.object].shape, hit.primitive, hit.barycentric, ray.o + ray.d * hit.t);
+    return surface_point(objects[hit.object].shape, hit.primitive, hit.barycentric,
+                         ray.o + ray.d * hit.t);
   }
   const Shape* light_shape(const Light& l) const {
     auto* a = std::get_if<AreaLight>(&l);
@@ -92,7 +93,8 @@ inline int medium_toward(const RenderScene& scene, int object, Vec3 ng, Vec3 w, 
 }
 
 // The fraction of light that crosses `distance` in `medium` (-1: vacuum) at each wavelength.
-inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float distance, const Wavelengths& wl) {
+inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float distance,
+                                     const Wavelengths& wl) {
   Spectrum t(1.0f);
   if (medium < 0) return t;
   Spectrum sigma = scene.media[size_t(medium)].sigma_a.sample(wl);
@@ -103,7 +105,8 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float
 
 // Attenuates a path's throughput over a segment of `distance` in `medium`; false when nothing is
 // left of it.
-inline bool cross_medium(const RenderScene& scene, int medium, float distance, const Wavelengths& wl, Spectrum& beta) {
+inline bool cross_medium(const RenderScene& scene, int medium, float distance,
+                         const Wavelengths& wl, Spectrum& beta) {
   if (medium < 0) return true;
   beta *= medium_transmittance(scene, medium, distance, wl);
   return !beta.is_black();
@@ -112,14 +115,16 @@ inline bool cross_medium(const RenderScene& scene, int medium, float distance, c
 // Whether a ray from o along d passes through an alpha-masked surface at sp: true with
 // probability 1 - alpha there, decided by a hash of the ray and the point, so that the same query
 // always gets the same answer and the layers a ray crosses decide independently.
-bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const SurfacePoint& sp, Vec3 o, Vec3 d);
+bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const SurfacePoint& sp,
+                  Vec3 o, Vec3 d);
 
 // The scene material a mix material stands for at a point (a material that is not a mix stands
 // for itself): the second with probability `amount`, by a hash of the point.
 int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx);
 
 // The material of a surface point at the wavelengths (resolved there, textures and mixes included).
-inline Material material_at(const RenderScene& scene, int material, const Wavelengths& wl, const TextureContext& ctx) {
+inline Material material_at(const RenderScene& scene, int material, const Wavelengths& wl,
+                            const TextureContext& ctx) {
   material = choose_mix(scene, material, ctx);
   return resolve_material(scene.materials[size_t(material)], wl, scene.textures, ctx);
 }
@@ -133,7 +138,8 @@ struct WavelengthMaterials {
   std::vector<char> textured;
   const RenderScene* scene;
   bool per_point = false;  // every material resolved at each point (no copies made)
-  WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths) : wl(wavelengths), scene(&s) {
+  WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths)
+      : wl(wavelengths), scene(&s) {
     materials.reserve(s.materials.size());
     for (const MaterialDesc& d : s.materials) {
       textured.push_back(material_is_textured(d));
@@ -142,7 +148,8 @@ struct WavelengthMaterials {
   }
   // For a single path (the path tracer draws wavelengths per pixel sample): copies of every
   // material would cost more than resolving the few the path meets.
-  static WavelengthMaterials resolved_per_point(const RenderScene& s, const Wavelengths& wavelengths) {
+  static WavelengthMaterials resolved_per_point(const RenderScene& s,
+                                                const Wavelengths& wavelengths) {
     return WavelengthMaterials(s, wavelengths, true);
   }
   // The material at a point: the iteration's copy, or for a textured one its resolution at ctx,
@@ -164,6 +171,8 @@ inline Vec3 offset_origin(Vec3 p, Vec3 n, Vec3 w) {
   float eps = 2e-5f * (1 + max_abs_component(p));
   return p + n * (dot(n, w) > 0 ? eps : -eps);
 }
-inline Ray spawn_ray(const SurfacePoint& sp, Vec3 w) { return Ray{offset_origin(sp.p, sp.ng, w), w, kInf}; }
+inline Ray spawn_ray(const SurfacePoint& sp, Vec3 w) {
+  return Ray{offset_origin(sp.p, sp.ng, w), w, kInf};
+}
 
 }  // namespace bpm

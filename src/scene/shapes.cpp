@@ -65,7 +65,8 @@ double intersect_disk(const Disk& k, Vec3 o_world, Vec3 d_world, double t_min, d
   return t;
 }
 
-double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min, double t_max) {
+double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min,
+                          double t_max) {
   DVec o = to_object(c.world_from_object, o_world, true);
   DVec d = to_object(c.world_from_object, d_world, false);
   double a = d.x * d.x + d.y * d.y;
@@ -144,7 +145,8 @@ SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) 
     float theta = std::acos(std::clamp(po.z / s->radius, -1.0f, 1.0f));
     float theta_min = std::acos(std::clamp(s->z_min / s->radius, -1.0f, 1.0f));
     float theta_max = std::acos(std::clamp(s->z_max / s->radius, -1.0f, 1.0f));
-    sp.uv = {phi / s->phi_max, theta_max != theta_min ? (theta - theta_min) / (theta_max - theta_min) : 0.0f};
+    sp.uv = {phi / s->phi_max,
+             theta_max != theta_min ? (theta - theta_min) / (theta_max - theta_min) : 0.0f};
     return sp;
   }
   if (auto* c = std::get_if<Cylinder>(&shape)) {

@@ -61,9 +61,11 @@ struct SurfacePoint {
 // the nearest hit in (t_min, t_max) or a negative value.
 double intersect_sphere(const Sphere& s, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
 double intersect_disk(const Disk& d, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
-double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
+double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min,
+                          double t_max);
 // The analytic shapes (all but meshes) in one call.
-double intersect_analytic(const Shape& shape, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
+double intersect_analytic(const Shape& shape, Vec3 o_world, Vec3 d_world, double t_min,
+                          double t_max);
 
 // Surface point of a hit: for meshes from the primitive and Embree's barycentrics (b1, b2).
 SurfacePoint surface_point(const Shape& shape, int prim, Vec2 barycentric, Vec3 p_hit);

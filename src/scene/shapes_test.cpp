@@ -1,6 +1,8 @@
 // Tests of the analytic cylinder (intersections against a closed-form reference in double
 // precision, partial cylinders, surface points, bounds, the Embree scene) and of alpha masks in
 // the Embree scene (meshes through the filter functions, analytic shapes in their callbacks).
+#include "scene/shapes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,18 +10,19 @@
 #include "base/rng.h"
 #include "base/sampling.h"
 #include "scene/render_scene.h"
-#include "scene/shapes.h"
 
 namespace bpm {
 namespace {
 
 float radians(float degrees) { return degrees * kPi / 180; }
 bool contains(const Bounds3& b, Vec3 p) {
-  return p.x >= b.lo.x && p.y >= b.lo.y && p.z >= b.lo.z && p.x <= b.hi.x && p.y <= b.hi.y && p.z <= b.hi.z;
+  return p.x >= b.lo.x && p.y >= b.lo.y && p.z >= b.lo.z && p.x <= b.hi.x && p.y <= b.hi.y &&
+         p.z <= b.hi.z;
 }
 
 Transform cylinder_transform() {
-  return Transform::translate(Vec3(0.5f, -1, 2)) * Transform::rotate(35, normalize(Vec3(1, 2, -0.5f))) *
+  return Transform::translate(Vec3(0.5f, -1, 2)) *
+         Transform::rotate(35, normalize(Vec3(1, 2, -0.5f))) *
          Transform::scale(Vec3(1.5f, 1.5f, 1.5f));
 }
 
@@ -64,7 +67,8 @@ TEST(Cylinder, IntersectionsMatchTheClosedForm) {
       bool inside = k % 4 == 0;
       Vec3 o = inside ? c.world_from_object.point(Vec3(0.2f, -0.3f, 0.5f))
                       : centre + sample_uniform_sphere({rng.uniform(), rng.uniform()}) * 5.0f;
-      Vec3 target = centre + sample_uniform_sphere({rng.uniform(), rng.uniform()}) * (2.5f * rng.uniform());
+      Vec3 target =
+          centre + sample_uniform_sphere({rng.uniform(), rng.uniform()}) * (2.5f * rng.uniform());
       Vec3 d = normalize(target - o);
       std::vector<double> ref = reference_hits(c, o, d);
       double t = intersect_cylinder(c, o, d, 0, 1e30);
@@ -87,12 +91,15 @@ TEST(Cylinder, IntersectionsMatchTheClosedForm) {
       EXPECT_LT(intersect_cylinder(c, o, d, 0, ref[0] * 0.999), 0);
     }
     EXPECT_GT(hits, 2000) << phi_max;
-    EXPECT_GT(second_wall, phi_max > 100 ? 500 : 20) << phi_max;  // a quarter cylinder is rarely crossed twice
+    EXPECT_GT(second_wall, phi_max > 100 ? 500 : 20)
+        << phi_max;  // a quarter cylinder is rarely crossed twice
   }
   // Along the axis, never.
   Cylinder c = make_cylinder();
   Vec3 axis = c.world_from_object.vector(Vec3(0, 0, 1));
-  EXPECT_LT(intersect_cylinder(c, c.world_from_object.point(Vec3(0.3f, 0, -5)), normalize(axis), 0, 1e30), 0);
+  EXPECT_LT(
+      intersect_cylinder(c, c.world_from_object.point(Vec3(0.3f, 0, -5)), normalize(axis), 0, 1e30),
+      0);
 }
 
 TEST(Cylinder, SurfacePointNormalAndUv) {
@@ -190,9 +197,12 @@ TEST(Alpha, ConstantAlphaStopsThatFractionOfRaysAndLayersDecideIndependently) {
     cast_down(analytic ? 21 : 22, n, [&](const Ray& ray, Vec3) {
       Hit h, h2;
       bool hit = scene.intersect(ray, &h);
-      if (!hit) ++none;
-      else if (h.object == 0) ++first;
-      else ++second;
+      if (!hit)
+        ++none;
+      else if (h.object == 0)
+        ++first;
+      else
+        ++second;
       occluded += scene.occluded_ray(ray);
       // The same ray always gets the same answer.
       same += scene.intersect(ray, &h2) == hit && (!hit || h2.object == h.object);

@@ -25,22 +25,25 @@ std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKin
       {"metal-TiO2-eta", 3.1520, 2.9568, 2.8717},     {"metal-TiO2-k", 0, 0, 0},
   };
   for (const Metal& m : metals)
-    if (name == m.name) return SpectrumCurve::from_pairs({450, m.v450, 550, m.v550, 650, m.v650}, kind);
+    if (name == m.name)
+      return SpectrumCurve::from_pairs({450, m.v450, 550, m.v550, 650, m.v650}, kind);
   static const std::map<std::string, float> glasses = {
-      {"glass-BK7", 1.5168f}, {"glass-BAF10", 1.6700f}, {"glass-FK51A", 1.4866f}, {"glass-LASF9", 1.8503f},
-      {"glass-F5", 1.6034f},  {"glass-F10", 1.6200f},   {"glass-F11", 1.6209f},
+      {"glass-BK7", 1.5168f},   {"glass-BAF10", 1.6700f}, {"glass-FK51A", 1.4866f},
+      {"glass-LASF9", 1.8503f}, {"glass-F5", 1.6034f},    {"glass-F10", 1.6200f},
+      {"glass-F11", 1.6209f},
   };
   if (auto it = glasses.find(name); it != glasses.end()) return SpectrumCurve(it->second);
   if (kind == SpectrumKind::kIlluminant) {
     if (name == "stdillum-D65") return SpectrumCurve::from_rgb(Rgb(1.0f), kind);
     if (name == "stdillum-A") return SpectrumCurve::blackbody(2856);
-    if (name == "stdillum-D50") return SpectrumCurve::blackbody(5003);  // its CCT; not the daylight curve
+    if (name == "stdillum-D50")
+      return SpectrumCurve::blackbody(5003);  // its CCT; not the daylight curve
   }
   return std::nullopt;
 }
 
-std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string& name, SpectrumKind kind,
-                                     const std::string& directory) {
+std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string& name,
+                                          SpectrumKind kind, const std::string& directory) {
   const Param* p = ps.find_any(name);
   if (!p) return std::nullopt;
   p->used = true;
@@ -72,7 +75,9 @@ std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string&
                                        : std::filesystem::path(directory) / str;
       std::ifstream in(path);
       if (!in)
-        throw Error(p->loc, "\"" + str + "\" is neither a known named spectrum nor a readable spectrum file");
+        throw Error(
+            p->loc,
+            "\"" + str + "\" is neither a known named spectrum nor a readable spectrum file");
       std::vector<double> pairs;
       std::string line;
       while (std::getline(in, line)) {
@@ -80,7 +85,8 @@ std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string&
         std::istringstream ls(line);
         double v;
         while (ls >> v) pairs.push_back(v);
-        if (!ls.eof()) throw Error(p->loc, "spectrum file \"" + str + "\" holds something other than numbers");
+        if (!ls.eof())
+          throw Error(p->loc, "spectrum file \"" + str + "\" holds something other than numbers");
       }
       if (pairs.size() < 2 || pairs.size() % 2)
         throw Error(p->loc, "spectrum file \"" + str + "\" must hold wavelength/value pairs");

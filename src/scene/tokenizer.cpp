@@ -12,9 +12,15 @@ std::string Token::unquoted() const {
     if (body[i] == '\\' && i + 1 < body.size()) {
       char c = body[++i];
       switch (c) {
-        case 'n': out += '\n'; break;
-        case 't': out += '\t'; break;
-        default: out += c; break;
+        case 'n':
+          out += '\n';
+          break;
+        case 't':
+          out += '\t';
+          break;
+        default:
+          out += c;
+          break;
       }
     } else {
       out += body[i];
@@ -62,7 +68,8 @@ std::optional<Token> Tokenizer::next() {
         if (text_[pos_] == '\n') throw Error(loc, "unterminated string (newline inside quotes)");
         if (text_[pos_] == '\\') {
           ++pos_;
-          if (pos_ < text_.size() && text_[pos_] == '\n') throw Error(loc, "unterminated string (newline inside quotes)");
+          if (pos_ < text_.size() && text_[pos_] == '\n')
+            throw Error(loc, "unterminated string (newline inside quotes)");
         }
         ++pos_;
       }

@@ -21,7 +21,8 @@ struct Token {
 class Tokenizer {
  public:
   // Reads the whole file; throws Error when it cannot be read.
-  static std::unique_ptr<Tokenizer> from_file(const std::string& path, const FileLoc& included_from);
+  static std::unique_ptr<Tokenizer> from_file(const std::string& path,
+                                              const FileLoc& included_from);
   static std::unique_ptr<Tokenizer> from_string(std::string text, std::string name = "<string>");
 
   // Next token, or nullopt at the end of input. Throws on an unterminated string.

@@ -12,15 +12,21 @@
 namespace bpm {
 namespace {
 
-float srgb_to_linear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
 
 // Texel coordinate i on an axis of n texels, or -1 outside the image for kBlack.
 int wrap_coordinate(int i, int n, TexWrap wrap) {
   switch (wrap) {
-    case TexWrap::kRepeat: return ((i % n) + n) % n;
-    case TexWrap::kClamp: return std::clamp(i, 0, n - 1);
-    case TexWrap::kBlack: return i < 0 || i >= n ? -1 : i;
-    case TexWrap::kOctahedralSphere: return std::clamp(i, 0, n - 1);  // after the fold below
+    case TexWrap::kRepeat:
+      return ((i % n) + n) % n;
+    case TexWrap::kClamp:
+      return std::clamp(i, 0, n - 1);
+    case TexWrap::kBlack:
+      return i < 0 || i >= n ? -1 : i;
+    case TexWrap::kOctahedralSphere:
+      return std::clamp(i, 0, n - 1);  // after the fold below
   }
   return 0;
 }
@@ -58,10 +64,12 @@ Rgb TexImage::lookup(Vec2 st, TexFilter filter, TexWrap wrap) const {
          texel(xi, yi + 1, wrap) * ((1 - dx) * dy) + texel(xi + 1, yi + 1, wrap) * (dx * dy);
 }
 
-std::shared_ptr<const TexImage> load_texture_image(const std::string& path, const TexEncoding& encoding) {
+std::shared_ptr<const TexImage> load_texture_image(const std::string& path,
+                                                   const TexEncoding& encoding) {
   static std::mutex mutex;
   static std::map<std::string, std::shared_ptr<const TexImage>> cache;
-  std::string key = path + "|" + std::to_string(int(encoding.kind)) + "|" + std::to_string(encoding.gamma);
+  std::string key =
+      path + "|" + std::to_string(int(encoding.kind)) + "|" + std::to_string(encoding.gamma);
   std::lock_guard<std::mutex> lock(mutex);
   if (auto it = cache.find(key); it != cache.end()) return it->second;
 
@@ -89,8 +97,10 @@ std::shared_ptr<const TexImage> load_texture_image(const std::string& path, cons
     for (int c = 0; c < img->channels; ++c) {
       float v = all[i * n + c];
       if (!is_float) {
-        if (encoding.kind == TexEncoding::Kind::kSrgb) v = srgb_to_linear(v);
-        else if (encoding.kind == TexEncoding::Kind::kGamma) v = std::pow(std::max(v, 0.0f), encoding.gamma);
+        if (encoding.kind == TexEncoding::Kind::kSrgb)
+          v = srgb_to_linear(v);
+        else if (encoding.kind == TexEncoding::Kind::kGamma)
+          v = std::pow(std::max(v, 0.0f), encoding.gamma);
       }
       if (!std::isfinite(v)) throw Error("image \"" + path + "\" has a non-finite texel");
       img->texels[i * img->channels + c] = v;
@@ -101,7 +111,8 @@ std::shared_ptr<const TexImage> load_texture_image(const std::string& path, cons
 
 Vec2 TexMapping::map(const TextureContext& ctx) const {
   switch (kind) {
-    case Kind::kUV: return {su * ctx.uv.x + du, sv * ctx.uv.y + dv};
+    case Kind::kUV:
+      return {su * ctx.uv.x + du, sv * ctx.uv.y + dv};
     case Kind::kSpherical: {
       Vec3 d = normalize(texture_from_world.point(ctx.p));
       float theta = std::acos(std::clamp(d.z, -1.0f, 1.0f));
@@ -149,7 +160,8 @@ bool checker_first(const CheckerboardTexture& c, const TextureContext& ctx) {
 Spectrum TextureSet::spectrum(int i, const TextureContext& ctx, const Wavelengths& wl) const {
   const TextureNode& n = node(i);
   if (auto* c = std::get_if<ConstantTexture>(&n)) return c->spectrum.sample(wl);
-  if (auto* im = std::get_if<ImageTexture>(&n)) return rgb_texel_spectrum(image_rgb(*im, ctx), im->kind, wl);
+  if (auto* im = std::get_if<ImageTexture>(&n))
+    return rgb_texel_spectrum(image_rgb(*im, ctx), im->kind, wl);
   if (auto* c = std::get_if<CheckerboardTexture>(&n))
     return spectrum(checker_first(*c, ctx) ? c->tex1 : c->tex2, ctx, wl);
   if (auto* s = std::get_if<ScaleTexture>(&n)) {
@@ -168,7 +180,8 @@ float TextureSet::value(int i, const TextureContext& ctx) const {
   const TextureNode& n = node(i);
   if (auto* c = std::get_if<ConstantTexture>(&n)) return c->value;
   if (auto* im = std::get_if<ImageTexture>(&n)) return image_rgb(*im, ctx)[0];
-  if (auto* c = std::get_if<CheckerboardTexture>(&n)) return value(checker_first(*c, ctx) ? c->tex1 : c->tex2, ctx);
+  if (auto* c = std::get_if<CheckerboardTexture>(&n))
+    return value(checker_first(*c, ctx) ? c->tex1 : c->tex2, ctx);
   if (auto* s = std::get_if<ScaleTexture>(&n)) {
     float k = value(s->scale, ctx);
     return k == 0 ? 0 : value(s->tex, ctx) * k;

@@ -46,7 +46,8 @@ struct TexEncoding {
 // Reads an image through OpenImageIO (PNG, JPEG, TGA, EXR, PFM, HDR, TIFF, ...). Integer formats
 // are decoded with the encoding; float formats are kept as they are. Images are cached by path and
 // encoding. Throws Error naming the file.
-std::shared_ptr<const TexImage> load_texture_image(const std::string& path, const TexEncoding& encoding);
+std::shared_ptr<const TexImage> load_texture_image(const std::string& path,
+                                                   const TexEncoding& encoding);
 
 // pbrt-v4's TextureMapping2D: (s, t) from the surface point.
 struct TexMapping {
@@ -74,7 +75,7 @@ struct ImageTexture {
 // tex1 where the cells' integer coordinates sum to an even number, else tex2.
 struct CheckerboardTexture {
   int dimension = 2;
-  TexMapping mapping;           // 2D
+  TexMapping mapping;            // 2D
   Transform texture_from_world;  // 3D
   int tex1 = -1, tex2 = -1;
 };
@@ -85,7 +86,8 @@ struct ScaleTexture {
 struct MixTexture {
   int tex1 = -1, tex2 = -1, amount = -1;  // amount is a float texture
 };
-using TextureNode = std::variant<ConstantTexture, ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture>;
+using TextureNode =
+    std::variant<ConstantTexture, ImageTexture, CheckerboardTexture, ScaleTexture, MixTexture>;
 
 class TextureSet {
  public:

@@ -19,7 +19,8 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("bpm_texture_test_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    path_ = fs::temp_directory_path() /
+            ("bpm_texture_test_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -34,7 +35,8 @@ class TempDir {
 
 // Writes float values (width * height * channels, rows from the top) in the file's format,
 // converted to 8 bits for 8-bit formats.
-void write_image(const std::string& path, int w, int h, int channels, OIIO::TypeDesc format, const std::vector<float>& v) {
+void write_image(const std::string& path, int w, int h, int channels, OIIO::TypeDesc format,
+                 const std::vector<float>& v) {
   auto out = OIIO::ImageOutput::create(path);
   ASSERT_TRUE(out) << OIIO::geterror();
   OIIO::ImageSpec spec(w, h, channels, format);
@@ -43,7 +45,9 @@ void write_image(const std::string& path, int w, int h, int channels, OIIO::Type
   out->close();
 }
 
-float srgb_decode(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+float srgb_decode(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
 float byte(float v) { return std::round(v * 255) / 255; }
 
 const std::vector<float> kPixels = {0.2f, 0.5f, 1.0f, 0.0f, 0.25f, 0.75f};  // 2 x 1, RGB
@@ -146,9 +150,12 @@ TEST(TextureImage, PointAndBilinearLookups) {
   EXPECT_FLOAT_EQ(at(1.25f, 0.25f, TexFilter::kPoint, TexWrap::kBlack), 0);
   EXPECT_FLOAT_EQ(at(-0.25f, 0.75f, TexFilter::kPoint, TexWrap::kRepeat), 3);
   // The octahedral fold mirrors across the edge's middle.
-  EXPECT_FLOAT_EQ(img.texel(-1, 0, TexWrap::kOctahedralSphere)[0], img.texel(0, 1, TexWrap::kRepeat)[0]);
-  EXPECT_FLOAT_EQ(img.texel(1, -1, TexWrap::kOctahedralSphere)[0], img.texel(0, 0, TexWrap::kRepeat)[0]);
-  EXPECT_FLOAT_EQ(img.texel(2, 1, TexWrap::kOctahedralSphere)[0], img.texel(1, 0, TexWrap::kRepeat)[0]);
+  EXPECT_FLOAT_EQ(img.texel(-1, 0, TexWrap::kOctahedralSphere)[0],
+                  img.texel(0, 1, TexWrap::kRepeat)[0]);
+  EXPECT_FLOAT_EQ(img.texel(1, -1, TexWrap::kOctahedralSphere)[0],
+                  img.texel(0, 0, TexWrap::kRepeat)[0]);
+  EXPECT_FLOAT_EQ(img.texel(2, 1, TexWrap::kOctahedralSphere)[0],
+                  img.texel(1, 0, TexWrap::kRepeat)[0]);
 }
 
 TEST(TextureMapping, UvSphericalCylindricalPlanar) {
@@ -189,7 +196,9 @@ TEST(TextureSet, CheckerboardScaleAndMix) {
   CheckerboardTexture c2;
   c2.tex1 = a, c2.tex2 = b;
   int checker = ts.add(c2);
-  auto v = [&](int node, Vec3 p, Vec2 uv) { return ts.spectrum(node, TextureContext{p, uv}, wl)[0]; };
+  auto v = [&](int node, Vec3 p, Vec2 uv) {
+    return ts.spectrum(node, TextureContext{p, uv}, wl)[0];
+  };
   EXPECT_FLOAT_EQ(v(checker, {}, {0.5f, 0.5f}), 0.2f);
   EXPECT_FLOAT_EQ(v(checker, {}, {1.5f, 0.5f}), 0.8f);
   EXPECT_FLOAT_EQ(v(checker, {}, {-0.5f, 0.5f}), 0.8f);
@@ -233,10 +242,14 @@ TEST(TextureSet, ImageTexelsBecomeTheirColoursSpectrum) {
   TextureContext ctx{{}, {0.3f, 0.6f}};
   for (float u : {0.05f, 0.4f, 0.8f}) {
     Wavelengths wl = sample_wavelengths(u);
-    Spectrum want = SpectrumCurve::from_rgb(Rgb(0.7f, 0.3f, 0.1f), SpectrumKind::kAlbedo).sample(wl);
-    Spectrum want_half = SpectrumCurve::from_rgb(Rgb(0.35f, 0.15f, 0.05f), SpectrumKind::kAlbedo).sample(wl);
-    Spectrum want_inv = SpectrumCurve::from_rgb(Rgb(0.3f, 0.7f, 0.9f), SpectrumKind::kAlbedo).sample(wl);
-    Spectrum got = ts.spectrum(plain, ctx, wl), half = ts.spectrum(scaled, ctx, wl), inv = ts.spectrum(inverted, ctx, wl);
+    Spectrum want =
+        SpectrumCurve::from_rgb(Rgb(0.7f, 0.3f, 0.1f), SpectrumKind::kAlbedo).sample(wl);
+    Spectrum want_half =
+        SpectrumCurve::from_rgb(Rgb(0.35f, 0.15f, 0.05f), SpectrumKind::kAlbedo).sample(wl);
+    Spectrum want_inv =
+        SpectrumCurve::from_rgb(Rgb(0.3f, 0.7f, 0.9f), SpectrumKind::kAlbedo).sample(wl);
+    Spectrum got = ts.spectrum(plain, ctx, wl), half = ts.spectrum(scaled, ctx, wl),
+             inv = ts.spectrum(inverted, ctx, wl);
     for (int i = 0; i < Spectrum::kChannels; ++i) {
       EXPECT_NEAR(got[i], want[i], 0.01f) << wl.lambda[i];
       EXPECT_NEAR(half[i], want_half[i], 0.01f) << wl.lambda[i];
