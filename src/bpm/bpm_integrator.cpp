@@ -60,7 +60,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);
     // An iteration without its light pass would be a wrong image: it is dropped.
-    if (!complete) return PassResult{false};
+    if (!complete) return PassResult{false, 0, ""};
 
     // 2. Per-object sphere trees over the backward photons.
     t = Clock::now();
