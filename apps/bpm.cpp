@@ -104,8 +104,16 @@ void set_resolution(const std::string& resolution, FilmSettings* film) {
   film->height = h;
 }
 
+// The photon methods' settings on the file's Integrator line, read (and checked) right after
+// parsing, before the scene is built.
+struct IntegratorSettings {
+  BpmSettings bpm;
+  FpmSettings fpm;
+};
+
 // The scene file's settings, each overridden by its flag where one was given.
-RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls) {
+RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
+                             const IntegratorSettings& file) {
   RenderOptions opt;
   opt.integrator = a.integrator.empty() ? ls.render.integrator : a.integrator;
   opt.spp = a.spp > 0 ? a.spp : ls.render.spp;
@@ -117,8 +125,8 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls) {
   if (a.iterations > 0) opt.spp = a.iterations;  // one eye sample per pixel per iteration
   if (a.time > 0 && a.spp <= 0 && a.iterations <= 0)
     opt.spp = std::numeric_limits<int>::max();  // the time budget decides
-  opt.bpm = bpm_settings_from_file(ls.render.integrator_directive);
-  opt.fpm = fpm_settings_from_file(ls.render.integrator_directive);
+  opt.bpm = file.bpm;
+  opt.fpm = file.fpm;
   // Both photon methods read the same photon parameters from an Integrator line of either.
   static_cast<PhotonSettings&>(opt.fpm) = opt.bpm;
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
@@ -214,6 +222,8 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
 int run_render(const RenderArgs& a) {
   auto t_start = Clock::now();
   ParsedScene parsed = parse_scene_file(a.scene);
+  const IntegratorSettings file_settings{bpm_settings_from_file(parsed.integrator),
+                                         fpm_settings_from_file(parsed.integrator)};
   double t_parse = seconds_since(t_start);
 
   auto t1 = Clock::now();
@@ -221,7 +231,7 @@ int run_render(const RenderArgs& a) {
   double t_build = seconds_since(t1);
 
   if (!a.resolution.empty()) set_resolution(a.resolution, &ls.film);
-  RenderOptions opt = render_options(a, ls);
+  RenderOptions opt = render_options(a, ls, file_settings);
   std::string out = a.output;
   if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
   OutputPaths paths = output_paths(out);

@@ -45,6 +45,7 @@ RenderOptions test_options(const LoadedScene& ls, const std::string& integrator,
   RenderOptions opt = quiet_options(ls, integrator, passes, seed);
   opt.bpm = bpm;
   opt.fpm = fpm;
+  static_cast<PhotonSettings&>(opt.fpm) = bpm;  // radii and photon counts of both photon methods
   return opt;
 }
 

@@ -1,5 +1,5 @@
 // Ctrl-C and SIGTERM: the handlers only raise a flag; the render loops look at it between tiles,
-// chunks and passes, stop, and the image so far is still written.
+// blocks, photon batches and passes, stop, and the image so far is still written.
 #pragma once
 #include <atomic>
 

@@ -1,5 +1,5 @@
 // Stage 3 of a bpm iteration, the light pass (section 3 of the paper), in batches of photons until
-// the backward photons are covered (DESIGN.md, "photon passes per iteration"). Each batch runs in
+// the backward photons are covered. Each batch runs in
 // two phases. Phase one: photons travel as photons/light_path.h says; at each diffuse hit the hit
 // object's tree gives the backward photons whose spheres contain the hit, and each accepted pair
 // is appended as (backward photon, contribution) to the lists of its chunk, one list per mask

@@ -1,4 +1,4 @@
-// What a bpm render reports (DESIGN.md, "statistics every render reports"): rays and backward
+// What a bpm render reports: rays and backward
 // photons of the eye pass with the paper's Table 1 measures, bytes of maps, trees and entries,
 // photons, queries and batches of the light pass, and time per stage.
 #pragma once

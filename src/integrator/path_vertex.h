@@ -16,7 +16,7 @@ namespace bpm {
 struct PathState {
   Ray ray;
   Spectrum beta{1.0f};  // throughput
-  int medium = -1;      // the medium the ray travels in; cameras and lights start in vacuum
+  int medium = -1;      // the medium the ray travels in (-1: vacuum)
   float length = 0;     // world distance travelled, interfaces included
 };
 
@@ -30,6 +30,9 @@ struct PathVertex {
   Material storage;          // holds the material when it had to be resolved at sp
   Frame frame;               // shading frame
   Vec3 wo_local;
+  PathVertex() = default;
+  PathVertex(const PathVertex&) = delete;  // material may point into storage
+  PathVertex& operator=(const PathVertex&) = delete;
   int object() const { return hit.object; }
   const Material& m() const { return *material; }
 };
@@ -83,7 +86,7 @@ inline StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& 
 }
 
 // Samples the BSDF at v. The caller draws uc and u, in an order of its own that is fixed in the
-// code (argument evaluation order is not), so that every compiler gives the same image.
+// code (argument evaluation order is not), so that the image does not depend on the compiler.
 inline std::optional<BsdfSample> sample_bsdf(const PathVertex& v, float uc, Vec2 u,
                                              TransportMode mode) {
   return bsdf_sample(v.m(), v.wo_local, uc, u, mode);

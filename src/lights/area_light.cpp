@@ -46,7 +46,7 @@ struct AreaSample {
 };
 
 // Uniform point on the primitive (triangles; full spheres and disks, and cylinders, under
-// similarity transforms, which flatten.cpp guarantees for emitters).
+// similarity transforms, which flatten_shapes.cpp guarantees for emitters).
 AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
   if (std::holds_alternative<TriangleMesh>(shape)) {
     Vec2 b = sample_uniform_triangle(u);  // (b0, b1); surface_point takes (b1, b2)

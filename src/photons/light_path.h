@@ -75,7 +75,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
   PathState s{Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin,
                   le->direction, kInf},
               le->flux / pmf};
-  // Only area lights may touch a medium (flatten.cpp): the one on the side the photon leaves to.
+  // Only area lights may touch a medium (flatten_lights.cpp): the one on the side the photon leaves
+  // to.
   if (const auto* area = std::get_if<AreaLight>(&light))
     s.medium = medium_toward(scene, area->object, le->n_light, le->direction,
                              scene.objects[size_t(area->object)].medium_outside);

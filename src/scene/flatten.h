@@ -1,5 +1,6 @@
 // Turns the parsed scene into what rendering needs: the render scene (flat arrays + Embree), the
-// camera, film and filter settings, and the integrator settings the file asks for. Every value is
+// camera, film and filter settings, and the Integrator directive (each integrator reads its own
+// parameters from it). Every value is
 // read with pbrt-v4's meaning; what bpm cannot render faithfully is an error, never a silently
 // different image.
 #pragma once

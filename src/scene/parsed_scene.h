@@ -1,5 +1,6 @@
 // The scene as the file states it: directives with their parameters and transforms, before any
-// interpretation. flatten.cpp turns it into the render scene.
+// interpretation. flatten.cpp and its flatten_*.cpp parts turn it into the
+// render scene.
 #pragma once
 #include <map>
 #include <optional>

@@ -21,7 +21,7 @@ bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const Sur
 }
 
 int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx) {
-  // Nested mixes choose in turn; flatten.cpp rejects cycles, the bound is a safeguard.
+  // Nested mixes choose in turn; flatten_materials.cpp rejects cycles, the bound is a safeguard.
   for (int depth = 0; depth < 64; ++depth) {
     const auto* mix = std::get_if<MixDesc>(&scene.materials[size_t(material)]);
     if (!mix) return material;
