@@ -1,5 +1,5 @@
 // Spectral rendering support, following pbrt-v4's model (Pharr, Jakob, Humphreys, 4th ed., ch. 4):
-// - a path samples four wavelengths (Wavelengths) and carries its values there (Spectrum);
+// - a path samples eight wavelengths (Wavelengths) and carries its values there (Spectrum);
 // - scene colours become smooth spectra (SpectrumCurve): an RGB reflectance is the sigmoid of a
 //   quadratic (Jakob and Hanika 2019, "A Low-Dimensional Function Space for Efficient Spectral
 //   Upsampling") fitted so that it reproduces the RGB under the sRGB white (D65); an RGB light is
@@ -25,8 +25,8 @@ struct Wavelengths {
   std::array<float, Spectrum::kChannels> pdf{};  // density of each wavelength (per nm)
 };
 
-// Four wavelengths stratified over [kLambdaMin, kLambdaMax] from one uniform number, each drawn
-// with a density that follows the eye's sensitivity (a sech^2 lobe about 540 nm).
+// Spectrum::kChannels wavelengths stratified over [kLambdaMin, kLambdaMax] from one uniform number,
+// each drawn with a density that follows the eye's sensitivity (a sech^2 lobe about 540 nm).
 Wavelengths sample_wavelengths(float u);
 float wavelength_pdf(float lambda);
 

@@ -36,13 +36,11 @@ bool near_rel(double a, double b, double rel, double abs_tol = 0) {
   return std::fabs(a - b) <= rel * std::fmax(std::fabs(a), std::fabs(b)) + abs_tol;
 }
 
-// A spectrum at four wavelengths, for materials whose values differ per wavelength.
+// A spectrum whose values differ per wavelength: a, b, c, d repeated over the channels.
 Spectrum spec4(float a, float b, float c, float d) {
+  const float v[4] = {a, b, c, d};
   Spectrum s;
-  s[0] = a;
-  s[1] = b;
-  s[2] = c;
-  s[3] = d;
+  for (int i = 0; i < Spectrum::kChannels; ++i) s[i] = v[i % 4];
   return s;
 }
 

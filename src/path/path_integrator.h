@@ -18,7 +18,7 @@ struct PathSettings {
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings,
                        const Wavelengths& wl, Rng& rng, PathCounters& counters);
 
-// Passes of one sample per pixel, each with its own four wavelengths, until a budget ends the
+// Passes of one sample per pixel, each with its own eight wavelengths, until a budget ends the
 // render.
 RenderStats render_path(const LoadedScene& scene, const IntegratorOptions& options, Film* film);
 

@@ -18,11 +18,17 @@ namespace bpm {
 // a fixed order, so that sums do not depend on the thread count.
 constexpr int kPhotonsPerChunk = 1024;
 
-// The wavelengths of iteration `it` of a photon method: drawn afresh each iteration, independently
-// of everything else, so that iterations stay independent estimates (the error estimate needs it).
+// The wavelengths of iteration `it` of a photon method, shared by all its eye and light paths.
+// Within an iteration they are stratified (sample_wavelengths); across iterations the strata's
+// offset follows the golden-ratio sequence from a random start per seed, so that successive
+// iterations fill the spectrum evenly and the image's colour converges about as 1 / iterations
+// instead of 1 / sqrt(iterations). The offset of each iteration alone is uniform, so every
+// iteration is still an unbiased estimate of the image.
 inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
-  Rng rng(stream_key(seed ^ 0x7761766573ull, uint64_t(it), 0, 3));
-  return sample_wavelengths(rng.uniform());
+  Rng rng(stream_key(seed ^ 0x7761766573ull, 0, 0, 3));
+  double v = rng.uniform() + double(it) * 0.6180339887498949;
+  v -= std::floor(v);
+  return sample_wavelengths(float(v / Spectrum::kChannels));
 }
 
 // How a photon arrived: straight from the light, through specular vertices only, or after at
