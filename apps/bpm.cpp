@@ -195,6 +195,7 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                    {"stop_reason", st.stop_reason},
                    {"mean_sampling_probability", st.mean_sampling_probability},
                    {"relative_error_delta", st.relative_error},
+                   {"relative_error_delta_luminance", film.relative_error_luminance()},
                    {"m_images", film.m_images()},
                    {"relative_error_delta_m_images", film.relative_error_m_images()}};
   rec["rays"] = {

@@ -5,8 +5,10 @@
 //
 // The measured noise part comes from two renders with different seeds, a and b:
 // sum (a - b)^2 / 2 estimates sum Var, whatever the bias, so noise = sqrt(sum (a-b)^2 / 2 / sum
-// ref^2). The total error is measured against a path-traced reference with its own seed; the bias
-// part is what the total has beyond the noise of the render and of the reference.
+// ref^2), the sums running over pixels and the three channels (the colour delta the renderer
+// reports); the same in luminance alone for the last column. The total error is measured against a
+// path-traced reference with its own seed; the bias part is what the total has beyond the noise of
+// the render and of the reference.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -19,6 +21,8 @@
 using namespace bpm;
 
 namespace {
+
+std::vector<double> channels(const Image& img) { return {img.rgb.begin(), img.rgb.end()}; }
 
 std::vector<double> luminance(const Image& img) {
   std::vector<double> l(size_t(img.width) * img.height);
@@ -63,33 +67,43 @@ int main(int argc, char** argv) {
   }
   std::printf("== predicted against measured error, %dx%d, %d passes, reference: path %d spp ==\n",
               w, h, passes, ref_passes);
-  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5", "delta M=4",
-              "noise", "ratio", "total", "bias");
+  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5",
+              "delta M=4", "noise", "ratio", "total", "bias", "ratio lum");
   for (const char* name : {"cornell-box", "caustic-sphere"}) {
     LoadedScene ls =
         flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/" + name + ".pbrt"));
     ls.film.width = w;
     ls.film.height = h;
     Rendered ref = run(ls, "path", ref_passes, 0x5eed);
-    std::vector<double> lr = luminance(ref.film.image());
-    double ref_sum2 = 0;
-    for (double v : lr) ref_sum2 += v * v;
+    const Image ref_img = ref.film.image();
     double ref_delta = ref.film.relative_error();
+    // Noise between the seeds and error against the reference, relative to the reference.
+    auto measure = [&](const Image& ia, const Image& ib, bool colour, double* noise,
+                       double* total) {
+      std::vector<double> va = colour ? channels(ia) : luminance(ia);
+      std::vector<double> vb = colour ? channels(ib) : luminance(ib);
+      std::vector<double> vr = colour ? channels(ref_img) : luminance(ref_img);
+      double d_ab = 0, d_ar = 0, r2 = 0;
+      for (size_t i = 0; i < va.size(); ++i) {
+        d_ab += (va[i] - vb[i]) * (va[i] - vb[i]);
+        d_ar += (va[i] - vr[i]) * (va[i] - vr[i]);
+        r2 += vr[i] * vr[i];
+      }
+      *noise = std::sqrt(d_ab / 2 / r2);
+      *total = std::sqrt(d_ar / r2);
+    };
     for (const char* integrator : {"path", "bpm", "fpm"}) {
       int n = std::string(integrator) == "path" ? passes * 8 : passes;
       Rendered a = run(ls, integrator, n, 1), b = run(ls, integrator, n, 2);
-      std::vector<double> la = luminance(a.film.image()), lb = luminance(b.film.image());
-      double d_ab = 0, d_ar = 0;
-      for (size_t i = 0; i < la.size(); ++i) {
-        d_ab += (la[i] - lb[i]) * (la[i] - lb[i]);
-        d_ar += (la[i] - lr[i]) * (la[i] - lr[i]);
-      }
-      double noise = std::sqrt(d_ab / 2 / ref_sum2), total = std::sqrt(d_ar / ref_sum2);
+      double noise, total, noise_lum, total_lum;
+      measure(a.film.image(), b.film.image(), true, &noise, &total);
+      measure(a.film.image(), b.film.image(), false, &noise_lum, &total_lum);
       double bias =
           std::sqrt(std::fmax(0.0, total * total - noise * noise - ref_delta * ref_delta));
       double pred = a.film.relative_error();
-      std::printf("%-16s %-5s %10.4f %10.4f %10.4f %10.2f %10.4f %10.4f\n", name, integrator, pred,
-                  a.film.relative_error_m_images(), noise, pred / noise, total, bias);
+      std::printf("%-16s %-5s %10.4f %10.4f %10.4f %10.2f %10.4f %10.4f %10.2f\n", name, integrator,
+                  pred, a.film.relative_error_m_images(), noise, pred / noise, total, bias,
+                  a.film.relative_error_luminance() / noise_lum);
     }
   }
   std::printf(

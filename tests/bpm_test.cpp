@@ -674,7 +674,8 @@ TEST(Fpm, SameImageWithOneAndTwoThreads) {
 
 // The predicted image error delta (eq. 4 from eq. 5, and from M = 4 intermediate images) agrees
 // within a factor of 2 with the noise actually made, measured from two renders with different
-// seeds: sum (a - b)^2 / 2 estimates the summed per-pixel variance whatever the bias.
+// seeds: sum (a - b)^2 / 2 estimates the summed per-pixel variance whatever the bias. In colour
+// (over R, G and B) and in luminance.
 TEST(Accuracy, PredictedDeltaMatchesMeasuredNoise) {
   LoadedScene ls = load(cornell());
   for (const char* integrator : {"path", "bpm", "fpm"}) {
@@ -687,18 +688,26 @@ TEST(Accuracy, PredictedDeltaMatchesMeasuredNoise) {
     };
     Film a = run(1), b = run(2);
     Image ia = a.image(), ib = b.image();
-    double d2 = 0, l2 = 0;
+    // Over the three channels (the colour delta) and of the luminance alone.
+    double d2 = 0, v2 = 0, d2_lum = 0, v2_lum = 0;
     for (int y = 0; y < ia.height; ++y)
       for (int x = 0; x < ia.width; ++x) {
-        double la = ia.at(x, y).luminance(), lb = ib.at(x, y).luminance();
-        d2 += (la - lb) * (la - lb);
-        l2 += 0.25 * (la + lb) * (la + lb);
+        Rgb ca = ia.at(x, y), cb = ib.at(x, y);
+        for (int c = 0; c < 3; ++c) {
+          d2 += (ca[c] - cb[c]) * (ca[c] - cb[c]);
+          v2 += 0.25 * (ca[c] + cb[c]) * (ca[c] + cb[c]);
+        }
+        double la = ca.luminance(), lb = cb.luminance();
+        d2_lum += (la - lb) * (la - lb);
+        v2_lum += 0.25 * (la + lb) * (la + lb);
       }
-    double noise = std::sqrt(d2 / 2 / l2);
+    double noise = std::sqrt(d2 / 2 / v2), noise_lum = std::sqrt(d2_lum / 2 / v2_lum);
     EXPECT_GT(a.relative_error(), noise / 2) << integrator;
     EXPECT_LT(a.relative_error(), noise * 2) << integrator;
     EXPECT_GT(a.relative_error_m_images(), noise / 2) << integrator;
     EXPECT_LT(a.relative_error_m_images(), noise * 2) << integrator;
+    EXPECT_GT(a.relative_error_luminance(), noise_lum / 2) << integrator;
+    EXPECT_LT(a.relative_error_luminance(), noise_lum * 2) << integrator;
   }
 }
 

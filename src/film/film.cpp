@@ -3,36 +3,27 @@
 #include <cmath>
 
 namespace bpm {
+namespace {
+
+// eq. (5): RMS^2 = (1/N) (mean(L^2) - mean(L)^2), with Bessel's correction: the standard error of
+// the mean of N pass estimates whose sum and sum of squares are given.
+float standard_error(double sum, double sum2, int passes) {
+  if (passes < 2) return 0;
+  double n = passes, mean = sum / n;
+  double var = std::fmax(0.0, (sum2 / n - mean * mean)) * n / (n - 1);
+  return float(std::sqrt(var / n));
+}
+
+}  // namespace
 
 Film::Film(int width, int height, int m_images)
     : width_(width),
       height_(height),
       pixels_(size_t(width) * height),
       m_(m_images > 1 ? m_images : 0) {
-  m_sum_.assign(pixels_.size() * size_t(m_), 0.0);
+  m_sum_.assign(pixels_.size() * size_t(m_) * 3, 0.0);
   m_count_.assign(pixels_.size() * size_t(m_), 0);
 }
-
-std::vector<float> Film::rms_m_images() const {
-  std::vector<float> out(pixels_.size(), 0.0f);
-  if (m_ == 0) return out;
-  for (size_t i = 0; i < pixels_.size(); ++i) {
-    const double* s = &m_sum_[i * m_];
-    const int* c = &m_count_[i * m_];
-    double mean = 0, var = 0;
-    bool full = true;
-    for (int k = 0; k < m_; ++k) full = full && c[k] > 0;
-    if (!full) continue;
-    for (int k = 0; k < m_; ++k) mean += s[k] / c[k];
-    mean /= m_;
-    for (int k = 0; k < m_; ++k) var += (s[k] / c[k] - mean) * (s[k] / c[k] - mean);
-    // The standard deviation between the M images, over sqrt(M): the error of their average.
-    out[i] = float(std::sqrt(var / (m_ - 1) / m_));
-  }
-  return out;
-}
-
-double Film::relative_error_m_images() const { return m_ == 0 ? 0 : delta_from(rms_m_images()); }
 
 Image Film::image(float scale) const {
   Image img;
@@ -47,32 +38,98 @@ Image Film::image(float scale) const {
   return img;
 }
 
-std::vector<float> Film::rms() const {
-  std::vector<float> out(pixels_.size(), 0.0f);
+std::vector<float> Film::rms_rgb() const {
+  std::vector<float> out(pixels_.size() * 3, 0.0f);
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const Pixel& p = pixels_[i];
-    if (p.passes < 2) continue;
-    double n = p.passes, mean = p.sum_e / n;
-    // eq. (5): RMS_i^2 = (1/N) (mean(L^2) - mean(L)^2), with Bessel's correction.
-    double var = std::fmax(0.0, (p.sum_e2 / n - mean * mean)) * n / (n - 1);
-    out[i] = float(std::sqrt(var / n));
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = standard_error(p.sum_e[c], p.sum_e2[c], p.passes);
   }
   return out;
 }
 
-double Film::relative_error() const { return delta_from(rms()); }
+std::vector<float> Film::rms() const {
+  std::vector<float> out(pixels_.size(), 0.0f);
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    out[i] = standard_error(p.sum_y, p.sum_y2, p.passes);
+  }
+  return out;
+}
 
-double Film::delta_from(const std::vector<float>& r) const {
+double Film::delta_rgb(const std::vector<float>& r) const {
   double num = 0, den = 0;
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const Pixel& p = pixels_[i];
     if (p.passes == 0) continue;
-    double mean = p.sum_e / p.passes;
+    for (int c = 0; c < 3; ++c) {
+      double mean = p.sum_e[c] / p.passes;
+      num += double(r[3 * i + c]) * r[3 * i + c];
+      den += mean * mean;
+    }
+  }
+  return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
+}
+
+double Film::relative_error() const { return delta_rgb(rms_rgb()); }
+
+double Film::relative_error_luminance() const {
+  std::vector<float> r = rms();
+  double num = 0, den = 0;
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    if (p.passes == 0) continue;
+    double mean = p.sum_y / p.passes;
     num += double(r[i]) * r[i];
     den += mean * mean;
   }
   return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
 }
+
+std::vector<float> Film::rms_m_images_rgb() const {
+  std::vector<float> out(pixels_.size() * 3, 0.0f);
+  if (m_ == 0) return out;
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const int* count = &m_count_[i * size_t(m_)];
+    bool full = true;
+    for (int k = 0; k < m_; ++k) full = full && count[k] > 0;
+    if (!full) continue;
+    for (int c = 0; c < 3; ++c) {
+      double mean = 0, var = 0;
+      for (int k = 0; k < m_; ++k) mean += m_sum_[3 * (i * m_ + k) + c] / count[k];
+      mean /= m_;
+      for (int k = 0; k < m_; ++k) {
+        double d = m_sum_[3 * (i * m_ + k) + c] / count[k] - mean;
+        var += d * d;
+      }
+      // The standard deviation between the M images, over sqrt(M): the error of their average.
+      out[3 * i + c] = float(std::sqrt(var / (m_ - 1) / m_));
+    }
+  }
+  return out;
+}
+
+std::vector<float> Film::rms_m_images() const {
+  std::vector<float> out(pixels_.size(), 0.0f);
+  if (m_ == 0) return out;
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const int* count = &m_count_[i * size_t(m_)];
+    bool full = true;
+    for (int k = 0; k < m_; ++k) full = full && count[k] > 0;
+    if (!full) continue;
+    auto image_luminance = [&](int k) {
+      double e[3];
+      for (int c = 0; c < 3; ++c) e[c] = m_sum_[3 * (i * m_ + k) + c] / count[k];
+      return luminance(e);
+    };
+    double mean = 0, var = 0;
+    for (int k = 0; k < m_; ++k) mean += image_luminance(k) / m_;
+    for (int k = 0; k < m_; ++k) var += (image_luminance(k) - mean) * (image_luminance(k) - mean);
+    out[i] = float(std::sqrt(var / (m_ - 1) / m_));
+  }
+  return out;
+}
+
+double Film::relative_error_m_images() const { return m_ == 0 ? 0 : delta_rgb(rms_m_images_rgb()); }
 
 std::vector<float> Film::pass_counts() const {
   std::vector<float> out(pixels_.size());

@@ -41,54 +41,72 @@ class Film {
 
   void add_sample(int x, int y, const Rgb& L, float weight) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
-    for (int c = 0; c < 3; ++c) p.sum_wl[c] += double(weight) * L[c];
+    for (int c = 0; c < 3; ++c) {
+      p.sum_wl[c] += double(weight) * L[c];
+      p.pass_wl[c] += double(weight) * L[c];
+    }
     p.sum_w += weight;
-    p.pass_wl += double(weight) * L.luminance();
     p.pass_w += weight;
   }
   // Ends the current pass for one pixel: its pass estimate joins the running moments.
   void end_pass(int x, int y) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
     if (p.pass_w != 0) {
-      double e = p.pass_wl / p.pass_w;
-      p.sum_e += e;
-      p.sum_e2 += e * e;
+      double e[3];
+      for (int c = 0; c < 3; ++c) {
+        e[c] = p.pass_wl[c] / p.pass_w;
+        p.sum_e[c] += e[c];
+        p.sum_e2[c] += e[c] * e[c];
+      }
+      double y_e = luminance(e);
+      p.sum_y += y_e;
+      p.sum_y2 += y_e * y_e;
       if (m_ > 0) {
-        size_t k = size_t(y) * width_ * m_ + x * size_t(m_) + size_t(p.passes % m_);
-        m_sum_[k] += e;
-        ++m_count_[k];
+        size_t k = 3 * ((size_t(y) * width_ + x) * size_t(m_) + size_t(p.passes % m_));
+        for (int c = 0; c < 3; ++c) m_sum_[k + c] += e[c];
+        ++m_count_[k / 3];
       }
       ++p.passes;
     }
-    p.pass_wl = p.pass_w = 0;
+    p.pass_wl[0] = p.pass_wl[1] = p.pass_wl[2] = p.pass_w = 0;
   }
 
   Image image(float scale = 1) const;
-  // Per-pixel standard error of the luminance mean (eq. 5), and the image error delta (eq. 4).
+  // Per-pixel standard error (eq. 5) of the mean of each channel, R G B per pixel, and of the
+  // luminance.
+  std::vector<float> rms_rgb() const;
   std::vector<float> rms() const;
+  // The image error delta (eq. 4) over the three channels, sqrt(sum RMS_ic^2 / sum L_ic^2): what
+  // the accuracy budget and the progress line use, so that an error of colour counts; and delta
+  // of the luminance alone.
   double relative_error() const;
+  double relative_error_luminance() const;
   std::vector<float> pass_counts() const;
   // The M-images estimates: per-pixel standard error of the mean from the spread of the M image
-  // means, and the image error delta from them (eq. 4). Zero until every image has a pass.
+  // means (per channel, and of the luminance), and delta over the channels from them. Zero until
+  // every image of a pixel has a pass.
   int m_images() const { return m_; }
+  std::vector<float> rms_m_images_rgb() const;
   std::vector<float> rms_m_images() const;
   double relative_error_m_images() const;
 
  private:
-  // eq. (4) from per-pixel standard errors.
-  double delta_from(const std::vector<float>& rms) const;
+  static double luminance(const double* c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+  // eq. (4) from per-pixel standard errors of the three channels.
+  double delta_rgb(const std::vector<float>& rms_rgb) const;
   struct Pixel {
     double sum_wl[3] = {0, 0, 0};
     double sum_w = 0;
-    double pass_wl = 0, pass_w = 0;
-    double sum_e = 0, sum_e2 = 0;
+    double pass_wl[3] = {0, 0, 0}, pass_w = 0;
+    double sum_e[3] = {0, 0, 0}, sum_e2[3] = {0, 0, 0};  // per-pass estimates, per channel
+    double sum_y = 0, sum_y2 = 0;                        // and of their luminance
     int passes = 0;
   };
   int width_, height_;
   std::vector<Pixel> pixels_;
   int m_ = 0;
-  std::vector<double> m_sum_;
-  std::vector<int> m_count_;
+  std::vector<double> m_sum_;  // [pixel][image][channel]
+  std::vector<int> m_count_;   // [pixel][image]
 };
 
 }  // namespace bpm

@@ -18,15 +18,19 @@ OutputPaths output_paths(const std::string& exr) {
 
 Image error_false_colour(const Film& film) {
   Image img = film.image();
-  std::vector<float> rms = film.rms();
+  std::vector<float> rms = film.rms_rgb();
   Image out;
   out.width = img.width;
   out.height = img.height;
   out.rgb.resize(img.rgb.size());
-  for (size_t i = 0; i < rms.size(); ++i) {
-    Rgb c(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]);
-    float lum = c.luminance();
-    float rel = lum > 1e-6f ? rms[i] / lum : (rms[i] > 0 ? 1.0f : 0.0f);
+  for (size_t i = 0; i < img.rgb.size() / 3; ++i) {
+    // The pixel's error relative to its value, over the three channels (as eq. 4 per pixel).
+    double e2 = 0, v2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      e2 += double(rms[3 * i + c]) * rms[3 * i + c];
+      v2 += double(img.rgb[3 * i + c]) * img.rgb[3 * i + c];
+    }
+    float rel = v2 > 1e-12 ? float(std::sqrt(e2 / v2)) : (e2 > 0 ? 1.0f : 0.0f);
     float t = std::clamp(rel / 0.1f, 0.0f, 1.0f);
     // blue (0) -> green (0.5) -> red (1)
     out.rgb[3 * i] = std::clamp(2 * t - 1, 0.0f, 1.0f);
@@ -36,17 +40,44 @@ Image error_false_colour(const Film& film) {
   return out;
 }
 
+namespace {
+
+// Per-pixel values, scaled: one vector, or three (R, G, B) from an interleaved one.
+std::vector<float> scaled(std::vector<float> v, float s) {
+  for (float& x : v) x *= s;
+  return v;
+}
+std::vector<float> channel(const std::vector<float>& rgb, int c, float s) {
+  std::vector<float> out(rgb.size() / 3);
+  for (size_t i = 0; i < out.size(); ++i) out[i] = rgb[3 * i + size_t(c)] * s;
+  return out;
+}
+
+}  // namespace
+
 void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio) {
   Image img = film.image(imaging_ratio);
-  std::vector<float> rms = film.rms();
-  for (float& r : rms) r *= imaging_ratio;
   std::vector<float> passes = film.pass_counts();
-  std::vector<float> rms_m = film.rms_m_images();
-  for (float& r : rms_m) r *= imaging_ratio;
-  if (film.m_images() > 0)
-    write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}, {"rms_m_images", &rms_m}});
-  else
-    write_exr(paths.exr, img, {{"rms", &rms}, {"passes", &passes}});
+  // eq. (5) of the luminance and of each channel; the same from the M images.
+  std::vector<std::vector<float>> values;
+  std::vector<std::string> names;
+  auto add = [&](const std::string& name, std::vector<float> v) {
+    names.push_back(name);
+    values.push_back(std::move(v));
+  };
+  add("rms", scaled(film.rms(), imaging_ratio));
+  std::vector<float> rgb = film.rms_rgb();
+  for (int c = 0; c < 3; ++c) add(std::string("rms.") + "RGB"[c], channel(rgb, c, imaging_ratio));
+  add("passes", passes);
+  if (film.m_images() > 0) {
+    add("rms_m_images", scaled(film.rms_m_images(), imaging_ratio));
+    std::vector<float> m_rgb = film.rms_m_images_rgb();
+    for (int c = 0; c < 3; ++c)
+      add(std::string("rms_m_images.") + "RGB"[c], channel(m_rgb, c, imaging_ratio));
+  }
+  std::vector<ExtraChannel> extra;
+  for (size_t k = 0; k < names.size(); ++k) extra.push_back({names[k], &values[k]});
+  write_exr(paths.exr, img, extra);
   write_png(paths.png, img);
   write_png_display(paths.error_png, error_false_colour(film));
 }

@@ -44,20 +44,26 @@ bool RenderControl::keep_going(int done) {
 }
 
 void RenderControl::update_probabilities() {
-  std::vector<float> rms = film_.rms();
+  std::vector<float> rms = film_.rms_rgb();
   Image img = film_.image();
-  size_t n = rms.size();
-  // Relative RMS, with a small share of the image's mean added to the denominator so that black
+  size_t n = rms.size() / 3;
+  // Relative RMS over the three channels (an error of colour counts as much as one of
+  // brightness), with a small share of the image's mean added to the denominator so that black
   // pixels (rms 0 / mean 0) are not declared infinitely noisy.
-  std::vector<double> lum(n);
+  std::vector<double> value(n), error(n);
   double image_mean = 0;
   for (size_t i = 0; i < n; ++i) {
-    lum[i] = Rgb(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]).luminance();
-    image_mean += lum[i] / double(n);
+    double v2 = 0, e2 = 0;
+    for (int c = 0; c < 3; ++c) {
+      v2 += double(img.rgb[3 * i + c]) * img.rgb[3 * i + c];
+      e2 += double(rms[3 * i + c]) * rms[3 * i + c];
+    }
+    value[i] = std::sqrt(v2);
+    error[i] = std::sqrt(e2);
+    image_mean += value[i] / double(n);
   }
   std::vector<float> rel(n);
-  for (size_t i = 0; i < n; ++i)
-    rel[i] = float(rms[i] / (std::fabs(lum[i]) + 0.01 * image_mean + 1e-12));
+  for (size_t i = 0; i < n; ++i) rel[i] = float(error[i] / (value[i] + 0.01 * image_mean + 1e-12));
   // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
   std::vector<float> sorted = rel;
   size_t k = std::min(n - 1, size_t(0.9 * double(n)));
