@@ -1,6 +1,7 @@
 // Sampling routines; each says in its name the measure of the density it returns.
 #pragma once
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "base/vec.h"
@@ -57,6 +58,17 @@ inline Vec2 sample_uniform_triangle(Vec2 u) {
     b0 = u.x - b1;
   }
   return {b0, b1};
+}
+
+// The base-2 radical inverse of i (van der Corput): its bits mirrored about the binary point. The
+// first 2^k values fall one in each interval of width 2^-k.
+inline double radical_inverse_base2(uint32_t i) {
+  i = (i << 16) | (i >> 16);
+  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+  i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+  i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+  i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+  return double(i) * 0x1p-32;
 }
 
 inline float power_heuristic(float pdf_a, float pdf_b) {

@@ -96,4 +96,24 @@ TEST(Distribution2D, SamplesFollowTheWeights) {
 }
 
 }  // namespace
+// The first 2^k values of the van der Corput sequence fall one in each interval of width 2^-k,
+// whatever k, so the photon methods' wavelength offsets are stratified at every power of two.
+TEST(RadicalInverse, FirstPowerOfTwoValuesStratify) {
+  EXPECT_EQ(radical_inverse_base2(0), 0.0);
+  EXPECT_EQ(radical_inverse_base2(1), 0.5);
+  EXPECT_EQ(radical_inverse_base2(2), 0.25);
+  EXPECT_EQ(radical_inverse_base2(3), 0.75);
+  for (int k = 0; k <= 10; ++k) {
+    const uint32_t n = 1u << k;
+    std::vector<int> hits(n, 0);
+    for (uint32_t i = 0; i < n; ++i) {
+      double v = radical_inverse_base2(i);
+      ASSERT_GE(v, 0.0);
+      ASSERT_LT(v, 1.0);
+      ++hits[size_t(v * n)];
+    }
+    for (uint32_t j = 0; j < n; ++j) EXPECT_EQ(hits[j], 1) << "k " << k << " interval " << j;
+  }
+}
+
 }  // namespace bpm

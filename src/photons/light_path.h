@@ -20,13 +20,13 @@ constexpr int kPhotonsPerChunk = 1024;
 
 // The wavelengths of iteration `it` of a photon method, shared by all its eye and light paths.
 // Within an iteration they are stratified (sample_wavelengths); across iterations the strata's
-// offset follows the golden-ratio sequence from a random start per seed, so that successive
-// iterations fill the spectrum evenly and the image's colour converges about as 1 / iterations
-// instead of 1 / sqrt(iterations). The offset of each iteration alone is uniform, so every
-// iteration is still an unbiased estimate of the image.
+// offset follows the van der Corput sequence shifted by a random start per seed, so that the
+// first 2^k iterations put one offset in each 2^-k of the stratum: the spectrum is covered evenly
+// and the image's colour converges about as 1 / iterations instead of 1 / sqrt(iterations). The
+// offset of each iteration alone is uniform, so every iteration is still an unbiased estimate.
 inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
   Rng rng(stream_key(seed ^ 0x7761766573ull, 0, 0, 3));
-  double v = rng.uniform() + double(it) * 0.6180339887498949;
+  double v = rng.uniform() + radical_inverse_base2(uint32_t(it));
   v -= std::floor(v);
   return sample_wavelengths(float(v / Spectrum::kChannels));
 }
