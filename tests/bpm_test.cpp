@@ -223,7 +223,7 @@ std::string cornell(
 
 // A glass sphere on a floor under a small light: the caustic is the test's subject.
 // absorbing: the glass is filled with a green absorbing medium (pbrt-v4 MediumInterface).
-std::string caustic_scene(bool absorbing = false) {
+std::string caustic_scene(bool absorbing = false, const std::string& eta = "\"float eta\" 1.5") {
   std::string s = absorbing ? "MakeNamedMedium \"green\" \"string type\" \"homogeneous\" \"rgb "
                               "sigma_a\" [1.5 1.5 1.5] "
                               "\"rgb sigma_s\" [0 0 0]\n"
@@ -239,7 +239,7 @@ std::string caustic_scene(bool absorbing = false) {
        quad(-1.5f, -1.5f, 1.5f, 2, 0, false);
   s += "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.5 0 2  1.5 0 2  "
        "1.5 2 2  -1.5 2 2]\n";
-  s += "AttributeBegin\nMaterial \"dielectric\" \"float eta\" 1.5\nTranslate 0 0.45 0.3\n";
+  s += "AttributeBegin\nMaterial \"dielectric\" " + eta + "\nTranslate 0 0.45 0.3\n";
   if (absorbing) s += "MediumInterface \"green\" \"\"\n";
   s += "Shape \"sphere\" \"float radius\" 0.45\nAttributeEnd\n";
   return s;
@@ -408,6 +408,25 @@ TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
 TEST(Bpm, GlassSphereCausticConvergesToPath) {
   LoadedScene ls = load(caustic_scene());
   expect_bpm_converges(ls, render_with(ls, "path", 4096).film, 5);
+}
+
+// The same caustic through dispersive glass (Schott SF11): eye paths and photons that pass the
+// glass follow their hero wavelength alone, and a photon and a backward photon that both did must
+// count the hero's scaling once (hero_join_factor). Any slip shows as a caustic that is too bright
+// or too dark against path, which handles a single path.
+TEST(Bpm, DispersiveGlassCausticConvergesToPath) {
+  LoadedScene ls = load(caustic_scene(false, "\"spectrum eta\" \"glass-F11\""));
+  const Film ref = render_with(ls, "path", 4096).film;
+  expect_bpm_converges(ls, ref, 6);
+  BpmSettings s = small_batches(0);
+  s.photons_per_batch = 8192;
+  for (bool gather : {false, true}) {
+    FpmSettings f;
+    f.final_gather = gather;
+    Iterations its = render_iterations(ls, "fpm", 120, 3, s, f);
+    std::string what = std::string("fpm ") + (gather ? "final gather" : "direct");
+    expect_blocks_agree(its, ref, 8, edge_bias(s, 120, 8), what);
+  }
 }
 
 // A furnace whose material is pbrt-v4's mix of two diffuse materials (0.2 and 0.8, amount 0.25),

@@ -25,6 +25,17 @@ struct Wavelengths {
   std::array<float, Spectrum::kChannels> pdf{};  // density of each wavelength (per nm)
 };
 
+// The estimate of a path that from some vertex on follows the first (hero) wavelength alone,
+// because what it met there sends each wavelength its own way (dispersion): the others are
+// dropped and the hero's value is scaled by the number of wavelengths, as pbrt-v4's
+// TerminateSecondary does through the densities. The hero alone is an unbiased estimate because
+// its wavelength has the full sampling density (each channel's does).
+inline Spectrum hero_wavelength_only(const Spectrum& s) {
+  Spectrum r;
+  r[0] = s[0] * Spectrum::kChannels;
+  return r;
+}
+
 // Spectrum::kChannels wavelengths stratified over [kLambdaMin, kLambdaMax] from one uniform number,
 // each drawn with a density that follows the eye's sensitivity (a sech^2 lobe about 540 nm).
 Wavelengths sample_wavelengths(float u);

@@ -24,6 +24,7 @@ struct BackwardPhoton {
   uint16_t eye_depth;     // scattering events on the eye path, this vertex included
   uint8_t accepts;        // AcceptMask bits
   uint8_t diffuse_index;  // j - 1 for the j-th diffuse vertex (0..3)
+  bool hero_only;         // the eye path keeps its hero wavelength alone (PathState)
 
   bool accepts_class(PhotonClass c) const {
     return (c == PhotonClass::kCaustic && (accepts & kAcceptsCaustic)) ||

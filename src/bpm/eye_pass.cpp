@@ -30,6 +30,7 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
   bp.eye_depth = uint16_t(std::min(depth, 65535));
   bp.accepts = last ? (kAcceptsCaustic | kAcceptsIndirect) : kAcceptsCaustic;
   bp.diffuse_index = uint8_t(diffuse - 1);
+  bp.hero_only = s.hero_only;
   return bp;
 }
 
@@ -53,6 +54,7 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       break;
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
+    keep_hero_wavelength_at(v, s);
     bool is_diffuse = !bsdf_is_specular(v.m());
     if (is_diffuse) {
       ++diffuse;

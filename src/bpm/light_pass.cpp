@@ -23,7 +23,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`.
 void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                    const std::vector<uint16_t>& owner, int object, const SurfacePoint& sp, Vec3 wi,
-                   const Spectrum& flux, PhotonClass cls, int bounces,
+                   const Spectrum& flux, PhotonClass cls, int bounces, bool hero_only,
                    std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   ++counters.queries;
   maps.query(object, sp.p, [&](uint32_t g) {
@@ -37,6 +37,7 @@ void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
             : prm.photon_materials[g];
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
+    if (hero_only && bp.hero_only) value *= hero_join_factor(true, true);
     out[owner[bp.pixel]].push_back({g, value});
     ++counters.entries;
   });
@@ -63,8 +64,8 @@ void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Ligh
   // estimation counts direct light).
   trace_light_path(scene, *prm.materials, prm.max_depth, 1, rng, counters, [&](const PhotonHit& h) {
     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
-      gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, out,
-                    counters);
+      gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, h.hero_only,
+                    out, counters);
   });
 }
 

@@ -14,8 +14,8 @@ namespace {
 // sum f dPhi / (pi r^2 N). With knn > 0 the radius is the distance to the knn-th nearest
 // photon within `radius` (Jensen's estimate), else `radius`.
 template <class Accept>
-Spectrum estimate(const PhotonMap& map, const PathVertex& v, float radius, int eye_depth,
-                  const FpmEyeParams& prm, Accept&& accept, FpmEyeCounters& c) {
+Spectrum estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only, float radius,
+                  int eye_depth, const FpmEyeParams& prm, Accept&& accept, FpmEyeCounters& c) {
   ++c.lookups;
   const SurfacePoint& sp = v.sp;
   auto usable = [&](const ForwardPhoton& ph) {
@@ -38,7 +38,8 @@ Spectrum estimate(const PhotonMap& map, const PathVertex& v, float radius, int e
     const ForwardPhoton& ph = map.photons[i];
     if (!usable(ph)) return;
     ++c.photons_used;
-    sum += photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux);
+    sum += photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux) *
+           hero_join_factor(eye_hero_only, ph.hero_only);
   });
   return sum * float(1.0 / (kPi * double(r) * r * prm.emitted));
 }
@@ -65,21 +66,22 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
     if (next_eye_vertex(scene, *prm.materials, s, v, c.rays, emitter, L) != StepEnd::kVertex) break;
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
+    keep_hero_wavelength_at(v, s);
     if (!bsdf_is_specular(v.m())) {
       float r1 = s.length * prm.radius_per_length1;
       if (gathering) {
         // x2: everything the global map holds, direct photons included.
-        L += s.beta * estimate(maps.global, v, r1, depth, prm, any_class, c);
+        L += s.beta * estimate(maps.global, v, s.hero_only, r1, depth, prm, any_class, c);
         break;
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
                                         v.wo_local, false, wl, rng, c.rays);
-      L += s.beta * estimate(maps.caustic, v, s.length * prm.radius_per_length0, depth, prm,
-                             caustic_class, c);
+      L += s.beta * estimate(maps.caustic, v, s.hero_only, s.length * prm.radius_per_length0, depth,
+                             prm, caustic_class, c);
       if (!prm.fpm->final_gather) {
-        L += s.beta * estimate(maps.global, v, r1, depth, prm, indirect_class, c);
+        L += s.beta * estimate(maps.global, v, s.hero_only, r1, depth, prm, indirect_class, c);
         break;
       }
       gathering = true;

@@ -37,8 +37,9 @@ void trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& 
             trace_light_path(
                 scene, wm, max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
                   if (hit.bounces + min_eye_vertices > max_depth) return;
-                  ForwardPhoton ph{hit.sp.p, hit.wi, hit.sp.ng, hit.flux, uint16_t(hit.bounces),
-                                   hit.cls};
+                  ForwardPhoton ph{
+                      hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
+                      hit.cls,  hit.hero_only};
                   ch.global.push_back(ph);
                   if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
                   ++lc.entries;

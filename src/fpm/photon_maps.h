@@ -20,6 +20,7 @@ struct ForwardPhoton {
   Spectrum flux;
   uint16_t bounces;
   PhotonClass cls;
+  bool hero_only;  // the photon keeps its hero wavelength alone (PathState)
 };
 
 struct PhotonMap {

@@ -15,9 +15,10 @@ namespace bpm {
 // A path between two vertices.
 struct PathState {
   Ray ray;
-  Spectrum beta{1.0f};  // throughput
-  int medium = -1;      // the medium the ray travels in (-1: vacuum)
-  float length = 0;     // world distance travelled, interfaces included
+  Spectrum beta{1.0f};     // throughput
+  int medium = -1;         // the medium the ray travels in (-1: vacuum)
+  float length = 0;        // world distance travelled, interfaces included
+  bool hero_only = false;  // only the first wavelength goes on (hero_wavelength_only)
 };
 
 // A surface where the path scatters.
@@ -90,6 +91,20 @@ inline StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& 
 inline std::optional<BsdfSample> sample_bsdf(const PathVertex& v, float uc, Vec2 u,
                                              TransportMode mode) {
   return bsdf_sample(v.m(), v.wo_local, uc, u, mode);
+}
+
+// At a dispersive surface the path goes on at its hero wavelength alone (once: the scaling of
+// hero_wavelength_only applies to the whole path).
+inline void keep_hero_wavelength_at(const PathVertex& v, PathState& s) {
+  if (s.hero_only || !material_is_dispersive(v.m())) return;
+  s.beta = hero_wavelength_only(s.beta);
+  s.hero_only = true;
+}
+
+// Two half paths that meet (a photon and a gathering point) each scaled the hero by the number of
+// wavelengths when they kept it alone; the full path must be scaled once.
+inline float hero_join_factor(bool eye_hero_only, bool light_hero_only) {
+  return eye_hero_only && light_hero_only ? 1.0f / Spectrum::kChannels : 1.0f;
 }
 
 // Leaves v toward wi (world): the medium on that side, and a ray lifted off the surface.

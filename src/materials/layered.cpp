@@ -51,7 +51,7 @@ struct Layer {
   float thickness;
   int max_depth, samples;
   Layer(const CoatLayer& c, Material base_material)
-      : top{c.eta, c.roughness},
+      : top{c.eta, c.roughness, nullptr},
         base(std::move(base_material)),
         thickness(c.thickness),
         max_depth(c.max_depth),

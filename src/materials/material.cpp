@@ -38,8 +38,16 @@ struct Resolver {
     }
     return c;
   }
-  Material operator()(const DielectricMaterial& d) const { return d; }
-  Material operator()(const ThinDielectricMaterial& d) const { return d; }
+  Material operator()(const DielectricMaterial& d) const {
+    DielectricMaterial r = d;
+    if (d.eta_spectrum) r.eta = d.eta_spectrum->value(wl.lambda[0]);
+    return r;
+  }
+  Material operator()(const ThinDielectricMaterial& d) const {
+    ThinDielectricMaterial r = d;
+    if (d.eta_spectrum) r.eta = d.eta_spectrum->value(wl.lambda[0]);
+    return r;
+  }
   Material operator()(const DiffuseTransmissionDesc& d) const {
     return DiffuseTransmissionMaterial{eval(d.reflectance), eval(d.transmittance)};
   }
@@ -107,6 +115,12 @@ bool material_is_textured(const MaterialDesc& desc) {
     bool operator()(const MixDesc&) const { return true; }
   };
   return std::visit(V{}, desc);
+}
+
+bool material_is_dispersive(const Material& m) {
+  if (const auto* d = std::get_if<DielectricMaterial>(&m)) return d->eta_spectrum != nullptr;
+  if (const auto* t = std::get_if<ThinDielectricMaterial>(&m)) return t->eta_spectrum != nullptr;
+  return false;
 }
 
 }  // namespace bpm

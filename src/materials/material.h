@@ -5,6 +5,7 @@
 // sample() returns f, wi, and pdf_solid_angle; `mode` says whether radiance (camera paths) or
 // importance (light paths) flows, which matters for refraction (eta^2 scaling, Veach 1997 5.2).
 #pragma once
+#include <memory>
 #include <optional>
 #include <variant>
 
@@ -32,13 +33,20 @@ struct ConductorMaterial {
   Roughness roughness;
 };
 
+// A dielectric whose index depends on the wavelength (dispersion) keeps its curve; resolved at a
+// path's wavelengths, eta is the index at the first (hero) wavelength, and the path follows that
+// wavelength alone from there on (pbrt-v4's TerminateSecondary; see PathState).
+using EtaSpectrum = std::shared_ptr<const SpectrumCurve>;
+
 struct DielectricMaterial {
   float eta = 1.5f;  // inside over outside; the outside is the side the normal points to
   Roughness roughness;
+  EtaSpectrum eta_spectrum;  // null: eta at every wavelength
 };
 
 struct ThinDielectricMaterial {
   float eta = 1.5f;
+  EtaSpectrum eta_spectrum;  // null: eta at every wavelength
 };
 
 struct DiffuseTransmissionMaterial {
@@ -149,6 +157,8 @@ Material resolve_material(const MaterialDesc& desc, const Wavelengths& wl,
 // True when a parameter of the material is a texture, or it is a mix (it must be resolved per
 // surface point).
 bool material_is_textured(const MaterialDesc& desc);
+// True for a dielectric whose index depends on the wavelength.
+bool material_is_dispersive(const Material& m);
 
 enum BsdfFlags : unsigned {
   kReflection = 1,

@@ -24,6 +24,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     if (next_eye_vertex(scene, materials, s, v, counters, emitter, L) != StepEnd::kVertex) break;
     if (depth++ == settings.max_depth) break;
     if (v.wo_local.z == 0) break;
+    keep_hero_wavelength_at(v, s);
     if (!bsdf_is_specular(v.m()))
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
                                         v.wo_local, true, wl, rng, counters);

@@ -4,6 +4,7 @@
 // and reports every diffuse surface it reaches, with the class of the path so far. bpm looks up
 // backward photons there; fpm stores a forward photon.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -24,11 +25,15 @@ constexpr int kPhotonsPerChunk = 1024;
 // first 2^k iterations put one offset in each 2^-k of the stratum: the spectrum is covered evenly
 // and the image's colour converges about as 1 / iterations instead of 1 / sqrt(iterations). The
 // offset of each iteration alone is uniform, so every iteration is still an unbiased estimate.
+// The stratum of the first (hero) wavelength is drawn afresh each iteration, so that the hero alone
+// has the full density too (hero_wavelength_only relies on it).
 inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
   Rng rng(stream_key(seed ^ 0x7761766573ull, 0, 0, 3));
   double v = rng.uniform() + radical_inverse_base2(uint32_t(it));
   v -= std::floor(v);
-  return sample_wavelengths(float(v / Spectrum::kChannels));
+  Rng hero(stream_key(seed ^ 0x7761766573ull, uint64_t(it), 0, 4));
+  int stratum = std::min(Spectrum::kChannels - 1, int(hero.uniform() * Spectrum::kChannels));
+  return sample_wavelengths(float((v + stratum) / Spectrum::kChannels));
 }
 
 // How a photon arrived: straight from the light, through specular vertices only, or after at
@@ -60,6 +65,7 @@ struct PhotonHit {
   Spectrum flux;
   PhotonClass cls;
   int bounces;
+  bool hero_only;  // the photon keeps its hero wavelength alone (PathState)
 };
 
 // Traces one photon at the wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse
@@ -98,10 +104,11 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
       PhotonClass cls = bounces == 0
                             ? PhotonClass::kDirect
                             : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
-      on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces});
+      on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only});
     }
     if (bounces + 1 + min_eye_vertices > max_depth) break;
     if (v.wo_local.z == 0) break;
+    keep_hero_wavelength_at(v, s);
     Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
     float uc = rng.uniform();
     auto bs = sample_bsdf(v, uc, u, TransportMode::kImportance);

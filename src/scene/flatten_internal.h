@@ -64,7 +64,13 @@ class Flattener {
   FloatParam float_or_texture(const ParamSet& ps, const std::string& name, float def);
   Roughness roughness(const ParamSet& ps, const FileLoc& loc, const std::string& prefix = "",
                       RoughnessTextures* tex = nullptr);
-  float dielectric_eta(const ParamSet& ps, const FileLoc& loc, const std::string& name = "eta");
+  // A dielectric's index: its value at 587.56 nm, and the curve when it depends on the wavelength.
+  struct DielectricEta {
+    float eta = 1.5f;
+    EtaSpectrum spectrum;
+  };
+  DielectricEta dielectric_eta(const ParamSet& ps, const FileLoc& loc,
+                               const std::string& name = "eta");
   ConductorDesc conductor_desc(const ParamSet& ps, const FileLoc& loc, const std::string& prefix);
   CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
                        RoughnessTextures* tex);

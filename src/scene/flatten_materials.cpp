@@ -81,22 +81,25 @@ Roughness Flattener::roughness(const ParamSet& ps, const FileLoc& loc, const std
 }
 
 // A dielectric's index of refraction: a float, or a spectrum reduced to its value at 550 nm.
-float Flattener::dielectric_eta(const ParamSet& ps, const FileLoc& loc, const std::string& name) {
-  float eta = 1.5f;
+Flattener::DielectricEta Flattener::dielectric_eta(const ParamSet& ps, const FileLoc& loc,
+                                                   const std::string& name) {
+  DielectricEta out;
   const Param* p = ps.find_any(name);
   if (p && p->type == "float") {
-    eta = ps.get_float(name, 1.5f);
+    out.eta = ps.get_float(name, 1.5f);
   } else if (p) {
     SpectrumParam sp = *spectrum_param(ps, name, SpectrumKind::kUnbounded);
     if (sp.textured()) throw Error(p->loc, "a textured eta is not supported");
     const SpectrumCurve& s = sp.curve;
-    if (s.max_value() - s.min_value() > 1e-4f)
-      warning(p->loc,
-              "a wavelength-dependent eta is reduced to its value at 550 nm (no dispersion)");
-    eta = s.value(550);
+    // The index at the d line (587.56 nm) stands for the glass where one index is needed.
+    out.eta = s.value(587.56f);
+    if (s.max_value() - s.min_value() > 1e-4f) {
+      if (!(s.min_value() > 0)) throw Error(p->loc, "eta must be positive at every wavelength");
+      out.spectrum = std::make_shared<const SpectrumCurve>(s);
+    }
   }
-  if (!(eta > 0)) throw Error(p ? p->loc : loc, "eta must be positive");
-  return eta;
+  if (!(out.eta > 0)) throw Error(p ? p->loc : loc, "eta must be positive");
+  return out;
 }
 
 // A conductor from eta and k (copper by default) or from a reflectance; prefix names the
@@ -126,7 +129,12 @@ CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const 
                                 RoughnessTextures* tex) {
   CoatLayer c;
   c.roughness = roughness(ps, e.loc, prefix, tex);
-  c.eta = dielectric_eta(ps, e.loc, prefix + "eta");
+  DielectricEta eta = dielectric_eta(ps, e.loc, prefix + "eta");
+  if (eta.spectrum)
+    warning(
+        ps.find_any(prefix + "eta")->loc,
+        "a coat's wavelength-dependent eta is reduced to its value at 587.56 nm (no dispersion)");
+  c.eta = eta.eta;
   c.thickness = float_param(ps, "thickness", 0.01f);
   if (!(c.thickness > 0) || !std::isfinite(c.thickness))
     throw Error(ps.find_any("thickness")->loc, "thickness must be positive");
@@ -160,11 +168,11 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
   } else if (e.name == "conductor") {
     m = conductor_desc(ps, e.loc, "");
   } else if (e.name == "dielectric" || e.name == "thindielectric") {
-    float eta = dielectric_eta(ps, e.loc);
+    DielectricEta eta = dielectric_eta(ps, e.loc);
     if (e.name == "dielectric")
-      m = DielectricMaterial{eta, roughness(ps, e.loc)};
+      m = DielectricMaterial{eta.eta, roughness(ps, e.loc), eta.spectrum};
     else
-      m = ThinDielectricMaterial{eta};
+      m = ThinDielectricMaterial{eta.eta, eta.spectrum};
   } else if (e.name == "diffusetransmission") {
     DiffuseTransmissionDesc d;
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <vector>
 
 namespace bpm {
 
@@ -27,12 +28,42 @@ std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKin
   for (const Metal& m : metals)
     if (name == m.name)
       return SpectrumCurve::from_pairs({450, m.v450, 550, m.v550, 650, m.v650}, kind);
-  static const std::map<std::string, float> glasses = {
-      {"glass-BK7", 1.5168f},   {"glass-BAF10", 1.6700f}, {"glass-FK51A", 1.4866f},
-      {"glass-LASF9", 1.8503f}, {"glass-F5", 1.6034f},    {"glass-F10", 1.6200f},
-      {"glass-F11", 1.6209f},
+  // Glasses: Schott's Sellmeier dispersion formula, n^2 = 1 + sum B_i l^2 / (l^2 - C_i) (l in um),
+  // with the catalogue coefficients of the glasses pbrt-v4 names (its "glass-F5", "-F10" and
+  // "-F11" are Schott SF5, SF10 and SF11). Each gives its catalogue n_d at 587.56 nm.
+  struct Glass {
+    const char* name;
+    double b[3], c[3];
   };
-  if (auto it = glasses.find(name); it != glasses.end()) return SpectrumCurve(it->second);
+  static const Glass glasses[] = {
+      {"glass-BK7",
+       {1.03961212, 0.231792344, 1.01046945},
+       {0.00600069867, 0.0200179144, 103.560653}},
+      {"glass-BAF10",
+       {1.5851495, 0.143559385, 1.08521269},
+       {0.00926681282, 0.0424489805, 105.613573}},
+      {"glass-FK51A",
+       {0.971247817, 0.216901417, 0.904651666},
+       {0.00472301995, 0.0153575612, 168.68133}},
+      {"glass-LASF9",
+       {2.00029547, 0.298926886, 1.80691843},
+       {0.0121426017, 0.0538736236, 156.530829}},
+      {"glass-F5", {1.52481889, 0.187085527, 1.42729015}, {0.011254756, 0.0588995392, 129.141675}},
+      {"glass-F10",
+       {1.62153902, 0.256287842, 1.64447552},
+       {0.0122241457, 0.0595736775, 147.468793}},
+      {"glass-F11", {1.73759695, 0.313747346, 1.89878101}, {0.013188707, 0.0623068142, 155.23629}},
+  };
+  for (const Glass& g : glasses) {
+    if (name != g.name) continue;
+    std::vector<float> values;
+    for (float lambda = kLambdaMin; lambda <= kLambdaMax; lambda += 1) {
+      double l2 = double(lambda) * lambda * 1e-6, n2 = 1;
+      for (int i = 0; i < 3; ++i) n2 += g.b[i] * l2 / (l2 - g.c[i]);
+      values.push_back(float(std::sqrt(n2)));
+    }
+    return SpectrumCurve::from_table(std::move(values), SpectrumKind::kUnbounded);
+  }
   if (kind == SpectrumKind::kIlluminant) {
     if (name == "stdillum-D65") return SpectrumCurve::from_rgb(Rgb(1.0f), kind);
     if (name == "stdillum-A") return SpectrumCurve::blackbody(2856);
