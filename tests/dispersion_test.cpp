@@ -48,7 +48,8 @@ double expected_screen_y(double n) {
 TEST(Dispersion, PrismBendsEachWavelengthBySnellsLaw) {
   LoadedScene ls = load(kPrism);
   const int screen = 2;  // objects: the two glass faces, then the screen
-  const auto& glass = std::get<DielectricMaterial>(ls.scene.materials[ls.scene.objects[0].material]);
+  const auto& glass =
+      std::get<DielectricMaterial>(ls.scene.materials[ls.scene.objects[0].material]);
   ASSERT_TRUE(glass.eta_spectrum);
   double previous_y = -1e9;  // longer wavelengths bend less: y grows with lambda
   for (float lambda : {420.0f, 480.0f, 550.0f, 620.0f, 700.0f}) {
