@@ -429,6 +429,37 @@ TEST(Bpm, DispersiveGlassCausticConvergesToPath) {
   }
 }
 
+// Camera and light above a pane of dispersive thin glass, a floor below it: every light path the
+// camera sees passes the pane on its eye half and on its light half, so in bpm and fpm each half
+// keeps its hero wavelength alone and the join must scale the hero once (hero_join_factor), not
+// twice. The image mean against path's, which handles a single path; the floor is flat, so the
+// radius bias is small, and 2% allows for it.
+TEST(Bpm, DispersivePaneOnBothHalfPathsCountsTheHeroOnce) {
+  LoadedScene ls = load(header(16, 6, "0 2.5 -0.5  0 0 0  0 1 0") +
+                        "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [20 20 20]\n" +
+                        quad(-0.3f, -0.3f, 0.3f, 0.3f, 3, true) + "AttributeEnd\n" +
+                        "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n" +
+                        quad(-3, -3, 3, 3, 0, false) +
+                        "Material \"thindielectric\" \"spectrum eta\" \"glass-F11\"\n" +
+                        quad(-3, -3, 3, 3, 1.5f, false));
+  RenderRun ref = render_with(ls, "path", 1024);
+  Image img = ref.film.image();
+  std::vector<float> rms = ref.film.rms();
+  double path_mean = 0, path_var = 0;
+  for (int i = 0; i < 256; ++i) {
+    path_mean += img.at(i % 16, i / 16).luminance() / 256.0;
+    path_var += double(rms[size_t(i)]) * rms[size_t(i)] / (256.0 * 256.0);
+  }
+  ASSERT_GT(path_mean, 0.01);
+  BpmSettings s = small_batches(0);
+  s.photons_per_batch = 8192;
+  for (const char* integrator : {"bpm", "fpm"}) {
+    BlockStats m = image_mean(render_iterations(ls, integrator, 40, 13, s));
+    EXPECT_NEAR(m.mean, path_mean, 4.5 * std::sqrt(m.var + path_var) + 0.02 * path_mean)
+        << integrator;
+  }
+}
+
 // A furnace whose material is pbrt-v4's mix of two diffuse materials (0.2 and 0.8, amount 0.25),
 // chosen per point: its mean albedo is 0.35, and every pixel sees Le + 0.35 A_{D-1} with
 // A_k = Le + 0.35 A_{k-1}, for path (per pixel) and bpm (image mean over iterations).
