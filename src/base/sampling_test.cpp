@@ -116,4 +116,22 @@ TEST(RadicalInverse, FirstPowerOfTwoValuesStratify) {
   }
 }
 
+// With the van der Corput sequence the second Sobol dimension forms a (0,2)-sequence: the first
+// 2^m points put one point in every box of 2^-a by 2^-(m-a), for every a (the photon methods draw
+// their wavelength offsets and hero strata from it).
+TEST(Sobol2, WithVanDerCorputFormsA02Sequence) {
+  for (int m = 0; m <= 8; ++m)
+    for (int a = 0; a <= m; ++a) {
+      const uint32_t n = 1u << m;
+      std::vector<int> hits(n, 0);
+      for (uint32_t i = 0; i < n; ++i) {
+        // The top a bits of the first coordinate and the top m - a bits of the second.
+        uint32_t x = a ? van_der_corput_bits(i) >> (32 - a) : 0;
+        uint32_t y = m - a ? sobol2_bits(i) >> (32 - (m - a)) : 0;
+        ++hits[(size_t(x) << (m - a)) | y];
+      }
+      for (uint32_t j = 0; j < n; ++j) EXPECT_EQ(hits[j], 1) << "m " << m << " a " << a;
+    }
+}
+
 }  // namespace bpm

@@ -20,20 +20,22 @@ namespace bpm {
 constexpr int kPhotonsPerChunk = 1024;
 
 // The wavelengths of iteration `it` of a photon method, shared by all its eye and light paths.
-// Within an iteration they are stratified (sample_wavelengths); across iterations the strata's
-// offset follows the van der Corput sequence shifted by a random start per seed, so that the
-// first 2^k iterations put one offset in each 2^-k of the stratum: the spectrum is covered evenly
-// and the image's colour converges about as 1 / iterations instead of 1 / sqrt(iterations). The
-// offset of each iteration alone is uniform, so every iteration is still an unbiased estimate.
-// The stratum of the first (hero) wavelength is drawn afresh each iteration, so that the hero alone
-// has the full density too (hero_wavelength_only relies on it).
+// Within an iteration they are stratified (sample_wavelengths): one in each of the kChannels
+// strata, at the same offset v within its stratum, the first (hero) one in stratum k. Across
+// iterations (v, k / kChannels) follows a (0,2)-sequence (van der Corput and the second Sobol
+// dimension) under a random digital shift per seed, so that the first 2^m iterations place the
+// offsets one in each 2^-m of the stratum (the spectrum is covered evenly: the colour converges
+// about as 1 / iterations instead of 1 / sqrt(iterations)), and place the hero one in each 2^-m of
+// the whole range (light that only the hero carries, past dispersive glass, converges as well).
+// For each iteration alone v and the hero are uniform, so every iteration is an unbiased estimate
+// and the hero alone has the full density (hero_wavelength_only relies on it).
 inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
   Rng rng(stream_key(seed ^ 0x7761766573ull, 0, 0, 3));
-  double v = rng.uniform() + radical_inverse_base2(uint32_t(it));
-  v -= std::floor(v);
-  Rng hero(stream_key(seed ^ 0x7761766573ull, uint64_t(it), 0, 4));
-  int stratum = std::min(Spectrum::kChannels - 1, int(hero.uniform() * Spectrum::kChannels));
-  return sample_wavelengths(float((v + stratum) / Spectrum::kChannels));
+  uint32_t shift_v = rng.next_u32(), shift_k = rng.next_u32();
+  double v = double(van_der_corput_bits(uint32_t(it)) ^ shift_v) * 0x1p-32;
+  double k =
+      std::floor(double(sobol2_bits(uint32_t(it)) ^ shift_k) * 0x1p-32 * Spectrum::kChannels);
+  return sample_wavelengths(float((v + k) / Spectrum::kChannels));
 }
 
 // How a photon arrived: straight from the light, through specular vertices only, or after at
