@@ -85,25 +85,30 @@ double Film::relative_error_luminance() const {
   return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
 }
 
+namespace {
+
+// The error of the average of M images from the spread of their values value(k): the standard
+// deviation between them over sqrt(M). Zero until every image has a pass (count[k] > 0).
+template <class Value>
+float m_images_error(const int* count, int m, Value&& value) {
+  for (int k = 0; k < m; ++k)
+    if (count[k] == 0) return 0;
+  double mean = 0, var = 0;
+  for (int k = 0; k < m; ++k) mean += value(k) / m;
+  for (int k = 0; k < m; ++k) var += (value(k) - mean) * (value(k) - mean);
+  return float(std::sqrt(var / (m - 1) / m));
+}
+
+}  // namespace
+
 std::vector<float> Film::rms_m_images_rgb() const {
   std::vector<float> out(pixels_.size() * 3, 0.0f);
   if (m_ == 0) return out;
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const int* count = &m_count_[i * size_t(m_)];
-    bool full = true;
-    for (int k = 0; k < m_; ++k) full = full && count[k] > 0;
-    if (!full) continue;
-    for (int c = 0; c < 3; ++c) {
-      double mean = 0, var = 0;
-      for (int k = 0; k < m_; ++k) mean += m_sum_[3 * (i * m_ + k) + c] / count[k];
-      mean /= m_;
-      for (int k = 0; k < m_; ++k) {
-        double d = m_sum_[3 * (i * m_ + k) + c] / count[k] - mean;
-        var += d * d;
-      }
-      // The standard deviation between the M images, over sqrt(M): the error of their average.
-      out[3 * i + c] = float(std::sqrt(var / (m_ - 1) / m_));
-    }
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + c] =
+          m_images_error(count, m_, [&](int k) { return m_sum_[3 * (i * m_ + k) + c] / count[k]; });
   }
   return out;
 }
@@ -113,18 +118,11 @@ std::vector<float> Film::rms_m_images() const {
   if (m_ == 0) return out;
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const int* count = &m_count_[i * size_t(m_)];
-    bool full = true;
-    for (int k = 0; k < m_; ++k) full = full && count[k] > 0;
-    if (!full) continue;
-    auto image_luminance = [&](int k) {
+    out[i] = m_images_error(count, m_, [&](int k) {
       double e[3];
       for (int c = 0; c < 3; ++c) e[c] = m_sum_[3 * (i * m_ + k) + c] / count[k];
       return luminance(e);
-    };
-    double mean = 0, var = 0;
-    for (int k = 0; k < m_; ++k) mean += image_luminance(k) / m_;
-    for (int k = 0; k < m_; ++k) var += (image_luminance(k) - mean) * (image_luminance(k) - mean);
-    out[i] = float(std::sqrt(var / (m_ - 1) / m_));
+    });
   }
   return out;
 }
