@@ -1,0 +1,261 @@
+// Equal time against pbrt-v4: every integrator renders each scene for the same wall time, and the
+// table gives its relative MSE against a converged reference, the same without the worst 0.1% of
+// pixels (fireflies), and the ratio of each channel's image mean to the reference's. Prints
+// figures; never fails.
+//   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
+// Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism (references by bpm) and the
+// Cornell box (../shared's at 256x256 when present, else ours; reference by path).
+//
+// Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
+// loaded). pbrt-v4 (its path, bdpt and sppm), when ../shared/tools/pbrt-v4/pbrt or --pbrt is there,
+// renders a copy of the scene file whose Integrator line is replaced; its sample count is
+// calibrated from two short runs (wall time = start-up + cost per sample) so that its whole run,
+// start-up included, takes --time seconds. sppm's radius is stated in the table: 0.002 of the
+// scene's bounding-box diagonal. References are made once, with their own seed, and kept in
+// equal_time_references/ in the working folder (a JSON beside each says how it was made).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "film/image_compare.h"
+#include "film/image_io.h"
+#include "render/renderer.h"
+#include "scene/flatten.h"
+
+using namespace bpm;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct SceneEntry {
+  std::string name;             // short name for the table
+  std::string path;             // scene file
+  std::string reference;        // our integrator that makes its reference: path or bpm
+  std::string resolution = "";  // WxH instead of the file's, or "" for the file's
+};
+
+std::vector<SceneEntry> default_scenes() {
+  const std::string ours = std::string(BPM_SOURCE_DIR) + "/scenes/";
+  const fs::path shared_cornell =
+      fs::path(BPM_SOURCE_DIR) / ".." / "shared" / "scenes" / "cornell-box" / "scene-v4.pbrt";
+  std::vector<SceneEntry> s = {
+      {"caustic-sphere", ours + "caustic-sphere.pbrt", "bpm"},
+      {"light-guides-inside", ours + "light-guides-inside.pbrt", "bpm"},
+      {"light-guides-outside", ours + "light-guides-outside.pbrt", "bpm"},
+      {"light-guides-side", ours + "light-guides-side.pbrt", "bpm"},
+      {"prism", ours + "prism.pbrt", "bpm"},
+  };
+  if (fs::exists(shared_cornell))
+    s.push_back({"cornell-box", shared_cornell.lexically_normal().string(), "path", "256x256"});
+  else
+    s.push_back({"cornell-box", ours + "cornell-box.pbrt", "path"});
+  return s;
+}
+
+struct Metrics {
+  double rel_mse = 0, rel_mse_trimmed = 0;
+  std::array<double, 3> ratio{};
+};
+
+// relMSE as `bpm compare` (mean over pixels and channels of (a - r)^2 / (r^2 + 0.01)); the same
+// without the 0.1% of pixels with the largest error; each channel's mean over the reference's.
+Metrics measure(const Image& a, const Image& ref) {
+  Metrics m;
+  ImageComparison c = compare_images(a, ref);
+  m.rel_mse = c.rel_mse;
+  for (int k = 0; k < 3; ++k) m.ratio[size_t(k)] = c.mean_a[size_t(k)] / c.mean_b[size_t(k)];
+  std::vector<double> per_pixel(size_t(a.width) * size_t(a.height));
+  for (size_t i = 0; i < per_pixel.size(); ++i) {
+    double e = 0;
+    for (int k = 0; k < 3; ++k) {
+      double d = a.rgb[3 * i + size_t(k)] - ref.rgb[3 * i + size_t(k)];
+      double r = ref.rgb[3 * i + size_t(k)];
+      e += d * d / (r * r + 0.01) / 3;
+    }
+    per_pixel[i] = e;
+  }
+  std::sort(per_pixel.begin(), per_pixel.end());
+  size_t keep = per_pixel.size() - per_pixel.size() / 1000;
+  double sum = 0;
+  for (size_t i = 0; i < keep; ++i) sum += per_pixel[i];
+  m.rel_mse_trimmed = keep ? sum / double(keep) : 0;
+  return m;
+}
+
+Image render_ours(const LoadedScene& ls, const std::string& integrator, double seconds,
+                  uint64_t seed, RenderStats* stats) {
+  Film film(ls.film.width, ls.film.height);
+  RenderOptions opt = quiet_options(ls, integrator, std::numeric_limits<int>::max(), seed);
+  // The file's own settings, as the command line takes them.
+  opt.bpm = bpm_settings_from_file(ls.render.integrator_directive);
+  opt.fpm = fpm_settings_from_file(ls.render.integrator_directive);
+  static_cast<PhotonSettings&>(opt.fpm) = opt.bpm;
+  opt.time_limit_s = seconds;
+  opt.adaptive = true;  // as the command line renders by default
+  *stats = render(ls, opt, &film);
+  return film.image();
+}
+
+// The reference of a scene: read from the cache, or rendered now and kept.
+Image reference_for(const SceneEntry& e, const LoadedScene& ls, double seconds) {
+  fs::create_directories("equal_time_references");
+  std::string stem = "equal_time_references/" + e.name + "_" + std::to_string(ls.film.width) + "x" +
+                     std::to_string(ls.film.height);
+  if (fs::exists(stem + ".exr")) return read_exr(stem + ".exr");
+  RenderStats st;
+  Image img = render_ours(ls, e.reference, seconds, 0x5eed, &st);
+  write_exr(stem + ".exr", img);
+  nlohmann::json how = {{"scene", e.path},
+                        {"integrator", e.reference},
+                        {"seconds", st.render_seconds},
+                        {"passes", st.passes},
+                        {"seed", 0x5eed},
+                        {"relative_error_delta", st.relative_error}};
+  write_text_atomic(stem + ".json", how.dump(2) + "\n");
+  std::printf("  reference made: %s, %s for %.0f s (%d passes, delta %.4f)\n", stem.c_str(),
+              e.reference.c_str(), st.render_seconds, st.passes, st.relative_error);
+  return img;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// A copy of the scene file beside it (so that relative paths still resolve) whose Integrator
+// directive is `integrator`.
+std::string scene_with_integrator(const std::string& path, const std::string& integrator) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string s = text.str(), out;
+  std::istringstream lines(s);
+  bool skipping = false, placed = false;
+  for (std::string line; std::getline(lines, line);) {
+    std::string t = line.substr(line.find_first_not_of(" \t") == std::string::npos
+                                    ? line.size()
+                                    : line.find_first_not_of(" \t"));
+    bool directive = !t.empty() && std::isupper(static_cast<unsigned char>(t[0]));
+    if (directive) skipping = t.rfind("Integrator", 0) == 0;
+    if (!placed && t.rfind("WorldBegin", 0) == 0) {
+      out += integrator + "\n";
+      placed = true;
+    }
+    if (!skipping) out += line + "\n";
+  }
+  std::string copy =
+      (fs::path(path).parent_path() / (".equal_time_" + std::to_string(::getpid()) + ".pbrt"))
+          .string();
+  write_text_atomic(copy, out);
+  return copy;
+}
+
+// Runs pbrt-v4; returns its wall time, or a negative value when it failed.
+double run_pbrt(const std::string& pbrt, const std::string& scene, int spp,
+                const std::string& out) {
+  std::string cmd = pbrt + " --quiet --nthreads 2 --seed 7 --spp " + std::to_string(spp) +
+                    " --outfile " + out + " " + scene + " > /dev/null 2>&1";
+  auto t = std::chrono::steady_clock::now();
+  int rc = std::system(cmd.c_str());
+  double s = seconds_since(t);
+  return rc == 0 ? s : -1;
+}
+
+void row(const std::string& who, double seconds, const std::string& samples, const Metrics& m) {
+  std::printf("  %-28s %7.1f %10s %12.3e %12.3e   %6.3f %6.3f %6.3f\n", who.c_str(), seconds,
+              samples.c_str(), m.rel_mse, m.rel_mse_trimmed, m.ratio[0], m.ratio[1], m.ratio[2]);
+}
+
+void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& ls, double seconds,
+               const Image& ref) {
+  const int maxdepth = ls.render.max_depth;
+  Vec3 diag = ls.scene.bounds.hi - ls.scene.bounds.lo;
+  const float radius = 0.002f * length(diag);
+  const std::string out = "equal_time_references/.pbrt_out.exr";
+  struct Variant {
+    std::string label, line;
+  };
+  std::vector<Variant> variants = {
+      {"pbrt-v4 path", "Integrator \"path\" \"integer maxdepth\" " + std::to_string(maxdepth)},
+      {"pbrt-v4 bdpt", "Integrator \"bdpt\" \"integer maxdepth\" " + std::to_string(maxdepth)},
+      {"pbrt-v4 sppm r=" + std::to_string(radius).substr(0, 6),
+       "Integrator \"sppm\" \"integer maxdepth\" " + std::to_string(maxdepth) +
+           " \"float radius\" " + std::to_string(radius)},
+  };
+  for (const Variant& v : variants) {
+    std::string copy = scene_with_integrator(e.path, v.line);
+    // Calibration: wall time = start-up + cost * samples, from runs of 2 and 4 samples.
+    double t2 = run_pbrt(pbrt, copy, 2, out), t4 = run_pbrt(pbrt, copy, 4, out);
+    if (t2 < 0 || t4 < 0) {
+      std::printf("  %-28s failed to run\n", v.label.c_str());
+      fs::remove(copy);
+      continue;
+    }
+    double per_sample = std::max(1e-4, (t4 - t2) / 2), startup = std::max(0.0, t2 - 2 * per_sample);
+    int spp = std::max(1, int((seconds - startup) / per_sample));
+    double t = run_pbrt(pbrt, copy, spp, out);
+    fs::remove(copy);
+    if (t < 0) continue;
+    Image img = read_exr(out);
+    if (img.width != ref.width || img.height != ref.height) continue;
+    row(v.label, t, std::to_string(spp) + " spp", measure(img, ref));
+  }
+  fs::remove(out);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  double seconds = 60, reference_s = 600;
+  std::string only, pbrt, res;
+  const fs::path default_pbrt =
+      fs::path(BPM_SOURCE_DIR) / ".." / "shared" / "tools" / "pbrt-v4" / "pbrt";
+  if (fs::exists(default_pbrt)) pbrt = default_pbrt.lexically_normal().string();
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
+    if (!std::strcmp(argv[i], "--time"))
+      seconds = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--reference-time"))
+      reference_s = std::atof(next().c_str());
+    else if (!std::strcmp(argv[i], "--scenes"))
+      only = next();
+    else if (!std::strcmp(argv[i], "--pbrt"))
+      pbrt = next();
+    else if (!std::strcmp(argv[i], "--res"))
+      res = next();
+  }
+  std::printf("== equal time: %.0f s each; reference: a %.0f s render with its own seed ==\n",
+              seconds, reference_s);
+  std::printf("  %-28s %7s %10s %12s %12s   %s\n", "integrator", "s", "samples", "relMSE",
+              "relMSE 99.9%", "mean / reference R G B");
+  for (const SceneEntry& e : default_scenes()) {
+    if (!only.empty() && ("," + only + ",").find("," + e.name + ",") == std::string::npos) continue;
+    LoadedScene ls = flatten_scene(parse_scene_file(e.path));
+    const std::string& wxh = res.empty() ? e.resolution : res;
+    if (!wxh.empty()) std::sscanf(wxh.c_str(), "%dx%d", &ls.film.width, &ls.film.height);
+    std::printf("%s (%dx%d, maxdepth %d)\n", e.name.c_str(), ls.film.width, ls.film.height,
+                ls.render.max_depth);
+    Image ref = reference_for(e, ls, reference_s);
+    for (const char* integrator : {"path", "bpm", "fpm"}) {
+      RenderStats st;
+      Image img = render_ours(ls, integrator, seconds, 1, &st);
+      std::string samples =
+          std::to_string(st.passes) + (std::string(integrator) == "path" ? " spp" : " its");
+      row(std::string("bpm ") + integrator, st.render_seconds, samples, measure(img, ref));
+    }
+    if (!pbrt.empty()) pbrt_rows(pbrt, e, ls, seconds, ref);
+  }
+  return 0;
+}
