@@ -3,8 +3,9 @@
 // pixels (fireflies), and the ratio of each channel's image mean to the reference's. Prints
 // figures; never fails.
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
-// Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism (references by bpm) and the
-// Cornell box (../shared's at 256x256 when present, else ours; reference by path).
+// Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
+// (references by bpm), lamp-room and the Cornell box (../shared's at 256x256 when present, else
+// ours; references by path). scenes/tools/make_equal_time_scenes.py writes the last three of ours.
 //
 // Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
 // loaded). pbrt-v4 (its path, bdpt and sppm), when ../shared/tools/pbrt-v4/pbrt or --pbrt is there,
@@ -56,6 +57,9 @@ std::vector<SceneEntry> default_scenes() {
       {"light-guides-outside", ours + "light-guides-outside.pbrt", "bpm"},
       {"light-guides-side", ours + "light-guides-side.pbrt", "bpm"},
       {"prism", ours + "prism.pbrt", "bpm"},
+      {"spot-facets", ours + "spot-facets.pbrt", "bpm"},
+      {"water-box", ours + "water-box.pbrt", "bpm"},
+      {"lamp-room", ours + "lamp-room.pbrt", "path"},
   };
   if (fs::exists(shared_cornell))
     s.push_back({"cornell-box", shared_cornell.lexically_normal().string(), "path", "256x256"});

@@ -23,7 +23,7 @@ const char* kPrism = R"(
   Film "rgb" "integer xresolution" [8] "integer yresolution" [8]
   WorldBegin
   LightSource "spot" "point3 from" [0 0 0] "point3 to" [1 0 0] "float coneangle" [0.3]
-      "float conedelta" [0] "rgb I" [1 1 1]
+      "float conedeltaangle" [0] "rgb I" [1 1 1]
   AttributeBegin
     Material "dielectric" "spectrum eta" "glass-F11"
     Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]

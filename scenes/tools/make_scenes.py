@@ -113,7 +113,7 @@ def guides(variant):
                   % (["60 20 12", "15 50 20", "12 25 60"][i], x0 + 0.08, y + h / 2, z + d / 2))
         else:
             s += ("  LightSource \"spot\" \"point3 from\" [ %g %g %g ] \"point3 to\" [ %g %g %g ]\n"
-                  "    \"float coneangle\" [ 8 ] \"float conedelta\" [ 2 ] \"rgb I\" [ %s ]\n"
+                  "    \"float coneangle\" [ 8 ] \"float conedeltaangle\" [ 2 ] \"rgb I\" [ %s ]\n"
                   % (x0 - 0.3, y + h / 2, z + d / 2, x1, y + h / 2, z + d / 2, ["20 7 4", "5 17 7", "4 8 20"][i]))
         s += "AttributeEnd\n"
     return names[variant], s

@@ -183,7 +183,7 @@ void Flattener::add_spot_light(const LightEntity& e, float* scale, RenderScene* 
   SpectrumCurve I = light_spectrum(ps, "I");
   Vec3 from = ps.get_point3("from", Vec3(0, 0, 0)), to = ps.get_point3("to", Vec3(0, 0, 1));
   if (length(to - from) == 0) throw Error(e.loc, "spot light with from == to");
-  float cone = ps.get_float("coneangle", 30), delta = ps.get_float("conedelta", 5);
+  float cone = ps.get_float("coneangle", 30), delta = ps.get_float("conedeltaangle", 5);
   SpotLight l;
   l.position = xf.point(from);
   l.frame = Frame::from_z(normalize(xf.vector(to - from)));

@@ -620,7 +620,7 @@ TEST(SceneParse, SpotLight) {
   LoadedScene ls =
       flatten_scene(parse_scene_string("WorldBegin\nLightSource \"spot\" \"point3 from\" [0 0 5] "
                                        "\"point3 to\" [0 0 0] \"float coneangle\" 60 "
-                                       "\"float conedelta\" 10\n"));
+                                       "\"float conedeltaangle\" 10\n"));
   ASSERT_EQ(ls.scene.lights.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<SpotLight>(ls.scene.lights[0]));
   const SpotLight& s = std::get<SpotLight>(ls.scene.lights[0]);

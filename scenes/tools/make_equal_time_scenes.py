@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Writes the equal-time benchmark's own scenes in pbrt-v4 format (bench/equal_time):
+- spot-facets: a spot light through a faceted glass object onto a glossy coated floor;
+- water-box: a wavy water surface over a diffuse floor in a closed box, under a tiny bright light;
+- lamp-room: a room lit only indirectly, by a lamp inside a shade aimed at the ceiling, with a
+  glass egg on a table.
+    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those three scenes/*.pbrt
+"""
+import math
+import os
+
+from make_scenes import OUT, box, header, quad
+
+
+def outward(points, tris, inside):
+    """Orders each triangle so that pbrt-v4's normal cross(p0 - p2, p1 - p2) points away from
+    the point `inside` (for a closed convex mesh) or along +y when inside is None."""
+    def sub(a, b):
+        return [a[i] - b[i] for i in range(3)]
+
+    def cross(a, b):
+        return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+    out = []
+    for a, b, c in tris:
+        n = cross(sub(points[a], points[c]), sub(points[b], points[c]))
+        if inside is None:
+            away = n[1]
+        else:
+            centre = [(points[a][i] + points[b][i] + points[c][i]) / 3 for i in range(3)]
+            away = sum(n[i] * (centre[i] - inside[i]) for i in range(3))
+        out.append((a, b, c) if away > 0 else (b, a, c))
+    return out
+
+
+def mesh(points, tris):
+    idx = " ".join("%d %d %d" % t for t in tris)
+    pts = "  ".join("%.5g %.5g %.5g" % tuple(p) for p in points)
+    return 'Shape "trianglemesh" "integer indices" [ %s ]\n    "point3 P" [ %s ]\n' % (idx, pts)
+
+
+def icosahedron(centre, r):
+    t = (1 + 5 ** 0.5) / 2
+    v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
+         (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    s = r / math.sqrt(1 + t * t)
+    pts = [[centre[0] + s * x, centre[1] + s * y, centre[2] + s * z] for x, y, z in v]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+             (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+             (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    return mesh(pts, outward(pts, faces, centre))
+
+
+def spot_facets():
+    s = header("# A spot light through a faceted glass icosahedron onto a glossy coated floor: the\n"
+               "# caustic reaches the camera through the coat's glossy reflection.\n",
+               "0 1.4 -2.6   0 0.3 0.4   0 1 0", 40, (256, 256), 8, "spot-facets")
+    s += ('LightSource "spot" "point3 from" [ -0.6 2.4 -0.2 ] "point3 to" [ 0 0.35 0.4 ]\n'
+          '    "float coneangle" [ 12 ] "float conedeltaangle" [ 3 ] "rgb I" [ 60 60 60 ]\n')
+    s += 'LightSource "point" "point3 from" [ 1.5 2.5 -2 ] "rgb I" [ 0.6 0.6 0.6 ]\n'
+    s += ('Material "coateddiffuse" "rgb reflectance" [ 0.45 0.4 0.35 ] "float roughness" [ 0.05 ]\n')
+    s += quad((-3, 0, -3), (-3, 0, 3), (3, 0, 3), (3, 0, -3))
+    s += 'Material "diffuse" "rgb reflectance" [ 0.6 0.62 0.65 ]\n'
+    s += quad((-3, 0, 2), (3, 0, 2), (3, 3, 2), (-3, 3, 2))
+    s += 'AttributeBegin\n  Material "dielectric" "float eta" [ 1.5 ]\n'
+    s += "  " + icosahedron((0, 0.35, 0.4), 0.35)
+    s += "AttributeEnd\n"
+    return s
+
+
+def water_box():
+    s = header("# A wavy water surface over a diffuse floor in a closed box, lit by a tiny, very bright\n"
+               "# light under the ceiling: the floor is lit through the water (specular-diffuse-\n"
+               "# specular paths to the camera).\n",
+               "0.5 0.9 -0.9   0.5 0.2 0.5   0 1 0", 50, (256, 256), 10, "water-box")
+    s += ('AttributeBegin\n  AreaLightSource "diffuse" "rgb L" [ 1200 1200 1200 ]\n'
+          '  Material "diffuse" "rgb reflectance" [ 0 0 0 ]\n  '
+          + quad((0.48, 0.999, 0.48), (0.52, 0.999, 0.48), (0.52, 0.999, 0.52), (0.48, 0.999, 0.52))
+          + "AttributeEnd\n")
+    s += 'Material "diffuse" "rgb reflectance" [ 0.75 0.75 0.7 ]\n'
+    for q in [((0, 0, 0), (0, 0, 1), (1, 0, 1), (1, 0, 0)),   # floor
+              ((0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)),   # ceiling
+              ((0, 0, 1), (0, 1, 1), (1, 1, 1), (1, 0, 1)),   # back
+              ((0, 0, -1.2), (1, 0, -1.2), (1, 1, -1.2), (0, 1, -1.2))]:  # front, behind the camera
+        s += quad(*q)
+    s += 'Material "diffuse" "rgb reflectance" [ 0.7 0.2 0.15 ]\n'
+    s += quad((0, 0, -1.2), (0, 1, -1.2), (0, 1, 1), (0, 0, 1))
+    s += 'Material "diffuse" "rgb reflectance" [ 0.2 0.6 0.25 ]\n'
+    s += quad((1, 0, -1.2), (1, 0, 1), (1, 1, 1), (1, 1, -1.2))
+    n = 48
+    pts, tris = [], []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            x, z = i / n, j / n
+            y = 0.3 + 0.012 * math.sin(17 * x + 3 * z) + 0.008 * math.cos(23 * z - 5 * x)
+            pts.append([x, y, z])
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            tris += [(a, a + 1, a + n + 2), (a, a + n + 2, a + n + 1)]
+    s += 'AttributeBegin\n  Material "dielectric" "float eta" [ 1.33 ]\n'
+    s += "  " + mesh(pts, outward(pts, tris, None)) + "AttributeEnd\n"
+    return s
+
+
+def lamp_room():
+    s = header("# A room lit only indirectly: a small bright lamp inside an opaque shade aimed at the\n"
+               "# ceiling, a glass egg on a table. Almost every path to the camera has two or more\n"
+               "# diffuse bounces.\n",
+               "1.7 1.6 -2.7   0.0 0.8 1.2   0 1 0", 55, (256, 256), 10, "lamp-room")
+    s += 'Material "diffuse" "rgb reflectance" [ 0.75 0.73 0.7 ]\n'
+    s += quad((-2, 3, -3), (2, 3, -3), (2, 3, 3), (-2, 3, 3))   # ceiling, facing down
+    s += quad((-2, 0, 3), (-2, 3, 3), (2, 3, 3), (2, 0, 3))     # back wall
+    s += quad((-2, 0, -3), (-2, 0, 3), (-2, 3, 3), (-2, 3, -3))  # left wall
+    s += quad((2, 0, -3), (2, 3, -3), (2, 3, 3), (2, 0, 3))     # right wall
+    s += quad((-2, 0, -3), (2, 0, -3), (2, 3, -3), (-2, 3, -3))  # front wall
+    s += 'Material "diffuse" "rgb reflectance" [ 0.45 0.35 0.25 ]\n'
+    s += quad((-2, 0, -3), (-2, 0, 3), (2, 0, 3), (2, 0, -3))   # floor
+    s += 'Material "diffuse" "rgb reflectance" [ 0.5 0.4 0.3 ]\n' + box(-0.5, 0, 0.8, 0.7, 0.7, 1.6)
+    # The lamp: a shade (open cylinder, dark outside and inside) around a small light facing up.
+    s += ('AttributeBegin\n  Translate -1.4 0 2.2\n'
+          '  Material "diffuse" "rgb reflectance" [ 0.2 0.2 0.2 ]\n'
+          '  ' + box(-0.03, 0, -0.03, 0.03, 1.4, 0.03) +
+          '  AttributeBegin\n    Translate 0 1.4 0\n    Rotate -90 1 0 0\n'
+          '    Shape "cylinder" "float radius" [ 0.22 ] "float zmin" [ 0 ] "float zmax" [ 0.35 ]\n'
+          '    AreaLightSource "diffuse" "rgb L" [ 240 208 160 ]\n'
+          '    Translate 0 0 0.05\n    Shape "disk" "float radius" [ 0.12 ]\n'
+          '  AttributeEnd\nAttributeEnd\n')
+    s += ('AttributeBegin\n  Material "dielectric" "float eta" [ 1.5 ]\n'
+          '  Translate 0.1 0.86 1.2\n  Scale 1 1.3 1\n  Shape "sphere" "float radius" [ 0.12 ]\n'
+          'AttributeEnd\n')
+    return s
+
+
+def main():
+    for name, text in [("spot-facets", spot_facets()), ("water-box", water_box()),
+                       ("lamp-room", lamp_room())]:
+        with open(os.path.join(OUT, name + ".pbrt"), "w") as f:
+            f.write(text)
+
+
+if __name__ == "__main__":
+    main()
