@@ -10,9 +10,9 @@
 // Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
 // loaded). pbrt-v4 (its path, bdpt and sppm), when ../shared/tools/pbrt-v4/pbrt or --pbrt is there,
 // renders a copy of the scene file whose Integrator line is replaced; its sample count is
-// calibrated from two short runs (wall time = start-up + cost per sample) so that its whole run,
-// start-up included, takes --time seconds. sppm's radius is stated in the table: 0.002 of the
-// scene's bounding-box diagonal. References are made once, with their own seed, and kept in
+// calibrated from runs of 1 and 4 samples (wall time = start-up + cost per sample) so that its
+// whole run, start-up included, takes --time seconds. sppm's radius is stated in the table: 0.002
+// of the scene's bounding-box diagonal. References are made once, with their own seed, and kept in
 // equal_time_references/ in the working folder (a JSON beside each says how it was made).
 #include <unistd.h>
 
@@ -199,14 +199,17 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
   };
   for (const Variant& v : variants) {
     std::string copy = scene_with_integrator(e.path, v.line);
-    // Calibration: wall time = start-up + cost * samples, from runs of 2 and 4 samples.
-    double t2 = run_pbrt(pbrt, copy, 2, out), t4 = run_pbrt(pbrt, copy, 4, out);
-    if (t2 < 0 || t4 < 0) {
+    // Calibration: wall time = start-up + cost * samples, from runs of 1 and 4 samples. When the
+    // difference drowns in the start-up's noise, the whole time of 4 samples counts as their cost
+    // (fewer samples rather than a run far over the budget).
+    double t1 = run_pbrt(pbrt, copy, 1, out), t4 = run_pbrt(pbrt, copy, 4, out);
+    if (t1 < 0 || t4 < 0) {
       std::printf("  %-28s failed to run\n", v.label.c_str());
       fs::remove(copy);
       continue;
     }
-    double per_sample = std::max(1e-4, (t4 - t2) / 2), startup = std::max(0.0, t2 - 2 * per_sample);
+    double per_sample = (t4 - t1) / 3, startup = std::max(0.0, t1 - per_sample);
+    if (per_sample < 0.1 * t4 / 4) per_sample = t4 / 4, startup = 0;
     int spp = std::max(1, int((seconds - startup) / per_sample));
     double t = run_pbrt(pbrt, copy, spp, out);
     fs::remove(copy);
