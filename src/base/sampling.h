@@ -60,26 +60,26 @@ inline Vec2 sample_uniform_triangle(Vec2 u) {
   return {b0, b1};
 }
 
-// The base-2 radical inverse of i (van der Corput): its bits mirrored about the binary point. The
-// first 2^k values fall one in each interval of width 2^-k.
-inline uint32_t van_der_corput_bits(uint32_t i);
-inline double radical_inverse_base2(uint32_t i) { return double(van_der_corput_bits(i)) * 0x1p-32; }
-
-// The second dimension of the Sobol sequence, as 32 bits: with the van der Corput sequence (bits
-// reversed) it forms a (0,2)-sequence: the first 2^k points put one point in every rectangle of
-// area 2^-k whose sides are powers of two.
-inline uint32_t sobol2_bits(uint32_t i) {
-  uint32_t v = 1u << 31, r = 0;
-  for (; i; i >>= 1, v ^= v >> 1)
-    if (i & 1) r ^= v;
-  return r;
-}
+// The van der Corput sequence: i's bits mirrored about the binary point (the base-2 radical
+// inverse), as 32 bits and as a number in [0, 1). The first 2^k values fall one in each interval of
+// width 2^-k.
 inline uint32_t van_der_corput_bits(uint32_t i) {
   i = (i << 16) | (i >> 16);
   i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
   i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
   i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
   return ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+}
+inline double radical_inverse_base2(uint32_t i) { return double(van_der_corput_bits(i)) * 0x1p-32; }
+
+// The second dimension of the Sobol sequence, as 32 bits: with the van der Corput sequence it
+// forms a (0,2)-sequence: the first 2^k points put one point in every rectangle of area 2^-k
+// whose sides are powers of two.
+inline uint32_t sobol2_bits(uint32_t i) {
+  uint32_t v = 1u << 31, r = 0;
+  for (; i; i >>= 1, v ^= v >> 1)
+    if (i & 1) r ^= v;
+  return r;
 }
 
 inline float power_heuristic(float pdf_a, float pdf_b) {

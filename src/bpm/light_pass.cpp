@@ -37,7 +37,7 @@ void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
             : prm.photon_materials[g];
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
-    if (hero_only && bp.hero_only) value *= hero_join_factor(true, true);
+    value *= hero_join_factor(bp.hero_only, hero_only);
     out[owner[bp.pixel]].push_back({g, value});
     ++counters.entries;
   });
