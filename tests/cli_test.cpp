@@ -219,7 +219,7 @@ TEST_F(Cli, SigintAndSigtermStillWriteEveryOutput) {
             "--spp", "10000000", "--photons-per-batch", "5000", "-o", out.c_str(), nullptr);
       _exit(127);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
     kill(pid, std::string(integrator) == "bpm" ? SIGINT : SIGTERM);  // Ctrl-C and SIGTERM alike
     int status = 0;
     waitpid(pid, &status, 0);
