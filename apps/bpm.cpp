@@ -41,9 +41,9 @@ struct RenderArgs {
   int iterations = 0;
   // bpm; negative or empty means "the scene file's value or the default"
   int diffuse_depth = -1;
-  float k0 = -1, k1 = -1, alpha = -1, coverage = -1;
+  float k0 = -1, k1 = -1, alpha = -1;
   std::string radius_policy, tree;
-  int photons_per_batch = 0, max_batches = 0;
+  int photons = 0;
   bool final_gather = false;
   int knn = -1;
   double accuracy = 0, write_every = 0;
@@ -61,7 +61,7 @@ void print_bpm_summary(const nlohmann::json& d) {
       "bpm: maps: %.1f MB photons, %.1f MB trees (peak), build %.2f s, sphere duplication %.2f\n"
       "bpm: light: %.3g photons, %.3g rays, %.2f Mrays/s, %.3g queries (%.2f M/s), %.1f "
       "batches/iteration, "
-      "coverage %.2f\n"
+      "%.2f of the last backward photons hit\n"
       "bpm: stages: eye %.2f s, trees %.2f s, light %.2f + %.2f s, accumulate %.2f s\n",
       double(eye["camera_rays"].get<uint64_t>() + eye["bounce_rays"].get<uint64_t>() +
              eye["shadow_rays"].get<uint64_t>()),
@@ -130,9 +130,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   // Both photon methods read the same photon parameters from an Integrator line of either.
   static_cast<PhotonSettings&>(opt.fpm) = opt.bpm;
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
-  if (a.coverage >= 0) opt.bpm.coverage = a.coverage;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
-  if (a.max_batches > 0) opt.bpm.max_batches = a.max_batches;
   for (PhotonSettings* p :
        {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
     if (a.k0 > 0) p->k0 = a.k0;
@@ -141,7 +139,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
     if (!a.radius_policy.empty())
       p->radius_policy =
           a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
-    if (a.photons_per_batch > 0) p->photons_per_batch = a.photons_per_batch;
+    if (a.photons > 0) p->photons_per_iteration = a.photons;
   }
   if (a.final_gather) opt.fpm.final_gather = true;
   if (a.knn >= 0) opt.fpm.knn = a.knn;
@@ -357,7 +355,7 @@ int main(int argc, char** argv) {
   const char* g = "Backward photon mapping (--integrator bpm)";
   render
       ->add_option("--diffuse-depth", ra.diffuse_depth,
-                   "Diffuse vertices before the last backward photon (0..3; default 1)")
+                   "Diffuse vertices before the last backward photon (0..3; default 0)")
       ->check(CLI::Range(0, 3))
       ->group(g);
   render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")
@@ -378,27 +376,16 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 0.999))
       ->group(g);
   render
-      ->add_option("--photons-per-batch", ra.photons_per_batch,
-                   "Photons per light-pass batch (default 100000)")
+      ->add_option("--photons", ra.photons,
+                   "Photons per iteration (default 100000; file: integer photonsperiteration)")
       ->check(CLI::Range(1, 1 << 30))
-      ->group(g);
-  render
-      ->add_option(
-          "--coverage", ra.coverage,
-          "Fraction of last-vertex backward photons hit that ends the photon phase (default 0.9)")
-      ->check(CLI::Range(0.0, 1.0))
-      ->group(g);
-  render
-      ->add_option("--max-batches", ra.max_batches,
-                   "Cap on photon batches per iteration (default 16)")
-      ->check(CLI::Range(1, 1 << 20))
       ->group(g);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))
       ->group(g);
   const char* gf =
       "Forward photon mapping (--integrator fpm; also uses --k0, --k1, --radius-policy, --alpha, "
-      "--photons-per-batch as photons per iteration)";
+      "--photons)";
   render
       ->add_flag("--final-gather", ra.final_gather,
                  "Read indirect light one diffuse bounce after the first hit")

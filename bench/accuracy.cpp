@@ -42,8 +42,8 @@ Rendered run(const LoadedScene& ls, const std::string& integrator, int passes, u
   RenderOptions opt = quiet_options(ls, integrator, passes, seed);
   opt.accuracy = accuracy;
   opt.adaptive = adaptive;
-  opt.bpm.photons_per_batch = 30000;
-  opt.fpm.photons_per_batch = 30000;
+  opt.bpm.photons_per_iteration = 30000;
+  opt.fpm.photons_per_iteration = 30000;
   r.stats = render(ls, opt, &r.film);
   return r;
 }

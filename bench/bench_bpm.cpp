@@ -111,7 +111,7 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     std::vector<std::vector<PhotonEntry>> out(1);
     LightCounters lc;
     lc.observer = &light_log;
-    for (int k = 0; k < bs.photons_per_batch; ++k) {
+    for (int k = 0; k < bs.photons_per_iteration; ++k) {
       Rng rng(stream_key(98, 0, k));
       trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos, {}},
                    owner, rng, out, lc);
@@ -210,7 +210,7 @@ int main(int argc, char** argv) {
   std::printf(
       "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per batch\n",
       scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1,
-      bs.photons_per_batch);
+      bs.photons_per_iteration);
   if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
   if (only.empty() || only == "rays") rays(ls, iterations, bs, hw);
   if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);

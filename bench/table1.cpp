@@ -74,8 +74,9 @@ int main(int argc, char** argv) {
     ls.film.width = w;
     ls.film.height = h;
     RenderOptions opt = quiet_options(ls, "path", 16, 1);
-    opt.bpm.photons_per_batch = photons;
-    opt.fpm.photons_per_batch = photons;
+    opt.bpm.photons_per_iteration = photons;
+    opt.fpm.photons_per_iteration = photons;
+    opt.bpm.diffuse_depth = 1;  // the paper's setting for its Table 1
 
     Run f;
     {

@@ -25,7 +25,9 @@
 #include <sstream>
 #include <string>
 
+#include "bpm/eye_pass.h"
 #include "camera/camera.h"
+#include "photons/light_path.h"
 #include "test_util.h"
 
 namespace bpm {
@@ -67,7 +69,7 @@ double edge_bias(const BpmSettings& s, int iterations, int block) {
 BpmSettings small_batches(int diffuse_depth) {
   BpmSettings s;
   s.diffuse_depth = diffuse_depth;
-  s.photons_per_batch = 4096;
+  s.photons_per_iteration = 4096;
   return s;
 }
 
@@ -289,7 +291,7 @@ TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
       s.radius_policy = policy;
       // At D = 0 every pixel reads the photons directly: their noise is shared by all pixels
       // and needs more photons for the test to have power.
-      if (d == 0) s.photons_per_batch = 32768;
+      if (d == 0) s.photons_per_iteration = 32768;
       expect_furnace("bpm", s, {}, 1 + 2 * d, "D=" + std::to_string(d) + " " + to_string(policy));
     }
 }
@@ -400,6 +402,58 @@ void expect_bpm_converges(const LoadedScene& ls, const Film& ref, uint64_t seed)
   }
 }
 
+// Caustic light at the first diffuse vertex is gathered over the small radius r0, indirect light
+// over r1: with D = 0 the first vertex is also the last, so it holds one backward photon of each
+// (one accepting both when k0 = k1). With D = 1 the first vertex takes caustics over r0 and the
+// second everything over r1.
+TEST(Bpm, FirstDiffuseVertexGathersCausticsOverK0AndIndirectOverK1) {
+  LoadedScene ls = load(cornell());
+  const CameraSampler camera(ls.camera, ls.filter, ls.film.width, ls.film.height, 1);
+  const WavelengthMaterials wm(ls.scene, iteration_wavelengths(1, 0));
+  const uint32_t centre = uint32_t(ls.film.width * (ls.film.height / 2) + ls.film.width / 2);
+  struct Case {
+    int diffuse_depth;
+    float r0, r1;
+  };
+  for (Case c : {Case{0, 0.01f, 0.03f}, Case{0, 0.02f, 0.02f}, Case{1, 0.01f, 0.03f}}) {
+    SCOPED_TRACE("D = " + std::to_string(c.diffuse_depth) + ", r0 " + std::to_string(c.r0));
+    const EyePassParams ep{&wm, c.diffuse_depth, 8, c.r0, c.r1};
+    // The first sample whose path reaches D + 1 diffuse vertices (with D = 1 the bounce off the
+    // back wall may leave through the open side).
+    std::vector<BackwardPhoton> all;
+    for (int pass = 0; pass < 64 && all.size() < size_t(c.diffuse_depth + 1); ++pass) {
+      ObjectPhotonLists lists(ls.scene.objects.size());
+      EyeCounters counters;
+      CameraSample cs = camera.sample(pass, centre);
+      trace_eye_path(ls.scene, ep, cs.ray, centre, cs.rng, lists, counters);
+      all.clear();
+      for (const auto& l : lists) all.insert(all.end(), l.begin(), l.end());
+    }
+    std::sort(all.begin(), all.end(),
+              [](const BackwardPhoton& a, const BackwardPhoton& b) { return a.key() < b.key(); });
+    // The centre pixel sees the back wall: a diffuse vertex at about 2.3 from the camera.
+    ASSERT_FALSE(all.empty());
+    const float length = all[0].radius / (all[0].accepts == kAcceptsCaustic ? c.r0 : c.r1);
+    EXPECT_NEAR(length, 2.3f, 0.1f);
+    if (c.diffuse_depth == 0 && c.r0 != c.r1) {
+      ASSERT_EQ(all.size(), 2u);
+      EXPECT_EQ(all[0].accepts, kAcceptsCaustic);
+      EXPECT_EQ(all[1].accepts, kAcceptsIndirect);
+      EXPECT_FLOAT_EQ(all[1].radius / all[0].radius, c.r1 / c.r0);
+    } else if (c.diffuse_depth == 0) {
+      ASSERT_EQ(all.size(), 1u);
+      EXPECT_EQ(all[0].accepts, kAcceptsCaustic | kAcceptsIndirect);
+    } else {
+      ASSERT_EQ(all.size(), 2u);  // the back wall reflects the path onto another wall
+      EXPECT_EQ(all[0].accepts, kAcceptsCaustic);
+      EXPECT_EQ(all[0].diffuse_index, 0);
+      EXPECT_EQ(all[1].accepts, kAcceptsCaustic | kAcceptsIndirect);
+      EXPECT_EQ(all[1].diffuse_index, 1);
+      EXPECT_GT(all[1].radius / c.r1, length);  // r1 at the end of the longer path
+    }
+  }
+}
+
 TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
   LoadedScene ls = load(cornell());
   expect_bpm_converges(ls, render_with(ls, "path", 2048).film, 3);
@@ -419,7 +473,7 @@ TEST(Bpm, DispersiveGlassCausticConvergesToPath) {
   const Film ref = render_with(ls, "path", 4096).film;
   expect_bpm_converges(ls, ref, 6);
   BpmSettings s = small_batches(0);
-  s.photons_per_batch = 8192;
+  s.photons_per_iteration = 8192;
   for (bool gather : {false, true}) {
     FpmSettings f;
     f.final_gather = gather;
@@ -452,7 +506,7 @@ TEST(Bpm, DispersivePaneOnBothHalfPathsCountsTheHeroOnce) {
   }
   ASSERT_GT(path_mean, 0.01);
   BpmSettings s = small_batches(0);
-  s.photons_per_batch = 8192;
+  s.photons_per_iteration = 8192;
   for (const char* integrator : {"bpm", "fpm"}) {
     BlockStats m = image_mean(render_iterations(ls, integrator, 40, 13, s));
     EXPECT_NEAR(m.mean, path_mean, 4.5 * std::sqrt(m.var + path_var) + 0.02 * path_mean)
@@ -629,7 +683,7 @@ TEST(Bpm, SmoothShadedCornerMatchesPath) {
   RenderRun ref = render_with(ls, "path", 2048);
   BpmSettings bs = small_batches(0);
   bs.k1 = 1;
-  bs.photons_per_batch = 16384;
+  bs.photons_per_iteration = 16384;
   Iterations its = render_iterations(ls, "bpm", 120, 8, bs);
   BlockStats a = image_mean(its), b = block_stats(ref.film, 32)[0];
   double r_px = bs.k1 * radius_scale(bs, 119);
@@ -684,7 +738,7 @@ TEST(Bpm, CentreTreeGivesTheSameImageAsSphereTree) {
 TEST(Fpm, SphereFurnaceMatchesAnalyticRadiance) {
   for (bool gather : {false, true}) {
     BpmSettings s = small_batches(0);
-    s.photons_per_batch = 32768;
+    s.photons_per_iteration = 32768;
     FpmSettings f;
     f.final_gather = gather;
     expect_furnace("fpm", s, f, gather ? 3 : 1, gather ? "final gather" : "direct");
@@ -697,7 +751,7 @@ TEST(Fpm, CornellBoxAndCausticConvergeToPath) {
     RenderRun ref = render_with(ls, "path", 2048);
     for (bool gather : {false, true}) {
       BpmSettings s = small_batches(gather ? 1 : 0);
-      s.photons_per_batch = 8192;
+      s.photons_per_iteration = 8192;
       FpmSettings f;
       f.final_gather = gather;
       Iterations its = render_iterations(ls, "fpm", 120, 3, s, f);

@@ -137,7 +137,7 @@ TEST_F(Cli, BadFlagsAreErrors) {
 TEST_F(Cli, BpmWritesItsStatistics) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r = run("render " + scene +
-                 " --integrator bpm --iterations 2 --photons-per-batch 2000 --diffuse-depth 0 "
+                 " --integrator bpm --iterations 2 --photons 2000 --diffuse-depth 0 "
                  "--k1 2 --radius-policy fixed --tree centres -o " +
                  (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -151,7 +151,7 @@ TEST_F(Cli, BpmWritesItsStatistics) {
   EXPECT_EQ(b["settings"]["radius_policy"], "fixed");
   EXPECT_EQ(b["settings"]["tree"], "centres");
   EXPECT_GT(b["eye"]["backward_photons"].get<uint64_t>(), 0u);
-  EXPECT_GE(b["light"]["photons"].get<uint64_t>(), 4000u);
+  EXPECT_EQ(b["light"]["photons"].get<uint64_t>(), 4000u);
   EXPECT_GT(rec["rays"]["light"].get<uint64_t>(), 0u);
   for (const char* f : {"out.exr", "out.png", "out.error.png"})
     EXPECT_TRUE(fs::exists(dir_ / f)) << f;
@@ -159,10 +159,9 @@ TEST_F(Cli, BpmWritesItsStatistics) {
 
 TEST_F(Cli, FpmWritesItsStatistics) {
   std::string scene = write("s.pbrt", kTinyScene);
-  CliRun r =
-      run("render " + scene +
-          " --integrator fpm --iterations 2 --photons-per-batch 2000 --final-gather --knn 8 -o " +
-          (dir_ / "out.exr").string());
+  CliRun r = run("render " + scene +
+                 " --integrator fpm --iterations 2 --photons 2000 --final-gather --knn 8 -o " +
+                 (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("per photon path"), std::string::npos) << r.err;
   auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
@@ -179,7 +178,7 @@ TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   std::string text = kTinyScene;
   text.replace(text.find("WorldBegin"), 0,
                "Integrator \"bpm\" \"integer diffusedepth\" 2 \"float k0\" 0.5 \"integer "
-               "photonsperbatch\" 1500\n");
+               "photonsperiteration\" 1500\n");
   std::string scene = write("s.pbrt", text);
   CliRun r = run("render " + scene + " -q --spp 1 --k0 0.75 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -187,7 +186,8 @@ TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   EXPECT_EQ(rec["settings"]["integrator"], "bpm");
   EXPECT_EQ(rec["bpm"]["settings"]["diffuse_depth"], 2);
   EXPECT_EQ(rec["bpm"]["settings"]["k0"], 0.75);
-  EXPECT_EQ(rec["bpm"]["settings"]["photons_per_batch"], 1500);
+  EXPECT_EQ(rec["bpm"]["settings"]["photons_per_iteration"], 1500);
+  EXPECT_EQ(rec["bpm"]["light"]["photons"].get<uint64_t>(), 1500u);
 }
 
 TEST_F(Cli, BadBpmSettingsAreErrors) {
@@ -202,7 +202,7 @@ TEST_F(Cli, BadBpmSettingsAreErrors) {
   EXPECT_NE(run("render " + good + " --integrator bpm --diffuse-depth 4").exit_code, 0);
   EXPECT_NE(run("render " + good + " --integrator bpm --k1 0").exit_code, 0);
   EXPECT_NE(run("render " + good + " --integrator bpm --radius-policy wild").exit_code, 0);
-  EXPECT_NE(run("render " + good + " --integrator bpm --coverage 1.5").exit_code, 0);
+  EXPECT_NE(run("render " + good + " --integrator bpm --photons 0").exit_code, 0);
   EXPECT_TRUE(outputs().empty());
 }
 
@@ -216,7 +216,7 @@ TEST_F(Cli, SigintAndSigtermStillWriteEveryOutput) {
       int devnull = ::open("/dev/null", 1);
       dup2(devnull, 2);
       execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", integrator,
-            "--spp", "10000000", "--photons-per-batch", "5000", "-o", out.c_str(), nullptr);
+            "--spp", "10000000", "--photons", "5000", "-o", out.c_str(), nullptr);
       _exit(127);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
@@ -244,8 +244,7 @@ TEST_F(Cli, WriteEveryLeavesIntermediateOutputs) {
     int devnull = ::open("/dev/null", 1);
     dup2(devnull, 2);
     execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", "bpm", "--spp",
-          "10000000", "--photons-per-batch", "5000", "--write-every", "0.2", "-o", out.c_str(),
-          nullptr);
+          "10000000", "--photons", "5000", "--write-every", "0.2", "-o", out.c_str(), nullptr);
     _exit(127);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(1200));

@@ -302,9 +302,8 @@ TEST(Integrators, AlphaMasksLetLightThrough) {
     for (const char* integrator : {"path", "bpm", "fpm"}) {
       Film film(16, 16);
       RenderOptions opt = quiet_options(*c.ls, integrator, 64, 1);
-      opt.bpm.max_batches = 1;
-      opt.bpm.photons_per_batch = 20000;
-      opt.fpm.photons_per_batch = 20000;
+      opt.bpm.photons_per_iteration = 20000;
+      opt.fpm.photons_per_iteration = 20000;
       render(*c.ls, opt, &film);
       Image img = film.image();
       std::vector<float> rms = film.rms();
@@ -381,8 +380,7 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
     for (const char* integrator : {"path", "bpm"}) {
       Film film(12, 12);
       RenderOptions opt = quiet_options(ls, integrator, 64, 1);
-      opt.bpm.max_batches = 1;  // no caustic or indirect light to gather
-      opt.bpm.photons_per_batch = 20000;
+      opt.bpm.photons_per_iteration = 20000;
       render(ls, opt, &film);
       Image img = film.image();
       std::vector<float> rms = film.rms();
@@ -472,8 +470,7 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
     PerspectiveCamera cam(ls.camera, 24, 16);
     for (const char* integrator : {"path", "bpm"}) {
       RenderOptions opt = quiet_options(ls, integrator, 16, 1);
-      opt.bpm.max_batches = 1;
-      opt.bpm.photons_per_batch = 20000;
+      opt.bpm.photons_per_iteration = 20000;
       Film film(24, 16);
       render(ls, opt, &film);
       Image img = film.image();

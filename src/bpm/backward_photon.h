@@ -31,7 +31,7 @@ struct BackwardPhoton {
            (c == PhotonClass::kIndirect && (accepts & kAcceptsIndirect));
   }
   // Sort key that fixes the order of backward photons whatever thread stored them.
-  uint64_t key() const { return (uint64_t(pixel) << 2) | diffuse_index; }
+  uint64_t key() const { return (uint64_t(pixel) << 4) | (uint64_t(diffuse_index) << 2) | accepts; }
 };
 
 }  // namespace bpm

@@ -22,9 +22,7 @@ void check(const BpmSettings& s) {
   if (s.diffuse_depth < 0 || s.diffuse_depth > 3) throw Error("bpm: diffuse depth must be in 0..3");
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("bpm: radius factors k0 and k1 must be positive");
   if (!(s.alpha > 0 && s.alpha < 1)) throw Error("bpm: alpha must be in (0, 1)");
-  if (s.photons_per_batch <= 0 || s.max_batches <= 0)
-    throw Error("bpm: photons per batch and batch cap must be positive");
-  if (!(s.coverage >= 0 && s.coverage <= 1)) throw Error("bpm: coverage must be in [0, 1]");
+  if (s.photons_per_iteration <= 0) throw Error("bpm: photons per iteration must be positive");
 }
 
 }  // namespace
@@ -72,7 +70,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     tot.build_s += since(t);
     tot.add_maps(maps);
 
-    // 3. Light pass, in batches until the backward photons are covered.
+    // 3. Light pass: a fixed number of photons, in batches.
     LightPassResult light_result = run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light);
     tot.add_light_pass(light_result);
 
@@ -87,8 +85,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     for (const EyeCounters& c : eye_counters) r.rays += c.rays.total();
     for (const LightCounters& c : light.counters) r.rays += c.light_rays;
     char progress[128];
-    std::snprintf(progress, sizeof progress, "  %zu backward photons  %d batches  coverage %.2f",
-                  maps.photons.size(), light_result.batches, light_result.coverage);
+    std::snprintf(progress, sizeof progress, "  %zu backward photons  coverage %.2f",
+                  maps.photons.size(), light_result.coverage);
     r.progress = progress;
     return r;
   };

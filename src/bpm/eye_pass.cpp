@@ -14,12 +14,15 @@
 namespace bpm {
 namespace {
 
-// The backward photon at diffuse vertex v (the diffuse-th of its path, the last one when `last`).
+// A backward photon at diffuse vertex v (the diffuse-th of its path) that accepts `accepts`.
+// Caustic light at the first diffuse vertex is gathered over the small radius (k0); everything
+// gathered at a later vertex, and indirect light anywhere, over the large one (k1).
 BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const EyePassParams& prm,
-                                  uint32_t pixel, int depth, int diffuse, bool last) {
+                                  uint32_t pixel, int depth, int diffuse, uint8_t accepts) {
   BackwardPhoton bp;
   bp.p = v.sp.p;
-  bp.radius = s.length * (last ? prm.radius_per_length1 : prm.radius_per_length0);
+  const bool small = diffuse == 1 && accepts == kAcceptsCaustic;
+  bp.radius = s.length * (small ? prm.radius_per_length0 : prm.radius_per_length1);
   bp.ng = v.sp.ng;
   bp.ns = v.sp.ns;
   bp.uv = v.sp.uv;
@@ -28,7 +31,7 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
   bp.pixel = pixel;
   bp.material = uint32_t(v.material_index);
   bp.eye_depth = uint16_t(std::min(depth, 65535));
-  bp.accepts = last ? (kAcceptsCaustic | kAcceptsIndirect) : kAcceptsCaustic;
+  bp.accepts = accepts;
   bp.diffuse_index = uint8_t(diffuse - 1);
   bp.hero_only = s.hero_only;
   return bp;
@@ -63,10 +66,22 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
       // last vertex, where the path ends.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
                                         v.wo_local, !last, wl, rng, counters.rays);
-      BackwardPhoton bp = backward_photon_at(v, s, prm, pixel, depth, diffuse, last);
-      if (bp.radius > 0 && !s.beta.is_black()) {
-        out[size_t(v.object())].push_back(bp);
-        ++counters.backward_photons;
+      // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
+      // vertex is also the last: two backward photons, one per radius.
+      auto store = [&](uint8_t accepts) {
+        BackwardPhoton bp = backward_photon_at(v, s, prm, pixel, depth, diffuse, accepts);
+        if (bp.radius > 0 && !s.beta.is_black()) {
+          out[size_t(v.object())].push_back(bp);
+          ++counters.backward_photons;
+        }
+      };
+      if (!last)
+        store(kAcceptsCaustic);
+      else if (diffuse > 1 || prm.radius_per_length0 == prm.radius_per_length1)
+        store(kAcceptsCaustic | kAcceptsIndirect);
+      else {
+        store(kAcceptsCaustic);
+        store(kAcceptsIndirect);
       }
       if (last) break;
     }

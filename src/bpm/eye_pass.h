@@ -1,9 +1,10 @@
 // Stage 1 of a bpm iteration, the eye pass (DESIGN.md, "one path, counted exactly once"): a
 // camera path through specular vertices and up to D + 1 diffuse vertices. It counts emission seen
 // through specular vertices only, direct light at each diffuse vertex by next-event estimation,
-// and leaves a backward photon at each diffuse vertex for the light pass to fill: caustic photons
-// only at x_1..x_D (radius r0), every photon but direct ones at x_(D+1) (radius r1), where the path
-// ends. The pass runs block by block, each thread over the pixels of its mask (section 3).
+// and leaves backward photons at each diffuse vertex for the light pass to fill: caustic photons
+// only at x_1..x_D, every photon but direct ones at x_(D+1), where the path ends. Caustic light at
+// x_1 is gathered over the small radius r0, the rest over r1; so with D = 0, x_1 has two backward
+// photons. The pass runs block by block, each thread over the pixels of its mask (section 3).
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 

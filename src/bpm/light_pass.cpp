@@ -73,8 +73,8 @@ namespace {
 
 // Phase one of a batch: every chunk traces its photons into its own lists.
 void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                 const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t photons_per_batch,
-                 int batch, LightPassBuffers* buf) {
+                 const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t first_photon,
+                 uint64_t count, LightPassBuffers* buf) {
   const int slots = masks.slots();
   tbb::parallel_for(tbb::blocked_range<int>(0, int(buf->chunks.size()), 1),
                     [&](const tbb::blocked_range<int>& r) {
@@ -84,9 +84,9 @@ void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const Light
                         by_slot.resize(size_t(slots));
                         for (auto& v : by_slot) v.clear();
                         uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-                        uint64_t last = std::min(first + kPhotonsPerChunk, photons_per_batch);
+                        uint64_t last = std::min(first + kPhotonsPerChunk, count);
                         for (uint64_t k = first; k < last; ++k) {
-                          uint64_t index = uint64_t(batch) * photons_per_batch + k;
+                          uint64_t index = first_photon + k;
                           Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
                           trace_photon(scene, maps, prm, masks.owner(), rng, by_slot, lc);
                         }
@@ -113,19 +113,19 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
                                const LightPassParams& prm, const BpmSettings& s,
                                const PixelMasks& masks, uint64_t seed, int pass_index,
                                LightPassBuffers* buf) {
-  const uint64_t photons_per_batch = uint64_t(s.photons_per_batch);
-  buf->chunks.resize(size_t((photons_per_batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
+  const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
   LightPassResult res;
   res.flux.assign(n_bp, Spectrum());
   std::vector<uint8_t> hit(n_bp, 0);
-  size_t n_indirect = 0;
-  for (const BackwardPhoton& bp : maps.photons) n_indirect += (bp.accepts & kAcceptsIndirect) != 0;
-  res.coverage = n_indirect ? 0.0 : 1.0;
-  for (int batch = 0; batch < s.max_batches; ++batch) {
+  // An interrupt ends the pass after a batch: N of eq. (2) is then the photons emitted so far.
+  for (uint64_t first = 0; first < total && (first == 0 || !interrupt_flag().load());
+       first += kPhotonsPerBatch) {
+    const uint64_t count = std::min(kPhotonsPerBatch, total - first);
+    buf->chunks.resize(size_t((count + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
     auto t = std::chrono::steady_clock::now();
-    trace_batch(scene, maps, prm, masks, seed, pass_index, photons_per_batch, batch, buf);
-    res.emitted += photons_per_batch;
+    trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, buf);
+    res.emitted += count;
     ++res.batches;
     res.trace_s += seconds_since(t);
     size_t entry_bytes = 0;
@@ -136,14 +136,14 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     t = std::chrono::steady_clock::now();
     apply_batch(*buf, masks.slots(), &res.flux, &hit);
     res.apply_s += seconds_since(t);
-    if (n_indirect) {
-      size_t covered = 0;
-      for (size_t g = 0; g < n_bp; ++g)
-        covered += hit[g] && (maps.photons[g].accepts & kAcceptsIndirect);
-      res.coverage = double(covered) / double(n_indirect);
-    }
-    if (res.coverage >= s.coverage || interrupt_flag().load()) break;
   }
+  size_t n_indirect = 0, covered = 0;
+  for (size_t g = 0; g < n_bp; ++g)
+    if (maps.photons[g].accepts & kAcceptsIndirect) {
+      ++n_indirect;
+      covered += hit[g];
+    }
+  res.coverage = n_indirect ? double(covered) / double(n_indirect) : 1.0;
   return res;
 }
 

@@ -1,10 +1,10 @@
-// Stage 3 of a bpm iteration, the light pass (section 3 of the paper), in batches of photons until
-// the backward photons are covered. Each batch runs in
-// two phases. Phase one: photons travel as photons/light_path.h says; at each diffuse hit the hit
-// object's tree gives the backward photons whose spheres contain the hit, and each accepted pair
-// is appended as (backward photon, contribution) to the lists of its chunk, one list per mask
-// slot. Phase two: each slot applies the entries of its own pixels, chunk by chunk in order, so
-// that no locks are needed and the sums do not depend on the thread count.
+// Stage 3 of a bpm iteration, the light pass (section 3 of the paper): a fixed number of photons,
+// in batches that bound the memory of the recorded entries. Each batch runs in two phases. Phase
+// one: photons travel as photons/light_path.h says; at each diffuse hit the hit object's tree gives
+// the backward photons whose spheres contain the hit, and each accepted pair is appended as
+// (backward photon, contribution) to the lists of its chunk, one list per mask slot. Phase two:
+// each slot applies the entries of its own pixels, chunk by chunk in order, so that no locks are
+// needed and the sums do not depend on the thread count.
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
@@ -53,13 +53,17 @@ struct LightPassResult {
   std::vector<Spectrum> flux;  // per backward photon: the sum of its entries' values
   uint64_t emitted = 0;        // photons emitted, N of eq. (2)
   int batches = 0;
-  double coverage = 0;  // fraction of the backward photons accepting indirect light that were hit
+  // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
+  double coverage = 0;
   double trace_s = 0, apply_s = 0;
   size_t peak_entry_bytes = 0;
 };
 
-// Shoots batches of photons (streams keyed by seed, pass_index and photon index) until the
-// coverage target, the batch cap or an interrupt.
+// Photons per batch: the entries of one batch are held in memory until they are applied.
+constexpr uint64_t kPhotonsPerBatch = 100000;
+
+// Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
+// index) in batches of kPhotonsPerBatch; stops early on an interrupt.
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,

@@ -12,10 +12,6 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("diffusedepth", b.diffuse_depth >= 0 && b.diffuse_depth <= 3, "must be in 0..3",
              in.loc);
   read_photon_settings(in, &b);
-  b.coverage = ps.get_float("coverage", b.coverage);
-  ps.require("coverage", b.coverage >= 0 && b.coverage <= 1, "must be in [0, 1]", in.loc);
-  b.max_batches = ps.get_int("maxbatches", b.max_batches);
-  ps.require("maxbatches", b.max_batches > 0, "must be positive", in.loc);
   std::string tree = ps.get_string("tree", "spheres");
   b.centre_tree = tree == "centres";
   ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"",

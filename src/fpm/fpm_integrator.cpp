@@ -32,7 +32,7 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
         {"k1", s.k1},
         {"radius_policy", to_string(s.radius_policy)},
         {"alpha", s.alpha},
-        {"photons_per_iteration", s.photons_per_batch},
+        {"photons_per_iteration", s.photons_per_iteration},
         {"final_gather", s.final_gather},
         {"knn", s.knn},
         {"normal_cos", s.normal_cos}}},
@@ -68,12 +68,12 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
 RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, const FpmSettings& s,
                        Film* film) {
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: radius factors k0 and k1 must be positive");
-  if (s.photons_per_batch <= 0) throw Error("fpm: photons per iteration must be positive");
+  if (s.photons_per_iteration <= 0) throw Error("fpm: photons per iteration must be positive");
   if (s.knn < 0) throw Error("fpm: knn must not be negative");
   const RenderScene& scene = ls.scene;
   const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
   const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
-  const uint64_t n_photons = uint64_t(s.photons_per_batch);
+  const uint64_t n_photons = uint64_t(s.photons_per_iteration);
   const int min_eye_vertices = s.final_gather ? 2 : 1;
   ForwardMaps maps;
   tbb::enumerable_thread_specific<LightCounters> light_counters;

@@ -1,5 +1,5 @@
 // Settings of forward photon mapping: the photon settings it shares with bpm (k0 for the caustic
-// map, k1 for the global map, photons_per_batch photons per iteration) and its own.
+// map, k1 for the global map, photons_per_iteration) and its own.
 #pragma once
 #include "photons/settings.h"
 #include "scene/parsed_scene.h"

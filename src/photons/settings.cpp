@@ -25,8 +25,8 @@ void read_photon_settings(const SceneEntity& in, PhotonSettings* s) {
   s->radius_policy = policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
   s->alpha = ps.get_float("alpha", s->alpha);
   ps.require("alpha", s->alpha > 0 && s->alpha < 1, "must be in (0, 1)", in.loc);
-  s->photons_per_batch = ps.get_int("photonsperbatch", s->photons_per_batch);
-  ps.require("photonsperbatch", s->photons_per_batch > 0, "must be positive", in.loc);
+  s->photons_per_iteration = ps.get_int("photonsperiteration", s->photons_per_iteration);
+  ps.require("photonsperiteration", s->photons_per_iteration > 0, "must be positive", in.loc);
 }
 
 }  // namespace bpm

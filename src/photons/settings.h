@@ -16,7 +16,8 @@ struct PhotonSettings {
   RadiusPolicy radius_policy = RadiusPolicy::kProgressive;
   // Knaus & Zwicker 2011: r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1).
   float alpha = 2.0f / 3.0f;
-  int photons_per_batch = 100000;  // per light-pass batch (bpm), per iteration (fpm)
+  // Photons emitted per iteration: a fixed count, never one that depends on what they hit.
+  int photons_per_iteration = 100000;
   // Photons count only where the normals of the photon's surface and of the gathering point agree
   // to within this cosine.
   float normal_cos = 0.5f;
@@ -29,8 +30,8 @@ inline const char* to_string(RadiusPolicy p) {
 // Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.
 float radius_scale(const PhotonSettings& s, int iteration);
 
-// Reads k0, k1, radiuspolicy, alpha and photonsperbatch from an Integrator line; a bad value is an
-// error at its place in the file.
+// Reads k0, k1, radiuspolicy, alpha and photonsperiteration (pbrt-v4 sppm's name) from an
+// Integrator line; a bad value is an error at its place in the file.
 void read_photon_settings(const SceneEntity& integrator, PhotonSettings* s);
 
 }  // namespace bpm
