@@ -1,6 +1,7 @@
 #include "photons/sphere_kdtree.h"
 
 #include <algorithm>
+#include <optional>
 
 namespace bpm {
 namespace {
@@ -60,25 +61,49 @@ void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int dept
   }
   cell.lo = vmax(cell.lo, tight.lo);
   cell.hi = vmin(cell.hi, tight.hi);
-  int axis = longest_axis(cell);
-  float lo = cell.lo[axis], hi = cell.hi[axis];
-  if (!(hi > lo)) return make_leaf();
-  // Split at the median centre (balanced trees for clustered photons), unless it sits on the
-  // cell's boundary, then at the middle.
+  // The plane: the median centre on the longest axis (balanced trees for clustered photons). Where
+  // many centres share that coordinate (photons on a wall perpendicular to the axis) a plane
+  // through them puts every such sphere on both sides and splits nothing; then the middle of the
+  // axis, then the other axes. The first plane that separates some spheres is kept if it pays.
+  struct Split {
+    int axis;
+    float at;
+    size_t nl, nr;
+    float cost;
+  };
+  auto evaluate = [&](int axis, float at) {
+    size_t nl = 0, nr = 0;
+    for (uint32_t i : ids) {
+      const SphereRef& s = spheres[i];
+      nl += s.c[axis] - s.r < at;
+      nr += s.c[axis] + s.r >= at;
+    }
+    float lo = cell.lo[axis], hi = cell.hi[axis];
+    float pl = (at - lo) / (hi - lo);
+    return Split{axis, at, nl, nr, kTraversalCost + pl * float(nl) + (1 - pl) * float(nr)};
+  };
+  const int first_axis = longest_axis(cell);
+  std::optional<Split> best;
   std::vector<float> cs(n);
-  for (size_t k = 0; k < n; ++k) cs[k] = spheres[ids[k]].c[axis];
-  std::nth_element(cs.begin(), cs.begin() + n / 2, cs.end());
-  float split = cs[n / 2];
-  if (!(split > lo && split < hi)) split = 0.5f * (lo + hi);
-  size_t nl = 0, nr = 0;
-  for (uint32_t i : ids) {
-    const SphereRef& s = spheres[i];
-    nl += s.c[axis] - s.r < split;
-    nr += s.c[axis] + s.r >= split;
+  for (int k = 0; k < 3 && !best; ++k) {
+    const int axis = (first_axis + k) % 3;
+    const float lo = cell.lo[axis], hi = cell.hi[axis];
+    if (!(hi > lo)) continue;
+    for (size_t j = 0; j < n; ++j) cs[j] = spheres[ids[j]].c[axis];
+    std::nth_element(cs.begin(), cs.begin() + n / 2, cs.end());
+    for (float at : {cs[n / 2], 0.5f * (lo + hi)}) {
+      if (!(at > lo && at < hi)) continue;
+      Split c = evaluate(axis, at);
+      if (c.nl < n && c.nr < n) {
+        best = c;
+        break;
+      }
+    }
   }
-  float pl = (split - lo) / (hi - lo);
-  float cost_split = kTraversalCost + pl * float(nl) + (1 - pl) * float(nr);
-  if (cost_split >= float(n) || nl == n || nr == n) return make_leaf();
+  if (!best || best->cost >= float(n)) return make_leaf();
+  const int axis = best->axis;
+  const float split = best->at;
+  const size_t nl = best->nl, nr = best->nr;
 
   std::vector<uint32_t> left, right;
   left.reserve(nl);

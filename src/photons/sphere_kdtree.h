@@ -33,6 +33,13 @@ class SphereKdTree {
       if (length_squared(p - s.c) < s.r * s.r) f(items_[k]);
     }
   }
+  // How many spheres a query at p tests (the size of its leaf).
+  size_t tests_at(Vec3 p) const {
+    if (nodes_.empty()) return 0;
+    uint32_t n = 0;
+    while (nodes_[n].axis != kLeaf) n = p[nodes_[n].axis] < nodes_[n].split ? n + 1 : nodes_[n].a;
+    return nodes_[n].b;
+  }
   size_t bytes() const;
   // Sphere references stored in leaves, and that over the spheres given (1: no duplication).
   size_t reference_count() const { return items_.size(); }

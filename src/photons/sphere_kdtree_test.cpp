@@ -75,6 +75,31 @@ TEST(CentreKdTree, PointQueriesWithinARadiusMatchBruteForce) {
   }
 }
 
+// Backward photons on two walls of one object that meet at a corner, most of them on the wall
+// perpendicular to the cell's longest axis: the median centre on that axis lies on that wall, and
+// a plane there separates nothing. The tree must still split, or every query scans them all.
+TEST(SphereKdTree, PhotonsOnAWallAcrossTheLongestAxisStillSplit) {
+  Rng rng(stream_key(7, 0));
+  std::vector<SphereRef> s;
+  const float r = 0.01f;
+  for (int i = 0; i < 20000; ++i) {
+    float a = rng.uniform(), b = rng.uniform() * 0.5f;
+    // The floor-like wall is longer in x, so that x is the longest axis.
+    s.push_back(i % 5 < 3 ? SphereRef{Vec3(1, a, b), r}
+                          : SphereRef{Vec3(1.5f * a - 0.5f, 1, b), r});
+  }
+  SphereKdTree t;
+  t.build(s);
+  size_t worst = 0;
+  for (int q = 0; q < 1000; ++q) {
+    float a = rng.uniform(), b = rng.uniform() * 0.5f;
+    Vec3 p = q % 2 ? Vec3(1, a, b) : Vec3(1.5f * a - 0.5f, 1, b);
+    worst = std::max(worst, t.tests_at(p));
+  }
+  // About 7 spheres contain a point; a leaf of a few hundred is the tree's cost trade-off.
+  EXPECT_LT(worst, 1000u);
+}
+
 TEST(SphereKdTree, IdenticalSpheresDoNotRecurseForever) {
   std::vector<SphereRef> s(5000, SphereRef{Vec3(1, 2, 3), 0.5f});
   SphereKdTree t;
