@@ -43,6 +43,7 @@ struct RenderArgs {
   int diffuse_depth = -1;
   float k0 = -1, k1 = -1, alpha = -1;
   std::string radius_policy, tree;
+  bool no_guide = false;
   int photons = 0;
   bool final_gather = false;
   int knn = -1;
@@ -131,6 +132,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   static_cast<PhotonSettings&>(opt.fpm) = opt.bpm;
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
+  if (a.no_guide) opt.bpm.guide_emission = false;
   for (PhotonSettings* p :
        {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
     if (a.k0 > 0) p->k0 = a.k0;
@@ -379,6 +381,12 @@ int main(int argc, char** argv) {
       ->add_option("--photons", ra.photons,
                    "Photons per iteration (default 100000; file: integer photonsperiteration)")
       ->check(CLI::Range(1, 1 << 30))
+      ->group(g);
+  render
+      ->add_flag(
+          "--no-guide", ra.no_guide,
+          "Emit photons in proportion to light power only, without learning where the camera "
+          "sees them (file: bool guideemission false)")
       ->group(g);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))

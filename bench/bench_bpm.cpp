@@ -113,8 +113,9 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
     lc.observer = &light_log;
     for (int k = 0; k < bs.photons_per_iteration; ++k) {
       Rng rng(stream_key(98, 0, k));
+      const EmissionDraw e = unguided_emission(ls.scene, rng);
       trace_photon(ls.scene, empty, LightPassParams{&wm, ls.render.max_depth, bs.normal_cos, {}},
-                   owner, rng, out, lc);
+                   owner, e, rng, out, lc);
     }
   }
   std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays\n",

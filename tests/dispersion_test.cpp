@@ -64,7 +64,8 @@ TEST(Dispersion, PrismBendsEachWavelengthBySnellsLaw) {
     LightCounters counters;
     for (uint64_t k = 0; k < 4000; ++k) {
       Rng rng(stream_key(7, k));
-      trace_light_path(ls.scene, wm, 5, 1, rng, counters, [&](const PhotonHit& h) {
+      const EmissionDraw e = unguided_emission(ls.scene, rng);
+      trace_light_path(ls.scene, wm, 5, 1, e, rng, counters, [&](const PhotonHit& h) {
         if (h.object != screen) return;
         ++hits;
         EXPECT_TRUE(h.hero_only);

@@ -9,7 +9,8 @@ namespace bpm {
 
 void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
                           uint64_t emitted, const EyePixels& eye, const Wavelengths& wl,
-                          float max_component_value, Film* film) {
+                          float max_component_value, Film* film, std::vector<double>* estimates,
+                          std::vector<uint32_t>* counts) {
   const int w = film->width(), h = film->height();
   std::vector<Spectrum> photon_L(size_t(w) * size_t(h));
   for (size_t g = 0; g < maps.photons.size(); ++g) {
@@ -24,8 +25,12 @@ void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>&
       for (int x = 0; x < w; ++x) {
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
-        record_pass(film, p, eye.radiance[p] + photon_L[p], wl, eye.filter_weight[p],
-                    max_component_value);
+        const Spectrum L = eye.radiance[p] + photon_L[p];
+        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value);
+        if (estimates && L.is_finite()) {
+          (*estimates)[p] += L.average();
+          ++(*counts)[p];
+        }
       }
   });
 }

@@ -11,9 +11,13 @@
 
 namespace bpm {
 
-// flux[g]: the summed contributions backward photon g received from `emitted` photons.
+// flux[g]: the summed contributions backward photon g received from `emitted` photons. When
+// `estimates` is given, each sampled pixel's estimate (the mean over its wavelengths) is added to
+// it and that pixel's count in `counts` incremented.
 void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
                           uint64_t emitted, const EyePixels& eye, const Wavelengths& wl,
-                          float max_component_value, Film* film);
+                          float max_component_value, Film* film,
+                          std::vector<double>* estimates = nullptr,
+                          std::vector<uint32_t>* counts = nullptr);
 
 }  // namespace bpm

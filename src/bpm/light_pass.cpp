@@ -20,11 +20,14 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`.
-void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
-                   const std::vector<uint16_t>& owner, int object, const SurfacePoint& sp, Vec3 wi,
-                   const Spectrum& flux, PhotonClass cls, int bounces, bool hero_only,
-                   std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
+// Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`. Returns
+// the sum of the entries' contributions to their pixels (per unit of 1 / N), each times the
+// pixel's weight, when prm.pixel_weight is set.
+float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
+                    const std::vector<uint16_t>& owner, int object, const SurfacePoint& sp, Vec3 wi,
+                    const Spectrum& flux, PhotonClass cls, int bounces, bool hero_only,
+                    std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
+  float score = 0;
   ++counters.queries;
   maps.query(object, sp.p, [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
@@ -40,7 +43,11 @@ void gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     value *= hero_join_factor(bp.hero_only, hero_only);
     out[owner[bp.pixel]].push_back({g, value});
     ++counters.entries;
+    if (prm.pixel_weight)
+      score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
+               (kPi * bp.radius * bp.radius);
   });
+  return score;
 }
 
 }  // namespace
@@ -57,16 +64,20 @@ void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
   });
 }
 
-void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                  const std::vector<uint16_t>& owner, Rng& rng,
-                  std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
+float trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                   const std::vector<uint16_t>& owner, const EmissionDraw& e, Rng& rng,
+                   std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   // A backward photon adds at least one eye vertex; direct photons are never used (next-event
   // estimation counts direct light).
-  trace_light_path(scene, *prm.materials, prm.max_depth, 1, rng, counters, [&](const PhotonHit& h) {
-    if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
-      gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls, h.bounces, h.hero_only,
-                    out, counters);
-  });
+  float score = 0;
+  trace_light_path(scene, *prm.materials, prm.max_depth, 1, e, rng, counters,
+                   [&](const PhotonHit& h) {
+                     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
+                       score += gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls,
+                                              h.bounces, h.hero_only, out, counters);
+                   });
+  // The score as if the photon had been emitted without guidance.
+  return e.weight > 0 ? score / e.weight : 0;
 }
 
 namespace {
@@ -83,12 +94,18 @@ void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const Light
                         std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
                         by_slot.resize(size_t(slots));
                         for (auto& v : by_slot) v.clear();
+                        std::vector<CellScore>& scores = buf->scores[size_t(c)];
+                        scores.clear();
                         uint64_t first = uint64_t(c) * kPhotonsPerChunk;
                         uint64_t last = std::min(first + kPhotonsPerChunk, count);
                         for (uint64_t k = first; k < last; ++k) {
                           uint64_t index = first_photon + k;
                           Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
-                          trace_photon(scene, maps, prm, masks.owner(), rng, by_slot, lc);
+                          const EmissionDraw e =
+                              prm.guide ? prm.guide->sample(rng) : unguided_emission(scene, rng);
+                          float score =
+                              trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
+                          if (prm.guide && prm.pixel_weight) scores.push_back({e.cell, score});
                         }
                       }
                     });
@@ -112,7 +129,7 @@ void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* 
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& prm, const BpmSettings& s,
                                const PixelMasks& masks, uint64_t seed, int pass_index,
-                               LightPassBuffers* buf) {
+                               LightPassBuffers* buf, EmissionGuide* learner) {
   const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
   LightPassResult res;
@@ -123,6 +140,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
        first += kPhotonsPerBatch) {
     const uint64_t count = std::min(kPhotonsPerBatch, total - first);
     buf->chunks.resize(size_t((count + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
+    buf->scores.resize(buf->chunks.size());
     auto t = std::chrono::steady_clock::now();
     trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, buf);
     res.emitted += count;
@@ -135,6 +153,8 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
 
     t = std::chrono::steady_clock::now();
     apply_batch(*buf, masks.slots(), &res.flux, &hit);
+    if (learner && prm.guide && prm.pixel_weight)
+      for (const std::vector<CellScore>& s : buf->scores) learner->learn(s);
     res.apply_s += seconds_since(t);
   }
   size_t n_indirect = 0, covered = 0;

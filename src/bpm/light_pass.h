@@ -32,20 +32,28 @@ struct LightPassParams {
   // When the scene has textured materials: each backward photon's material, resolved once at its
   // point (resolve_photon_materials) instead of once per photon that reaches it; may be empty.
   std::vector<Material> photon_materials;
+  // Where photons start (guided emission); null: unguided.
+  const EmissionGuide* guide = nullptr;
+  // Per pixel, 1 / (its estimated value + a floor): a photon's score for the guide is the sum of
+  // its contributions weighted so. Empty: photons are not scored.
+  const std::vector<float>* pixel_weight = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
 void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm);
 
-// Traces one photon. owner[pixel] is the mask slot of the pixel; out has one list per slot.
-void trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& params,
-                  const std::vector<uint16_t>& owner, Rng& rng,
-                  std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters);
+// Traces one photon emitted as `e` says. owner[pixel] is the mask slot of the pixel; out has one
+// list per slot. Returns the photon's score for the guide (zero when params.pixel_weight is null).
+float trace_photon(const RenderScene& scene, const BackwardMaps& maps,
+                   const LightPassParams& params, const std::vector<uint16_t>& owner,
+                   const EmissionDraw& e, Rng& rng, std::vector<std::vector<PhotonEntry>>& out,
+                   LightCounters& counters);
 
-// What the light pass keeps between iterations: the entry lists of each chunk of a batch and the
-// per-thread counters.
+// What the light pass keeps between iterations: the entry lists and photon scores of each chunk
+// of a batch and the per-thread counters.
 struct LightPassBuffers {
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [chunk][slot]
+  std::vector<std::vector<CellScore>> scores;                 // [chunk]
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
 
@@ -63,10 +71,12 @@ struct LightPassResult {
 constexpr uint64_t kPhotonsPerBatch = 100000;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in batches of kPhotonsPerBatch; stops early on an interrupt.
+// index) in batches of kPhotonsPerBatch; stops early on an interrupt. With params.guide the
+// photons start where it sends them, and with params.pixel_weight their scores are added to
+// `learner` (which may be the guide itself: learning does not change its density until update).
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,
-                               LightPassBuffers* buffers);
+                               LightPassBuffers* buffers, EmissionGuide* learner = nullptr);
 
 }  // namespace bpm

@@ -16,6 +16,7 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   b.centre_tree = tree == "centres";
   ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"",
              in.loc);
+  b.guide_emission = ps.get_bool("guideemission", b.guide_emission);
   return b;
 }
 

@@ -14,6 +14,8 @@ struct BpmSettings : PhotonSettings {
   // Use the kd-tree over sphere centres (range search with the largest radius) instead of the
   // kd-tree over whole integration spheres; for measuring the paper's claim (section 2).
   bool centre_tree = false;
+  // Guide photon emission toward what the camera sees (photons/emission_guide.h).
+  bool guide_emission = true;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones); defaults

@@ -61,6 +61,7 @@ nlohmann::json light_json(const BpmTotals& t, int iterations) {
           {"batches_per_iteration", ratio(double(t.batches), iterations)},
           {"coverage_mean", ratio(t.coverage_sum, iterations)},
           {"coverage_last", t.last_coverage},
+          {"guide_moved", t.guide_moved},
           {"rays_per_second", ratio(double(t.light.light_rays), light_s)}};
 }
 
@@ -76,7 +77,8 @@ nlohmann::json to_json(const BpmTotals& t, const BpmSettings& s, int iterations,
         {"alpha", s.alpha},
         {"photons_per_iteration", s.photons_per_iteration},
         {"normal_cos", s.normal_cos},
-        {"tree", s.centre_tree ? "centres" : "spheres"}}},
+        {"tree", s.centre_tree ? "centres" : "spheres"},
+        {"guide_emission", s.guide_emission}}},
       {"eye", eye_json(t, iterations, pixels)},
       {"maps",
        {{"peak_photon_bytes", t.peak_photon_bytes},

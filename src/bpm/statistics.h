@@ -20,6 +20,7 @@ struct BpmTotals {
   double coverage_sum = 0, last_coverage = 0;
   double duplication_sum = 0;
   int duplication_n = 0;
+  double guide_moved = 0;  // share of photons the emission guide moved, at the end
 
   // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.
   void add_maps(const BackwardMaps& maps);

@@ -34,8 +34,9 @@ void trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& 
                    last = std::min(first + kPhotonsPerChunk, n_photons);
           for (uint64_t k = first; k < last; ++k) {
             Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
+            const EmissionDraw e = unguided_emission(scene, rng);
             trace_light_path(
-                scene, wm, max_depth, min_eye_vertices, rng, lc, [&](const PhotonHit& hit) {
+                scene, wm, max_depth, min_eye_vertices, e, rng, lc, [&](const PhotonHit& hit) {
                   if (hit.bounces + min_eye_vertices > max_depth) return;
                   ForwardPhoton ph{
                       hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),

@@ -1,8 +1,8 @@
 // Light paths for both photon methods: a photon leaves a light chosen in proportion to power
-// (pbrt-v4's SampleLe), travels with the adjoint BSDF (importance transport: no 1/eta^2 on
-// refraction, Veach's shading-normal correction) and Russian roulette on its change of power,
-// and reports every diffuse surface it reaches, with the class of the path so far. bpm looks up
-// backward photons there; fpm stores a forward photon.
+// (pbrt-v4's SampleLe), or where an EmissionGuide sends it, travels with the adjoint BSDF
+// (importance transport: no 1/eta^2 on refraction, Veach's shading-normal correction) and Russian
+// roulette on its change of power, and reports every diffuse surface it reaches, with the class of
+// the path so far. bpm looks up backward photons there; fpm stores a forward photon.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -11,6 +11,7 @@
 #include "base/rng.h"
 #include "integrator/counters.h"
 #include "integrator/path_vertex.h"
+#include "photons/emission_guide.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -70,25 +71,35 @@ struct PhotonHit {
   bool hero_only;  // the photon keeps its hero wavelength alone (PathState)
 };
 
-// Traces one photon at the wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse
-// surface. The path stops once a further bounce could not make a path of at most max_depth
-// scattering events with the `min_eye_vertices` the estimator adds on the camera side.
+// Unguided emission: a light in proportion to power, u_pos and u_dir uniform (five numbers).
+inline EmissionDraw unguided_emission(const RenderScene& scene, Rng& rng) {
+  EmissionDraw e;
+  if (scene.lights.empty()) return e;
+  e.light = scene.light_distribution.sample(rng.uniform(), &e.light_pmf);
+  e.u_pos = {rng.uniform(), rng.uniform()};
+  e.u_dir = {rng.uniform(), rng.uniform()};
+  return e;
+}
+
+// Traces one photon emitted as `e` says (unguided_emission, or an EmissionGuide's draw) at the
+// wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface. The path stops once
+// a further bounce could not make a path of at most max_depth scattering events with the
+// `min_eye_vertices` the estimator adds on the camera side.
 template <class OnHit>
 void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
-                      int min_eye_vertices, Rng& rng, LightCounters& counters, OnHit&& on_hit) {
+                      int min_eye_vertices, const EmissionDraw& e, Rng& rng,
+                      LightCounters& counters, OnHit&& on_hit) {
   ++counters.photons;
-  if (scene.lights.empty() || max_depth < min_eye_vertices) return;
-  float pmf;
-  int li = scene.light_distribution.sample(rng.uniform(), &pmf);
-  const Light& light = scene.lights[li];
-  Vec2 u_pos{rng.uniform(), rng.uniform()}, u_dir{rng.uniform(), rng.uniform()};
+  if (scene.lights.empty() || max_depth < min_eye_vertices || e.light_pmf == 0 || e.weight == 0)
+    return;
+  const Light& light = scene.lights[size_t(e.light)];
   auto le =
-      light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info, wm.wl);
-  if (!le || le->flux.is_black() || pmf == 0) return;
+      light_sample_le(light, scene.light_shape(light), e.u_pos, e.u_dir, scene.bounds_info, wm.wl);
+  if (!le || le->flux.is_black()) return;
   bool has_surface = length_squared(le->n_light) > 0;
   PathState s{Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin,
                   le->direction, kInf},
-              le->flux / pmf};
+              le->flux * (e.weight / e.light_pmf)};
   // Only area lights may touch a medium (flatten_lights.cpp): the one on the side the photon leaves
   // to.
   if (const auto* area = std::get_if<AreaLight>(&light))

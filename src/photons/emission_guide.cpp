@@ -1,0 +1,103 @@
+#include "photons/emission_guide.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace bpm {
+namespace {
+
+// Cells per light: a point, spot, goniometric or projection light has one position, a distant
+// light one direction; the grid shrinks when a scene has many lights (emissive meshes), so that
+// the guide stays within about a million cells.
+constexpr size_t kMaxCells = size_t(1) << 20;
+
+bool has_one_position(const Light& l) {
+  return std::holds_alternative<PointLight>(l) || std::holds_alternative<SpotLight>(l) ||
+         std::holds_alternative<GoniometricLight>(l) || std::holds_alternative<ProjectionLight>(l);
+}
+
+}  // namespace
+
+EmissionGuide::EmissionGuide(const RenderScene& scene) {
+  const size_t n = scene.lights.size();
+  if (n == 0 || scene.light_distribution.empty()) return;
+  // Resolutions (position, direction) from the finest that fits.
+  for (auto [pos, dir] : {std::pair{4, 16}, std::pair{2, 8}, std::pair{1, 4}, std::pair{1, 1}}) {
+    lights_.clear();
+    size_t total = 0;
+    for (const Light& l : scene.lights) {
+      int p = has_one_position(l) ? 1 : pos;
+      int d = std::holds_alternative<DistantLight>(l) ? 1 : (has_one_position(l) ? 2 * dir : dir);
+      lights_.push_back({uint32_t(total), p, d});
+      total += size_t(p * p) * size_t(d * d);
+    }
+    cells_ = total;
+    if (total <= kMaxCells) break;
+  }
+  unguided_.resize(cells_);
+  for (size_t li = 0; li < n; ++li) {
+    const LightCells& lc = lights_[li];
+    size_t count = size_t(lc.pos_res * lc.pos_res) * size_t(lc.dir_res * lc.dir_res);
+    float p = scene.light_distribution.pmf(int(li)) / float(count);
+    std::fill_n(unguided_.begin() + lc.first, count, p);
+  }
+  guided_ = Distribution1D(unguided_);
+  score_sum_.assign(cells_, 0.0);
+  photons_.assign(cells_, 0.0);
+}
+
+EmissionDraw EmissionGuide::sample(Rng& rng) const {
+  EmissionDraw d;
+  float pmf = 0;
+  const uint32_t cell = uint32_t(guided_.sample(rng.uniform(), &pmf));
+  // The light owning the cell: the last whose first cell is not after it.
+  auto it = std::upper_bound(lights_.begin(), lights_.end(), cell,
+                             [](uint32_t c, const LightCells& l) { return c < l.first; });
+  const int li = int(it - lights_.begin()) - 1;
+  const LightCells& lc = lights_[size_t(li)];
+  uint32_t local = cell - lc.first;
+  const uint32_t dir_cells = uint32_t(lc.dir_res * lc.dir_res);
+  const uint32_t pos_cell = local / dir_cells, dir_cell = local % dir_cells;
+  auto in_cell = [&](uint32_t index, int res) {
+    float x = (float(index % uint32_t(res)) + rng.uniform()) / float(res);
+    float y = (float(index / uint32_t(res)) + rng.uniform()) / float(res);
+    return Vec2{std::min(x, 0x1.fffffep-1f), std::min(y, 0x1.fffffep-1f)};
+  };
+  d.light = li;
+  d.u_pos = in_cell(pos_cell, lc.pos_res);
+  d.u_dir = in_cell(dir_cell, lc.dir_res);
+  d.cell = cell;
+  const float unguided = unguided_[cell];
+  d.light_pmf = unguided * float(lc.pos_res * lc.pos_res) * float(dir_cells);
+  d.weight = pmf > 0 ? unguided / pmf : 0;
+  return d;
+}
+
+void EmissionGuide::learn(const std::vector<CellScore>& scores) {
+  for (const CellScore& s : scores) {
+    score_sum_[s.cell] += s.score;
+    photons_[s.cell] += 1;
+  }
+}
+
+void EmissionGuide::update() {
+  if (cells_ == 0) return;
+  // Learnt density: the unguided probability of a cell times the mean score of its photons.
+  std::vector<double> learnt(cells_, 0.0);
+  double total = 0;
+  for (size_t c = 0; c < cells_; ++c) {
+    if (photons_[c] > 0) learnt[c] = double(unguided_[c]) * score_sum_[c] / photons_[c];
+    total += learnt[c];
+  }
+  if (!(total > 0) || !std::isfinite(total)) return;
+  std::vector<float> mixed(cells_);
+  moved_ = 0;
+  for (size_t c = 0; c < cells_; ++c) {
+    double g = 0.5 * double(unguided_[c]) + 0.5 * learnt[c] / total;
+    mixed[c] = float(g);
+    moved_ += 0.5 * std::fabs(g - double(unguided_[c]));
+  }
+  guided_ = Distribution1D(mixed);
+}
+
+}  // namespace bpm

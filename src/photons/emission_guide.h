@@ -1,0 +1,66 @@
+// Photon emission guided toward what the camera sees. A photon's emission is drawn from five
+// uniform numbers: the light, u_pos (the point on it) and u_dir (the direction). The guide cuts
+// that primary sample space into cells (per light, a grid over u_pos times a grid over u_dir),
+// learns from earlier iterations how much a photon started in each cell adds to the image,
+// relative to the pixels it reaches, and draws cells from an even mixture of that and the
+// unguided density (lights in proportion to power, u_pos and u_dir uniform). Inside a cell the
+// numbers stay uniform, so the density ratio is constant per cell: a photon's flux is multiplied
+// by unguided / guided probability of its cell, which is at most 2. Every iteration is therefore
+// an unbiased estimate of its radius-blurred image, whatever was learnt.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "base/rng.h"
+#include "base/sampling.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+// Where a photon starts, in primary sample space, and how its flux is weighted.
+struct EmissionDraw {
+  int light = 0;
+  float light_pmf = 0;  // the unguided probability of the light (power)
+  Vec2 u_pos, u_dir;
+  uint32_t cell = 0;
+  float weight = 1;  // unguided / guided probability of the cell
+};
+
+// What one photon added: its cell and the sum of its relative contributions, each computed as if
+// it had been emitted without guidance (weight removed).
+struct CellScore {
+  uint32_t cell;
+  float score;
+};
+
+class EmissionGuide {
+ public:
+  EmissionGuide() = default;
+  explicit EmissionGuide(const RenderScene& scene);
+  bool empty() const { return cells_ == 0; }
+  size_t cells() const { return cells_; }
+  // Draws the emission of one photon (five numbers from rng).
+  EmissionDraw sample(Rng& rng) const;
+  // Adds the scores of photons, in a fixed order (the sums must not depend on the thread count).
+  void learn(const std::vector<CellScore>& scores);
+  // Rebuilds the guided density from everything learnt so far; until a photon has scored, the
+  // density stays the unguided one.
+  void update();
+  // The share of photons guidance moves (total variation between the guided and unguided
+  // densities): 0 before anything is learnt, at most 1/2 with the even mixture.
+  double moved() const { return moved_; }
+
+ private:
+  struct LightCells {
+    uint32_t first;  // index of the light's first cell
+    int pos_res, dir_res;
+  };
+  std::vector<LightCells> lights_;
+  std::vector<float> unguided_;  // probability of each cell without guidance
+  Distribution1D guided_;
+  std::vector<double> score_sum_, photons_;
+  size_t cells_ = 0;
+  double moved_ = 0;
+};
+
+}  // namespace bpm
