@@ -19,7 +19,8 @@ LoadedScene two_kinds_of_light() {
       "\"integer yresolution\" 8\nWorldBegin\n"
       "LightSource \"point\" \"rgb I\" [5 5 5] \"point3 from\" [0 2 0]\n"
       "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [3 3 3]\n"
-      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1 3 -1  1 3 -1  1 3 1 "
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1 3 -1  1 3 -1  1 3 "
+      "1 "
       " -1 3 1]\nAttributeEnd\n"
       "Shape \"sphere\" \"float radius\" 0.5\n"));
 }
