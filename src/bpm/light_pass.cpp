@@ -139,7 +139,10 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
   for (uint64_t first = 0; first < total && (first == 0 || !interrupt_flag().load());
        first += kPhotonsPerBatch) {
     const uint64_t count = std::min(kPhotonsPerBatch, total - first);
-    buf->chunks.resize(size_t((count + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
+    // Sized for a whole batch, so that a shorter last batch keeps the lists' memory (its chunks
+    // past `count` stay empty).
+    const uint64_t batch = std::min(kPhotonsPerBatch, total);
+    buf->chunks.resize(size_t((batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
     buf->scores.resize(buf->chunks.size());
     auto t = std::chrono::steady_clock::now();
     trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, buf);

@@ -75,7 +75,8 @@ EmissionDraw EmissionGuide::sample(Rng& rng) const {
 
 void EmissionGuide::learn(const std::vector<CellScore>& scores) {
   for (const CellScore& s : scores) {
-    score_sum_[s.cell] += s.score;
+    // A non-finite score (a numerical accident) would poison its cell's sum for good.
+    if (std::isfinite(s.score) && s.score >= 0) score_sum_[s.cell] += s.score;
     photons_[s.cell] += 1;
   }
 }

@@ -42,7 +42,7 @@ TEST(EmissionGuide, LearntDensityIsDrawnAndWeightedWithoutBias) {
   std::vector<CellScore> scores;
   for (int k = 0; k < n; ++k) {
     EmissionDraw e = guide.sample(rng);
-    ASSERT_EQ(e.weight, 1.0f);
+    ASSERT_NEAR(e.weight, 1.0f, 1e-5f);
     ASSERT_NEAR(e.light_pmf, ls.scene.light_distribution.pmf(e.light), 1e-6f);
     region += in_region(e);
     // Photons in the region score; all others score nothing.
