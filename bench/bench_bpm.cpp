@@ -209,7 +209,8 @@ int main(int argc, char** argv) {
   int hw = int(std::thread::hardware_concurrency());
   BpmSettings bs = bpm_settings_from_file(ls.render.integrator_directive);
   std::printf(
-      "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per iteration\n",
+      "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per "
+      "iteration\n",
       scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1,
       bs.photons_per_iteration);
   if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
