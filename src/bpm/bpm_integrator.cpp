@@ -92,16 +92,13 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     build_backward_maps(lists, scene.objects.size(), s.centre_tree, &maps);
     LightPassParams lp{&wm, opt.max_depth, s.normal_cos, {}};
     resolve_photon_materials(maps, &lp);
-    if (!guide.empty()) {
-      lp.guide = &guide;
-      if (!pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
-    }
+    if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
     tot.build_s += since(t);
     tot.add_maps(maps);
 
     // 3. Light pass: a fixed number of photons, in batches.
-    LightPassResult light_result =
-        run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light, &guide);
+    LightPassResult light_result = run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
+                                                  guide.empty() ? nullptr : &guide);
     tot.add_light_pass(light_result);
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.

@@ -85,30 +85,29 @@ namespace {
 // Phase one of a batch: every chunk traces its photons into its own lists.
 void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
                  const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t first_photon,
-                 uint64_t count, LightPassBuffers* buf) {
+                 uint64_t count, const EmissionGuide* guide, LightPassBuffers* buf) {
   const int slots = masks.slots();
-  tbb::parallel_for(tbb::blocked_range<int>(0, int(buf->chunks.size()), 1),
-                    [&](const tbb::blocked_range<int>& r) {
-                      LightCounters& lc = buf->counters.local();
-                      for (int c = r.begin(); c < r.end(); ++c) {
-                        std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
-                        by_slot.resize(size_t(slots));
-                        for (auto& v : by_slot) v.clear();
-                        std::vector<CellScore>& scores = buf->scores[size_t(c)];
-                        scores.clear();
-                        uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-                        uint64_t last = std::min(first + kPhotonsPerChunk, count);
-                        for (uint64_t k = first; k < last; ++k) {
-                          uint64_t index = first_photon + k;
-                          Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
-                          const EmissionDraw e =
-                              prm.guide ? prm.guide->sample(rng) : unguided_emission(scene, rng);
-                          float score =
-                              trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
-                          if (prm.guide && prm.pixel_weight) scores.push_back({e.cell, score});
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, int(buf->chunks.size()), 1),
+      [&](const tbb::blocked_range<int>& r) {
+        LightCounters& lc = buf->counters.local();
+        for (int c = r.begin(); c < r.end(); ++c) {
+          std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
+          by_slot.resize(size_t(slots));
+          for (auto& v : by_slot) v.clear();
+          std::vector<CellScore>& scores = buf->scores[size_t(c)];
+          scores.clear();
+          uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+          uint64_t last = std::min(first + kPhotonsPerChunk, count);
+          for (uint64_t k = first; k < last; ++k) {
+            uint64_t index = first_photon + k;
+            Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
+            const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
+            float score = trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
+            if (guide && prm.pixel_weight) scores.push_back({e.cell, score});
+          }
+        }
+      });
 }
 
 // Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
@@ -129,7 +128,7 @@ void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* 
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& prm, const BpmSettings& s,
                                const PixelMasks& masks, uint64_t seed, int pass_index,
-                               LightPassBuffers* buf, EmissionGuide* learner) {
+                               LightPassBuffers* buf, EmissionGuide* guide) {
   const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
   LightPassResult res;
@@ -145,7 +144,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     buf->chunks.resize(size_t((batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
     buf->scores.resize(buf->chunks.size());
     auto t = std::chrono::steady_clock::now();
-    trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, buf);
+    trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, guide, buf);
     res.emitted += count;
     ++res.batches;
     res.trace_s += seconds_since(t);
@@ -156,8 +155,8 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
 
     t = std::chrono::steady_clock::now();
     apply_batch(*buf, masks.slots(), &res.flux, &hit);
-    if (learner && prm.guide && prm.pixel_weight)
-      for (const std::vector<CellScore>& s : buf->scores) learner->learn(s);
+    if (guide && prm.pixel_weight)
+      for (const std::vector<CellScore>& s : buf->scores) guide->learn(s);
     res.apply_s += seconds_since(t);
   }
   size_t n_indirect = 0, covered = 0;

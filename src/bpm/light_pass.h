@@ -32,8 +32,6 @@ struct LightPassParams {
   // When the scene has textured materials: each backward photon's material, resolved once at its
   // point (resolve_photon_materials) instead of once per photon that reaches it; may be empty.
   std::vector<Material> photon_materials;
-  // Where photons start (guided emission); null: unguided.
-  const EmissionGuide* guide = nullptr;
   // Per pixel, 1 / (its estimated value + a floor): a photon's score for the guide is the sum of
   // its contributions weighted so. Empty: photons are not scored.
   const std::vector<float>* pixel_weight = nullptr;
@@ -71,12 +69,12 @@ struct LightPassResult {
 constexpr uint64_t kPhotonsPerBatch = 100000;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in batches of kPhotonsPerBatch; stops early on an interrupt. With params.guide the
-// photons start where it sends them, and with params.pixel_weight their scores are added to
-// `learner` (which may be the guide itself: learning does not change its density until update).
+// index) in batches of kPhotonsPerBatch; stops early on an interrupt. With a guide the photons
+// start where it sends them, and with params.pixel_weight as well their scores are added to it
+// (learning does not change its density until its update).
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,
-                               LightPassBuffers* buffers, EmissionGuide* learner = nullptr);
+                               LightPassBuffers* buffers, EmissionGuide* guide = nullptr);
 
 }  // namespace bpm
