@@ -42,6 +42,48 @@ int Distribution1D::sample(float u, float* pmf_out, float* u_remapped) const {
   return i;
 }
 
+AliasTable::AliasTable(const std::vector<float>& weights) {
+  const size_t n = weights.size();
+  bins_.resize(n);
+  if (n == 0) return;
+  double total = 0;
+  for (float w : weights) {
+    BPM_CHECK(w >= 0 && std::isfinite(w));
+    total += w;
+  }
+  // Each bin's share scaled so that the mean is 1; bins below 1 are topped up from bins above.
+  std::vector<double> scaled(n);
+  std::vector<uint32_t> small, large;
+  for (size_t i = 0; i < n; ++i) {
+    const double p = total > 0 ? weights[i] / total : 1.0 / double(n);
+    bins_[i] = {1, uint32_t(i), float(p)};
+    scaled[i] = p * double(n);
+    (scaled[i] < 1 ? small : large).push_back(uint32_t(i));
+  }
+  while (!small.empty() && !large.empty()) {
+    const uint32_t s = small.back(), l = large.back();
+    small.pop_back();
+    bins_[s].keep = float(scaled[s]);
+    bins_[s].alias = l;
+    scaled[l] -= 1 - scaled[s];
+    if (scaled[l] < 1) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  // What is left is 1 up to rounding: those bins keep their own index. A zero-weight bin left
+  // over by rounding must still never be drawn: it sends every draw to a bin of positive weight.
+  for (uint32_t i : small) bins_[i].keep = 1;
+  for (uint32_t i : large) bins_[i].keep = 1;
+  for (Bin& b : bins_)
+    if (b.pmf == 0 && b.keep > 0) {
+      b.keep = 0;
+      if (bins_[b.alias].pmf == 0)
+        for (uint32_t k = 0; k < n; ++k)
+          if (bins_[k].pmf > 0) b.alias = k;
+    }
+}
+
 Distribution2D::Distribution2D(const std::vector<float>& weights, int w, int h) : w_(w), h_(h) {
   BPM_CHECK(w > 0 && h > 0 && weights.size() == size_t(w) * size_t(h));
   std::vector<float> row_totals(static_cast<size_t>(h));

@@ -106,6 +106,35 @@ class Distribution1D {
   double total_ = 0;
 };
 
+// Discrete distribution by Walker's alias method (Vose's construction): a draw costs two look-ups
+// whatever the number of entries, where the inverse CDF costs a binary search. For large tables
+// drawn often (the emission guide's cells). The bin comes from 32 random bits, so every bin is
+// equally likely to within n / 2^32; zero-weight entries are never drawn.
+class AliasTable {
+ public:
+  AliasTable() = default;
+  explicit AliasTable(const std::vector<float>& weights);
+  bool empty() const { return bins_.empty(); }
+  int size() const { return static_cast<int>(bins_.size()); }
+  // An index with probability pmf(index), from 32 uniform bits and a uniform coin in [0, 1).
+  int sample(uint32_t bits, float coin, float* pmf_out = nullptr) const {
+    const uint32_t i = uint32_t((uint64_t(bits) * bins_.size()) >> 32);
+    const Bin& b = bins_[i];
+    const uint32_t k = coin < b.keep ? i : b.alias;
+    if (pmf_out) *pmf_out = bins_[k].pmf;
+    return int(k);
+  }
+  float pmf(int i) const { return bins_[size_t(i)].pmf; }
+
+ private:
+  struct Bin {
+    float keep;      // probability of keeping this bin's own index
+    uint32_t alias;  // the index drawn otherwise
+    float pmf;       // this index's probability
+  };
+  std::vector<Bin> bins_;
+};
+
 // Piecewise-constant density over [0, 1]^2 on a w x h grid of non-negative weights (row-major,
 // row 0 at the smallest y); an all-zero grid is uniform.
 class Distribution2D {

@@ -95,6 +95,47 @@ TEST(Distribution2D, SamplesFollowTheWeights) {
   EXPECT_NEAR(pdf, 1.0f, 1e-6f);
 }
 
+// Alias-method draws follow the weights, zero weights are never drawn, and the reported pmf is the
+// weight's share. The weights span six decades, so a bin that must lend most of its mass and one
+// that borrows from several others are both exercised.
+TEST(AliasTable, SamplesFollowTheWeights) {
+  std::vector<float> weights = {1, 0, 2, 3, 0.5f, 0, 1e-3f, 40, 1e-6f, 7, 0, 2.5f, 1, 1, 9};
+  AliasTable t(weights);
+  double total = 0;
+  for (float x : weights) total += x;
+  Rng rng(11);
+  const int n = 1000000;
+  std::vector<int> count(weights.size(), 0);
+  for (int k = 0; k < n; ++k) {
+    float pmf = 0;
+    const uint32_t bits = rng.next_u32();
+    int i = t.sample(bits, rng.uniform(), &pmf);
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, int(weights.size()));
+    ASSERT_GT(weights[size_t(i)], 0.0f) << "a zero weight was drawn";
+    ASSERT_NEAR(pmf, weights[size_t(i)] / total, 1e-6 * pmf);
+    ++count[size_t(i)];
+  }
+  for (size_t i = 0; i < weights.size(); ++i) {
+    double p = weights[i] / total;
+    EXPECT_NEAR(count[i], n * p, 4 * std::sqrt(n * p * (1 - p)) + 1e-9) << "entry " << i;
+  }
+  // The probabilities the table implies, integrated over the coin on a fine grid for each bin
+  // (the coin's grid step bounds the error): equal to the weights' shares.
+  const int bins = int(weights.size()), steps = 100000;
+  std::vector<double> implied(weights.size(), 0.0);
+  for (int b = 0; b < bins; ++b) {
+    const uint32_t bits = uint32_t(((uint64_t(b) << 32) + uint64_t(bins) - 1) / uint64_t(bins));
+    for (int c = 0; c < steps; ++c)
+      implied[size_t(t.sample(bits, (float(c) + 0.5f) / steps))] += 1.0 / (double(bins) * steps);
+  }
+  for (size_t i = 0; i < weights.size(); ++i)
+    EXPECT_NEAR(implied[i], weights[i] / total, 2.0 / steps) << "entry " << i;
+  // All-zero weights: uniform.
+  AliasTable zero(std::vector<float>(4, 0.0f));
+  EXPECT_NEAR(zero.pmf(2), 0.25f, 1e-7f);
+}
+
 }  // namespace
 // The first 2^k values of the van der Corput sequence fall one in each interval of width 2^-k,
 // whatever k, so the photon methods' wavelength offsets are stratified at every power of two.

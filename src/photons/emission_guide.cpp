@@ -41,7 +41,7 @@ EmissionGuide::EmissionGuide(const RenderScene& scene) {
     float p = scene.light_distribution.pmf(int(li)) / float(count);
     std::fill_n(unguided_.begin() + lc.first, count, p);
   }
-  guided_ = Distribution1D(unguided_);
+  guided_ = AliasTable(unguided_);
   score_sum_.assign(cells_, 0.0);
   photons_.assign(cells_, 0.0);
 }
@@ -49,7 +49,8 @@ EmissionGuide::EmissionGuide(const RenderScene& scene) {
 EmissionDraw EmissionGuide::sample(Rng& rng) const {
   EmissionDraw d;
   float pmf = 0;
-  const uint32_t cell = uint32_t(guided_.sample(rng.uniform(), &pmf));
+  const uint32_t bits = rng.next_u32();
+  const uint32_t cell = uint32_t(guided_.sample(bits, rng.uniform(), &pmf));
   // The light owning the cell: the last whose first cell is not after it.
   auto it = std::upper_bound(lights_.begin(), lights_.end(), cell,
                              [](uint32_t c, const LightCells& l) { return c < l.first; });
@@ -98,7 +99,7 @@ void EmissionGuide::update() {
     mixed[c] = float(g);
     moved_ += 0.5 * std::fabs(g - double(unguided_[c]));
   }
-  guided_ = Distribution1D(mixed);
+  guided_ = AliasTable(mixed);
 }
 
 }  // namespace bpm

@@ -39,7 +39,7 @@ class EmissionGuide {
   explicit EmissionGuide(const RenderScene& scene);
   bool empty() const { return cells_ == 0; }
   size_t cells() const { return cells_; }
-  // Draws the emission of one photon (five numbers from rng).
+  // Draws the emission of one photon (six numbers from rng: two choose the cell).
   EmissionDraw sample(Rng& rng) const;
   // Adds the scores of photons, in a fixed order (the sums must not depend on the thread count).
   void learn(const std::vector<CellScore>& scores);
@@ -57,7 +57,7 @@ class EmissionGuide {
   };
   std::vector<LightCells> lights_;
   std::vector<float> unguided_;  // probability of each cell without guidance
-  Distribution1D guided_;
+  AliasTable guided_;            // drawn once per photon: two look-ups, not a binary search
   std::vector<double> score_sum_, photons_;
   size_t cells_ = 0;
   double moved_ = 0;
