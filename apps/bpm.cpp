@@ -44,6 +44,7 @@ struct RenderArgs {
   float k0 = -1, k1 = -1, alpha = -1;
   std::string radius_policy, tree;
   bool no_guide = false;
+  int emission_samples = 0;
   int photons = 0;
   bool final_gather = false;
   int knn = -1;
@@ -133,6 +134,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
   if (a.no_guide) opt.bpm.guide_emission = false;
+  if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;
   for (PhotonSettings* p :
        {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
     if (a.k0 > 0) p->k0 = a.k0;
@@ -387,6 +389,12 @@ int main(int argc, char** argv) {
           "--no-guide", ra.no_guide,
           "Emit photons in proportion to light power only, without learning where the camera "
           "sees them (file: bool guideemission false)")
+      ->group(g);
+  render
+      ->add_option("--emission-samples", ra.emission_samples,
+                   "Camera samples per iteration for light seen directly or through specular "
+                   "surfaces, in pixels that show any (default 8; file: integer emissionsamples)")
+      ->check(CLI::Range(1, 1024))
       ->group(g);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))

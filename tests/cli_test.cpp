@@ -178,7 +178,7 @@ TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   std::string text = kTinyScene;
   text.replace(text.find("WorldBegin"), 0,
                "Integrator \"bpm\" \"integer diffusedepth\" 2 \"float k0\" 0.5 \"integer "
-               "photonsperiteration\" 1500\n");
+               "photonsperiteration\" 1500 \"integer emissionsamples\" 3\n");
   std::string scene = write("s.pbrt", text);
   CliRun r = run("render " + scene + " -q --spp 1 --k0 0.75 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -187,6 +187,7 @@ TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   EXPECT_EQ(rec["bpm"]["settings"]["diffuse_depth"], 2);
   EXPECT_EQ(rec["bpm"]["settings"]["k0"], 0.75);
   EXPECT_EQ(rec["bpm"]["settings"]["photons_per_iteration"], 1500);
+  EXPECT_EQ(rec["bpm"]["settings"]["emission_samples"], 3);
   EXPECT_EQ(rec["bpm"]["light"]["photons"].get<uint64_t>(), 1500u);
 }
 
@@ -203,6 +204,7 @@ TEST_F(Cli, BadBpmSettingsAreErrors) {
   EXPECT_NE(run("render " + good + " --integrator bpm --k1 0").exit_code, 0);
   EXPECT_NE(run("render " + good + " --integrator bpm --radius-policy wild").exit_code, 0);
   EXPECT_NE(run("render " + good + " --integrator bpm --photons 0").exit_code, 0);
+  EXPECT_NE(run("render " + good + " --integrator bpm --emission-samples 0").exit_code, 0);
   EXPECT_TRUE(outputs().empty());
 }
 

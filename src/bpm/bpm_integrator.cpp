@@ -24,6 +24,7 @@ void check(const BpmSettings& s) {
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("bpm: radius factors k0 and k1 must be positive");
   if (!(s.alpha > 0 && s.alpha < 1)) throw Error("bpm: alpha must be in (0, 1)");
   if (s.photons_per_iteration <= 0) throw Error("bpm: photons per iteration must be positive");
+  if (s.emission_samples < 1) throw Error("bpm: emission samples must be at least 1");
 }
 
 // 1 / (value + floor) per pixel from the running means; the floor, a tenth of the image's mean
@@ -77,8 +78,12 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
 
     // 1. Eye pass: backward photons, and the light the eye paths count themselves.
     auto t = Clock::now();
-    EyePassParams ep{&wm, s.diffuse_depth, opt.max_depth, s.k0 * pixel_angle * scale,
-                     s.k1 * pixel_angle * scale};
+    EyePassParams ep{&wm,
+                     s.diffuse_depth,
+                     opt.max_depth,
+                     s.k0 * pixel_angle * scale,
+                     s.k1 * pixel_angle * scale,
+                     s.emission_samples};
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);

@@ -39,11 +39,14 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
 
 }  // namespace
 
-Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray, uint32_t pixel,
-                        Rng& rng, ObjectPhotonLists& out, EyeCounters& counters) {
+EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray,
+                           uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
+                           bool emission_only) {
   const Wavelengths& wl = prm.materials->wl;
   PathState s{ray};
   Spectrum L;
+  // L up to the first diffuse vertex (its own emission included); until then L is all emission.
+  std::optional<Spectrum> emission;
   int diffuse = 0;  // diffuse vertices so far (j of DESIGN.md)
   int depth = 0;    // scattering events so far, as the path integrator counts them
   // Emitters are counted here when seen through specular vertices only, and when a diffuse
@@ -59,6 +62,10 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     bool is_diffuse = !bsdf_is_specular(v.m());
+    if (is_diffuse && !emission) {
+      emission = L;
+      if (emission_only) break;
+    }
     if (is_diffuse) {
       ++diffuse;
       bool last = diffuse == prm.diffuse_depth + 1;
@@ -100,8 +107,29 @@ Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray 
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++counters.rays.bounce_rays;
   }
-  return L;
+  return {L, emission ? *emission : L};
 }
+
+namespace {
+
+// Replaces the first sample's emission by the mean over prm.emission_samples camera samples of the
+// pixel (the first and emission_samples - 1 more); returns what to add to the first sample's
+// radiance. Each sample counts by its filter weight relative to the first one's, so the film's
+// weighted sums stay those of unbiased estimates. The extra samples have their own streams.
+Spectrum more_emission_samples(const RenderScene& scene, const EyePassParams& prm,
+                               const CameraSampler& camera, int pass_index, uint32_t pixel,
+                               float first_weight, const Spectrum& first_emission,
+                               ObjectPhotonLists& lists, EyeCounters& ec) {
+  Spectrum sum = first_emission;
+  for (int k = 1; k < prm.emission_samples; ++k) {
+    CameraSample cs = camera.sample(pass_index, pixel, uint32_t(k));
+    EyeRadiance e = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, true);
+    sum += e.emission * (cs.filter_weight / first_weight);
+  }
+  return sum / float(prm.emission_samples) - first_emission;
+}
+
+}  // namespace
 
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const CameraSampler& camera,
                   const PixelMasks& masks, const RenderControl& control, int pass, int pass_index,
@@ -123,8 +151,13 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             }
             auto t0 = Clock::now();
             CameraSample cs = camera.sample(pass_index, pixel);
-            px->radiance[pixel] = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec);
+            EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec);
+            px->radiance[pixel] = r.total;
             px->filter_weight[pixel] = cs.filter_weight;
+            if (prm.emission_samples > 1 && px->sees_emission[pixel] && cs.filter_weight != 0)
+              px->radiance[pixel] += more_emission_samples(scene, prm, camera, pass_index, pixel,
+                                                           cs.filter_weight, r.emission, lists, ec);
+            if (!r.emission.is_black()) px->sees_emission[pixel] = 1;
             px->cost_ns[pixel] =
                 float(std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
           }

@@ -25,6 +25,10 @@ struct EyePassParams {
   int max_depth = 5;
   // Radius per unit of eye path length: k * sqrt(pixel solid angle) * radius_scale(iteration).
   float radius_per_length0 = 0, radius_per_length1 = 0;
+  // Camera samples per iteration for emission seen before the first diffuse vertex, in pixels
+  // where some sample has seen any (emitter edges, lights behind glass): cheap paths that end at
+  // that vertex, averaged with the full path's share (1: the full path alone).
+  int emission_samples = 1;
 };
 
 struct EyeCounters {
@@ -39,10 +43,18 @@ struct EyeCounters {
 // Backward photons of one thread, one list per scene object (no locks: each thread has its own).
 using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 
+// What an eye path counts itself: everything, and the part of it seen before the first diffuse
+// vertex (emitters seen directly or through specular vertices only).
+struct EyeRadiance {
+  Spectrum total, emission;
+};
+
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
-// appends the path's backward photons to out[object].
-Spectrum trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
-                        uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters);
+// appends the path's backward photons to out[object]. With emission_only the path ends at its
+// first diffuse vertex and stores nothing: only `emission` is computed.
+EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
+                           uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
+                           bool emission_only = false);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
@@ -50,7 +62,11 @@ struct EyePixels {
   std::vector<float> filter_weight;  // of the pixel's camera sample
   std::vector<float> cost_ns;        // time spent on the pixel, to rebuild the masks
   std::vector<uint8_t> sampled;      // whether this iteration samples the pixel
-  explicit EyePixels(size_t n) : radiance(n), filter_weight(n), cost_ns(n), sampled(n, 0) {}
+  // Whether any earlier sample of the pixel saw emission before its first diffuse vertex: such
+  // pixels take EyePassParams::emission_samples camera samples for it.
+  std::vector<uint8_t> sees_emission;
+  explicit EyePixels(size_t n)
+      : radiance(n), filter_weight(n), cost_ns(n), sampled(n, 0), sees_emission(n, 0) {}
 };
 
 // Per-thread state the eye pass fills.

@@ -16,6 +16,10 @@ struct BpmSettings : PhotonSettings {
   bool centre_tree = false;
   // Guide photon emission toward what the camera sees (photons/emission_guide.h).
   bool guide_emission = true;
+  // Camera samples per iteration for emission seen before the first diffuse vertex, in pixels
+  // that show any (EyePassParams::emission_samples): emitter edges and lights seen through glass
+  // converge with these, not with the iterations.
+  int emission_samples = 8;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones); defaults

@@ -53,8 +53,9 @@ class CameraSampler {
   CameraSampler(const CameraSettings& camera, const FilterSettings& filter, int width, int height,
                 uint64_t seed)
       : camera_(camera, width, height), filter_(filter), width_(width), seed_(seed) {}
-  CameraSample sample(int pass_index, uint32_t pixel) const {
-    Rng rng(stream_key(seed_, uint64_t(pass_index), pixel));
+  // `sub` > 0: further samples of the same pixel and pass, each with its own stream.
+  CameraSample sample(int pass_index, uint32_t pixel, uint32_t sub = 0) const {
+    Rng rng(stream_key(seed_, uint64_t(pass_index), pixel, sub));
     int x = int(pixel % uint32_t(width_)), y = int(pixel / uint32_t(width_));
     FilterSample fs = filter_.sample({rng.uniform(), rng.uniform()});
     Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
