@@ -31,9 +31,9 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
   maps->sphere_trees.clear();
   maps->centre_trees.clear();
   if (centre_tree)
-    maps->centre_trees.resize(object_count);
+    maps->centre_trees.resize(2 * object_count);
   else
-    maps->sphere_trees.resize(object_count);
+    maps->sphere_trees.resize(2 * object_count);
 
   std::vector<uint32_t> order;
   for (uint32_t o = 0; o < object_count; ++o)
@@ -54,12 +54,20 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
     }
     std::sort(dst, dst + n,
               [](const BackwardPhoton& a, const BackwardPhoton& b) { return a.key() < b.key(); });
-    std::vector<SphereRef> spheres(n);
-    for (size_t k = 0; k < n; ++k) spheres[k] = {dst[k].p, dst[k].radius};
-    if (centre_tree)
-      maps->centre_trees[o].build(spheres);
-    else
-      maps->sphere_trees[o].build(spheres);
+    for (int c = 0; c < 2; ++c) {
+      const uint8_t accepts = c == 0 ? kAcceptsCaustic : kAcceptsIndirect;
+      std::vector<SphereRef> spheres;
+      std::vector<uint32_t> ids;
+      for (size_t k = 0; k < n; ++k)
+        if (dst[k].accepts & accepts) {
+          spheres.push_back({dst[k].p, dst[k].radius});
+          ids.push_back(maps->object_begin[o] + uint32_t(k));
+        }
+      if (centre_tree)
+        maps->centre_trees[2 * o + c].build(spheres, &ids);
+      else
+        maps->sphere_trees[2 * o + c].build(spheres, &ids);
+    }
   };
   // The queue: each worker takes the largest object not yet taken.
   std::atomic<size_t> next{0};

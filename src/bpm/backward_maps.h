@@ -1,6 +1,8 @@
 // The backward photon maps of one iteration: every backward photon of the eye pass, grouped by
-// scene object, and one kd-tree per object (section 2 of the paper: per-object maps keep trees
-// small and light from leaking between objects).
+// scene object, and per object one kd-tree for each class of photon (section 2 of the paper:
+// per-object maps keep trees small and light from leaking between objects; per class, a caustic
+// photon tests only the small caustic spheres and an indirect photon only the spheres that accept
+// it). A backward photon that accepts both classes is in both trees.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -16,19 +18,21 @@ struct BackwardMaps {
   std::vector<uint32_t>
       object_begin;  // photons of object o: [object_begin[o], object_begin[o + 1])
   bool centre_tree = false;
-  std::vector<SphereKdTree> sphere_trees;  // per object (empty when centre_tree)
-  std::vector<CentreKdTree> centre_trees;  // per object (empty unless centre_tree)
+  // Index 2 * object + tree_class(class); items are global photon indices.
+  std::vector<SphereKdTree> sphere_trees;  // empty when centre_tree
+  std::vector<CentreKdTree> centre_trees;  // empty unless centre_tree
 
+  static int tree_class(PhotonClass c) { return c == PhotonClass::kCaustic ? 0 : 1; }
   bool has_photons(int object) const { return object_begin[object + 1] > object_begin[object]; }
-  // Calls f(global index) for every backward photon of `object` whose sphere contains p.
+  // Calls f(global index) for every backward photon of `object` that accepts class `cls` (caustic
+  // or indirect) and whose sphere contains p.
   template <class F>
-  void query(int object, Vec3 p, F&& f) const {
-    uint32_t base = object_begin[object];
-    auto g = [&](uint32_t local) { f(base + local); };
+  void query(int object, PhotonClass cls, Vec3 p, F&& f) const {
+    const size_t t = 2 * size_t(object) + size_t(tree_class(cls));
     if (centre_tree)
-      centre_trees[object].query(p, g);
+      centre_trees[t].query(p, f);
     else
-      sphere_trees[object].query(p, g);
+      sphere_trees[t].query(p, f);
   }
   size_t photon_bytes() const { return photons.size() * sizeof(BackwardPhoton); }
   size_t tree_bytes() const;

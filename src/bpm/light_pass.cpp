@@ -29,9 +29,9 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                     std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   float score = 0;
   ++counters.queries;
-  maps.query(object, sp.p, [&](uint32_t g) {
+  maps.query(object, cls, sp.p, [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
-    if (!bp.accepts_class(cls) || int(bp.eye_depth) + bounces > prm.max_depth) return;
+    if (int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
     Material storage;
     const Material& m =

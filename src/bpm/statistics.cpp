@@ -11,7 +11,8 @@ void BpmTotals::add_maps(const BackwardMaps& maps) {
   size_t in = 0, stored = 0;
   for (size_t o = 0; o + 1 < maps.object_begin.size(); ++o) {
     in += maps.object_begin[o + 1] - maps.object_begin[o];
-    stored += maps.sphere_trees[o].reference_count();
+    stored +=
+        maps.sphere_trees[2 * o].reference_count() + maps.sphere_trees[2 * o + 1].reference_count();
   }
   if (in) {
     duplication_sum += double(stored) / double(in);

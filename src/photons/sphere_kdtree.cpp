@@ -21,22 +21,24 @@ int longest_axis(const Bounds3& b) {
 
 }  // namespace
 
-void SphereKdTree::build(const std::vector<SphereRef>& spheres) {
+void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids) {
   nodes_.clear();
   items_.clear();
   spheres_.clear();
   input_count_ = spheres.size();
   if (spheres.empty()) return;
-  std::vector<uint32_t> ids(spheres.size());
+  std::vector<uint32_t> order(spheres.size());
   Bounds3 cell;
-  for (uint32_t i = 0; i < ids.size(); ++i) {
-    ids[i] = i;
+  for (uint32_t i = 0; i < order.size(); ++i) {
+    order[i] = i;
     cell.expand(spheres[i].c - Vec3(spheres[i].r, spheres[i].r, spheres[i].r));
     cell.expand(spheres[i].c + Vec3(spheres[i].r, spheres[i].r, spheres[i].r));
   }
   nodes_.reserve(2 * spheres.size() / kMinLeaf + 1);
-  build_node(ids, cell, 0, spheres);
+  build_node(order, cell, 0, spheres);
   nodes_.shrink_to_fit();
+  if (ids)
+    for (uint32_t& item : items_) item = (*ids)[item];
 }
 
 void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth,
@@ -132,13 +134,13 @@ double SphereKdTree::duplication() const {
   return input_count_ ? double(items_.size()) / double(input_count_) : 0.0;
 }
 
-void CentreKdTree::build(const std::vector<SphereRef>& spheres) {
+void CentreKdTree::build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids) {
   nodes_.clear();
   max_radius_ = 0;
   spheres_ = spheres;
   items_.resize(spheres.size());
   for (uint32_t i = 0; i < items_.size(); ++i) {
-    items_[i] = i;
+    items_[i] = ids ? (*ids)[i] : i;
     max_radius_ = std::max(max_radius_, spheres[i].r);
   }
   if (spheres.empty()) return;

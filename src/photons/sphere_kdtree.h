@@ -21,7 +21,8 @@ struct SphereRef {
 
 class SphereKdTree {
  public:
-  void build(const std::vector<SphereRef>& spheres);
+  // Queries report sphere i as ids[i] when ids are given (one per sphere), else as i.
+  void build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids = nullptr);
   // Calls f(i) for every sphere i with |p - c_i| < r_i.
   template <class F>
   void query(Vec3 p, F&& f) const {
@@ -63,7 +64,8 @@ class SphereKdTree {
 
 class CentreKdTree {
  public:
-  void build(const std::vector<SphereRef>& spheres);
+  // Queries report sphere i as ids[i] when ids are given (one per sphere), else as i.
+  void build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids = nullptr);
   // Calls f(i) for every sphere i with |p - c_i| < r_i (a range search with the largest radius).
   template <class F>
   void query(Vec3 p, F&& f) const {

@@ -112,3 +112,34 @@ TEST(SphereKdTree, IdenticalSpheresDoNotRecurseForever) {
 
 }  // namespace
 }  // namespace bpm
+
+namespace bpm {
+namespace {
+
+// Both trees report the ids they were given for their spheres (the backward maps build one tree
+// per class of photon from a subset of an object's photons and want the photons' own indices).
+TEST(SphereKdTree, QueriesReportTheGivenIds) {
+  std::vector<SphereRef> spheres;
+  std::vector<uint32_t> ids;
+  for (int i = 0; i < 200; ++i) {
+    spheres.push_back({Vec3(0.01f * float(i), 0, 0), 0.015f});
+    ids.push_back(uint32_t(1000 + 3 * i));
+  }
+  SphereKdTree st;
+  st.build(spheres, &ids);
+  CentreKdTree ct;
+  ct.build(spheres, &ids);
+  for (int i = 0; i < 200; i += 17) {
+    std::vector<uint32_t> a, b;
+    st.query(Vec3(0.01f * float(i), 0, 0), [&](uint32_t k) { a.push_back(k); });
+    ct.query(Vec3(0.01f * float(i), 0, 0), [&](uint32_t k) { b.push_back(k); });
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    EXPECT_NE(std::find(a.begin(), a.end(), uint32_t(1000 + 3 * i)), a.end()) << "sphere " << i;
+    for (uint32_t k : a) EXPECT_EQ((k - 1000) % 3, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace bpm
