@@ -45,6 +45,7 @@ struct RenderArgs {
   std::string radius_policy, tree;
   bool no_guide = false;
   int emission_samples = 0;
+  float radius = -1;
   int photons = 0;
   bool final_gather = false;
   int knn = -1;
@@ -135,6 +136,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
   if (a.no_guide) opt.bpm.guide_emission = false;
   if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;
+  if (a.radius >= 0) opt.bpm.radius = a.radius;
   for (PhotonSettings* p :
        {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {
     if (a.k0 > 0) p->k0 = a.k0;
@@ -234,6 +236,9 @@ int run_render(const RenderArgs& a) {
   double t_build = seconds_since(t1);
 
   if (!a.resolution.empty()) set_resolution(a.resolution, &ls.film);
+  // The file's integrator decides only without --integrator; then say how it was read.
+  if (a.integrator.empty() && !ls.render.integrator_note.empty())
+    warning(ls.render.integrator_directive.loc, ls.render.integrator_note);
   RenderOptions opt = render_options(a, ls, file_settings);
   std::string out = a.output;
   if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
@@ -389,6 +394,12 @@ int main(int argc, char** argv) {
           "--no-guide", ra.no_guide,
           "Emit photons in proportion to light power only, without learning where the camera "
           "sees them (file: bool guideemission false)")
+      ->group(g);
+  render
+      ->add_option("--radius", ra.radius,
+                   "Initial radius of every backward photon in scene units, in place of --k0 and "
+                   "--k1 (default 0: off; file: float radius, also pbrt-v4 sppm's)")
+      ->check(CLI::Range(0.0, 1e30))
       ->group(g);
   render
       ->add_option("--emission-samples", ra.emission_samples,

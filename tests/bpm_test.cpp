@@ -653,6 +653,53 @@ TEST(Bpm, EmissionSamplesAverageEmitterEdgesWithoutBias) {
   std::printf("pixel RMS error: 1 sample %.4f, 8 samples %.4f\n", e1, e8);
 }
 
+// pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon
+// count; sppm's default of -1 photons (one per pixel) keeps ours; a negative radius is an error.
+TEST(BpmSettings, SppmLineGivesDepth0ItsRadiusAndItsPhotons) {
+  auto settings = [](const std::string& line) {
+    return bpm_settings_from_file(parse_scene_string(line + "\nWorldBegin\n").integrator);
+  };
+  BpmSettings s =
+      settings("Integrator \"sppm\" \"float radius\" 0.25 \"integer photonsperiteration\" 5000");
+  EXPECT_EQ(s.diffuse_depth, 0);
+  EXPECT_FLOAT_EQ(s.radius, 0.25f);
+  EXPECT_EQ(s.photons_per_iteration, 5000);
+  BpmSettings d = settings("Integrator \"sppm\" \"integer photonsperiteration\" -1");
+  EXPECT_EQ(d.photons_per_iteration, BpmSettings().photons_per_iteration);
+  EXPECT_FLOAT_EQ(d.radius, 0.0f);
+  try {
+    settings("Integrator \"sppm\" \"float radius\" -1");
+    ADD_FAILURE() << "a negative radius was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("radius"), std::string::npos) << e.what();
+  }
+}
+
+// A world-space radius gives every backward photon that radius (times the iteration's scale), and
+// one backward photon at the first vertex with D = 0, accepting both classes.
+TEST(Bpm, WorldRadiusGivesEveryBackwardPhotonThatRadius) {
+  LoadedScene ls = load(cornell());
+  const WavelengthMaterials wm(ls.scene, sample_wavelengths(0.5f));
+  EyePassParams ep{&wm, 0, 8, 1e-3f, 3e-3f};
+  ep.world_radius = 0.07f;
+  PerspectiveCamera cam(ls.camera, 32, 32);
+  ObjectPhotonLists lists(ls.scene.objects.size());
+  EyeCounters c;
+  for (uint32_t pixel = 0; pixel < 32 * 32; pixel += 7) {
+    Rng rng(stream_key(3, 0, pixel));
+    Ray r = cam.generate_ray({float(pixel % 32) + 0.5f, float(pixel / 32) + 0.5f}, {0.5f, 0.5f});
+    trace_eye_path(ls.scene, ep, r, pixel, rng, lists, c);
+  }
+  size_t n = 0;
+  for (const auto& l : lists)
+    for (const BackwardPhoton& bp : l) {
+      EXPECT_FLOAT_EQ(bp.radius, 0.07f);
+      EXPECT_EQ(bp.accepts, kAcceptsCaustic | kAcceptsIndirect);
+      ++n;
+    }
+  EXPECT_GT(n, 50u);
+}
+
 // A glass block without a bottom face stands on a floor whose mesh has smooth shading normals
 // (tilted up to ~15 degrees from the geometric ones): the floor under the glass is inside the
 // dielectric, so photons reach it through one refraction. Radiance-mode eta^2 scaling in the

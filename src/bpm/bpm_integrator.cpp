@@ -25,6 +25,7 @@ void check(const BpmSettings& s) {
   if (!(s.alpha > 0 && s.alpha < 1)) throw Error("bpm: alpha must be in (0, 1)");
   if (s.photons_per_iteration <= 0) throw Error("bpm: photons per iteration must be positive");
   if (s.emission_samples < 1) throw Error("bpm: emission samples must be at least 1");
+  if (!(s.radius >= 0) || !std::isfinite(s.radius)) throw Error("bpm: radius must not be negative");
 }
 
 // 1 / (value + floor) per pixel from the running means; the floor, a tenth of the image's mean
@@ -83,7 +84,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                      opt.max_depth,
                      s.k0 * pixel_angle * scale,
                      s.k1 * pixel_angle * scale,
-                     s.emission_samples};
+                     s.emission_samples,
+                     s.radius * scale};
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);

@@ -22,7 +22,9 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
   BackwardPhoton bp;
   bp.p = v.sp.p;
   const bool small = diffuse == 1 && accepts == kAcceptsCaustic;
-  bp.radius = s.length * (small ? prm.radius_per_length0 : prm.radius_per_length1);
+  bp.radius = prm.world_radius > 0
+                  ? prm.world_radius
+                  : s.length * (small ? prm.radius_per_length0 : prm.radius_per_length1);
   bp.ng = v.sp.ng;
   bp.ns = v.sp.ns;
   bp.uv = v.sp.uv;
@@ -84,7 +86,8 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       };
       if (!last)
         store(kAcceptsCaustic);
-      else if (diffuse > 1 || prm.radius_per_length0 == prm.radius_per_length1)
+      else if (diffuse > 1 || prm.world_radius > 0 ||
+               prm.radius_per_length0 == prm.radius_per_length1)
         store(kAcceptsCaustic | kAcceptsIndirect);
       else {
         store(kAcceptsCaustic);

@@ -29,6 +29,9 @@ struct EyePassParams {
   // where some sample has seen any (emitter edges, lights behind glass): cheap paths that end at
   // that vertex, averaged with the full path's share (1: the full path alone).
   int emission_samples = 1;
+  // When positive, every backward photon's radius in world units instead of the per-length radii
+  // (BpmSettings::radius, times the iteration's radius scale).
+  float world_radius = 0;
 };
 
 struct EyeCounters {

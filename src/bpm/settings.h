@@ -20,10 +20,14 @@ struct BpmSettings : PhotonSettings {
   // that show any (EyePassParams::emission_samples): emitter edges and lights seen through glass
   // converge with these, not with the iterations.
   int emission_samples = 8;
+  // When positive, the initial radius of every backward photon in world units (pbrt-v4 sppm's
+  // "radius"), in place of k0 and k1; it shrinks with the radius policy like them.
+  float radius = 0;
 };
 
-// bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones); defaults
-// for any other integrator. A bad value is an error at its place in the file.
+// bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"
+// line gives diffuse depth 0, its radius and its photons per iteration); defaults for any other
+// integrator. A bad value is an error at its place in the file.
 BpmSettings bpm_settings_from_file(const SceneEntity& integrator);
 
 }  // namespace bpm

@@ -24,6 +24,9 @@ struct FilmSettings {
 struct FileRenderSettings {
   std::string integrator = "path";
   std::string integrator_as_written;
+  // Why the file's integrator is rendered with another of bpm's, and with what (empty when it is
+  // one of bpm's own or none was named); printed unless the command line chooses.
+  std::string integrator_note;
   int max_depth = 5;
   int spp = 16;
   int seed = 0;

@@ -110,19 +110,33 @@ void Flattener::read_sampler_and_integrator(LoadedScene* out) {
   out->render.integrator_as_written = in.name;
   out->render.max_depth = in.params.get_int("maxdepth", 5);
   if (out->render.max_depth < 0) throw Error(in.loc, "maxdepth must not be negative");
-  if (in.name == "path" || in.name == "bpm" || in.name == "fpm") {
-    out->render.integrator = in.name;
-  } else if (in.name == "volpath" || in.name == "bdpt" || in.name == "mlt" || in.name == "sppm" ||
-             in.name == "simplepath" || in.name == "lightpath" || in.name == "randomwalk" ||
-             in.name == "simplevolpath") {
-    // These estimate the same image for scenes without media; bpm's reference for them is path.
+  // pbrt-v4's integrators map to the one of ours that reaches the same light: the path tracers to
+  // path; those that also carry light from the lights' side (bidirectional, Metropolis, light
+  // tracing, photon mapping) to bpm, for a path tracer cannot reach a point or spot light through
+  // glass and would silently drop such caustics. All of them estimate the same image.
+  const std::string& n = in.name;
+  std::string& note = out->render.integrator_note;
+  if (n == "path" || n == "bpm" || n == "fpm") {
+    out->render.integrator = n;
+  } else if (n == "volpath" || n == "simplepath" || n == "simplevolpath" || n == "randomwalk") {
     out->render.integrator = "path";
+    // volpath is also pbrt-v4's default when the file names none.
     if (parsed_.integrator_given)
-      warning(in.loc,
-              "integrator \"" + in.name +
-                  "\" is rendered with bpm's \"path\" integrator (same image for surfaces)");
+      note = "integrator \"" + n + "\" is rendered with bpm's path tracer (\"path\"), as " + n +
+             " is one";
+  } else if (n == "bdpt" || n == "mlt" || n == "lightpath") {
+    out->render.integrator = "bpm";
+    note = "integrator \"" + n +
+           "\" is rendered with backward photon mapping (\"bpm\"), which like " + n +
+           " also reaches light a path tracer cannot (caustics of small and point lights)";
+  } else if (n == "sppm") {
+    out->render.integrator = "bpm";
+    note =
+        "integrator \"sppm\" is rendered with backward photon mapping (\"bpm\") at diffuse "
+        "depth 0, the photon method closest to sppm" +
+        std::string(in.params.find_any("radius") ? ", from its initial radius" : "");
   } else {
-    throw Error(in.loc, "integrator \"" + in.name + "\" is not supported");
+    throw Error(in.loc, "integrator \"" + n + "\" is not supported");
   }
   for (const Param& p : in.params.all()) p.used = true;  // other integrators' knobs are advisory
   out->render.integrator_directive = in;

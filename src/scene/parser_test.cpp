@@ -437,14 +437,29 @@ TEST(SceneParse, Integrator) {
   EXPECT_EQ(ls.render.max_depth, 7);
 }
 
-TEST(SceneParse, VolpathIntegratorIsRenderedAsPathWithWarning) {
+TEST(SceneParse, VolpathIntegratorIsRenderedAsPathWithANote) {
   ParsedScene p = parse_scene_string("Integrator \"volpath\" \"integer maxdepth\" 3\nWorldBegin\n");
   int before = warning_count();
   LoadedScene ls = flatten_scene(p);
-  EXPECT_EQ(warning_count() - before, 1);
+  EXPECT_EQ(warning_count() - before, 0);  // the program prints the note unless --integrator
   EXPECT_EQ(ls.render.integrator, "path");
   EXPECT_EQ(ls.render.integrator_as_written, "volpath");
+  EXPECT_NE(ls.render.integrator_note.find("volpath"), std::string::npos);
   EXPECT_EQ(ls.render.max_depth, 3);
+  // pbrt-v4's default (no Integrator line) is volpath: path, without a note.
+  LoadedScene none = flatten_scene(parse_scene_string("WorldBegin\n"));
+  EXPECT_EQ(none.render.integrator, "path");
+  EXPECT_TRUE(none.render.integrator_note.empty());
+}
+
+// Integrators that carry light from the lights' side reach caustics a path tracer misses: bpm.
+TEST(SceneParse, BidirectionalAndPhotonIntegratorsAreRenderedWithBpm) {
+  for (const char* name : {"bdpt", "mlt", "lightpath", "sppm"}) {
+    LoadedScene ls =
+        flatten_scene(parse_scene_string(std::string("Integrator \"") + name + "\"\nWorldBegin\n"));
+    EXPECT_EQ(ls.render.integrator, "bpm") << name;
+    EXPECT_NE(ls.render.integrator_note.find(name), std::string::npos) << name;
+  }
 }
 
 TEST(SceneParse, AcceleratorIsAcceptedAndIgnored) {
