@@ -135,4 +135,10 @@ std::vector<float> Film::pass_counts() const {
   return out;
 }
 
+std::vector<int> Film::lit_pass_counts() const {
+  std::vector<int> out(pixels_.size());
+  for (size_t i = 0; i < pixels_.size(); ++i) out[i] = pixels_[i].lit_passes;
+  return out;
+}
+
 }  // namespace bpm

@@ -58,6 +58,7 @@ class Film {
         p.sum_e[c] += e[c];
         p.sum_e2[c] += e[c] * e[c];
       }
+      if (e[0] != 0 || e[1] != 0 || e[2] != 0) ++p.lit_passes;
       double y_e = luminance(e);
       p.sum_y += y_e;
       p.sum_y2 += y_e * y_e;
@@ -82,6 +83,9 @@ class Film {
   double relative_error() const;
   double relative_error_luminance() const;
   std::vector<float> pass_counts() const;
+  // Per pixel, the passes whose estimate was not black: a pixel without any has no error estimate
+  // yet (its RMS is zero because nothing was found, not because it converged).
+  std::vector<int> lit_pass_counts() const;
   // The M-images estimates: per-pixel standard error of the mean from the spread of the M image
   // means (per channel, and of the luminance), and delta over the channels from them. Zero until
   // every image of a pixel has a pass.
@@ -101,6 +105,7 @@ class Film {
     double sum_e[3] = {0, 0, 0}, sum_e2[3] = {0, 0, 0};  // per-pass estimates, per channel
     double sum_y = 0, sum_y2 = 0;                        // and of their luminance
     int passes = 0;
+    int lit_passes = 0;  // passes whose estimate was not black
   };
   int width_, height_;
   std::vector<Pixel> pixels_;

@@ -69,9 +69,14 @@ void RenderControl::update_probabilities() {
   size_t k = std::min(n - 1, size_t(0.9 * double(n)));
   std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
   float ref = sorted[k];
+  // A pixel whose passes have all been black has no error estimate: light may reach it by rare
+  // paths (a small lit spot seen after two bounces) that the passes so far missed. Sampling it less
+  // would leave it black far longer (unbiased, but heavily skewed), so it is sampled every pass.
+  const std::vector<int> lit = film_.lit_pass_counts();
   probability_.resize(n);
   for (size_t i = 0; i < n; ++i)
-    probability_[i] = ref > 0 ? std::clamp(rel[i] / ref, opt_.adaptive_floor, 1.0f) : 1.0f;
+    probability_[i] =
+        ref > 0 && lit[i] > 0 ? std::clamp(rel[i] / ref, opt_.adaptive_floor, 1.0f) : 1.0f;
 }
 
 void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra) {

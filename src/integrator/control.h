@@ -7,7 +7,8 @@
 // not, with a probability decided from the passes before (never from the pass itself), and its
 // value is the mean of the passes that sampled it. The probability follows the pixel's relative
 // RMS (eq. 5 over its mean), is 1 for the noisiest pixels and never below a floor, so that no
-// pixel starves and the error estimate of every pixel stays alive.
+// pixel starves and the error estimate of every pixel stays alive; it is 1 for a pixel whose
+// passes have all been black, which has no error estimate at all.
 #pragma once
 #include <chrono>
 #include <cstdint>
