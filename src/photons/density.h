@@ -11,6 +11,13 @@ namespace bpm {
 
 inline Spectrum photon_contribution(const Material& m, Vec3 ng, Vec3 ns, Vec3 wo, Vec3 wi,
                                     const Spectrum& flux) {
+  // The common case without a frame or a call: Lambertian, f = R / pi with wo and wi on the same
+  // side of the shading surface (the frame's z is ns, so these are its local z components).
+  if (const auto* d = std::get_if<DiffuseMaterial>(&m)) {
+    const float cos_o = dot(wo, ns), cos_i = dot(wi, ns), cos_g = std::fabs(dot(wi, ng));
+    if (!(cos_o * cos_i > 0) || cos_g == 0) return {};
+    return flux * d->reflectance * (kInvPi * std::fabs(cos_i) / cos_g);
+  }
   Frame frame = Frame::from_z(ns);
   Vec3 wo_local = frame.to_local(wo), wi_local = frame.to_local(wi);
   Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance);
