@@ -9,7 +9,8 @@ namespace bpm {
 namespace {
 
 // The general form of photon_contribution, through the BSDF in the shading frame.
-Spectrum through_frame(const Material& m, Vec3 ng, Vec3 ns, Vec3 wo, Vec3 wi, const Spectrum& flux) {
+Spectrum through_frame(const Material& m, Vec3 ng, Vec3 ns, Vec3 wo, Vec3 wi,
+                       const Spectrum& flux) {
   Frame frame = Frame::from_z(ns);
   Spectrum f = bsdf_f(m, frame.to_local(wo), frame.to_local(wi), TransportMode::kRadiance);
   float cos_g = std::fabs(dot(wi, ng));
@@ -31,7 +32,8 @@ TEST(PhotonContribution, LambertianShortcutEqualsTheBsdf) {
     Vec3 ns = normalize(ng + 0.4f * sample_uniform_sphere({rng.uniform(), rng.uniform()}));
     Vec3 wo = sample_uniform_sphere({rng.uniform(), rng.uniform()});
     Vec3 wi = sample_uniform_sphere({rng.uniform(), rng.uniform()});
-    Spectrum a = photon_contribution(m, ng, ns, wo, wi, flux), b = through_frame(m, ng, ns, wo, wi, flux);
+    Spectrum a = photon_contribution(m, ng, ns, wo, wi, flux),
+             b = through_frame(m, ng, ns, wo, wi, flux);
     for (int c = 0; c < Spectrum::kChannels; ++c)
       ASSERT_NEAR(a[c], b[c], 1e-4f * std::fabs(b[c]) + 1e-6f) << "sample " << k;
     nonzero += !a.is_black();
