@@ -262,6 +262,17 @@ TEST_F(Cli, BadBpmSettingsAreErrors) {
   EXPECT_TRUE(outputs().empty());
 }
 
+// The progress piped into a reader that quits after its first byte (as `| head` does): the
+// render goes on and writes every output.
+TEST_F(Cli, AReaderThatQuitsDoesNotEndTheRender) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  std::string cmd = std::string(BPM_BINARY) + " render " + scene + " --time 1.5 -o " +
+                    (dir_ / "out.exr").string() + " 2>&1 | head -c 1 > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  for (const char* f : {"out.exr", "out.png", "out.error.png", "out.json"})
+    EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+}
+
 TEST_F(Cli, SigintAndSigtermStillWriteEveryOutput) {
   std::string scene = write("s.pbrt", kTinyScene);
   for (const char* integrator : {"path", "bpm", "fpm"}) {

@@ -1,5 +1,6 @@
 // Ctrl-C and SIGTERM: the handlers only raise a flag; the render loops look at it between tiles,
-// blocks, photon batches and passes, stop, and the image so far is still written.
+// blocks, photon batches and passes, stop, and the image so far is still written. A closed
+// stderr (SIGPIPE) is ignored, so that it cannot end a render either.
 #pragma once
 #include <atomic>
 
