@@ -26,10 +26,6 @@ struct BackwardPhoton {
   uint8_t diffuse_index;  // j - 1 for the j-th diffuse vertex (0..3)
   bool hero_only;         // the eye path keeps its hero wavelength alone (PathState)
 
-  bool accepts_class(PhotonClass c) const {
-    return (c == PhotonClass::kCaustic && (accepts & kAcceptsCaustic)) ||
-           (c == PhotonClass::kIndirect && (accepts & kAcceptsIndirect));
-  }
   // Sort key that fixes the order of backward photons whatever thread stored them.
   uint64_t key() const { return (uint64_t(pixel) << 4) | (uint64_t(diffuse_index) << 2) | accepts; }
 };

@@ -8,17 +8,17 @@ namespace bpm {
 BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   BpmSettings b;
   const ParamSet& ps = in.params;
+  if (in.name != "bpm" && in.name != "fpm" && in.name != "sppm") return b;
+  b.radius = ps.get_float("radius", b.radius);
+  ps.require("radius", b.radius >= 0 && std::isfinite(b.radius), "must not be negative", in.loc);
   if (in.name == "sppm") {
     // pbrt-v4's sppm: its radius is a world-space initial radius; its photons per iteration
     // default to the pixel count (-1), ours to a fixed count.
     b.diffuse_depth = 0;
-    b.radius = ps.get_float("radius", 0);
-    ps.require("radius", b.radius >= 0 && std::isfinite(b.radius), "must not be negative", in.loc);
     const int photons = ps.get_int("photonsperiteration", -1);
     if (photons > 0) b.photons_per_iteration = photons;
     return b;
   }
-  if (in.name != "bpm" && in.name != "fpm") return b;
   b.diffuse_depth = ps.get_int("diffusedepth", b.diffuse_depth);
   ps.require("diffusedepth", b.diffuse_depth >= 0 && b.diffuse_depth <= 3, "must be in 0..3",
              in.loc);
@@ -28,8 +28,6 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"",
              in.loc);
   b.guide_emission = ps.get_bool("guideemission", b.guide_emission);
-  b.radius = ps.get_float("radius", b.radius);
-  ps.require("radius", b.radius >= 0 && std::isfinite(b.radius), "must not be negative", in.loc);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
