@@ -3,6 +3,7 @@
 // pixels (fireflies), and the ratio of each channel's image mean to the reference's. Prints
 // figures; never fails.
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
+//              [--references-only]
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
 // (references by bpm), lamp-room and the Cornell box (../shared's at 256x256 when present, else
 // ours; references by path). scenes/tools/make_equal_time_scenes.py writes the last three of ours.
@@ -227,6 +228,7 @@ int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   double seconds = 60, reference_s = 600;
   std::string only, pbrt, res;
+  bool references_only = false;
   const fs::path default_pbrt =
       fs::path(BPM_SOURCE_DIR) / ".." / "shared" / "tools" / "pbrt-v4" / "pbrt";
   if (fs::exists(default_pbrt)) pbrt = default_pbrt.lexically_normal().string();
@@ -242,6 +244,18 @@ int main(int argc, char** argv) {
       pbrt = next();
     else if (!std::strcmp(argv[i], "--res"))
       res = next();
+    else if (!std::strcmp(argv[i], "--references-only"))
+      references_only = true;
+    else {
+      bool help = !std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h");
+      if (!help) std::fprintf(stderr, "equal_time: unknown argument '%s'\n", argv[i]);
+      std::fprintf(help ? stdout : stderr,
+                   "usage: equal_time [--time S] [--scenes a,b] [--pbrt PATH] "
+                   "[--reference-time S] [--res WxH] [--references-only]\n"
+                   "  references are kept in ./equal_time_references/; --references-only makes "
+                   "the missing ones and stops\n");
+      return help ? 0 : 2;
+    }
   }
   std::printf("== equal time: %.0f s each; reference: a %.0f s render with its own seed ==\n",
               seconds, reference_s);
@@ -255,6 +269,7 @@ int main(int argc, char** argv) {
     std::printf("%s (%dx%d, maxdepth %d)\n", e.name.c_str(), ls.film.width, ls.film.height,
                 ls.render.max_depth);
     Image ref = reference_for(e, ls, reference_s);
+    if (references_only) continue;
     for (const char* integrator : {"path", "bpm", "fpm"}) {
       RenderStats st;
       Image img = render_ours(ls, integrator, seconds, 1, &st);
