@@ -841,6 +841,33 @@ TEST(Bpm, SameImageWithOneAndTwoThreads) {
   }
 }
 
+// The time budget holds inside an iteration: a light pass far longer than the budget ends early,
+// and what it keeps is a prefix of its photons: the image is bit for bit that of an iteration
+// asked for exactly that many photons (with another thread count, too).
+TEST(Bpm, TimeBudgetCutsTheLightPassToAPrefixOfItsPhotons) {
+  LoadedScene ls = load(caustic_scene());
+  for (const std::string integrator : {"bpm", "fpm"}) {
+    BpmSettings s = small_batches(1);
+    s.photons_per_iteration = 2000000000;  // hours of photons
+    RenderRun cut{Film(ls.film.width, ls.film.height), {}};
+    RenderOptions opt = test_options(ls, integrator, 1000, 9, s);
+    opt.time_limit_s = 0.3;
+    opt.threads = 2;
+    cut.stats = render(ls, opt, &cut.film);
+    ASSERT_EQ(cut.stats.passes, 1) << integrator;
+    const nlohmann::json& light = cut.stats.details["light"];
+    EXPECT_EQ(light["iterations_cut"].get<int>(), 1) << integrator;
+    const uint64_t kept = light["photons_kept"].get<uint64_t>();
+    ASSERT_GT(kept, 0u) << integrator;
+    EXPECT_LT(kept, uint64_t(s.photons_per_iteration)) << integrator;
+
+    s.photons_per_iteration = int(kept);
+    RenderRun whole = render_with(ls, integrator, 1, 1, 9, s);
+    EXPECT_EQ(whole.stats.details["light"]["iterations_cut"].get<int>(), 0) << integrator;
+    EXPECT_EQ(cut.film.image().rgb, whole.film.image().rgb) << integrator;
+  }
+}
+
 // Both kd-trees find the same spheres, so they give the same image.
 TEST(Bpm, CentreTreeGivesTheSameImageAsSphereTree) {
   LoadedScene ls = load(caustic_scene());

@@ -89,7 +89,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);
-    // An iteration without its light pass would be a wrong image: it is dropped.
+    // An eye pass cut short (an interrupt, or the time budget after the first iteration) leaves
+    // pixels without their estimate: the iteration is dropped.
     if (!complete) return PassResult{false, 0, ""};
 
     // 2. Per-object sphere trees over the backward photons.
@@ -98,6 +99,9 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     for (ObjectPhotonLists& l : thread_lists) lists.push_back(&l);
     build_backward_maps(lists, scene.objects.size(), s.centre_tree, &maps);
     LightPassParams lp{&wm, opt.max_depth, s.normal_cos, {}};
+    // The time budget holds inside an iteration: its light pass ends early with the photons
+    // traced so far (the iteration is still a complete estimate, only noisier).
+    lp.stop = [&] { return interrupted() || control.out_of_time(); };
     resolve_photon_materials(maps, &lp);
     if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
     tot.build_s += since(t);
@@ -124,8 +128,9 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     for (const EyeCounters& c : eye_counters) r.rays += c.rays.total();
     for (const LightCounters& c : light.counters) r.rays += c.light_rays;
     char progress[128];
-    std::snprintf(progress, sizeof progress, "  %zu backward photons  coverage %.2f",
-                  maps.photons.size(), light_result.coverage);
+    std::snprintf(progress, sizeof progress, "  %zu backward photons  coverage %.2f%s",
+                  maps.photons.size(), light_result.coverage,
+                  light_result.cut ? "  (light pass cut short by the budget)" : "");
     r.progress = progress;
     return r;
   };

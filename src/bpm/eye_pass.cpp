@@ -4,10 +4,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
-#include "base/interrupt.h"
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
 
@@ -139,13 +139,17 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
                   EyePixels* px, EyeThreadData threads) {
   using Clock = std::chrono::steady_clock;
   const int slots = masks.slots();
+  std::atomic<bool> skipped{false};
   tbb::parallel_for(
       tbb::blocked_range<int>(0, masks.block_count() * slots, 1),
       [&](const tbb::blocked_range<int>& r) {
         ObjectPhotonLists& lists = threads.lists.local();
         EyeCounters& ec = threads.counters.local();
         for (int task = r.begin(); task < r.end(); ++task) {
-          if (interrupted()) return;
+          if (control.cut(pass)) {
+            skipped = true;
+            return;
+          }
           for (uint32_t pixel : masks.pixels(task / slots, task % slots)) {
             px->sampled[pixel] = control.sample_pixel(pass, pixel);
             if (!px->sampled[pixel]) {
@@ -166,7 +170,7 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
           }
         }
       });
-  if (!interrupt_flag().load()) return true;
+  if (!skipped) return true;
   for (ObjectPhotonLists& l : threads.lists)
     for (auto& v : l) v.clear();
   return false;

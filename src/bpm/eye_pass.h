@@ -79,7 +79,8 @@ struct EyeThreadData {
 };
 
 // Runs the eye pass of pass `pass` (random streams keyed by `pass_index`) over every pixel the
-// control samples. Returns false when interrupted: the backward photons are then dropped.
+// control samples. Returns false when control.cut(pass) left pixels out: the backward photons are
+// then dropped.
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& params,
                   const CameraSampler& camera, const PixelMasks& masks,
                   const RenderControl& control, int pass, int pass_index, EyePixels* pixels,

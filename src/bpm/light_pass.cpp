@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "base/interrupt.h"
 #include "photons/density.h"
 
 namespace bpm {
@@ -82,32 +81,38 @@ float trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Lig
 
 namespace {
 
-// Phase one of a batch: every chunk traces its photons into its own lists.
-void trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                 const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t first_photon,
-                 uint64_t count, const EmissionGuide* guide, LightPassBuffers* buf) {
+// Phase one of a batch: every chunk traces its photons into its own lists. Returns the photons
+// kept: all `count`, or fewer when prm.stop cut the batch (the lists of the chunks past them are
+// emptied).
+uint64_t trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                     const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t first_photon,
+                     uint64_t count, const EmissionGuide* guide, LightPassBuffers* buf) {
   const int slots = masks.slots();
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, int(buf->chunks.size()), 1),
-      [&](const tbb::blocked_range<int>& r) {
-        LightCounters& lc = buf->counters.local();
-        for (int c = r.begin(); c < r.end(); ++c) {
-          std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
-          by_slot.resize(size_t(slots));
-          for (auto& v : by_slot) v.clear();
-          std::vector<CellScore>& scores = buf->scores[size_t(c)];
-          scores.clear();
-          uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-          uint64_t last = std::min(first + kPhotonsPerChunk, count);
-          for (uint64_t k = first; k < last; ++k) {
-            uint64_t index = first_photon + k;
-            Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
-            const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
-            float score = trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
-            if (guide && prm.pixel_weight) scores.push_back({e.cell, score});
-          }
-        }
-      });
+  const int n_chunks = int(buf->chunks.size());
+  auto stop = [&] { return prm.stop && prm.stop(); };
+  // A pass keeps at least its first chunk: N of eq. (2) is never zero.
+  const int kept = run_chunks_until(n_chunks, first_photon == 0, stop, [&](int c) {
+    LightCounters& lc = buf->counters.local();
+    std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
+    by_slot.resize(size_t(slots));
+    for (auto& v : by_slot) v.clear();
+    std::vector<CellScore>& scores = buf->scores[size_t(c)];
+    scores.clear();
+    uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+    uint64_t last = std::min(first + kPhotonsPerChunk, count);
+    for (uint64_t k = first; k < last; ++k) {
+      uint64_t index = first_photon + k;
+      Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
+      const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
+      float score = trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
+      if (guide && prm.pixel_weight) scores.push_back({e.cell, score});
+    }
+  });
+  for (int c = kept; c < n_chunks; ++c) {
+    for (auto& v : buf->chunks[size_t(c)]) v.clear();
+    buf->scores[size_t(c)].clear();
+  }
+  return std::min(count, uint64_t(kept) * kPhotonsPerChunk);
 }
 
 // Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
@@ -134,9 +139,9 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
   LightPassResult res;
   res.flux.assign(n_bp, Spectrum());
   std::vector<uint8_t> hit(n_bp, 0);
-  // An interrupt ends the pass after a batch: N of eq. (2) is then the photons emitted so far.
-  for (uint64_t first = 0; first < total && (first == 0 || !interrupt_flag().load());
-       first += kPhotonsPerBatch) {
+  // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
+  // then the photons emitted so far.
+  for (uint64_t first = 0; first < total; first += kPhotonsPerBatch) {
     const uint64_t count = std::min(kPhotonsPerBatch, total - first);
     // Sized for a whole batch, so that a shorter last batch keeps the lists' memory (its chunks
     // past `count` stay empty).
@@ -144,8 +149,10 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     buf->chunks.resize(size_t((batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
     buf->scores.resize(buf->chunks.size());
     auto t = std::chrono::steady_clock::now();
-    trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, guide, buf);
-    res.emitted += count;
+    const uint64_t kept =
+        trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, guide, buf);
+    res.emitted += kept;
+    res.cut = kept < count;
     ++res.batches;
     res.trace_s += seconds_since(t);
     size_t entry_bytes = 0;
@@ -158,6 +165,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     if (guide && prm.pixel_weight)
       for (const std::vector<CellScore>& s : buf->scores) guide->learn(s);
     res.apply_s += seconds_since(t);
+    if (res.cut) break;
   }
   size_t n_indirect = 0, covered = 0;
   for (size_t g = 0; g < n_bp; ++g)

@@ -9,6 +9,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "base/rng.h"
@@ -35,6 +36,9 @@ struct LightPassParams {
   // Per pixel, 1 / (its estimated value + a floor): a photon's score for the guide is the sum of
   // its contributions weighted so. Empty: photons are not scored.
   const std::vector<float>* pixel_weight = nullptr;
+  // A stop request (an interrupt, the time budget), asked before each chunk of photons: once true,
+  // the pass ends with the photons traced so far (at least its first chunk). Empty: never.
+  std::function<bool()> stop = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -58,6 +62,7 @@ struct LightPassBuffers {
 struct LightPassResult {
   std::vector<Spectrum> flux;  // per backward photon: the sum of its entries' values
   uint64_t emitted = 0;        // photons emitted, N of eq. (2)
+  bool cut = false;            // a stop request ended the pass before all its photons
   int batches = 0;
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;
@@ -69,9 +74,9 @@ struct LightPassResult {
 constexpr uint64_t kPhotonsPerBatch = 100000;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in batches of kPhotonsPerBatch; stops early on an interrupt. With a guide the photons
-// start where it sends them, and with params.pixel_weight as well their scores are added to it
-// (learning does not change its density until its update).
+// index) in batches of kPhotonsPerBatch; stops early, at a chunk, when params.stop says so. With a
+// guide the photons start where it sends them, and with params.pixel_weight as well their scores
+// are added to it (learning does not change its density until its update).
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,

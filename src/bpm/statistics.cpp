@@ -26,6 +26,8 @@ void BpmTotals::add_light_pass(const LightPassResult& r) {
   light_apply_s += r.apply_s;
   peak_entry_bytes = std::max(peak_entry_bytes, r.peak_entry_bytes);
   coverage_sum += r.coverage;
+  emitted += r.emitted;
+  if (r.cut) ++iterations_cut;
   last_coverage = r.coverage;
 }
 
@@ -53,6 +55,8 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
 nlohmann::json light_json(const BpmTotals& t, int iterations) {
   double light_s = t.light_trace_s + t.light_apply_s;
   return {{"photons", t.light.photons},
+          {"photons_kept", t.emitted},
+          {"iterations_cut", t.iterations_cut},
           {"light_rays", t.light.light_rays},
           {"diffuse_hits", t.light.diffuse_hits},
           {"queries", t.light.queries},

@@ -20,6 +20,8 @@ struct FpmTotals {
   double light_s = 0, build_s = 0, eye_s = 0;
   uint64_t stored = 0, stored_caustic = 0;
   size_t peak_map_bytes = 0, peak_tree_bytes = 0;
+  uint64_t emitted = 0;    // photons kept in the estimates (N summed over iterations)
+  int iterations_cut = 0;  // iterations whose light pass the time budget cut short
 };
 
 double ratio(double a, double b) { return b > 0 ? a / b : 0.0; }
@@ -42,6 +44,8 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
         {"diffuse_hits", lt.diffuse_hits},
         {"photons_stored", t.stored},
         {"caustic_photons_stored", t.stored_caustic},
+        {"photons_kept", t.emitted},
+        {"iterations_cut", t.iterations_cut},
         // The paper's Table 1 counts per ray traced from a light with all its continuations (a
         // photon path); per segment counts every emitted and bounce ray.
         {"photons_per_forward_ray", ratio(double(t.stored), double(lt.photons))},
@@ -86,9 +90,15 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
     // 1. Light pass: a forward photon at every diffuse hit.
     auto t = Clock::now();
-    trace_forward_photons(scene, wm, opt.max_depth, min_eye_vertices, n_photons, opt.seed, it,
-                          light_counters, &maps);
+    // The time budget holds inside an iteration: the light pass may end early, with fewer photons.
+    const uint64_t emitted = trace_forward_photons(
+        scene, wm, opt.max_depth, min_eye_vertices, n_photons, opt.seed, it, light_counters,
+        [&] { return interrupted() || control.out_of_time(); }, &maps);
     tot.light_s += since(t);
+    // After the first iteration, an eye pass would be cut at once: the iteration is dropped.
+    if (control.cut(pass)) return PassResult{false, 0, ""};
+    if (emitted < n_photons) ++tot.iterations_cut;
+    tot.emitted += emitted;
 
     // 2. The maps, in chunk order (the same for any thread count), and their trees.
     t = Clock::now();
@@ -110,7 +120,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                     opt.max_depth,
                     s.k0 * pixel_angle * scale,
                     s.k1 * pixel_angle * scale,
-                    double(n_photons)};
+                    double(emitted)};
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(it, pixel);
       Spectrum L = fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local());

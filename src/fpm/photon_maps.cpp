@@ -17,37 +17,38 @@ void PhotonMap::build() {
   tree.build(points);
 }
 
-void trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
-                           int min_eye_vertices, uint64_t n_photons, uint64_t seed, int pass_index,
-                           tbb::enumerable_thread_specific<LightCounters>& counters,
-                           ForwardMaps* maps) {
-  maps->chunks.resize(size_t((n_photons + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, int(maps->chunks.size()), 1),
-      [&](const tbb::blocked_range<int>& r) {
-        LightCounters& lc = counters.local();
-        for (int c = r.begin(); c < r.end(); ++c) {
-          ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
-          ch.global.clear();
-          ch.caustic.clear();
-          uint64_t first = uint64_t(c) * kPhotonsPerChunk,
-                   last = std::min(first + kPhotonsPerChunk, n_photons);
-          for (uint64_t k = first; k < last; ++k) {
-            Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
-            const EmissionDraw e = unguided_emission(scene, rng);
-            trace_light_path(
-                scene, wm, max_depth, min_eye_vertices, e, rng, lc, [&](const PhotonHit& hit) {
-                  if (hit.bounces + min_eye_vertices > max_depth) return;
-                  ForwardPhoton ph{
-                      hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
-                      hit.cls,  hit.hero_only};
-                  ch.global.push_back(ph);
-                  if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
-                  ++lc.entries;
-                });
-          }
-        }
-      });
+uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm,
+                               int max_depth, int min_eye_vertices, uint64_t n_photons,
+                               uint64_t seed, int pass_index,
+                               tbb::enumerable_thread_specific<LightCounters>& counters,
+                               const std::function<bool()>& stop, ForwardMaps* maps) {
+  const int n_chunks = int((n_photons + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
+  maps->chunks.resize(size_t(n_chunks));
+  auto stop_now = [&] { return stop && stop(); };
+  const int kept = run_chunks_until(n_chunks, true, stop_now, [&](int c) {
+    LightCounters& lc = counters.local();
+    ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
+    ch.global.clear();
+    ch.caustic.clear();
+    uint64_t first = uint64_t(c) * kPhotonsPerChunk,
+             last = std::min(first + kPhotonsPerChunk, n_photons);
+    for (uint64_t k = first; k < last; ++k) {
+      Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
+      const EmissionDraw e = unguided_emission(scene, rng);
+      trace_light_path(
+          scene, wm, max_depth, min_eye_vertices, e, rng, lc, [&](const PhotonHit& hit) {
+            if (hit.bounces + min_eye_vertices > max_depth) return;
+            ForwardPhoton ph{hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
+                             hit.cls,  hit.hero_only};
+            ch.global.push_back(ph);
+            if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
+            ++lc.entries;
+          });
+    }
+  });
+  // The chunks past the kept ones leave the maps.
+  maps->chunks.resize(size_t(kept));
+  return std::min(n_photons, uint64_t(kept) * kPhotonsPerChunk);
 }
 
 void build_forward_maps(ForwardMaps* maps) {

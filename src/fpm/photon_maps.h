@@ -5,6 +5,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "photons/light_path.h"
@@ -42,11 +43,14 @@ struct ForwardMaps {
 
 // Traces n_photons photons (streams keyed by seed, pass_index and photon index) at the wavelengths
 // of wm and stores them. min_eye_vertices: the eye vertices the estimate adds (2 with final
-// gathering), so that no stored photon makes a path longer than max_depth.
-void trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
-                           int min_eye_vertices, uint64_t n_photons, uint64_t seed, int pass_index,
-                           tbb::enumerable_thread_specific<LightCounters>& counters,
-                           ForwardMaps* maps);
+// gathering), so that no stored photon makes a path longer than max_depth. `stop`, asked before
+// each chunk of photons, may end the pass early (after its first chunk). Returns the photons
+// emitted into the maps: N of the density estimate.
+uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm,
+                               int max_depth, int min_eye_vertices, uint64_t n_photons,
+                               uint64_t seed, int pass_index,
+                               tbb::enumerable_thread_specific<LightCounters>& counters,
+                               const std::function<bool()>& stop, ForwardMaps* maps);
 
 // Joins the chunks into the two maps and builds their trees.
 void build_forward_maps(ForwardMaps* maps);

@@ -23,6 +23,12 @@ double RenderControl::elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
 }
 
+bool RenderControl::out_of_time() const {
+  return opt_.time_limit_s > 0 && elapsed() >= opt_.time_limit_s;
+}
+
+bool RenderControl::cut(int pass) const { return interrupted() || (pass > 0 && out_of_time()); }
+
 bool RenderControl::keep_going(int done) {
   if (interrupt_flag().load()) {
     stop_reason_ = "interrupted";

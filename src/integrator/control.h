@@ -37,6 +37,12 @@ class RenderControl {
   // After a pass: updates the sampling probabilities, prints progress, writes a checkpoint.
   // `rays` is the total traced so far; `extra` is appended to the progress line.
   void after_pass(int done, uint64_t rays, const std::string& extra = "");
+  // Whether work of pass `pass` not yet started (tiles, chunks of photons) is to be left out: an
+  // interrupt, or the time budget spent. The time budget never cuts the first pass, so that a
+  // render always has a complete image; a later pass cut by it ends the render.
+  bool cut(int pass) const;
+  // The time budget alone: set and spent.
+  bool out_of_time() const;
   // Whether the pass samples the pixel (always, without adaptive sampling).
   bool sample_pixel(int pass, uint32_t pixel) const;
   // Call once at the end: finishes the progress line.

@@ -81,12 +81,13 @@ inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wav
 }
 
 // Calls f(pixel) for every pixel that pass samples, over 16 x 16 tiles in parallel; tiles not yet
-// started when an interrupt arrives are skipped.
+// started when control.cut(pass) turns true (an interrupt, the time budget) are skipped: their
+// pixels are not sampled in this pass, as with adaptive sampling.
 template <class F>
 void for_each_sampled_pixel(int width, int height, const RenderControl& control, int pass, F&& f) {
   tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 16, 0, width, 16),
                     [&](const tbb::blocked_range2d<int>& r) {
-                      if (interrupted()) return;
+                      if (control.cut(pass)) return;
                       for (int y = r.rows().begin(); y < r.rows().end(); ++y)
                         for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                           uint32_t pixel = uint32_t(y) * uint32_t(width) + uint32_t(x);

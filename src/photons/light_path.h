@@ -4,9 +4,13 @@
 // roulette on its change of power, and reports every diffuse surface it reaches, with the class of
 // the path so far. bpm looks up backward photons there; fpm stores a forward photon.
 #pragma once
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "base/rng.h"
 #include "integrator/counters.h"
@@ -19,6 +23,26 @@ namespace bpm {
 // Photons per chunk: the unit of work of a light pass, and the unit whose results are combined in
 // a fixed order, so that sums do not depend on the thread count.
 constexpr int kPhotonsPerChunk = 1024;
+
+// Runs body(c) for the chunks c in [0, n) in parallel, where a stop request can cut the loop
+// short: a chunk does not start once stop() is true (chunk 0 still does when first_always), and
+// the result is the number of leading chunks that ran. The caller keeps only those: the photons
+// kept are then a prefix of the photon sequence, the same whichever thread ran which chunk, and
+// the work of any later chunk that ran is the caller's to discard.
+template <class Body, class Stop>
+int run_chunks_until(int n, bool first_always, const Stop& stop, const Body& body) {
+  std::vector<uint8_t> ran(size_t(n), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int c = r.begin(); c < r.end(); ++c) {
+      if ((c > 0 || !first_always) && stop()) continue;
+      body(c);
+      ran[size_t(c)] = 1;
+    }
+  });
+  int kept = 0;
+  while (kept < n && ran[size_t(kept)]) ++kept;
+  return kept;
+}
 
 // The wavelengths of iteration `it` of a photon method, shared by all its eye and light paths.
 // Within an iteration they are stratified (sample_wavelengths): one in each of the kChannels
