@@ -358,6 +358,8 @@ std::array<float, 3> sigmoid_coefficients_lookup(Rgb rgb) {
   return table.lookup(rgb);
 }
 
+void prepare_texel_spectra() { sigmoid_coefficients_lookup(Rgb(0.5f)); }
+
 Spectrum rgb_texel_spectrum(Rgb rgb, SpectrumKind kind, const Wavelengths& wl) {
   Spectrum s;
   if (kind == SpectrumKind::kAlbedo)

@@ -97,8 +97,11 @@ class SpectrumCurve {
 float fit_sigmoid(Rgb rgb, std::array<float, 3>* coeff);
 float sigmoid_spectrum(const std::array<float, 3>& coeff, float lambda);
 // The same coefficients interpolated in a table of fits over the colour cube, built on the first
-// call (about half a second on two cores): what per-texel colours use.
+// call (about 2 s of CPU, 1 s on two cores): what per-texel colours use.
 std::array<float, 3> sigmoid_coefficients_lookup(Rgb rgb);
+// Builds that table now, if it is not yet built: loading an image for per-texel colours calls it,
+// so that a render's time (and its budget) does not include it.
+void prepare_texel_spectra();
 // A colour read at render time (an image texel) as a spectrum at the wavelengths wl, through the
 // table: an albedo is clamped to [0, 1]; see SpectrumCurve::from_rgb for the other kinds.
 Spectrum rgb_texel_spectrum(Rgb rgb, SpectrumKind kind, const Wavelengths& wl);

@@ -13,6 +13,8 @@ constexpr float kInf = 1e30f;
 
 struct Vec2 {
   float x = 0, y = 0;
+  constexpr Vec2() = default;
+  constexpr Vec2(float x_, float y_) : x(x_), y(y_) {}
 };
 
 struct Vec3 {

@@ -68,16 +68,27 @@ std::shared_ptr<const TexImage> load_texture_image(const std::string& path,
                                                    const TexEncoding& encoding) {
   static std::mutex mutex;
   static std::map<std::string, std::shared_ptr<const TexImage>> cache;
+  prepare_texel_spectra();  // what every texel's colour will need, built before the render
   std::string key =
       path + "|" + std::to_string(int(encoding.kind)) + "|" + std::to_string(encoding.gamma);
   std::lock_guard<std::mutex> lock(mutex);
   if (auto it = cache.find(key); it != cache.end()) return it->second;
+  std::shared_ptr<const TexImage> img = read_texture_image(path, encoding);
+  cache[key] = img;
+  return img;
+}
 
+std::shared_ptr<const TexImage> read_texture_image(const std::string& path,
+                                                   const TexEncoding& encoding) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error("cannot read image \"" + path + "\": " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
     throw Error("image \"" + path + "\" has no usable pixels");
+  // A header can claim any size: more than 2^28 values (1 GiB of floats) is refused, not allocated.
+  if (double(spec.width) * spec.height * spec.nchannels > double(1 << 28))
+    throw Error("image \"" + path + "\" is too large (" + std::to_string(spec.width) + " x " +
+                std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) + ")");
   auto img = std::make_shared<TexImage>();
   img->path = path;
   img->width = spec.width;
@@ -105,7 +116,6 @@ std::shared_ptr<const TexImage> load_texture_image(const std::string& path,
       if (!std::isfinite(v)) throw Error("image \"" + path + "\" has a non-finite texel");
       img->texels[i * img->channels + c] = v;
     }
-  cache[key] = img;
   return img;
 }
 

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Builds the whole tree with clang in build-fuzz/ (ASan, UBSan and libFuzzer's coverage) and runs
+# each fuzz target for SECONDS (default 30) from its seed corpus: the scene parser with flattening,
+# the PLY reader, and image textures through OpenImageIO. Seeds come from scenes/ and fuzz/seeds/;
+# what a run learns is kept in build-fuzz/corpus/. A finding (crash, sanitizer report, leak, hang
+# over 10 s, more than 2 GiB) stops its target, leaves the input in build-fuzz/findings/ and makes
+# the script fail.
+#   scripts/fuzz.sh [SECONDS] [TARGET...]
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+seconds="${1:-30}"
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(scene_fuzzer ply_fuzzer image_fuzzer)
+build="$root/build-fuzz"
+
+"$root/scripts/install-deps.sh"
+if [ ! -f "$build/build.ninja" ]; then
+  CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DBPM_FUZZ=ON >/dev/null
+fi
+ninja -C "$build" ${BPM_JOBS:+-j "$BPM_JOBS"}
+
+mkdir -p "$build/findings"
+failed=0
+for target in "${targets[@]}"; do
+  corpus="$build/corpus/$target"
+  mkdir -p "$corpus"
+  seeds=("$root/fuzz/seeds/$target")
+  if [ "$target" = scene_fuzzer ]; then seeds+=("$root/scenes"); fi
+  if [ "$target" = image_fuzzer ]; then
+    # An image seed is its extension's index (the target's first byte) followed by the file.
+    mkdir -p "$build/image_seeds"
+    printf '\x00' | cat - "$root/scenes/textures/wood.png" >"$build/image_seeds/wood.png.seed"
+    seeds+=("$build/image_seeds")
+  fi
+  echo "fuzz: $target for ${seconds} s"
+  if ! ASAN_OPTIONS=detect_leaks=1 "$build/$target" "$corpus" "${seeds[@]}" \
+      -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+      -print_final_stats=1 -artifact_prefix="$build/findings/$target-" 2>"$build/$target.log"; then
+    echo "fuzz: $target found a problem; see $build/$target.log and $build/findings/" >&2
+    tail -n 40 "$build/$target.log" >&2
+    failed=1
+  fi
+  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$build/$target.log" | sed "s/^/  /"
+done
+exit $failed
