@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "base/color.h"
 #include "base/error.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
@@ -32,6 +33,13 @@ bool plain_name(const std::string& name) {
 }
 
 }  // namespace
+
+// The table of texel spectra is built once, before the inputs, as the command line builds it while
+// loading the first image (under the sanitizers it takes longer than a hang's timeout).
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  bpm::prepare_texel_spectra();
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const fs::path& dir = work_dir();

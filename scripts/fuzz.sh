@@ -35,7 +35,8 @@ for target in "${targets[@]}"; do
     seeds+=("$build/image_seeds")
   fi
   echo "fuzz: $target for ${seconds} s"
-  if ! ASAN_OPTIONS=detect_leaks=1 "$build/$target" "$corpus" "${seeds[@]}" \
+  if ! ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/fuzz/lsan.supp" \
+      "$build/$target" "$corpus" "${seeds[@]}" \
       -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
       -print_final_stats=1 -artifact_prefix="$build/findings/$target-" 2>"$build/$target.log"; then
     echo "fuzz: $target found a problem; see $build/$target.log and $build/findings/" >&2

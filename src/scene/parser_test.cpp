@@ -2177,6 +2177,23 @@ TEST(PlyReader, NotAPlyFile) {
   }
 }
 
+// Found by fuzzing (scripts/fuzz.sh, ply_fuzzer): an unsigned index past the range of int was
+// converted to int (undefined behaviour) before the range check.
+TEST(PlyReader, IndexBeyondIntIsAnError) {
+  TempDir dir;
+  fs::path path = dir.write(
+      "huge.ply",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2172748161\n");
+  try {
+    (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "bad vertex index 2172748161"));
+  }
+}
+
 TEST(PlyReader, FaceWithFiveVertices) {
   TempDir dir;
   fs::path path = dir.write(

@@ -1,8 +1,10 @@
 #include "scene/ply.h"
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace bpm {
@@ -195,7 +197,15 @@ class PlyParser {
         if (k == iidx) face.clear();
         for (int j = 0; j < int(n); ++j) {
           double v = r.read(p.type);
-          if (k == iidx) face.push_back(int(v));
+          if (k != iidx) continue;
+          // An index must be a whole number an int holds (checked against the vertex count later).
+          if (!(v >= 0 && v <= double(std::numeric_limits<int>::max()) && v == std::floor(v))) {
+            std::ostringstream msg;
+            msg.precision(17);
+            msg << "bad vertex index " << v;
+            fail(msg.str());
+          }
+          face.push_back(int(v));
         }
       }
       if (is_vertex) {
