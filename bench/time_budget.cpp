@@ -57,7 +57,8 @@ void budgets(double seconds, const std::vector<std::string>& scenes,
              const std::vector<std::string>& integrators) {
   std::vector<fs::path> files;
   for (const auto& f : fs::directory_iterator(fs::path(BPM_SOURCE_DIR) / "scenes"))
-    if (f.path().extension() == ".pbrt" && listed(scenes, f.path().stem().string()))
+    if (f.path().extension() == ".pbrt" && f.path().filename().string()[0] != '.' &&
+        listed(scenes, f.path().stem().string()))
       files.push_back(f.path());
   std::sort(files.begin(), files.end());
   std::printf("== --time %.0f s: the render stage's time ==\n", seconds);

@@ -7,7 +7,10 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
   RenderControl control(opt, *film, unit);
   for (int p = 0; control.keep_going(p); ++p) {
     PassResult r = pass(p, control);
-    if (!r.completed) break;
+    if (!r.completed) {
+      control.keep_going(p + 1);  // sets the stop reason: the interrupt or the time budget
+      break;
+    }
     stats->passes = p + 1;
     control.after_pass(p, r.rays, r.progress);
   }
