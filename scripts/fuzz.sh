@@ -41,9 +41,9 @@ for target in "${targets[@]}"; do
       -max_total_time="$seconds" -seed="${FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
       -print_final_stats=1 -artifact_prefix="$build/findings/$target-" 2>"$build/$target.log"; then
     echo "fuzz: $target found a problem; see $build/$target.log and $build/findings/" >&2
-    tail -n 40 "$build/$target.log" >&2
+    grep -av "^#\|NEW_FUNC" "$build/$target.log" | tail -n 40 >&2
     failed=1
   fi
-  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$build/$target.log" | sed "s/^/  /"
+  grep -aE "stat::number_of_executed_units|stat::peak_rss_mb" "$build/$target.log" | sed "s/^/  /"
 done
 exit $failed

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <variant>
@@ -2191,6 +2192,25 @@ TEST(PlyReader, IndexBeyondIntIsAnError) {
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
     EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "bad vertex index 2172748161"));
+  }
+}
+
+// Found by fuzzing (ply_fuzzer): a list length stored as a float NaN passed the length check and
+// was converted to int.
+TEST(PlyReader, ListLengthThatIsNotACountIsAnError) {
+  TempDir dir;
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list float int vertex_indices\nend_header\n";
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put_le(&ply, v);
+  put_le(&ply, std::numeric_limits<float>::quiet_NaN());
+  for (int32_t i : {0, 1, 2}) put_le(&ply, i);
+  fs::path path = dir.write("nan.ply", ply);
+  try {
+    (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "bad list length"));
   }
 }
 

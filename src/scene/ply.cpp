@@ -193,7 +193,7 @@ class PlyParser {
           continue;
         }
         double n = r.read(p.count_type);
-        if (n < 0 || n > 1e6) fail("bad list length");
+        if (!(n >= 0 && n <= 1e6 && n == std::floor(n))) fail("bad list length");
         if (k == iidx) face.clear();
         for (int j = 0; j < int(n); ++j) {
           double v = r.read(p.type);
