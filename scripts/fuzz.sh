@@ -3,7 +3,7 @@
 # each fuzz target for SECONDS (default 30) from its seed corpus: the scene parser with flattening,
 # the PLY reader, and image textures through OpenImageIO. Seeds come from scenes/ and fuzz/seeds/;
 # what a run learns is kept in build-fuzz/corpus/. A finding (crash, sanitizer report, leak, hang
-# over 10 s, more than 2 GiB) stops its target, leaves the input in build-fuzz/findings/ and makes
+# over 10 s, more than 4 GiB) stops its target, leaves the input in build-fuzz/findings/ and makes
 # the script fail.
 # FUZZ_SEED fixes libFuzzer's random seed (CI uses 1); unset, each run draws its own.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
@@ -38,7 +38,7 @@ for target in "${targets[@]}"; do
   echo "fuzz: $target for ${seconds} s"
   if ! ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/fuzz/lsan.supp" \
       "$build/$target" "$corpus" "${seeds[@]}" \
-      -max_total_time="$seconds" -seed="${FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+      -max_total_time="$seconds" -seed="${FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=4096 -max_len=65536 \
       -print_final_stats=1 -artifact_prefix="$build/findings/$target-" 2>"$build/$target.log"; then
     echo "fuzz: $target found a problem; see $build/$target.log and $build/findings/" >&2
     grep -av "^#\|NEW_FUNC" "$build/$target.log" | tail -n 40 >&2

@@ -2214,6 +2214,35 @@ TEST(PlyReader, ListLengthThatIsNotACountIsAnError) {
   }
 }
 
+// Found by fuzzing (ply_fuzzer): an element count past the range of long long was read as the
+// largest one, and an element without properties then looped that many times.
+TEST(PlyReader, ElementCountOutOfRangeIsAnError) {
+  TempDir dir;
+  fs::path path = dir.write("count.ply",
+                            "ply\nformat ascii 1.0\nelement thing 99999999999999999999999\n"
+                            "element vertex 1\nproperty float x\nproperty float y\n"
+                            "property float z\nend_header\n0 0 0\n");
+  try {
+    (void)read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(IsError(e.what(), "scene.pbrt:3:5", "bad element line"));
+  }
+}
+
+TEST(PlyReader, ElementWithoutPropertiesIsSkipped) {
+  TempDir dir;
+  fs::path path = dir.write("empty.ply",
+                            "ply\nformat ascii 1.0\nelement thing 4000000000000\n"
+                            "element vertex 3\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 1\n"
+                            "property list uchar int vertex_indices\nend_header\n"
+                            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  PlyMesh m = read_ply(path.string(), FileLoc{"scene.pbrt", 3, 5});
+  EXPECT_EQ(m.positions.size(), 3u);
+  EXPECT_EQ(m.indices.size(), 3u);
+}
+
 TEST(PlyReader, FaceWithFiveVertices) {
   TempDir dir;
   fs::path path = dir.write(

@@ -126,8 +126,7 @@ class PlyParser {
       } else if (word == "element") {
         Element e;
         long long count = -1;
-        ls >> e.name >> count;
-        if (count < 0) fail("bad element line '" + line + "'");
+        if (!(ls >> e.name >> count) || count < 0) fail("bad element line '" + line + "'");
         e.count = size_t(count);
         h.elements.push_back(e);
       } else if (word == "property") {
@@ -157,6 +156,8 @@ class PlyParser {
   // Every row of `e` is read, whatever the element, so that the ones after it start in the right
   // place; only vertices and faces add to the mesh.
   void read_element(const Element& e, Reader& r, PlyMesh* mesh) {
+    // An element without properties occupies no bytes, however many it claims to have.
+    if (e.props.empty()) return;
     bool is_vertex = e.name == "vertex", is_face = e.name == "face";
     int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, iu = -1, iv = -1, iidx = -1;
     for (int k = 0; k < int(e.props.size()); ++k) {
