@@ -110,6 +110,13 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     // 3. Light pass: a fixed number of photons, in batches.
     LightPassResult light_result = run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
                                                   guide.empty() ? nullptr : &guide);
+    // The film averages iterations with equal weights, so an iteration the budget cut to a share
+    // f of its photons adds variance ~ 1/f to a mean of n: with n - 1 whole ones, keeping it
+    // helps only when ((n - 1) + 1/f) / n^2 < 1 / (n - 1), about f > 1/2. A later iteration with
+    // less than half its photons is dropped; the first is always kept (an image needs one).
+    if (light_result.cut && pass > 0 &&
+        2 * light_result.emitted < uint64_t(s.photons_per_iteration))
+      return PassResult{false, 0, ""};
     tot.add_light_pass(light_result);
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
