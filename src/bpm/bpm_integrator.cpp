@@ -101,7 +101,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     LightPassParams lp{&wm, opt.max_depth, s.normal_cos, {}};
     // The time budget holds inside an iteration: its light pass ends early with the photons
     // traced so far (the iteration is still a complete estimate, only noisier).
-    lp.stop = [&] { return interrupted() || control.out_of_time(); };
+    lp.stop = [&] { return control.stop_requested(); };
     resolve_photon_materials(maps, &lp);
     if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
     tot.build_s += since(t);

@@ -93,7 +93,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     // The time budget holds inside an iteration: the light pass may end early, with fewer photons.
     const uint64_t emitted = trace_forward_photons(
         scene, wm, opt.max_depth, min_eye_vertices, n_photons, opt.seed, it, light_counters,
-        [&] { return interrupted() || control.out_of_time(); }, &maps);
+        [&] { return control.stop_requested(); }, &maps);
     tot.light_s += since(t);
     // After the first iteration, an eye pass would be cut at once: the iteration is dropped.
     if (control.cut(pass)) return PassResult{false, 0, ""};

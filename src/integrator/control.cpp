@@ -27,6 +27,8 @@ bool RenderControl::out_of_time() const {
   return opt_.time_limit_s > 0 && elapsed() >= opt_.time_limit_s;
 }
 
+bool RenderControl::stop_requested() const { return interrupted() || out_of_time(); }
+
 bool RenderControl::cut(int pass) const { return interrupted() || (pass > 0 && out_of_time()); }
 
 bool RenderControl::keep_going(int done) {

@@ -43,6 +43,8 @@ class RenderControl {
   bool cut(int pass) const;
   // The time budget alone: set and spent.
   bool out_of_time() const;
+  // An interrupt or the time budget, in any pass: what a light pass asks before each chunk.
+  bool stop_requested() const;
   // Whether the pass samples the pixel (always, without adaptive sampling).
   bool sample_pixel(int pass, uint32_t pixel) const;
   // Call once at the end: finishes the progress line.
