@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "base/error.h"
+#include "base/memory.h"
 #include "film/image_compare.h"
 #include "film/image_io.h"
 #include "film/outputs.h"
@@ -53,7 +54,12 @@ struct RenderArgs {
   bool no_adaptive = false;
   float adaptive_floor = 0.1f;
   int m_images = 4;
+  std::string memory;  // --memory; empty: default_memory_budget()
 };
+
+// Bytes per pixel the outputs take while they are written (the image, its error channels and
+// their copies in the EXR writer's layout): an upper estimate.
+constexpr double kOutputBytesPerPixel = 200;
 
 // The bpm statistics a user wants to see at the end of a run (all of them are in the JSON).
 void print_bpm_summary(const nlohmann::json& d) {
@@ -156,6 +162,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   opt.adaptive = !a.no_adaptive;
   opt.adaptive_floor = a.adaptive_floor;
   opt.write_every_s = a.write_every;
+  opt.memory_budget = a.memory.empty() ? default_memory_budget() : parse_memory_size(a.memory);
   return opt;
 }
 
@@ -177,6 +184,7 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                      {"integrator_in_file", ls.render.integrator_as_written},
                      {"spp_requested", opt.spp == std::numeric_limits<int>::max() ? -1 : opt.spp},
                      {"time_limit_s", opt.time_limit_s},
+                     {"memory_budget_bytes", opt.memory_budget},
                      {"accuracy", opt.accuracy},
                      {"adaptive", opt.adaptive},
                      {"adaptive_floor", opt.adaptive_floor},
@@ -199,6 +207,7 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                    {"stop_reason", st.stop_reason},
                    {"mean_sampling_probability", st.mean_sampling_probability},
                    {"relative_error_delta", st.relative_error},
+                   {"dropped_samples", film.dropped_samples()},
                    {"relative_error_delta_luminance", film.relative_error_luminance()},
                    {"m_images", film.m_images()},
                    {"relative_error_delta_m_images", film.relative_error_m_images()}};
@@ -252,6 +261,12 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n",
                  a.scene.c_str(), ls.scene.objects.size(), ls.scene.triangle_count(),
                  ls.scene.lights.size(), ls.film.width, ls.film.height, opt.integrator.c_str());
+  // The film and the images written from it must fit before anything is allocated.
+  const double pixels = double(ls.film.width) * double(ls.film.height);
+  check_memory("a " + std::to_string(ls.film.width) + "x" + std::to_string(ls.film.height) +
+                   " film with its outputs",
+               pixels * (double(Film::bytes_per_pixel(a.m_images)) + kOutputBytesPerPixel),
+               opt.memory_budget, "lower --resolution or --m-images, or raise --memory");
   install_interrupt_handlers();
   Film film(ls.film.width, ls.film.height, a.m_images);
   // Intermediate outputs: the images so far and a JSON record that says the render is running.
@@ -273,6 +288,11 @@ int run_render(const RenderArgs& a) {
   double t_write = seconds_since(t3);
   nlohmann::json rec = run_record(a, ls, opt, st, film, paths, {t_parse, t_build, t_write});
   write_text_atomic(paths.json, rec.dump(2) + "\n");
+  if (film.dropped_samples() > 0)
+    std::fprintf(stderr,
+                 "bpm: warning: %llu samples had a non-finite or negative value (a numerical "
+                 "accident) and were recorded as black (result.dropped_samples in the JSON)\n",
+                 (unsigned long long)film.dropped_samples());
   if (!a.quiet) {
     if (opt.integrator == "bpm") print_bpm_summary(st.details);
     if (opt.integrator == "fpm") print_fpm_summary(st.details);
@@ -357,6 +377,9 @@ int main(int argc, char** argv) {
       ->add_option("--write-every", ra.write_every,
                    "Write the outputs so far every SECONDS (atomically)")
       ->check(CLI::Range(0.1, 1e9));
+  render->add_option("--memory", ra.memory,
+                     "Memory budget for the render's data (film, photon maps, trees, photon "
+                     "entries), e.g. 512M or 8G; default: 3/4 of this machine's memory");
   render
       ->add_option("--iterations", ra.iterations,
                    "Iterations (each one eye sample per pixel and a photon pass); same as --spp")

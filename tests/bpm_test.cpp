@@ -26,6 +26,7 @@
 #include <sstream>
 #include <string>
 
+#include "base/error.h"
 #include "bpm/eye_pass.h"
 #include "camera/camera.h"
 #include "photons/light_path.h"
@@ -865,6 +866,58 @@ TEST(Bpm, TimeBudgetCutsTheLightPassToAPrefixOfItsPhotons) {
     RenderRun whole = render_with(ls, integrator, 1, 1, 9, s);
     EXPECT_EQ(whole.stats.details["light"]["iterations_cut"].get<int>(), 0) << integrator;
     EXPECT_EQ(cut.film.image().rgb, whole.film.image().rgb) << integrator;
+  }
+}
+
+// A memory budget: too small for the film and one iteration's backward photons, the render stops
+// before it starts with an error that names the budget; just large enough, the light pass holds
+// its entries in more, smaller batches, and the image is exactly the unlimited one (entries are
+// applied in photon order whatever the batches).
+TEST(Bpm, MemoryBudgetSplitsBatchesWithoutChangingTheImage) {
+  LoadedScene ls = load(caustic_scene());
+  BpmSettings s = small_batches(0);
+  s.photons_per_iteration = 40000;
+  const int iterations = 2;
+  RenderRun unlimited = render_with(ls, "bpm", iterations, 2, 9, s);
+  const nlohmann::json& light = unlimited.stats.details["light"];
+  ASSERT_EQ(light["batches"].get<uint64_t>(), uint64_t(iterations));
+  const size_t unlimited_entries =
+      unlimited.stats.details["maps"]["peak_entry_bytes"].get<size_t>();
+
+  bool refused = false;
+  for (double budget = double(unlimited.film.bytes());; budget *= 1.25) {
+    RenderRun r{Film(ls.film.width, ls.film.height), {}};
+    RenderOptions opt = test_options(ls, "bpm", iterations, 9, s);
+    opt.threads = 2;
+    opt.memory_budget = uint64_t(budget);
+    try {
+      r.stats = render(ls, opt, &r.film);
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("memory budget"), std::string::npos) << e.what();
+      refused = true;
+      continue;
+    }
+    EXPECT_TRUE(refused) << "the smallest budget tried should not fit";
+    EXPECT_GT(r.stats.details["light"]["batches"].get<uint64_t>(), uint64_t(2 * iterations));
+    EXPECT_LT(r.stats.details["maps"]["peak_entry_bytes"].get<size_t>(), unlimited_entries / 2);
+    EXPECT_EQ(r.film.image().rgb, unlimited.film.image().rgb);
+    break;
+  }
+}
+
+// fpm checks its worst iteration (every photon stored at every allowed bounce) before it starts.
+TEST(Fpm, MemoryBudgetRefusesMorePhotonsThanFit) {
+  LoadedScene ls = load(caustic_scene());
+  BpmSettings s = small_batches(0);
+  s.photons_per_iteration = 1 << 30;
+  RenderRun r{Film(ls.film.width, ls.film.height), {}};
+  RenderOptions opt = test_options(ls, "fpm", 1, 9, s);
+  opt.memory_budget = uint64_t(1) << 30;
+  try {
+    render(ls, opt, &r.film);
+    ADD_FAILURE() << "fpm started an iteration that cannot fit";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--photons"), std::string::npos) << e.what();
   }
 }
 

@@ -134,6 +134,32 @@ TEST_F(Cli, BadFlagsAreErrors) {
   EXPECT_TRUE(outputs().empty());
 }
 
+// A render that cannot fit the memory budget stops before allocating, says what it needed, and
+// writes nothing; the JSON of a render that fits records the budget.
+TEST_F(Cli, MemoryBudgetIsCheckedBeforeAllocating) {
+  std::string scene = write("s.pbrt", kTinyScene), out = (dir_ / "out.exr").string();
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    CliRun r = run("render " + scene + " -q --integrator " + integrator +
+                   " --resolution 60000x60000 --memory 512M -o " + out);
+    EXPECT_EQ(r.exit_code, 1) << integrator;
+    EXPECT_NE(r.err.find("memory budget of 512 MiB"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--resolution"), std::string::npos) << r.err;
+  }
+  CliRun big = run("render " + scene + " -q --integrator bpm --k1 3 --photons 1000 --maxdepth 3 " +
+                   "--iterations 1 --memory 600M --resolution 1000x1000 -o " + out);
+  EXPECT_EQ(big.exit_code, 1);
+  EXPECT_NE(big.err.find("backward photons per pixel"), std::string::npos) << big.err;
+  EXPECT_NE(run("render " + scene + " --memory lots -o " + out).exit_code, 0);
+  EXPECT_NE(run("render " + scene + " --memory 10K -o " + out).exit_code, 0);
+  EXPECT_TRUE(outputs().empty());
+
+  CliRun ok = run("render " + scene + " -q --integrator bpm --iterations 2 --memory 64M -o " + out);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  std::ifstream in(dir_ / "out.json");
+  nlohmann::json rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["settings"]["memory_budget_bytes"].get<uint64_t>(), uint64_t(64) << 20);
+}
+
 TEST_F(Cli, BpmWritesItsStatistics) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r = run("render " + scene +

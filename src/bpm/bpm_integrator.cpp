@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "base/error.h"
+#include "base/memory.h"
 #include "bpm/accumulate.h"
 #include "bpm/backward_maps.h"
 #include "bpm/eye_pass.h"
@@ -46,6 +47,21 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
     if (count[p]) (*weight)[p] = float(1 / (std::max(0.0, sum[p] / count[p]) + floor));
 }
 
+// Memory (base/memory.h). Per pixel, what the eye pass, the masks and the emission guide keep.
+constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
+                               sizeof(double) + sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
+// Per backward photon: the thread's list and the map's copy, its flux and hit flag, and its
+// references in the two trees (about two per tree where spheres overlap cells).
+constexpr double kBackwardPhotonBytes =
+    2 * sizeof(BackwardPhoton) + sizeof(Spectrum) + 1 + 4 * (sizeof(SphereRef) + sizeof(uint32_t));
+
+// What an iteration's maps take once built, with the light pass's per-photon arrays.
+double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
+  return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
+                maps.photons.size() * (sizeof(Spectrum) + 1) +
+                lp.photon_materials.capacity() * sizeof(Material));
+}
+
 }  // namespace
 
 RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, const BpmSettings& s,
@@ -70,6 +86,20 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
   std::vector<double> estimate_sum(n_pixels, 0.0);
   std::vector<uint32_t> estimate_count(n_pixels, 0);
   std::vector<float> pixel_weight;
+
+  // An eye path leaves at most D + 2 backward photons (two at x_1 when D = 0, one at each other
+  // diffuse vertex): the worst iteration must fit the memory budget before the first one starts.
+  // The light pass's entries get what the film and the actual maps leave (smaller batches).
+  const std::string size = std::to_string(film->width()) + "x" + std::to_string(film->height());
+  const std::string advice =
+      "lower --resolution or --diffuse-depth (or the radii: --k0, --k1, --radius), or raise "
+      "--memory";
+  const double fixed_bytes = double(film->bytes()) + double(n_pixels) * kPixelBytes;
+  check_memory("bpm at " + size + " with diffuse depth " + std::to_string(s.diffuse_depth) +
+                   " (up to " + std::to_string(s.diffuse_depth + 2) +
+                   " backward photons per pixel and iteration)",
+               fixed_bytes + double(n_pixels) * (s.diffuse_depth + 2) * kBackwardPhotonBytes,
+               opt.memory_budget, advice);
 
   auto iteration = [&](int pass, const RenderControl& control) {
     const int it = opt.first_iteration + pass;  // the index random streams and radii follow
@@ -104,6 +134,11 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     lp.stop = [&] { return control.stop_requested(); };
     resolve_photon_materials(maps, &lp);
     if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
+    if (opt.memory_budget > 0) {
+      const double used = fixed_bytes + maps_bytes(maps, lp);
+      check_memory("bpm's backward photons and trees at " + size, used, opt.memory_budget, advice);
+      lp.entry_bytes_limit = std::max<size_t>(1, size_t(double(opt.memory_budget) - used));
+    }
     tot.build_s += since(t);
     tot.add_maps(maps);
 

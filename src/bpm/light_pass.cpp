@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -81,38 +82,72 @@ float trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Lig
 
 namespace {
 
-// Phase one of a batch: every chunk traces its photons into its own lists. Returns the photons
-// kept: all `count`, or fewer when prm.stop cut the batch (the lists of the chunks past them are
-// emptied).
-uint64_t trace_batch(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                     const PixelMasks& masks, uint64_t seed, int pass_index, uint64_t first_photon,
-                     uint64_t count, const EmissionGuide* guide, LightPassBuffers* buf) {
+// Bytes the entry lists of one chunk hold.
+size_t chunk_bytes(const std::vector<std::vector<PhotonEntry>>& by_slot) {
+  size_t b = 0;
+  for (const auto& v : by_slot) b += v.capacity() * sizeof(PhotonEntry);
+  return b;
+}
+
+struct BatchResult {
+  uint64_t kept = 0;     // photons traced into the lists, from the batch's first one
+  bool stopped = false;  // prm.stop ended the batch (and the pass)
+};
+
+// Phase one of a batch: every chunk traces its photons into its own lists. The photons kept are
+// all `count`, or a prefix of whole chunks when prm.stop or prm.entry_bytes_limit ended the batch
+// early (the lists of the chunks past them are emptied). The first chunk always runs, except
+// after a stop request in a later batch.
+BatchResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
+                        const LightPassParams& prm, const PixelMasks& masks, uint64_t seed,
+                        int pass_index, uint64_t first_photon, uint64_t count,
+                        const EmissionGuide* guide, LightPassBuffers* buf) {
   const int slots = masks.slots();
-  const int n_chunks = int(buf->chunks.size());
+  const int n_chunks = int((count + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   auto stop = [&] { return prm.stop && prm.stop(); };
   // A pass keeps at least its first chunk: N of eq. (2) is never zero.
-  const int kept = run_chunks_until(n_chunks, first_photon == 0, stop, [&](int c) {
-    LightCounters& lc = buf->counters.local();
-    std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
+  if (first_photon > 0 && stop()) return {0, true};
+  // What every chunk's lists hold now (they keep their capacity from earlier batches). Every chunk
+  // has its slots, also one that does not run (phase two reads them all).
+  std::atomic<size_t> entry_bytes{0};
+  for (auto& by_slot : buf->chunks) {
     by_slot.resize(size_t(slots));
-    for (auto& v : by_slot) v.clear();
-    std::vector<CellScore>& scores = buf->scores[size_t(c)];
-    scores.clear();
-    uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-    uint64_t last = std::min(first + kPhotonsPerChunk, count);
-    for (uint64_t k = first; k < last; ++k) {
-      uint64_t index = first_photon + k;
-      Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
-      const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
-      float score = trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
-      if (guide && prm.pixel_weight) scores.push_back({e.cell, score});
+    entry_bytes += chunk_bytes(by_slot);
+  }
+  auto full = [&] { return prm.entry_bytes_limit && entry_bytes.load() > prm.entry_bytes_limit; };
+  const int kept = run_chunks_until(
+      n_chunks, true, [&] { return stop() || full(); },
+      [&](int c) {
+        LightCounters& lc = buf->counters.local();
+        std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
+        const size_t bytes_before = chunk_bytes(by_slot);
+        for (auto& v : by_slot) v.clear();
+        std::vector<CellScore>& scores = buf->scores[size_t(c)];
+        scores.clear();
+        uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+        uint64_t last = std::min(first + kPhotonsPerChunk, count);
+        for (uint64_t k = first; k < last; ++k) {
+          uint64_t index = first_photon + k;
+          Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
+          const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
+          float score = trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
+          if (guide && prm.pixel_weight) scores.push_back({e.cell, score});
+        }
+        entry_bytes += chunk_bytes(by_slot) - bytes_before;
+      });
+  BatchResult r;
+  r.kept = std::min(count, uint64_t(kept) * kPhotonsPerChunk);
+  r.stopped = kept < n_chunks && stop();
+  const bool full_batch_cut = kept < n_chunks && !r.stopped;
+  for (int c = kept; c < int(buf->chunks.size()); ++c) {
+    for (auto& v : buf->chunks[size_t(c)]) {
+      v.clear();
+      // Past a batch the entry limit ended, the memory goes back, so that the next one fits.
+      if (full_batch_cut) v.shrink_to_fit();
     }
-  });
-  for (int c = kept; c < n_chunks; ++c) {
-    for (auto& v : buf->chunks[size_t(c)]) v.clear();
     buf->scores[size_t(c)].clear();
   }
-  return std::min(count, uint64_t(kept) * kPhotonsPerChunk);
+  return r;
 }
 
 // Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
@@ -141,7 +176,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
   std::vector<uint8_t> hit(n_bp, 0);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
-  for (uint64_t first = 0; first < total; first += kPhotonsPerBatch) {
+  for (uint64_t first = 0; first < total;) {
     const uint64_t count = std::min(kPhotonsPerBatch, total - first);
     // Sized for a whole batch, so that a shorter last batch keeps the lists' memory (its chunks
     // past `count` stay empty).
@@ -149,10 +184,11 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     buf->chunks.resize(size_t((batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
     buf->scores.resize(buf->chunks.size());
     auto t = std::chrono::steady_clock::now();
-    const uint64_t kept =
+    const BatchResult b =
         trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, guide, buf);
-    res.emitted += kept;
-    res.cut = kept < count;
+    first += b.kept;
+    res.emitted += b.kept;
+    res.cut = b.stopped;
     ++res.batches;
     res.trace_s += seconds_since(t);
     size_t entry_bytes = 0;

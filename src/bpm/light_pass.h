@@ -39,6 +39,10 @@ struct LightPassParams {
   // A stop request (an interrupt, the time budget), asked before each chunk of photons: once true,
   // the pass ends with the photons traced so far (at least its first chunk). Empty: never.
   std::function<bool()> stop = nullptr;
+  // Bytes the entry lists of a batch may hold (the memory budget left after the film and the
+  // maps); 0: no limit. A batch that reaches it ends at a chunk and the next batch goes on from
+  // there: the image is the same, since entries are applied in photon order whatever the batches.
+  size_t entry_bytes_limit = 0;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -74,9 +78,10 @@ struct LightPassResult {
 constexpr uint64_t kPhotonsPerBatch = 100000;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in batches of kPhotonsPerBatch; stops early, at a chunk, when params.stop says so. With a
-// guide the photons start where it sends them, and with params.pixel_weight as well their scores
-// are added to it (learning does not change its density until its update).
+// index) in batches of kPhotonsPerBatch (fewer when params.entry_bytes_limit ends one early); stops
+// early, at a chunk, when params.stop says so. With a guide the photons start where it sends them,
+// and with params.pixel_weight as well their scores are added to it (learning does not change its
+// density until its update).
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,

@@ -135,6 +135,12 @@ std::vector<float> Film::pass_counts() const {
   return out;
 }
 
+uint64_t Film::dropped_samples() const {
+  uint64_t n = 0;
+  for (const Pixel& p : pixels_) n += uint64_t(p.dropped);
+  return n;
+}
+
 std::vector<int> Film::lit_pass_counts() const {
   std::vector<int> out(pixels_.size());
   for (size_t i = 0; i < pixels_.size(); ++i) out[i] = pixels_[i].lit_passes;

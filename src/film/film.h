@@ -3,6 +3,7 @@
 // sum and sum of squares of per-pass luminance estimates, from which the error estimate of the
 // paper's eq. (5) follows.
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include "base/color.h"
@@ -19,12 +20,17 @@ struct Image {
   }
 };
 
+// Whether a sample's radiance can be recorded: a non-finite or negative spectral value is a
+// numerical accident, recorded as black (Film::drop_sample counts it) rather than poisoning the
+// pixel.
+inline bool recordable(const Spectrum& L) { return L.is_finite() && !L.has_negative(); }
+
 // The colour a film records for a sample with radiance L at wavelengths wl: linear sRGB, with the
-// largest channel clamped to max_value (pbrt-v4's maxcomponentvalue). A non-finite or negative
-// spectral value (a numerical accident) gives black rather than poisoning the pixel. Colours may
-// have negative channels: a single sample's few wavelengths can lie outside the sRGB gamut.
+// largest channel clamped to max_value (pbrt-v4's maxcomponentvalue); black unless recordable(L).
+// Colours may have negative channels: a single sample's few wavelengths can lie outside the sRGB
+// gamut.
 inline Rgb film_rgb(const Spectrum& L, const Wavelengths& wl, float max_value) {
-  if (!L.is_finite() || L.has_negative()) return Rgb();
+  if (!recordable(L)) return Rgb();
   Rgb c = spectrum_to_rgb(L, wl);
   float m = c.max_component();
   if (m > max_value) c *= max_value / m;
@@ -38,6 +44,11 @@ class Film {
   Film(int width, int height, int m_images = 0);
   int width() const { return width_; }
   int height() const { return height_; }
+  // What a film takes per pixel with m_images intermediate images, and what this one takes.
+  static size_t bytes_per_pixel(int m_images) {
+    return sizeof(Pixel) + size_t(m_images) * (3 * sizeof(double) + sizeof(int));
+  }
+  size_t bytes() const { return size_t(width_) * size_t(height_) * bytes_per_pixel(m_); }
 
   void add_sample(int x, int y, const Rgb& L, float weight) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
@@ -48,6 +59,9 @@ class Film {
     p.sum_w += weight;
     p.pass_w += weight;
   }
+  // Counts a sample of the pixel that was not recordable (and was recorded as black).
+  void drop_sample(int x, int y) { ++pixels_[size_t(y) * width_ + x].dropped; }
+  uint64_t dropped_samples() const;
   // Ends the current pass for one pixel: its pass estimate joins the running moments.
   void end_pass(int x, int y) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
@@ -106,6 +120,7 @@ class Film {
     double sum_y = 0, sum_y2 = 0;                        // and of their luminance
     int passes = 0;
     int lit_passes = 0;  // passes whose estimate was not black
+    int dropped = 0;     // samples not recordable (drop_sample)
   };
   int width_, height_;
   std::vector<Pixel> pixels_;

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "base/error.h"
+#include "base/memory.h"
 #include "fpm/eye_paths.h"
 #include "fpm/photon_maps.h"
 #include "integrator/progressive.h"
@@ -79,6 +80,17 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
   const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
   const uint64_t n_photons = uint64_t(s.photons_per_iteration);
   const int min_eye_vertices = s.final_gather ? 2 : 1;
+  // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
+  // for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
+  // joined map and in the tree. The worst iteration must fit the budget before the first one.
+  const double stored_per_photon = std::max(0, opt.max_depth - min_eye_vertices + 1) + 1;
+  const double photon_bytes =
+      2 * sizeof(ForwardPhoton) + 2 * (sizeof(SphereRef) + sizeof(uint32_t));
+  check_memory("fpm with " + std::to_string(n_photons) + " photons per iteration and maxdepth " +
+                   std::to_string(opt.max_depth) + " (up to " +
+                   std::to_string(int(stored_per_photon)) + " stored per photon)",
+               double(film->bytes()) + double(n_photons) * stored_per_photon * photon_bytes,
+               opt.memory_budget, "lower --photons or --maxdepth, or raise --memory");
   ForwardMaps maps;
   tbb::enumerable_thread_specific<LightCounters> light_counters;
   tbb::enumerable_thread_specific<FpmEyeCounters> eye_counters;

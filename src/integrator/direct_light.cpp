@@ -22,10 +22,11 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
   if (f.is_black()) return {};
   ++counters.shadow_rays;
-  Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi);
+  Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi, sp.error);
   // Lights with a surface get the shadow ray's end lifted off that surface.
   bool has_surface = length_squared(ls->n_light) > 0;
-  Vec3 target = has_surface ? offset_origin(ls->p_light, ls->n_light, -ls->wi) : ls->p_light;
+  Vec3 target = has_surface ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
+                            : ls->p_light;
   if (counters.observer) {
     Vec3 d = target - origin;
     float len = length(d);

@@ -25,6 +25,9 @@ struct IntegratorOptions {
   bool adaptive = false;        // adaptive sampling (integrator/control.h)
   float adaptive_floor = 0.1f;  // lowest probability of sampling a pixel in a pass
   double write_every_s = 0;     // call checkpoint this often (between passes); 0: never
+  // Bytes the render's own data may take (film, photon maps, trees, entries; base/memory.h);
+  // 0: no budget.
+  uint64_t memory_budget = 0;
   std::function<void(int passes)> checkpoint;
 };
 

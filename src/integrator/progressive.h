@@ -76,6 +76,7 @@ class CameraSampler {
 inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wavelengths& wl,
                         float filter_weight, float max_component_value) {
   int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
+  if (!recordable(L)) film->drop_sample(x, y);
   film->add_sample(x, y, film_rgb(L, wl, max_component_value), filter_weight);
   film->end_pass(x, y);
 }

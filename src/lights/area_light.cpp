@@ -43,6 +43,7 @@ struct AreaSample {
   Vec3 p, n;
   float pdf_area;
   Vec2 uv;
+  float error;  // p's (SurfacePoint::error)
 };
 
 // Uniform point on the primitive (triangles; full spheres and disks, and cylinders, under
@@ -51,25 +52,25 @@ AreaSample sample_area(const AreaLight& l, const Shape& shape, Vec2 u) {
   if (std::holds_alternative<TriangleMesh>(shape)) {
     Vec2 b = sample_uniform_triangle(u);  // (b0, b1); surface_point takes (b1, b2)
     SurfacePoint sp = surface_point(shape, l.primitive, {b.y, 1 - b.x - b.y}, {});
-    return {sp.p, sp.ng, 1 / l.area, sp.uv};
+    return {sp.p, sp.ng, 1 / l.area, sp.uv, sp.error};
   }
   if (auto* s = std::get_if<Sphere>(&shape)) {
     Vec3 po = sample_uniform_sphere(u) * s->radius;
     SurfacePoint sp = surface_point(shape, 0, {}, s->world_from_object.point(po));
-    return {sp.p, sp.ng, 1 / l.area, sp.uv};
+    return {sp.p, sp.ng, 1 / l.area, sp.uv, sp.error};
   }
   if (auto* c = std::get_if<Cylinder>(&shape)) {
     float phi = u.y * c->phi_max;
     Vec3 po(c->radius * std::cos(phi), c->radius * std::sin(phi),
             c->z_min + u.x * (c->z_max - c->z_min));
     SurfacePoint sp = surface_point(shape, 0, {}, c->world_from_object.point(po));
-    return {sp.p, sp.ng, 1 / l.area, sp.uv};
+    return {sp.p, sp.ng, 1 / l.area, sp.uv, sp.error};
   }
   const Disk& k = std::get<Disk>(shape);
   Vec2 d = sample_uniform_disk_concentric(u);
   Vec3 po(d.x * k.radius, d.y * k.radius, k.height);
   SurfacePoint sp = surface_point(shape, 0, {}, k.world_from_object.point(po));
-  return {sp.p, sp.ng, 1 / l.area, sp.uv};
+  return {sp.p, sp.ng, 1 / l.area, sp.uv, sp.error};
 }
 
 struct SphereWorld {
@@ -107,6 +108,7 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
       ls.wi = w;
       ls.p_light = sp.p;
       ls.n_light = sp.ng;
+      ls.p_light_error = sp.error;
       ls.radiance = area_light_radiance(l, sp.ng, sp.uv, -w, wl);
       ls.pdf_solid_angle = uniform_cone_pdf_solid_angle(cos_max);
       if (ls.radiance.is_black()) return std::nullopt;
@@ -122,6 +124,7 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
   if (cos_l == 0) return std::nullopt;
   ls.p_light = as.p;
   ls.n_light = as.n;
+  ls.p_light_error = as.error;
   ls.radiance = area_light_radiance(l, as.n, as.uv, -ls.wi, wl);
   ls.pdf_solid_angle = as.pdf_area * d2 / cos_l;
   if (ls.radiance.is_black()) return std::nullopt;
@@ -167,6 +170,7 @@ std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape
   s.direction = Frame::from_z(n).to_world(w_local);
   s.origin = as.p;
   s.n_light = as.n;
+  s.origin_error = as.error;
   s.flux =
       area_light_radiance(l, as.n, as.uv, s.direction, wl) * (w_local.z / (as.pdf_area * pdf_dir));
   return s;

@@ -127,6 +127,7 @@ struct LightLiSample {
   Vec3 wi;                    // unit, toward the light
   Vec3 p_light;               // point on the light (for shadow rays); far away for distant lights
   Vec3 n_light;               // surface normal there (zero for lights without a surface)
+  float p_light_error = 0;    // p_light's error bound (SurfacePoint::error)
   float pdf_solid_angle = 0;  // 1 for delta lights
   bool is_delta = false;
   bool is_infinite = false;
@@ -141,8 +142,9 @@ struct SceneBoundsInfo {
 // Le |cos| / (pdf_area * pdf_solid_angle), whose expectation over samples is light_power().
 struct LightLeSample {
   Vec3 origin;
-  Vec3 direction;  // unit
-  Vec3 n_light;    // surface normal at the origin (zero for lights without a surface)
+  Vec3 direction;          // unit
+  Vec3 n_light;            // surface normal at the origin (zero for lights without a surface)
+  float origin_error = 0;  // the origin's error bound (SurfacePoint::error)
   Spectrum flux;
 };
 

@@ -121,9 +121,11 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
       light_sample_le(light, scene.light_shape(light), e.u_pos, e.u_dir, scene.bounds_info, wm.wl);
   if (!le || le->flux.is_black()) return;
   bool has_surface = length_squared(le->n_light) > 0;
-  PathState s{Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction) : le->origin,
-                  le->direction, kInf},
-              le->flux * (e.weight / e.light_pmf)};
+  PathState s{
+      Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction, le->origin_error)
+                      : le->origin,
+          le->direction, kInf},
+      le->flux * (e.weight / e.light_pmf)};
   // Only area lights may touch a medium (flatten_lights.cpp): the one on the side the photon leaves
   // to.
   if (const auto* area = std::get_if<AreaLight>(&light))

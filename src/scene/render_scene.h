@@ -165,14 +165,15 @@ struct WavelengthMaterials {
       : wl(wavelengths), scene(&s), per_point(true) {}
 };
 
-// Offsets a ray origin off the surface at p (normal n) toward direction w, to avoid
-// re-intersecting the surface it leaves.
-inline Vec3 offset_origin(Vec3 p, Vec3 n, Vec3 w) {
-  float eps = 2e-5f * (1 + max_abs_component(p));
+// Offsets a ray origin off the surface at p (normal n, p's error bound `error`, SurfacePoint)
+// toward direction w, to avoid re-intersecting the surface it leaves. No absolute floor: a scene
+// modelled in micrometres is as safe as one in metres.
+inline Vec3 offset_origin(Vec3 p, Vec3 n, Vec3 w, float error) {
+  const float eps = std::fmax(error, 1e-30f);
   return p + n * (dot(n, w) > 0 ? eps : -eps);
 }
 inline Ray spawn_ray(const SurfacePoint& sp, Vec3 w) {
-  return Ray{offset_origin(sp.p, sp.ng, w), w, kInf};
+  return Ray{offset_origin(sp.p, sp.ng, w, sp.error), w, kInf};
 }
 
 }  // namespace bpm

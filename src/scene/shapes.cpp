@@ -1,6 +1,8 @@
 #include "scene/shapes.h"
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace bpm {
 namespace {
@@ -101,12 +103,18 @@ double intersect_analytic(const Shape& shape, Vec3 o, Vec3 d, double t_min, doub
 
 namespace {
 
+// SurfacePoint::error per unit of coordinate magnitude: some 170 float ulps, room for the
+// rounding of the intersection, the barycentric interpolation and the transforms.
+constexpr float kPointErrorScale = 2e-5f;
+
 SurfacePoint mesh_point(const TriangleMesh& m, int prim, Vec2 b) {
   uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1], i2 = m.indices[3 * prim + 2];
   Vec3 p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
   float b0 = 1 - b.x - b.y;
   SurfacePoint sp;
   sp.p = p0 * b0 + p1 * b.x + p2 * b.y;
+  sp.error = kPointErrorScale *
+             std::max({max_abs_component(p0), max_abs_component(p1), max_abs_component(p2)});
   Vec3 ng = cross(p0 - p2, p1 - p2);
   float len = length(ng);
   ng = len > 0 ? ng / len : Vec3(0, 0, 1);
@@ -128,10 +136,7 @@ SurfacePoint mesh_point(const TriangleMesh& m, int prim, Vec2 b) {
   return sp;
 }
 
-}  // namespace
-
-SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) {
-  if (auto* m = std::get_if<TriangleMesh>(&shape)) return mesh_point(*m, prim, bary);
+SurfacePoint analytic_point(const Shape& shape, Vec3 p_hit) {
   SurfacePoint sp;
   if (auto* s = std::get_if<Sphere>(&shape)) {
     Vec3 po = s->world_from_object.inverse().point(p_hit);
@@ -170,6 +175,25 @@ SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) 
   sp.ng = sp.ns = k.flip_normal ? -n : n;
   float r = std::sqrt(po.x * po.x + po.y * po.y);
   sp.uv = {float(phi_of(po.x, po.y)) / k.phi_max, (k.radius - r) / (k.radius - k.inner_radius)};
+  return sp;
+}
+
+}  // namespace
+
+SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) {
+  if (auto* m = std::get_if<TriangleMesh>(&shape)) return mesh_point(*m, prim, bary);
+  SurfacePoint sp = analytic_point(shape, p_hit);
+  // The point is re-projected in object space and transformed back: its error is relative to its
+  // world coordinates and to its distance from the object's origin (the shape's size).
+  const Vec3 origin = std::visit(
+      [](const auto& s) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, TriangleMesh>)
+          return Vec3(0, 0, 0);
+        else
+          return s.world_from_object.point(Vec3(0, 0, 0));
+      },
+      shape);
+  sp.error = kPointErrorScale * (max_abs_component(sp.p) + max_abs_component(sp.p - origin));
   return sp;
 }
 

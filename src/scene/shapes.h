@@ -55,6 +55,10 @@ struct SurfacePoint {
   Vec3 ng;  // geometric normal, on the side pbrt-v4's orientation rules give
   Vec3 ns;  // shading normal, in ng's hemisphere
   Vec2 uv;
+  // A bound on p's floating-point error, in world units: a ray leaving the surface starts this
+  // far off it (offset_origin). Relative to the primitive's coordinates, so that it holds at any
+  // scene scale.
+  float error = 0;
 };
 
 // Analytic ray intersection in object space (double precision). Returns the ray parameter of
