@@ -26,7 +26,8 @@ std::string accident_scene(double s) {
     << "Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 18 "
        "\"string filename\" \"t.exr\"\n"
     << "PixelFilter \"box\"\nIntegrator \"path\" \"integer maxdepth\" 6\nWorldBegin\n"
-    << "AttributeBegin\nScale " << s << " " << s << " " << s << "\n"
+    << "AttributeBegin\nScale " << s << " " << s << " " << s
+    << "\n"
     // A ceiling light, so that the floor is lit directly as well.
     << "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [6 6 6]\n"
     << "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" "

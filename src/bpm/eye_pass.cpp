@@ -64,6 +64,16 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     bool is_diffuse = !bsdf_is_specular(v.m());
+    // A smooth coating's mirror lobe: followed as through a specular vertex, or left to the rest.
+    if (is_diffuse) {
+      if (auto wi = take_delta_lobe(v, rng, s)) {
+        if (s.beta.is_black()) break;
+        if (diffuse > 0) emitter = EmitterWeight::none();
+        leave_vertex(scene, v, v.frame.to_world(*wi), s);
+        ++counters.rays.bounce_rays;
+        continue;
+      }
+    }
     if (is_diffuse && !emission) {
       emission = L;
       if (emission_only) break;
@@ -101,7 +111,7 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
     // and the weight carries the ratio of the two BSDF values (the paper's Helmholtz
     // compensation, section 2; see PhongMaterial).
     auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance);
-    if (!bs) break;
+    if (!bs || (is_diffuse && skip_delta_lobe(v, *bs))) break;
     s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (s.beta.is_black()) break;
     emitter = diffuse == 0

@@ -67,7 +67,16 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
-    if (!bsdf_is_specular(v.m())) {
+    const bool is_diffuse = !bsdf_is_specular(v.m());
+    // A smooth coating's mirror lobe: followed as through a specular vertex, or left to the rest.
+    std::optional<Vec3> mirror = is_diffuse ? take_delta_lobe(v, rng, s) : std::nullopt;
+    if (mirror) {
+      if (s.beta.is_black()) break;
+      leave_vertex(scene, v, v.frame.to_world(*mirror), s);
+      ++c.rays.bounce_rays;
+      continue;
+    }
+    if (is_diffuse) {
       float r1 = s.length * prm.radius_per_length1;
       if (gathering) {
         // x2: everything the global map holds, direct photons included.
@@ -90,7 +99,7 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
     Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
     float uc = rng.uniform();
     auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance);
-    if (!bs) break;
+    if (!bs || (is_diffuse && skip_delta_lobe(v, *bs))) break;
     s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (s.beta.is_black()) break;
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);

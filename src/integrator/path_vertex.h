@@ -7,6 +7,7 @@
 #include <optional>
 #include <variant>
 
+#include "base/rng.h"
 #include "integrator/counters.h"
 #include "scene/render_scene.h"
 
@@ -91,6 +92,33 @@ inline StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& 
 inline std::optional<BsdfSample> sample_bsdf(const PathVertex& v, float uc, Vec2 u,
                                              TransportMode mode) {
   return bsdf_sample(v.m(), v.wo_local, uc, u, mode);
+}
+
+// The photon methods' eye paths at a vertex they would gather at (a material with non-delta
+// lobes) whose material also has a delta lobe (bsdf_delta_lobe: a smooth coating). Next-event
+// estimation, bsdf_f and so the photon estimates see only the other lobes; the delta lobe is a
+// specular vertex in DESIGN.md's sense. So the path takes it with probability p, its weight (the
+// coating's reflectance), and goes on along it as through a specular vertex: the function returns
+// its direction (local) with beta times weight / p. Otherwise beta /= 1 - p, the vertex gathers,
+// and it returns nullopt; a BSDF sample that then continues the path from the vertex must not be
+// the delta lobe (skip_delta_lobe), which the other choice counts.
+inline std::optional<Vec3> take_delta_lobe(const PathVertex& v, Rng& rng, PathState& s) {
+  auto lobe = bsdf_delta_lobe(v.m(), v.wo_local, TransportMode::kRadiance);
+  if (!lobe) return std::nullopt;
+  const Spectrum w = lobe->f * (std::fabs(lobe->wi.z) / lobe->pdf_solid_angle);
+  const float p = std::fmin(1.0f, w.max_component());
+  if (rng.uniform() < p) {
+    s.beta *= w / p;
+    return lobe->wi;
+  }
+  s.beta /= 1 - p;
+  return std::nullopt;
+}
+
+// Whether a BSDF sample at a vertex that gathered must be dropped: it is the delta lobe that
+// take_delta_lobe counts on its own.
+inline bool skip_delta_lobe(const PathVertex& v, const BsdfSample& bs) {
+  return bs.is_specular() && bsdf_delta_lobe(v.m(), v.wo_local, TransportMode::kRadiance);
 }
 
 // At a dispersive surface the path goes on at its hero wavelength alone (once: the scaling of

@@ -361,6 +361,17 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2
   }
   return s;
 }
+std::optional<BsdfSample> bsdf_delta_lobe(const Material& m, Vec3 wo, TransportMode mode) {
+  return std::visit(
+      [&](const auto& x) -> std::optional<BsdfSample> {
+        if constexpr (kLayered<std::decay_t<decltype(x)>>)
+          return bsdf_is_specular(m) ? std::nullopt : layered_delta_lobe(m, wo, mode);
+        else
+          return std::nullopt;  // either all delta lobes (bsdf_is_specular) or none
+      },
+      m);
+}
+
 bool bsdf_is_specular(const Material& m) {
   struct V {
     bool operator()(const DiffuseMaterial&) const { return false; }

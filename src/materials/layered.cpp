@@ -227,6 +227,17 @@ Layer layer_of(const Material& m) {
 
 }  // namespace
 
+std::optional<BsdfSample> layered_delta_lobe(const Material& m, Vec3 wo, TransportMode mode) {
+  const Layer L = layer_of(m);
+  if (!L.top.roughness.effectively_smooth() || wo.z == 0) return std::nullopt;
+  const bool flip = wo.z < 0;  // two-sided, as layered_f
+  auto s = dielectric_sample(L.top, flip ? -wo : wo, 0, {0, 0}, mode, kReflection);
+  if (!usable(s)) return std::nullopt;
+  if (flip) s->wi = -s->wi;
+  s->mis_pdf = s->pdf_solid_angle;
+  return s;
+}
+
 Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   return layered_f(layer_of(m), wo, wi, mode);
 }

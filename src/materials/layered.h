@@ -17,6 +17,9 @@ Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
 float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
 std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
                                          TransportMode mode);
+// The smooth coating's mirror reflection (weight: its Fresnel reflectance); nullopt when the
+// coating is rough (its reflection is then a glossy lobe of layered_f).
+std::optional<BsdfSample> layered_delta_lobe(const Material& m, Vec3 wo, TransportMode mode);
 
 template <class T>
 constexpr bool kLayered =

@@ -191,6 +191,11 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2
                                       TransportMode mode);
 // All lobes of the material are delta lobes (no use in next-event estimation).
 bool bsdf_is_specular(const Material& m);
+// The delta lobe of a material that has non-delta lobes as well (a smooth coating's mirror
+// reflection over a rough or diffuse base), sampled for wo (weight f |cos| / pdf: the coating's
+// reflectance); nullopt when the material has no such lobe. bsdf_f leaves it out, and bsdf_sample
+// returns it flagged kSpecular (any other sample of such a material is not).
+std::optional<BsdfSample> bsdf_delta_lobe(const Material& m, Vec3 wo, TransportMode mode);
 // True when the material has a non-delta lobe (a diffuse vertex in DESIGN.md's sense).
 inline bool bsdf_has_nonspecular(const Material& m) { return !bsdf_is_specular(m); }
 
