@@ -827,14 +827,12 @@ TEST(Bpm, NonReciprocalFloorMatchesPath) {
   }
 }
 
-// A smooth coating (pbrt-v4's coateddiffuse default, roughness 0) over a diffuse floor: the
-// coating's mirror reflection is a delta lobe beside the diffuse walk under it. Eye paths must
-// follow it as through a specular vertex (take_delta_lobe) while the floor gathers the rest;
-// gathering alone lost the reflection (the floor's blocks 10-30% dark in bpm and fpm).
-TEST(Bpm, SmoothCoatedFloorMatchesPath) {
-  LoadedScene ls = load(cornell("Material \"coateddiffuse\" \"rgb reflectance\" [0.5 0.5 0.5]"));
-  ASSERT_TRUE(
-      std::holds_alternative<CoatedDiffuseDesc>(ls.scene.materials[ls.scene.objects[1].material]));
+// A floor whose lobes the photon methods trace (BsdfPart) in part or in whole, against path: bpm
+// with D = 0 and 1, fpm with and without final gathering. Eye paths take the traced lobes as
+// specular vertices (with next-event estimation at glossy ones seen from the camera), photons
+// through them stay caustics, and the gathered lobes alone meet the photons.
+void expect_traced_floor_matches_path(const std::string& floor_material) {
+  LoadedScene ls = load(cornell(floor_material));
   RenderRun ref = render_with(ls, "path", 2048);
   for (int d : {0, 1}) {
     expect_blocks_agree(render_iterations(ls, "bpm", 160, 6, small_batches(d)), ref.film, 8,
@@ -848,6 +846,28 @@ TEST(Bpm, SmoothCoatedFloorMatchesPath) {
     expect_blocks_agree(render_iterations(ls, "fpm", 120, 6, s, f), ref.film, 8,
                         edge_bias(s, 120, 8), gather ? "fpm, final gather" : "fpm");
   }
+}
+
+// A smooth coating (pbrt-v4's coateddiffuse default, roughness 0) over a diffuse floor: its mirror
+// reflection is a delta lobe beside the diffuse walks under it. Gathering alone lost the
+// reflection (the floor's blocks 10-30% dark in bpm and fpm).
+TEST(Bpm, SmoothCoatedFloorMatchesPath) {
+  expect_traced_floor_matches_path("Material \"coateddiffuse\" \"rgb reflectance\" [0.5 0.5 0.5]");
+}
+
+// A sharp glossy coating (alpha 0.05) over a diffuse floor: the coating's glossy reflection is
+// traced, the walks under it gathered.
+TEST(Bpm, SharpCoatedFloorMatchesPath) {
+  expect_traced_floor_matches_path(
+      "Material \"coateddiffuse\" \"rgb reflectance\" [0.5 0.5 0.5] \"float roughness\" 0.05 "
+      "\"bool remaproughness\" false");
+}
+
+// A sharp glossy metal floor (alpha 0.05): never a gathering vertex; its highlight of the light
+// comes from next-event estimation with MIS, the light it throws on the walls from caustic photons.
+TEST(Bpm, SharpMetalFloorMatchesPath) {
+  expect_traced_floor_matches_path(
+      "Material \"conductor\" \"float roughness\" 0.05 \"bool remaproughness\" false");
 }
 
 // The random stream of a pixel sample or a photon depends on (seed, iteration, index) only, and

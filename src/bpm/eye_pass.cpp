@@ -63,17 +63,9 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
-    bool is_diffuse = !bsdf_is_specular(v.m());
-    // A smooth coating's mirror lobe: followed as through a specular vertex, or left to the rest.
-    if (is_diffuse) {
-      if (auto wi = take_delta_lobe(v, rng, s)) {
-        if (s.beta.is_black()) break;
-        if (diffuse > 0) emitter = EmitterWeight::none();
-        leave_vertex(scene, v, v.frame.to_world(*wi), s);
-        ++counters.rays.bounce_rays;
-        continue;
-      }
-    }
+    // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
+    const EyeVertexChoice choice = choose_eye_vertex(v, rng, s);
+    const bool is_diffuse = choice.gather;
     if (is_diffuse && !emission) {
       emission = L;
       if (emission_only) break;
@@ -84,7 +76,7 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, !last, wl, rng, counters.rays);
+                                        v.wo_local, !last, wl, rng, counters.rays, choice.part);
       // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
       // vertex is also the last: two backward photons, one per radius.
       auto store = [&](uint8_t accepts) {
@@ -105,18 +97,27 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       }
       if (last) break;
     }
+    // A glossy specular vertex seen through specular ones only (a highlight): direct light by
+    // next-event estimation, shared by MIS with the BSDF sample that goes on. After a diffuse
+    // vertex the backward photons there count such light as a caustic.
+    const bool direct_here =
+        !is_diffuse && diffuse == 0 && bsdf_part_has_nondelta(v.m(), choice.part);
+    if (direct_here)
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                        v.wo_local, true, wl, rng, counters.rays, choice.part);
     float uc = rng.uniform();
     Vec2 u{rng.uniform(), rng.uniform()};
     // Radiance-mode sampling; for a non-reciprocal BSDF the lobe drawn is the light-direction one
     // and the weight carries the ratio of the two BSDF values (the paper's Helmholtz
     // compensation, section 2; see PhongMaterial).
-    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance);
-    if (!bs || (is_diffuse && skip_delta_lobe(v, *bs))) break;
+    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);
+    if (!bs) break;
     s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (s.beta.is_black()) break;
-    emitter = diffuse == 0
-                  ? EmitterWeight::full()
-                  : (is_diffuse ? EmitterWeight::mis(bs->mis_pdf, v.sp.p) : EmitterWeight::none());
+    if (is_diffuse || (direct_here && !bs->is_specular()))
+      emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+    else
+      emitter = diffuse == 0 ? EmitterWeight::full() : EmitterWeight::none();
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++counters.rays.bounce_rays;
   }

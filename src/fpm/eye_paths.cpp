@@ -67,15 +67,9 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
     if (depth++ == prm.max_depth) break;
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
-    const bool is_diffuse = !bsdf_is_specular(v.m());
-    // A smooth coating's mirror lobe: followed as through a specular vertex, or left to the rest.
-    std::optional<Vec3> mirror = is_diffuse ? take_delta_lobe(v, rng, s) : std::nullopt;
-    if (mirror) {
-      if (s.beta.is_black()) break;
-      leave_vertex(scene, v, v.frame.to_world(*mirror), s);
-      ++c.rays.bounce_rays;
-      continue;
-    }
+    // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
+    const EyeVertexChoice choice = choose_eye_vertex(v, rng, s);
+    const bool is_diffuse = choice.gather;
     if (is_diffuse) {
       float r1 = s.length * prm.radius_per_length1;
       if (gathering) {
@@ -86,7 +80,7 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, false, wl, rng, c.rays);
+                                        v.wo_local, false, wl, rng, c.rays, choice.part);
       L += s.beta * estimate(maps.caustic, v, s.hero_only, s.length * prm.radius_per_length0, depth,
                              prm, caustic_class, c);
       if (!prm.fpm->final_gather) {
@@ -96,12 +90,22 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
       gathering = true;
       emitter = EmitterWeight::none();
     }
+    // A glossy specular vertex seen through specular ones only (a highlight): direct light by
+    // next-event estimation, shared by MIS with the BSDF sample that goes on.
+    const bool direct_here =
+        !is_diffuse && !gathering && bsdf_part_has_nondelta(v.m(), choice.part);
+    if (direct_here)
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                        v.wo_local, true, wl, rng, c.rays, choice.part);
     Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
     float uc = rng.uniform();
-    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance);
-    if (!bs || (is_diffuse && skip_delta_lobe(v, *bs))) break;
+    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);
+    if (!bs) break;
     s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (s.beta.is_black()) break;
+    if (!gathering)
+      emitter = direct_here && !bs->is_specular() ? EmitterWeight::mis(bs->mis_pdf, v.sp.p)
+                                                  : EmitterWeight::full();
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++c.rays.bounce_rays;
   }

@@ -8,8 +8,8 @@ namespace bpm {
 
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
-                             bool use_mis, const Wavelengths& wl, Rng& rng,
-                             PathCounters& counters) {
+                             bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                             BsdfPart part) {
   if (scene.lights.empty()) return {};
   float pmf;
   float ul = rng.uniform();
@@ -19,7 +19,8 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info, wl);
   if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
   Vec3 wi_local = frame.to_local(ls->wi);
-  Spectrum f = bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
+  Spectrum f =
+      bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance, part) * std::fabs(wi_local.z);
   if (f.is_black()) return {};
   ++counters.shadow_rays;
   Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi, sp.error);
@@ -40,7 +41,7 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   }
   float p_light = pmf * ls->pdf_solid_angle;
   if (ls->is_delta || !use_mis) return ls->radiance * f / p_light;
-  float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance);
+  float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance, part);
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
 }
 

@@ -13,9 +13,11 @@ namespace bpm {
 // heuristic against BSDF sampling when use_mis (the caller then weights the emitters its BSDF
 // samples hit by EmitterWeight::mis), else with full weight. sp lies on `object`, reached by a
 // ray in `medium`: the shadow ray's absorption is that of the medium on the light's side.
+// Only the lobes of `part` reflect it (BsdfPart).
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
-                             bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters);
+                             bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                             BsdfPart part = BsdfPart::kAll);
 
 // How emission found by the next ray of a path counts: in full (seen from the camera or through
 // specular vertices only), by the power heuristic against next-event estimation at the previous

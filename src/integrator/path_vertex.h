@@ -90,35 +90,30 @@ inline StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& 
 // Samples the BSDF at v. The caller draws uc and u, in an order of its own that is fixed in the
 // code (argument evaluation order is not), so that the image does not depend on the compiler.
 inline std::optional<BsdfSample> sample_bsdf(const PathVertex& v, float uc, Vec2 u,
-                                             TransportMode mode) {
-  return bsdf_sample(v.m(), v.wo_local, uc, u, mode);
+                                             TransportMode mode, BsdfPart part = BsdfPart::kAll) {
+  return bsdf_sample(v.m(), v.wo_local, uc, u, mode, part);
 }
 
-// The photon methods' eye paths at a vertex they would gather at (a material with non-delta
-// lobes) whose material also has a delta lobe (bsdf_delta_lobe: a smooth coating). Next-event
-// estimation, bsdf_f and so the photon estimates see only the other lobes; the delta lobe is a
-// specular vertex in DESIGN.md's sense. So the path takes it with probability p, its weight (the
-// coating's reflectance), and goes on along it as through a specular vertex: the function returns
-// its direction (local) with beta times weight / p. Otherwise beta /= 1 - p, the vertex gathers,
-// and it returns nullopt; a BSDF sample that then continues the path from the vertex must not be
-// the delta lobe (skip_delta_lobe), which the other choice counts.
-inline std::optional<Vec3> take_delta_lobe(const PathVertex& v, Rng& rng, PathState& s) {
-  auto lobe = bsdf_delta_lobe(v.m(), v.wo_local, TransportMode::kRadiance);
-  if (!lobe) return std::nullopt;
-  const Spectrum w = lobe->f * (std::fabs(lobe->wi.z) / lobe->pdf_solid_angle);
-  const float p = std::fmin(1.0f, w.max_component());
+// What a photon method's eye path does at a vertex (BsdfPart): gather there (a diffuse vertex:
+// next-event estimation and photon estimates with the gathered lobes), or go on through it as
+// through a specular vertex, with the traced lobes; `part` is what it then samples and evaluates.
+// A material with both parts is traced with probability p (bsdf_traced_part_probability) and
+// gathered otherwise, beta divided by p or 1 - p: each light path through it is counted by one of
+// the two choices, with the lobe that carries it.
+struct EyeVertexChoice {
+  bool gather;
+  BsdfPart part;
+};
+inline EyeVertexChoice choose_eye_vertex(const PathVertex& v, Rng& rng, PathState& s) {
+  if (bsdf_all_traced(v.m())) return {false, BsdfPart::kAll};
+  const float p = bsdf_traced_part_probability(v.m(), v.wo_local);
+  if (p == 0) return {true, BsdfPart::kAll};
   if (rng.uniform() < p) {
-    s.beta *= w / p;
-    return lobe->wi;
+    s.beta /= p;
+    return {false, BsdfPart::kTraced};
   }
   s.beta /= 1 - p;
-  return std::nullopt;
-}
-
-// Whether a BSDF sample at a vertex that gathered must be dropped: it is the delta lobe that
-// take_delta_lobe counts on its own.
-inline bool skip_delta_lobe(const PathVertex& v, const BsdfSample& bs) {
-  return bs.is_specular() && bsdf_delta_lobe(v.m(), v.wo_local, TransportMode::kRadiance);
+  return {true, BsdfPart::kGathered};
 }
 
 // At a dispersive surface the path goes on at its hero wavelength alone (once: the scaling of

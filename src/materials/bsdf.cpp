@@ -10,6 +10,7 @@ namespace bpm {
 
 // pbrt-v4 treats alpha below 1e-3 as a perfect mirror or smooth boundary.
 bool Roughness::effectively_smooth() const { return std::fmax(alpha_x, alpha_y) < 1e-3f; }
+bool Roughness::traced() const { return std::fmax(alpha_x, alpha_y) <= kTracedAlpha; }
 
 float fresnel_dielectric(float cos_i, float eta) {
   cos_i = std::clamp(cos_i, -1.0f, 1.0f);
@@ -321,32 +322,33 @@ std::optional<BsdfSample> sample_of(const InterfaceMaterial&, Vec3, float, Vec2,
 }  // namespace
 
 // Layered materials take the whole Material (materials/layered.h); the others their own struct.
-Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+// A part matters only for layered materials: any other has one part, which callers ask for alone.
+Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part) {
   return std::visit(
       [&](const auto& x) {
         if constexpr (kLayered<std::decay_t<decltype(x)>>)
-          return layered_f(m, wo, wi, mode);
+          return layered_f(m, wo, wi, mode, part);
         else
           return f_of(x, wo, wi, mode);
       },
       m);
 }
-float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part) {
   return std::visit(
       [&](const auto& x) {
         if constexpr (kLayered<std::decay_t<decltype(x)>>)
-          return layered_pdf(m, wo, wi, mode);
+          return layered_pdf(m, wo, wi, mode, part);
         else
           return pdf_of(x, wo, wi, mode);
       },
       m);
 }
 std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
-                                      TransportMode mode) {
+                                      TransportMode mode, BsdfPart part) {
   auto s = std::visit(
       [&](const auto& x) {
         if constexpr (kLayered<std::decay_t<decltype(x)>>)
-          return layered_sample(m, wo, uc, u, mode);
+          return layered_sample(m, wo, uc, u, mode, part);
         else
           return sample_of(x, wo, uc, u, mode);
       },
@@ -356,20 +358,48 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2
   if (s) {
     // A layered material's walk gives an exact weight but no density; MIS takes its estimate.
     bool layered = std::visit([](const auto& x) { return kLayered<std::decay_t<decltype(x)>>; }, m);
-    bool estimated = layered && !s->is_specular();
-    s->mis_pdf = estimated ? bsdf_pdf(m, wo, s->wi, mode) : s->pdf_solid_angle;
+    bool estimated = layered && !s->is_specular() && part != BsdfPart::kTraced;
+    s->mis_pdf = estimated ? bsdf_pdf(m, wo, s->wi, mode, part) : s->pdf_solid_angle;
+    if (!s->is_specular() && bsdf_all_traced(m)) s->flags |= kTraced;
   }
   return s;
 }
-std::optional<BsdfSample> bsdf_delta_lobe(const Material& m, Vec3 wo, TransportMode mode) {
-  return std::visit(
-      [&](const auto& x) -> std::optional<BsdfSample> {
-        if constexpr (kLayered<std::decay_t<decltype(x)>>)
-          return bsdf_is_specular(m) ? std::nullopt : layered_delta_lobe(m, wo, mode);
-        else
-          return std::nullopt;  // either all delta lobes (bsdf_is_specular) or none
-      },
-      m);
+bool bsdf_all_traced(const Material& m) {
+  struct V {
+    bool operator()(const DiffuseMaterial&) const { return false; }
+    bool operator()(const ConductorMaterial& c) const { return c.roughness.traced(); }
+    bool operator()(const DielectricMaterial& d) const {
+      return d.eta == 1 || d.roughness.traced();
+    }
+    bool operator()(const ThinDielectricMaterial&) const { return true; }
+    bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
+    bool operator()(const PhongMaterial&) const { return false; }
+    bool operator()(const InterfaceMaterial&) const { return true; }
+    bool operator()(const CoatedDiffuseMaterial&) const { return false; }
+    bool operator()(const CoatedConductorMaterial& c) const {
+      return c.layer.roughness.traced() && c.conductor.roughness.traced();
+    }
+  };
+  return std::visit(V{}, m);
+}
+
+float bsdf_traced_part_probability(const Material& m, Vec3 wo) {
+  const CoatLayer* layer = nullptr;
+  if (const auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) layer = &d->layer;
+  if (const auto* c = std::get_if<CoatedConductorMaterial>(&m)) layer = &c->layer;
+  if (!layer || !layer->roughness.traced() || bsdf_all_traced(m)) return 0;
+  return std::fmax(0.25f, fresnel_dielectric(std::fabs(wo.z), layer->eta));
+}
+
+bool bsdf_part_has_nondelta(const Material& m, BsdfPart part) {
+  if (part == BsdfPart::kGathered) return true;
+  if (part == BsdfPart::kTraced) {
+    if (const auto* d = std::get_if<CoatedDiffuseMaterial>(&m))
+      return !d->layer.roughness.effectively_smooth();
+    if (const auto* c = std::get_if<CoatedConductorMaterial>(&m))
+      return !c->layer.roughness.effectively_smooth();
+  }
+  return !bsdf_is_specular(m);
 }
 
 bool bsdf_is_specular(const Material& m) {

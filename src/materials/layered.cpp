@@ -50,12 +50,24 @@ struct Layer {
   Base base;
   float thickness;
   int max_depth, samples;
-  Layer(const CoatLayer& c, Material base_material)
+  // Which lobes to see (BsdfPart): the coating's own reflection (`coat`), the walks under it
+  // (`walks`), or both. A material whose coating is not traced, or whose base is traced as well,
+  // does not split: it is seen whole.
+  bool coat = true, walks = true;
+  Layer(const CoatLayer& c, Material base_material, BsdfPart part)
       : top{c.eta, c.roughness, nullptr},
         base(std::move(base_material)),
         thickness(c.thickness),
         max_depth(c.max_depth),
-        samples(c.samples) {}
+        samples(c.samples) {
+    const bool splits = c.roughness.traced() && !(base.specular || base_traced());
+    if (splits && part == BsdfPart::kGathered) coat = false;
+    if (splits && part == BsdfPart::kTraced) walks = false;
+  }
+  bool base_traced() const {
+    const auto* c = std::get_if<ConductorMaterial>(&base.m);
+    return c && c->roughness.traced();
+  }
 };
 
 Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
@@ -69,7 +81,8 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   const DielectricMaterial& top = L.top;
   const bool top_smooth = top.roughness.effectively_smooth();
   // Reflection off the coating itself (zero for a smooth coating: its mirror lobe is a delta).
-  Spectrum f = dielectric_f(top, wo, wi, mode) * float(L.samples);
+  Spectrum f = L.coat ? dielectric_f(top, wo, wi, mode) * float(L.samples) : Spectrum();
+  if (!L.walks) return f / float(L.samples);
   Rng rng(key_of(wo, wi));
   for (int s = 0; s < L.samples; ++s) {
     // Into the layer along wo, and the way out toward wi traced backwards (adjoint transport).
@@ -141,7 +154,8 @@ float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   if (wi.z > 0 && wo.z > 0) {
     const DielectricMaterial& top = L.top;
     const bool top_smooth = top.roughness.effectively_smooth();
-    sum = float(L.samples) * dielectric_pdf(top, wo, wi, kReflection);
+    if (L.coat) sum = float(L.samples) * dielectric_pdf(top, wo, wi, kReflection);
+    if (!L.walks) return sum / float(L.samples);
     Rng rng(key_of(wi, wo));
     for (int s = 0; s < L.samples; ++s) {
       // Transmission, base reflection, transmission: the dominant path.
@@ -174,10 +188,13 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
   const bool flip = wo.z < 0;
   if (flip) wo = -wo;
   const DielectricMaterial& top = L.top;
-  auto bs = dielectric_sample(top, wo, uc, u, mode, kReflection | kTransmission);
+  auto bs = dielectric_sample(top, wo, uc, u, mode,
+                              L.walks ? kReflection | kTransmission : unsigned(kReflection));
   if (!usable(bs)) return std::nullopt;
   if (!bs->is_transmission()) {  // reflected by the coating
+    if (!L.coat) return std::nullopt;
     if (flip) bs->wi = -bs->wi;
+    if (top.roughness.traced()) bs->flags |= kTraced;
     return bs;
   }
   Rng rng(key_of(wo, Vec3(uc, u.x, u.y)));
@@ -218,35 +235,24 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
   return std::nullopt;
 }
 
-Layer layer_of(const Material& m) {
+Layer layer_of(const Material& m, BsdfPart part) {
   if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m))
-    return Layer(d->layer, DiffuseMaterial{d->reflectance});
+    return Layer(d->layer, DiffuseMaterial{d->reflectance}, part);
   const auto& c = std::get<CoatedConductorMaterial>(m);
-  return Layer(c.layer, c.conductor);
+  return Layer(c.layer, c.conductor, part);
 }
 
 }  // namespace
 
-std::optional<BsdfSample> layered_delta_lobe(const Material& m, Vec3 wo, TransportMode mode) {
-  const Layer L = layer_of(m);
-  if (!L.top.roughness.effectively_smooth() || wo.z == 0) return std::nullopt;
-  const bool flip = wo.z < 0;  // two-sided, as layered_f
-  auto s = dielectric_sample(L.top, flip ? -wo : wo, 0, {0, 0}, mode, kReflection);
-  if (!usable(s)) return std::nullopt;
-  if (flip) s->wi = -s->wi;
-  s->mis_pdf = s->pdf_solid_angle;
-  return s;
+Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part) {
+  return layered_f(layer_of(m, part), wo, wi, mode);
 }
-
-Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
-  return layered_f(layer_of(m), wo, wi, mode);
-}
-float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
-  return layered_pdf(layer_of(m), wo, wi, mode);
+float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part) {
+  return layered_pdf(layer_of(m, part), wo, wi, mode);
 }
 std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
-                                         TransportMode mode) {
-  return layered_sample(layer_of(m), wo, uc, u, mode);
+                                         TransportMode mode, BsdfPart part) {
+  return layered_sample(layer_of(m, part), wo, uc, u, mode);
 }
 
 }  // namespace bpm

@@ -12,14 +12,14 @@
 
 namespace bpm {
 
-// m holds a CoatedDiffuseMaterial or a CoatedConductorMaterial (is_layered).
-Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
-float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
+// m holds a CoatedDiffuseMaterial or a CoatedConductorMaterial (is_layered). The traced part
+// (BsdfPart) is the coating's own reflection when the coating is traced; the gathered part is the
+// rest (the walks under it). Asked for a part the material does not split into, they answer for
+// the whole material.
+Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part);
+float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part);
 std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
-                                         TransportMode mode);
-// The smooth coating's mirror reflection (weight: its Fresnel reflectance); nullopt when the
-// coating is rough (its reflection is then a glossy lobe of layered_f).
-std::optional<BsdfSample> layered_delta_lobe(const Material& m, Vec3 wo, TransportMode mode);
+                                         TransportMode mode, BsdfPart part);
 
 template <class T>
 constexpr bool kLayered =

@@ -26,7 +26,18 @@ struct DiffuseMaterial {
 struct Roughness {
   float alpha_x = 0, alpha_y = 0;
   bool effectively_smooth() const;
+  // Sharp enough that the photon methods trace the lobe rather than gather it (BsdfPart).
+  bool traced() const;
 };
+
+// The photon methods' split of a material's lobes (DESIGN.md's vocabulary): delta lobes, and
+// glossy ones whose roughness alpha is at most kTracedAlpha, are *traced*: paths go on through
+// them as through specular vertices (a photon's estimate would be all noise: f peaks at about
+// 1 / (pi alpha^2)). The others are *gathered*: a diffuse vertex. A material may have both (a
+// smooth or sharp coating over a diffuse or rough base); functions that take a part see its lobes
+// only.
+enum class BsdfPart : unsigned char { kAll, kGathered, kTraced };
+constexpr float kTracedAlpha = 0.1f;
 
 struct ConductorMaterial {
   Spectrum eta{1.0f}, k{0.0f};  // complex index of refraction per channel
@@ -166,6 +177,7 @@ enum BsdfFlags : unsigned {
   kDiffuse = 4,
   kGlossy = 8,
   kSpecular = 16,
+  kTraced = 32,  // a glossy lobe the photon methods trace (BsdfPart); delta lobes are traced too
 };
 
 struct BsdfSample {
@@ -179,23 +191,31 @@ struct BsdfSample {
   // estimated (pbrt-v4's pdfIsProportional): bsdf_sample fills it.
   float mis_pdf = 0;
   bool is_specular() const { return flags & kSpecular; }
+  bool is_traced() const { return flags & (kSpecular | kTraced); }
   bool is_transmission() const { return flags & kTransmission; }
 };
 
-// f(wo, wi); zero for delta lobes.
-Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
+// f(wo, wi) of the lobes of `part`; zero for delta lobes.
+Spectrum bsdf_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode,
+                BsdfPart part = BsdfPart::kAll);
 // Density with which bsdf_sample returns wi; zero for delta lobes.
-float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
-// uc picks among lobes, u picks the direction.
+float bsdf_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode,
+               BsdfPart part = BsdfPart::kAll);
+// uc picks among lobes, u picks the direction. Samples of traced lobes are flagged kTraced (or
+// kSpecular). With a part, a sample of the other part's lobes is not returned (its weight is
+// still exact for the part: f of the part over the density of drawing it).
 std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
-                                      TransportMode mode);
+                                      TransportMode mode, BsdfPart part = BsdfPart::kAll);
 // All lobes of the material are delta lobes (no use in next-event estimation).
 bool bsdf_is_specular(const Material& m);
-// The delta lobe of a material that has non-delta lobes as well (a smooth coating's mirror
-// reflection over a rough or diffuse base), sampled for wo (weight f |cos| / pdf: the coating's
-// reflectance); nullopt when the material has no such lobe. bsdf_f leaves it out, and bsdf_sample
-// returns it flagged kSpecular (any other sample of such a material is not).
-std::optional<BsdfSample> bsdf_delta_lobe(const Material& m, Vec3 wo, TransportMode mode);
+// Every lobe of the material is traced (BsdfPart): never a gathering vertex.
+bool bsdf_all_traced(const Material& m);
+// For a material with both parts, the probability with which the photon methods' eye paths take
+// the traced part at wo: the coating's reflectance, but at least 1/4 (highlights come through it);
+// 0 for a material with one part only.
+float bsdf_traced_part_probability(const Material& m, Vec3 wo);
+// Whether the part has lobes that are not delta lobes (next-event estimation has use there).
+bool bsdf_part_has_nondelta(const Material& m, BsdfPart part);
 // True when the material has a non-delta lobe (a diffuse vertex in DESIGN.md's sense).
 inline bool bsdf_has_nonspecular(const Material& m) { return !bsdf_is_specular(m); }
 

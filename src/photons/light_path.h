@@ -138,7 +138,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     PathVertex v;
     if (next_vertex(scene, wm, s, v, counters.light_rays, counters.observer) != StepEnd::kVertex)
       break;
-    if (!bsdf_is_specular(v.m())) {
+    // A surface with gathered lobes (BsdfPart): the photon's estimate there sees those alone.
+    if (!bsdf_all_traced(v.m())) {
       ++counters.diffuse_hits;
       PhotonClass cls = bounces == 0
                             ? PhotonClass::kDirect
@@ -166,7 +167,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     s.beta = bnew / (1 - q);
     if (s.beta.is_black() || !s.beta.is_finite()) break;
     ++bounces;
-    all_specular = all_specular && bs->is_specular();
+    // Through a traced lobe (delta, or glossy and sharp) a caustic stays a caustic.
+    all_specular = all_specular && bs->is_traced();
     leave_vertex(scene, v, wi, s);
     ++counters.light_rays;
   }
