@@ -207,6 +207,8 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                    {"stop_reason", st.stop_reason},
                    {"mean_sampling_probability", st.mean_sampling_probability},
                    {"relative_error_delta", st.relative_error},
+                   {"relative_error_delta_bias", film.relative_error_bias()},
+                   {"relative_error_delta_total", film.relative_error_total()},
                    {"dropped_samples", film.dropped_samples()},
                    {"relative_error_delta_luminance", film.relative_error_luminance()},
                    {"m_images", film.m_images()},
@@ -278,7 +280,8 @@ int run_render(const RenderArgs& a) {
         {"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
     rec["result"] = {{"passes", passes},
                      {"stop_reason", "running"},
-                     {"relative_error_delta", film.relative_error()}};
+                     {"relative_error_delta", film.relative_error()},
+                     {"relative_error_delta_total", film.relative_error_total()}};
     write_text_atomic(paths.json, rec.dump(2) + "\n");
   };
   RenderStats st = render(ls, opt, &film);
@@ -296,11 +299,15 @@ int run_render(const RenderArgs& a) {
   if (!a.quiet) {
     if (opt.integrator == "bpm") print_bpm_summary(st.details);
     if (opt.integrator == "fpm") print_fpm_summary(st.details);
-    std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f -> %s\n", st.passes,
+    char bias[64] = "";
+    if (film.has_bias())
+      std::snprintf(bias, sizeof bias, " (noise %.4f, bias %.4f)", st.relative_error,
+                    film.relative_error_bias());
+    std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f%s -> %s\n", st.passes,
                  opt.integrator == "path" ? "spp" : "iterations", st.render_seconds,
                  st.stop_reason.c_str(),
                  st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0,
-                 st.relative_error, paths.exr.c_str());
+                 film.relative_error_total(), bias, paths.exr.c_str());
   }
   return st.stop_reason == "interrupted" ? 130 : 0;
 }

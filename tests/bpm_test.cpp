@@ -912,6 +912,61 @@ TEST(Bpm, TimeBudgetCutsTheLightPassToAPrefixOfItsPhotons) {
   }
 }
 
+// The bias estimate on an analytic case: a point light at height 1 over a diffuse floor, under a
+// mirror at height 2, so that the floor also receives the light's mirror image from height
+// H = 3, as caustic photons (maxdepth 2 leaves out every longer path). Irradiance from a source
+// at height H is I H / (H^2 + rho^2)^(3/2) ~ (I / H^2)(1 - 3 rho^2 / (2 H^2)); its mean over a
+// disc of radius s is lower by 3 s^2 / (4 H^2) (to order s^4: plus 5 s^4 / (8 H^4)). With the
+// radius r fixed: the true bias of the caustic part at the floor's centre is about
+// -0.75 (r/H)^2 + 0.625 (r/H)^4 of it, and 2 (L(r) - L(r / sqrt 2)) expects -0.75 (r/H)^2 +
+// 0.469 (r/H)^4. path finds the direct light alone (no path reaches a point light through a
+// mirror), and the caustic is a ninth of it at the centre (I / 9 against I / 1).
+TEST(Bpm, BiasEstimateMatchesTheAnalyticCurvature) {
+  const std::string text =
+      "LookAt 0 1.5 0  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 20\n"
+      "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16 \"string filename\" "
+      "\"t.exr\"\nPixelFilter \"box\"\nIntegrator \"path\" \"integer maxdepth\" 2\nWorldBegin\n"
+      "LightSource \"point\" \"rgb I\" [10 10 10] \"point3 from\" [0 1 0]\n"
+      "AttributeBegin\nMaterial \"conductor\" \"rgb reflectance\" [1 1 1] \"float roughness\" 0\n" +
+      quad(-30, -30, 30, 30, 2, true) + "AttributeEnd\n" +
+      "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n" + quad(-30, -30, 30, 30, 0, false);
+  LoadedScene ls = load(text);
+  const double H = 3, r = 0.9, x = r / H;
+  BpmSettings s = small_batches(0);
+  s.radius = float(r);
+  s.radius_policy = RadiusPolicy::kFixed;
+  s.photons_per_iteration = 50000;
+  s.guide_emission = false;
+  RenderRun bpm_run = render_with(ls, "bpm", 200, 0, 3, s);
+  RenderRun ref = render_with(ls, "path", 256, 0, 4);
+  // The centre (rho < 0.11, where the r^2 terms of rho^2 / H^2 stay below 0.2% of the bias).
+  const Image img = bpm_run.film.image(), truth = ref.film.image();
+  const std::vector<float> bias = bpm_run.film.bias_rgb(),
+                           bias_se = bpm_run.film.bias_standard_error_rgb(),
+                           rms = bpm_run.film.rms_rgb(), ref_rms = ref.film.rms_rgb();
+  double sum_b = 0, sum_se = 0, sum_img = 0, sum_ref = 0, sum_rms = 0;
+  int n = 0;
+  for (int y = 4; y < 12; ++y)
+    for (int px = 4; px < 12; ++px) {
+      const size_t i = 3 * (size_t(y) * 16 + px) + 1;  // green
+      sum_b += bias[i];
+      sum_se += bias_se[i];
+      sum_img += img.rgb[i];
+      sum_ref += truth.rgb[i];
+      sum_rms += rms[i] + ref_rms[i];
+      ++n;
+    }
+  const double caustic = sum_ref / n / 9;
+  const double true_bias = (-0.75 * x * x + 0.625 * x * x * x * x) * caustic,
+               expected_estimate = (-0.75 * x * x + 0.469 * x * x * x * x) * caustic;
+  // Pixels share photons: the patch's error is at most the mean of its pixels' errors.
+  EXPECT_NEAR(sum_img / n - sum_ref / n - caustic, true_bias, 4 * sum_rms / n)
+      << "the render's own bias (caustic " << caustic << ")";
+  EXPECT_NEAR(sum_b / n, expected_estimate, 4 * sum_se / n + 0.02 * std::fabs(expected_estimate))
+      << "the bias estimate (caustic " << caustic << ", true bias " << true_bias << ")";
+  EXPECT_LT(4 * sum_se / n, 0.5 * std::fabs(expected_estimate)) << "too noisy to tell";
+}
+
 // A memory budget: too small for the film and one iteration's backward photons, the render stops
 // before it starts with an error that names the budget; just large enough, the light pass holds
 // its entries in more, smaller batches, and the image is exactly the unlimited one (entries are

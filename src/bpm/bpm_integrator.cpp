@@ -50,15 +50,15 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 // Memory (base/memory.h). Per pixel, what the eye pass, the masks and the emission guide keep.
 constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
                                sizeof(double) + sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
-// Per backward photon: the thread's list and the map's copy, its flux and hit flag, and its
+// Per backward photon: the thread's list and the map's copy, its two fluxes and hit flag, and its
 // references in the two trees (about two per tree where spheres overlap cells).
-constexpr double kBackwardPhotonBytes =
-    2 * sizeof(BackwardPhoton) + sizeof(Spectrum) + 1 + 4 * (sizeof(SphereRef) + sizeof(uint32_t));
+constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 2 * sizeof(Spectrum) + 1 +
+                                        4 * (sizeof(SphereRef) + sizeof(uint32_t));
 
 // What an iteration's maps take once built, with the light pass's per-photon arrays.
 double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
   return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
-                maps.photons.size() * (sizeof(Spectrum) + 1) +
+                maps.photons.size() * (2 * sizeof(Spectrum) + 1) +
                 lp.photon_materials.capacity() * sizeof(Material));
 }
 
@@ -156,8 +156,9 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
-    accumulate_iteration(maps, light_result.flux, light_result.emitted, eye, wm.wl,
-                         ls.film.max_component_value, film, &estimate_sum, &estimate_count);
+    accumulate_iteration(maps, light_result.flux, light_result.flux_inner, light_result.emitted,
+                         eye, wm.wl, ls.film.max_component_value, film, &estimate_sum,
+                         &estimate_count);
     if (!guide.empty()) {
       guide.update();
       tot.guide_moved = guide.moved();

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "base/error.h"
 #include "photons/density.h"
 
 namespace bpm {
@@ -41,7 +42,8 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, hero_only);
-    out[owner[bp.pixel]].push_back({g, value});
+    const bool inner = 2 * length_squared(sp.p - bp.p) < bp.radius * bp.radius;
+    out[owner[bp.pixel]].push_back({g | (inner ? PhotonEntry::kInnerBit : 0u), value});
     ++counters.entries;
     if (prm.pixel_weight)
       score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
@@ -152,13 +154,15 @@ BatchResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
 
 // Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
 void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* flux,
-                 std::vector<uint8_t>* hit) {
+                 std::vector<Spectrum>* flux_inner, std::vector<uint8_t>* hit) {
   tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
     for (int slot = r.begin(); slot < r.end(); ++slot)
       for (const auto& by_slot : buf.chunks)
         for (const PhotonEntry& e : by_slot[size_t(slot)]) {
-          (*flux)[e.backward_photon] += e.value;
-          (*hit)[e.backward_photon] = 1;
+          const uint32_t g = e.backward_photon();
+          (*flux)[g] += e.value;
+          if (e.inner()) (*flux_inner)[g] += e.value;
+          (*hit)[g] = 1;
         }
   });
 }
@@ -171,8 +175,10 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
                                LightPassBuffers* buf, EmissionGuide* guide) {
   const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
+  BPM_CHECK(n_bp < PhotonEntry::kInnerBit);  // the memory budget refuses far fewer
   LightPassResult res;
   res.flux.assign(n_bp, Spectrum());
+  res.flux_inner.assign(n_bp, Spectrum());
   std::vector<uint8_t> hit(n_bp, 0);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
@@ -197,7 +203,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
 
     t = std::chrono::steady_clock::now();
-    apply_batch(*buf, masks.slots(), &res.flux, &hit);
+    apply_batch(*buf, masks.slots(), &res.flux, &res.flux_inner, &hit);
     if (guide && prm.pixel_weight)
       for (const std::vector<CellScore>& s : buf->scores) guide->learn(s);
     res.apply_s += seconds_since(t);

@@ -22,8 +22,13 @@
 namespace bpm {
 
 struct PhotonEntry {
-  uint32_t backward_photon;  // index into BackwardMaps::photons
-  Spectrum value;            // flux * f * |cos_s| / |cos_g|, before 1 / (pi r^2 N)
+  // Index into BackwardMaps::photons, with kInnerBit set when the photon lies within r / sqrt 2 of
+  // the backward photon (the inner half of its disc, for the bias estimate: film.h, add_bias).
+  uint32_t key;
+  Spectrum value;  // flux * f * |cos_s| / |cos_g|, before 1 / (pi r^2 N)
+  static constexpr uint32_t kInnerBit = 1u << 31;
+  uint32_t backward_photon() const { return key & ~kInnerBit; }
+  bool inner() const { return key & kInnerBit; }
 };
 
 struct LightPassParams {
@@ -64,9 +69,10 @@ struct LightPassBuffers {
 };
 
 struct LightPassResult {
-  std::vector<Spectrum> flux;  // per backward photon: the sum of its entries' values
-  uint64_t emitted = 0;        // photons emitted, N of eq. (2)
-  bool cut = false;            // a stop request ended the pass before all its photons
+  std::vector<Spectrum> flux;        // per backward photon: the sum of its entries' values
+  std::vector<Spectrum> flux_inner;  // the same over the entries of its inner half (inner())
+  uint64_t emitted = 0;              // photons emitted, N of eq. (2)
+  bool cut = false;                  // a stop request ended the pass before all its photons
   int batches = 0;
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;

@@ -72,6 +72,68 @@ double Film::delta_rgb(const std::vector<float>& r) const {
 
 double Film::relative_error() const { return delta_rgb(rms_rgb()); }
 
+bool Film::has_bias() const {
+  for (const Pixel& p : pixels_)
+    if (p.bias_passes > 0) return true;
+  return false;
+}
+
+std::vector<float> Film::bias_rgb() const {
+  std::vector<float> out(pixels_.size() * 3, 0.0f);
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    if (p.bias_passes == 0) continue;
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = float(p.sum_b[c] / p.bias_passes);
+  }
+  return out;
+}
+
+std::vector<float> Film::bias_standard_error_rgb() const {
+  std::vector<float> out(pixels_.size() * 3, 0.0f);
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + c] = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
+  }
+  return out;
+}
+
+std::vector<float> Film::total_rms_rgb() const {
+  std::vector<float> out = rms_rgb();
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    if (p.bias_passes == 0) continue;
+    for (int c = 0; c < 3; ++c) {
+      double b = p.sum_b[c] / p.bias_passes;
+      double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
+      double rms = out[3 * i + c];
+      out[3 * i + c] = float(std::sqrt(rms * rms + std::fmax(0.0, b * b - se * se)));
+    }
+  }
+  return out;
+}
+
+double Film::relative_error_bias() const {
+  double num = 0, den = 0;
+  for (const Pixel& p : pixels_) {
+    if (p.passes == 0) continue;
+    for (int c = 0; c < 3; ++c) {
+      double mean = p.sum_e[c] / p.passes;
+      den += mean * mean;
+      if (p.bias_passes == 0) continue;
+      double b = p.sum_b[c] / p.bias_passes;
+      double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
+      num += b * b - se * se;
+    }
+  }
+  return den > 0 && num > 0 ? std::sqrt(num / den) : 0;
+}
+
+double Film::relative_error_total() const {
+  double noise = relative_error(), bias = relative_error_bias();
+  return std::sqrt(noise * noise + bias * bias);
+}
+
 double Film::relative_error_luminance() const {
   std::vector<float> r = rms();
   double num = 0, den = 0;

@@ -59,6 +59,17 @@ class Film {
     p.sum_w += weight;
     p.pass_w += weight;
   }
+  // The photon methods' estimate of this pass's bias in the pixel (film colour, the same units as
+  // its estimate): 2 (L(r) - L(r / sqrt 2)) from the photons gathered over the radius r and over
+  // the inner half of its area (bias.h). Called at most once per pass, before end_pass.
+  void add_bias(int x, int y, const Rgb& b) {
+    Pixel& p = pixels_[size_t(y) * width_ + x];
+    for (int c = 0; c < 3; ++c) {
+      p.sum_b[c] += b[c];
+      p.sum_b2[c] += double(b[c]) * b[c];
+    }
+    ++p.bias_passes;
+  }
   // Counts a sample of the pixel that was not recordable (and was recorded as black).
   void drop_sample(int x, int y) { ++pixels_[size_t(y) * width_ + x].dropped; }
   uint64_t dropped_samples() const;
@@ -96,6 +107,20 @@ class Film {
   // of the luminance alone.
   double relative_error() const;
   double relative_error_luminance() const;
+  // The bias estimate (add_bias): per pixel its mean over the passes, R G B (zero without one);
+  // and delta of it, sqrt(sum bias^2 / sum L^2) over pixels and channels, where each pixel's
+  // bias^2 is estimated without the noise of its estimate (mean^2 minus its standard error^2,
+  // summed over the image before the root, never below zero).
+  bool has_bias() const;
+  std::vector<float> bias_rgb() const;
+  std::vector<float> bias_standard_error_rgb() const;  // of bias_rgb(), eq. (5) over its passes
+  // Per pixel and channel the total error, sqrt(RMS^2 + bias^2) with bias^2 estimated as above
+  // (its noise taken out, never below zero); rms_rgb() without a bias estimate.
+  std::vector<float> total_rms_rgb() const;
+  double relative_error_bias() const;
+  // The total error: sqrt(delta^2 + delta_bias^2), noise and bias together (what --accuracy
+  // bounds); delta alone for an integrator without a bias estimate.
+  double relative_error_total() const;
   std::vector<float> pass_counts() const;
   // Per pixel, the passes whose estimate was not black: a pixel without any has no error estimate
   // yet (its RMS is zero because nothing was found, not because it converged).
@@ -119,8 +144,10 @@ class Film {
     double sum_e[3] = {0, 0, 0}, sum_e2[3] = {0, 0, 0};  // per-pass estimates, per channel
     double sum_y = 0, sum_y2 = 0;                        // and of their luminance
     int passes = 0;
-    int lit_passes = 0;  // passes whose estimate was not black
-    int dropped = 0;     // samples not recordable (drop_sample)
+    int lit_passes = 0;                                  // passes whose estimate was not black
+    int dropped = 0;                                     // samples not recordable (drop_sample)
+    double sum_b[3] = {0, 0, 0}, sum_b2[3] = {0, 0, 0};  // per-pass bias estimates (add_bias)
+    int bias_passes = 0;
   };
   int width_, height_;
   std::vector<Pixel> pixels_;

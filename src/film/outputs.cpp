@@ -18,7 +18,7 @@ OutputPaths output_paths(const std::string& exr) {
 
 Image error_false_colour(const Film& film) {
   Image img = film.image();
-  std::vector<float> rms = film.rms_rgb();
+  std::vector<float> rms = film.total_rms_rgb();
   Image out;
   out.width = img.width;
   out.height = img.height;
@@ -69,6 +69,14 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   std::vector<float> rgb = film.rms_rgb();
   for (int c = 0; c < 3; ++c) add(std::string("rms.") + "RGB"[c], channel(rgb, c, imaging_ratio));
   add("passes", passes);
+  if (film.has_bias()) {
+    // The photon methods' bias estimate (signed) and the total error, noise and bias together.
+    std::vector<float> bias = film.bias_rgb(), total = film.total_rms_rgb();
+    for (int c = 0; c < 3; ++c)
+      add(std::string("bias.") + "RGB"[c], channel(bias, c, imaging_ratio));
+    for (int c = 0; c < 3; ++c)
+      add(std::string("total_error.") + "RGB"[c], channel(total, c, imaging_ratio));
+  }
   if (film.m_images() > 0) {
     add("rms_m_images", scaled(film.rms_m_images(), imaging_ratio));
     std::vector<float> m_rgb = film.rms_m_images_rgb();

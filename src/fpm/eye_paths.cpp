@@ -11,10 +11,14 @@ namespace bpm {
 namespace {
 
 // Radiance reflected at v toward wo from the map's photons of the accepted classes, eq. (2):
-// sum f dPhi / (pi r^2 N). With knn > 0 the radius is the distance to the knn-th nearest
-// photon within `radius` (Jensen's estimate), else `radius`.
+// sum f dPhi / (pi r^2 N), and the estimate of its bias, 2 (L(r) - L(r / sqrt 2)). With knn > 0
+// the radius is the distance to the knn-th nearest photon within `radius` (Jensen's estimate),
+// else `radius`.
+struct Estimate {
+  Spectrum L, bias;
+};
 template <class Accept>
-Spectrum estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only, float radius,
+Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only, float radius,
                   int eye_depth, const FpmEyeParams& prm, Accept&& accept, FpmEyeCounters& c) {
   ++c.lookups;
   const SurfacePoint& sp = v.sp;
@@ -33,15 +37,18 @@ Spectrum estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
       r = std::sqrt(d2[size_t(prm.fpm->knn - 1)]) * 1.0001f;
     }
   }
-  Spectrum sum;
+  Spectrum sum, inner;
   map.tree.query_within(sp.p, r, [&](uint32_t i) {
     const ForwardPhoton& ph = map.photons[i];
     if (!usable(ph)) return;
     ++c.photons_used;
-    sum += photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux) *
-           hero_join_factor(eye_hero_only, ph.hero_only);
+    const Spectrum value = photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux) *
+                           hero_join_factor(eye_hero_only, ph.hero_only);
+    sum += value;
+    if (2 * length_squared(ph.p - sp.p) < r * r) inner += value;
   });
-  return sum * float(1.0 / (kPi * double(r) * r * prm.emitted));
+  const float norm = float(1.0 / (kPi * double(r) * r * prm.emitted));
+  return {sum * norm, (sum - inner * 2.0f) * (2 * norm)};
 }
 
 bool any_class(PhotonClass) { return true; }
@@ -50,11 +57,11 @@ bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
 
 }  // namespace
 
-Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                          const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c) {
+FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
+                                const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c) {
   const Wavelengths& wl = prm.materials->wl;
   PathState s{ray};
-  Spectrum L;
+  Spectrum L, bias;
   int depth = 0;
   // Between x1 and x2 on a final-gather ray emission is not counted: next-event estimation at x1
   // has counted direct light there.
@@ -70,21 +77,25 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
     const EyeVertexChoice choice = choose_eye_vertex(v, rng, s);
     const bool is_diffuse = choice.gather;
+    auto gather = [&](const PhotonMap& map, float radius, auto accept) {
+      const Estimate e = estimate(map, v, s.hero_only, radius, depth, prm, accept, c);
+      L += s.beta * e.L;
+      bias += s.beta * e.bias;
+    };
     if (is_diffuse) {
       float r1 = s.length * prm.radius_per_length1;
       if (gathering) {
         // x2: everything the global map holds, direct photons included.
-        L += s.beta * estimate(maps.global, v, s.hero_only, r1, depth, prm, any_class, c);
+        gather(maps.global, r1, any_class);
         break;
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
                                         v.wo_local, false, wl, rng, c.rays, choice.part);
-      L += s.beta * estimate(maps.caustic, v, s.hero_only, s.length * prm.radius_per_length0, depth,
-                             prm, caustic_class, c);
+      gather(maps.caustic, s.length * prm.radius_per_length0, caustic_class);
       if (!prm.fpm->final_gather) {
-        L += s.beta * estimate(maps.global, v, s.hero_only, r1, depth, prm, indirect_class, c);
+        gather(maps.global, r1, indirect_class);
         break;
       }
       gathering = true;
@@ -109,7 +120,7 @@ Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++c.rays.bounce_rays;
   }
-  return L;
+  return {L, bias};
 }
 
 }  // namespace bpm

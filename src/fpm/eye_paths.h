@@ -29,8 +29,13 @@ struct FpmEyeCounters {
   }
 };
 
-// Radiance arriving along -ray.d at the camera.
-Spectrum fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                          const FpmEyeParams& params, Ray ray, Rng& rng, FpmEyeCounters& counters);
+// Radiance arriving along -ray.d at the camera, and the estimate of its bias: the photon
+// estimates' 2 (L(r) - L(r / sqrt 2)), as bpm's (film.h, add_bias).
+struct FpmEyeRadiance {
+  Spectrum L, bias;
+};
+FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
+                                const FpmEyeParams& params, Ray ray, Rng& rng,
+                                FpmEyeCounters& counters);
 
 }  // namespace bpm

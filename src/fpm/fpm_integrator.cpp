@@ -135,8 +135,12 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                     double(emitted)};
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(it, pixel);
-      Spectrum L = fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local());
-      record_pass(film, pixel, L, wm.wl, cs.filter_weight, ls.film.max_component_value);
+      const FpmEyeRadiance r =
+          fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local());
+      if (r.bias.is_finite())
+        film->add_bias(int(pixel % uint32_t(film->width())), int(pixel / uint32_t(film->width())),
+                       spectrum_to_rgb(r.bias, wm.wl));
+      record_pass(film, pixel, r.L, wm.wl, cs.filter_weight, ls.film.max_component_value);
     });
     tot.eye_s += since(t);
 

@@ -94,7 +94,8 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
   // Each of these reads the whole film: the accuracy budget needs delta after every pass, the rest
   // only now and then (sampling probabilities every pass at first, then every fourth).
   bool adapt = opt_.adaptive && passes >= kWarmupPasses && (passes < 16 || passes % 4 == 0);
-  if (opt_.accuracy > 0 || print) delta_ = film_.relative_error();
+  // The total error: noise, and for the photon methods their bias estimate as well.
+  if (opt_.accuracy > 0 || print) delta_ = film_.relative_error_total();
   if (adapt) update_probabilities();
   if (opt_.checkpoint && opt_.write_every_s > 0 && t - last_checkpoint_ >= opt_.write_every_s) {
     opt_.checkpoint(passes);
@@ -113,8 +114,11 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
     std::snprintf(buf, sizeof buf, "  %.0f s to delta %.3g", more * t / passes, opt_.accuracy);
     eta = buf;
   }
-  std::fprintf(stderr, "\rbpm: %s %d%s  %.1f s  delta %.4f  %.2f Mrays/s%s%s   ", unit_, passes,
-               budget, t, delta_, t > 0 ? double(rays) / t * 1e-6 : 0.0, extra.c_str(),
+  char bias[32] = "";
+  if (film_.has_bias())
+    std::snprintf(bias, sizeof bias, " (bias %.4f)", film_.relative_error_bias());
+  std::fprintf(stderr, "\rbpm: %s %d%s  %.1f s  delta %.4f%s  %.2f Mrays/s%s%s   ", unit_, passes,
+               budget, t, delta_, bias, t > 0 ? double(rays) / t * 1e-6 : 0.0, extra.c_str(),
                eta.c_str());
   std::fflush(stderr);
 }
