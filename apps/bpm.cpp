@@ -228,6 +228,7 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
   rec["peak_memory_bytes"] = uint64_t(ru.ru_maxrss) * 1024;
   rec["outputs"] = {
       {"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
+  if (film.has_bias()) rec["outputs"]["bias_png"] = paths.bias_png;
   rec["stages_s"] = {{"parse", t_parse},
                      {"build", t_build},
                      {"render", st.render_seconds},

@@ -179,8 +179,15 @@ TEST_F(Cli, BpmWritesItsStatistics) {
   EXPECT_GT(b["eye"]["backward_photons"].get<uint64_t>(), 0u);
   EXPECT_EQ(b["light"]["photons"].get<uint64_t>(), 4000u);
   EXPECT_GT(rec["rays"]["light"].get<uint64_t>(), 0u);
-  for (const char* f : {"out.exr", "out.png", "out.error.png"})
+  for (const char* f : {"out.exr", "out.png", "out.error.png", "out.bias.png"})
     EXPECT_TRUE(fs::exists(dir_ / f)) << f;
+  // The bias estimate beside the noise: the total is at least the noise, and what --accuracy
+  // bounds.
+  const auto& res = rec["result"];
+  EXPECT_GE(res["relative_error_delta_bias"].get<double>(), 0.0);
+  EXPECT_GE(res["relative_error_delta_total"].get<double>(),
+            res["relative_error_delta"].get<double>());
+  EXPECT_EQ(rec["outputs"]["bias_png"], (dir_ / "out.bias.png").string());
 }
 
 TEST_F(Cli, FpmWritesItsStatistics) {

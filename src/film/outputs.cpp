@@ -13,18 +13,18 @@ OutputPaths output_paths(const std::string& exr) {
   if (exr.size() <= ext.size() || exr.compare(exr.size() - ext.size(), ext.size(), ext) != 0)
     throw Error("output file \"" + exr + "\" must end in .exr");
   std::string stem = exr.substr(0, exr.size() - ext.size());
-  return {exr, stem + ".png", stem + ".error.png", stem + ".json"};
+  return {exr, stem + ".png", stem + ".error.png", stem + ".json", stem + ".bias.png"};
 }
 
-Image error_false_colour(const Film& film) {
+// Per pixel, an error (R G B) relative to the pixel's value over the three channels (as eq. 4 per
+// pixel), 0 to 10% from blue through green to red.
+Image relative_false_colour(const Film& film, const std::vector<float>& rms) {
   Image img = film.image();
-  std::vector<float> rms = film.total_rms_rgb();
   Image out;
   out.width = img.width;
   out.height = img.height;
   out.rgb.resize(img.rgb.size());
   for (size_t i = 0; i < img.rgb.size() / 3; ++i) {
-    // The pixel's error relative to its value, over the three channels (as eq. 4 per pixel).
     double e2 = 0, v2 = 0;
     for (int c = 0; c < 3; ++c) {
       e2 += double(rms[3 * i + c]) * rms[3 * i + c];
@@ -87,7 +87,14 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   for (size_t k = 0; k < names.size(); ++k) extra.push_back({names[k], &values[k]});
   write_exr(paths.exr, img, extra);
   write_png(paths.png, img);
-  write_png_display(paths.error_png, error_false_colour(film));
+  write_png_display(paths.error_png, relative_false_colour(film, film.total_rms_rgb()));
+  if (film.has_bias() && !paths.bias_png.empty()) {
+    // The bias alone, its noise taken out (what the total error holds of it).
+    std::vector<float> bias = film.total_rms_rgb(), rms = film.rms_rgb();
+    for (size_t k = 0; k < bias.size(); ++k)
+      bias[k] = std::sqrt(std::fmax(0.0f, bias[k] * bias[k] - rms[k] * rms[k]));
+    write_png_display(paths.bias_png, relative_false_colour(film, bias));
+  }
 }
 
 }  // namespace bpm

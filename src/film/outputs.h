@@ -9,16 +9,20 @@ namespace bpm {
 
 struct OutputPaths {
   std::string exr, png, error_png, json;
+  std::string bias_png;  // written only for a film with a bias estimate (the photon methods)
 };
 
-// OUT.exr -> OUT.png, OUT.error.png, OUT.json. Throws Error when the name does not end in .exr.
+// OUT.exr -> OUT.png, OUT.error.png, OUT.json, OUT.bias.png. Throws Error when the name does not
+// end in .exr.
 OutputPaths output_paths(const std::string& exr_path);
 
-// Writes the EXR and both PNGs, each atomically. The caller writes the JSON record last, so that
-// its presence means the set is complete.
+// Writes the EXR and the PNGs (the image, its total error, and with a bias estimate its bias),
+// each atomically. The caller writes the JSON record last, so that its presence means the set is
+// complete.
 void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio);
 
-// Relative error (RMS / mean) per pixel mapped through a blue-to-red ramp; 10% and more is red.
-Image error_false_colour(const Film& film);
+// An error per pixel and channel (R G B), relative to the pixel's value, mapped through a
+// blue-to-red ramp; 10% and more is red.
+Image relative_false_colour(const Film& film, const std::vector<float>& error_rgb);
 
 }  // namespace bpm
