@@ -45,6 +45,7 @@ struct RenderArgs {
   float k0 = -1, k1 = -1, alpha = -1;
   std::string radius_policy, tree;
   bool no_guide = false;
+  bool debias = false;
   int emission_samples = 0;
   float radius = -1;
   int photons = 0;
@@ -154,6 +155,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
     if (a.photons > 0) p->photons_per_iteration = a.photons;
   }
   if (a.final_gather) opt.fpm.final_gather = true;
+  if (a.debias) opt.bpm.debias = opt.fpm.debias = true;
   if (a.knn >= 0) opt.fpm.knn = a.knn;
 
   opt.accuracy = a.accuracy;
@@ -425,6 +427,11 @@ int main(int argc, char** argv) {
           "--no-guide", ra.no_guide,
           "Emit photons in proportion to light power only, without learning where the camera "
           "sees them (file: bool guideemission false)")
+      ->group(g);
+  render
+      ->add_flag("--debias", ra.debias,
+                 "bpm and fpm: record 2 L(r/sqrt 2) - L(r), the image less its bias estimate "
+                 "(the leading r^2 term of the radius bias); noisier, and without a bias estimate")
       ->group(g);
   render
       ->add_option("--radius", ra.radius,

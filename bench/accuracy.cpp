@@ -8,7 +8,8 @@
 // ref^2), the sums running over pixels and the three channels (the colour delta the renderer
 // reports); the same in luminance alone for the last column. The total error is measured against a
 // path-traced reference with its own seed; the bias part is what the total has beyond the noise of
-// the render and of the reference.
+// the render and of the reference. (3) For bpm and fpm at accuracy targets: the total error they
+// report (noise and bias estimate) beside the error measured against the reference.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -65,18 +66,36 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--target"))
       target = std::atof(next().c_str());
   }
-  std::printf("== predicted against measured error, %dx%d, %d passes, reference: path %d spp ==\n",
-              w, h, passes, ref_passes);
-  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5",
-              "delta M=4", "noise", "ratio", "total", "bias", "ratio lum");
-  for (const char* name : {"cornell-box", "caustic-sphere"}) {
+  std::printf(
+      "== predicted against measured error, %dx%d, %d passes, reference: path %d spp (caustic "
+      "sphere: bpm %d iterations) ==\n",
+      w, h, passes, ref_passes, 4 * ref_passes);
+  std::printf("%-16s %-5s %10s %10s %10s %10s %10s %10s %10s %10s\n", "scene", "", "delta eq5",
+              "delta M=4", "noise", "ratio", "total", "bias", "bias est", "ratio lum");
+  struct Reference {
+    std::string name;
+    Image img;
+    double delta;
+  };
+  std::vector<Reference> refs;
+  auto load = [&](const std::string& name) {
     LoadedScene ls =
         flatten_scene(parse_scene_file(std::string(BPM_SOURCE_DIR) + "/scenes/" + name + ".pbrt"));
     ls.film.width = w;
     ls.film.height = h;
-    Rendered ref = run(ls, "path", ref_passes, 0x5eed);
+    return ls;
+  };
+  for (const char* name : {"cornell-box", "caustic-sphere"}) {
+    LoadedScene ls = load(name);
+    // path cannot converge the caustic (a small light seen through glass): there the reference is
+    // bpm with 4x the reference passes as iterations. Its noise is taken out below; its radius
+    // bias is not (progressive radii: r^2 falls as iterations^(-1/3), so it keeps about 0.55 of
+    // the bias of a render at 2000 iterations).
+    const bool caustic = std::string(name) == "caustic-sphere";
+    Rendered ref = run(ls, caustic ? "bpm" : "path", caustic ? 4 * ref_passes : ref_passes, 0x5eed);
     const Image ref_img = ref.film.image();
     double ref_delta = ref.film.relative_error();
+    refs.push_back({name, ref_img, ref_delta});
     // Noise between the seeds and error against the reference, relative to the reference.
     auto measure = [&](const Image& ia, const Image& ib, bool colour, double* noise,
                        double* total) {
@@ -101,8 +120,9 @@ int main(int argc, char** argv) {
       double bias =
           std::sqrt(std::fmax(0.0, total * total - noise * noise - ref_delta * ref_delta));
       double pred = a.film.relative_error();
-      std::printf("%-16s %-5s %10.4f %10.4f %10.4f %10.2f %10.4f %10.4f %10.2f\n", name, integrator,
-                  pred, a.film.relative_error_m_images(), noise, pred / noise, total, bias,
+      std::printf("%-16s %-5s %10.4f %10.4f %10.4f %10.2f %10.4f %10.4f %10.4f %10.2f\n", name,
+                  integrator, pred, a.film.relative_error_m_images(), noise, pred / noise, total,
+                  bias, a.film.relative_error_bias(),
                   a.film.relative_error_luminance() / noise_lum);
     }
   }
@@ -110,7 +130,31 @@ int main(int argc, char** argv) {
       "(ratio: predicted delta over measured noise; total: against the reference; bias: total "
       "beyond\n"
       " the noise of the render and of the reference, %s)\n\n",
-      "whose own delta is subtracted");
+      "whose own delta is subtracted; bias est: the photon methods' own estimate)");
+
+  std::printf("== reported total error against the measured one at accuracy targets ==\n");
+  std::printf("%-16s %-5s %7s %8s %9s %9s %9s %9s %7s\n", "scene", "", "target", "passes", "noise",
+              "bias est", "total", "measured", "ratio");
+  for (const Reference& ref : refs)
+    for (const char* integrator : {"bpm", "fpm"})
+      for (double accuracy : {0.05, 0.02}) {
+        const LoadedScene ls = load(ref.name);
+        Rendered r = run(ls, integrator, 20000, 5, accuracy);
+        const Image img = r.film.image();
+        double d2 = 0, r2 = 0;
+        for (size_t i = 0; i < img.rgb.size(); ++i) {
+          d2 += (img.rgb[i] - ref.img.rgb[i]) * (img.rgb[i] - ref.img.rgb[i]);
+          r2 += double(ref.img.rgb[i]) * ref.img.rgb[i];
+        }
+        // The reference's own noise is taken out.
+        const double measured = std::sqrt(std::fmax(0.0, d2 / r2 - ref.delta * ref.delta));
+        const double total = r.film.relative_error_total();
+        std::printf("%-16s %-5s %7.3f %8d %9.4f %9.4f %9.4f %9.4f %7.2f\n", ref.name.c_str(),
+                    integrator, accuracy, r.stats.passes, r.film.relative_error(),
+                    r.film.relative_error_bias(), total, measured,
+                    measured > 0 ? total / measured : 0.0);
+      }
+  std::printf("(ratio: reported total over measured; the issue asks for 0.67 to 1.5)\n\n");
 
   std::printf("== rays to reach delta %.3g on the caustic scene, %dx%d ==\n", target, w, h);
   LoadedScene ls =

@@ -944,7 +944,7 @@ TEST(Bpm, BiasEstimateMatchesTheAnalyticCurvature) {
   const std::vector<float> bias = bpm_run.film.bias_rgb(),
                            bias_se = bpm_run.film.bias_standard_error_rgb(),
                            rms = bpm_run.film.rms_rgb(), ref_rms = ref.film.rms_rgb();
-  double sum_b = 0, sum_se = 0, sum_img = 0, sum_ref = 0, sum_rms = 0;
+  double sum_b = 0, sum_se = 0, sum_img = 0, sum_ref = 0, sum_rms = 0, sum_ref_var = 0;
   int n = 0;
   for (int y = 4; y < 12; ++y)
     for (int px = 4; px < 12; ++px) {
@@ -953,18 +953,40 @@ TEST(Bpm, BiasEstimateMatchesTheAnalyticCurvature) {
       sum_se += bias_se[i];
       sum_img += img.rgb[i];
       sum_ref += truth.rgb[i];
-      sum_rms += rms[i] + ref_rms[i];
+      sum_rms += rms[i];
+      sum_ref_var += double(ref_rms[i]) * ref_rms[i];
       ++n;
     }
+  // bpm's pixels share photons: its patch mean's error is at most the mean of its pixels' errors.
+  // path's pixels are independent.
+  auto patch_sigma = [&](double bpm_rms_sum) {
+    return std::sqrt(std::pow(bpm_rms_sum / n, 2) + sum_ref_var / (double(n) * n));
+  };
   const double caustic = sum_ref / n / 9;
   const double true_bias = (-0.75 * x * x + 0.625 * x * x * x * x) * caustic,
                expected_estimate = (-0.75 * x * x + 0.469 * x * x * x * x) * caustic;
-  // Pixels share photons: the patch's error is at most the mean of its pixels' errors.
-  EXPECT_NEAR(sum_img / n - sum_ref / n - caustic, true_bias, 4 * sum_rms / n)
+  EXPECT_NEAR(sum_img / n - sum_ref / n - caustic, true_bias, 4 * patch_sigma(sum_rms))
       << "the render's own bias (caustic " << caustic << ")";
   EXPECT_NEAR(sum_b / n, expected_estimate, 4 * sum_se / n + 0.02 * std::fabs(expected_estimate))
       << "the bias estimate (caustic " << caustic << ", true bias " << true_bias << ")";
   EXPECT_LT(4 * sum_se / n, 0.5 * std::fabs(expected_estimate)) << "too noisy to tell";
+
+  // --debias records the image less its bias estimate: what is left of the bias is of order
+  // (r/H)^4, 0.156 (r/H)^4 of the caustic here.
+  s.debias = true;
+  RenderRun debiased = render_with(ls, "bpm", 200, 0, 3, s);
+  EXPECT_FALSE(debiased.film.has_bias());
+  const Image dimg = debiased.film.image();
+  const std::vector<float> drms = debiased.film.rms_rgb();
+  double sum_d = 0, sum_drms = 0;
+  for (int y = 4; y < 12; ++y)
+    for (int px = 4; px < 12; ++px) {
+      const size_t i = 3 * (size_t(y) * 16 + px) + 1;
+      sum_d += dimg.rgb[i] - truth.rgb[i];
+      sum_drms += drms[i];
+    }
+  EXPECT_NEAR(sum_d / n - caustic, 0.156 * x * x * x * x * caustic, 4 * patch_sigma(sum_drms));
+  EXPECT_LT(4 * patch_sigma(sum_drms), std::fabs(true_bias)) << "too noisy to tell it is gone";
 }
 
 // A memory budget: too small for the film and one iteration's backward photons, the render stops

@@ -10,7 +10,7 @@ namespace bpm {
 void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
                           const std::vector<Spectrum>& flux_inner, uint64_t emitted,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
-                          Film* film, std::vector<double>* estimates,
+                          bool debias, Film* film, std::vector<double>* estimates,
                           std::vector<uint32_t>* counts) {
   const int w = film->width(), h = film->height();
   std::vector<Spectrum> photon_L(size_t(w) * size_t(h)), bias(size_t(w) * size_t(h));
@@ -30,9 +30,12 @@ void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>&
       for (int x = 0; x < w; ++x) {
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
-        const Spectrum L = eye.radiance[p] + photon_L[p];
-        if (bias[p].is_finite()) film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
-        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value);
+        Spectrum L = eye.radiance[p] + photon_L[p];
+        if (debias)
+          L -= bias[p];
+        else if (bias[p].is_finite())
+          film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
+        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, debias);
         if (estimates && L.is_finite()) {
           (*estimates)[p] += L.average();
           ++(*counts)[p];

@@ -19,7 +19,7 @@ namespace bpm {
 void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
                           const std::vector<Spectrum>& flux_inner, uint64_t emitted,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
-                          Film* film, std::vector<double>* estimates = nullptr,
+                          bool debias, Film* film, std::vector<double>* estimates = nullptr,
                           std::vector<uint32_t>* counts = nullptr);
 
 }  // namespace bpm

@@ -38,7 +38,8 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
         {"photons_per_iteration", s.photons_per_iteration},
         {"final_gather", s.final_gather},
         {"knn", s.knn},
-        {"normal_cos", s.normal_cos}}},
+        {"normal_cos", s.normal_cos},
+        {"debias", s.debias}}},
       {"light",
        {{"photons", lt.photons},
         {"light_rays", lt.light_rays},
@@ -137,6 +138,11 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
       CameraSample cs = camera.sample(it, pixel);
       const FpmEyeRadiance r =
           fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local());
+      if (s.debias) {
+        record_pass(film, pixel, r.L - r.bias, wm.wl, cs.filter_weight, ls.film.max_component_value,
+                    true);
+        return;
+      }
       if (r.bias.is_finite())
         film->add_bias(int(pixel % uint32_t(film->width())), int(pixel / uint32_t(film->width())),
                        spectrum_to_rgb(r.bias, wm.wl));

@@ -73,11 +73,18 @@ class CameraSampler {
 };
 
 // Records a pixel's estimate of this pass: the radiance at the pass's wavelengths as film colour.
+// A debiased estimate (PhotonSettings::debias) may be negative where the noise is: it is recorded
+// as it is (still not when it is not finite).
 inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wavelengths& wl,
-                        float filter_weight, float max_component_value) {
+                        float filter_weight, float max_component_value,
+                        bool may_be_negative = false) {
   int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
-  if (!recordable(L)) film->drop_sample(x, y);
-  film->add_sample(x, y, film_rgb(L, wl, max_component_value), filter_weight);
+  if (may_be_negative && L.is_finite()) {
+    film->add_sample(x, y, spectrum_to_rgb(L, wl), filter_weight);
+  } else {
+    if (!recordable(L)) film->drop_sample(x, y);
+    film->add_sample(x, y, film_rgb(L, wl, max_component_value), filter_weight);
+  }
   film->end_pass(x, y);
 }
 

@@ -21,6 +21,9 @@ struct PhotonSettings {
   // Photons count only where the normals of the photon's surface and of the gathering point agree
   // to within this cosine.
   float normal_cos = 0.5f;
+  // Record 2 L(r / sqrt 2) - L(r) for the photon estimates: the image less its bias estimate (the
+  // leading r^2 term; film.h, add_bias), noisier, and without a bias estimate of its own.
+  bool debias = false;
 };
 
 inline const char* to_string(RadiusPolicy p) {
