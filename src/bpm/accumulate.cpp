@@ -33,7 +33,7 @@ void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>&
         Spectrum L = eye.radiance[p] + photon_L[p];
         if (debias)
           L -= bias[p];
-        else if (bias[p].is_finite())
+        else if (bias[p].is_finite() && eye.filter_weight[p] != 0 && recordable(L))
           film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, debias);
         if (estimates && L.is_finite()) {

@@ -136,7 +136,15 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
     if (opt.memory_budget > 0) {
       const double used = fixed_bytes + maps_bytes(maps, lp);
-      check_memory("bpm's backward photons and trees at " + size, used, opt.memory_budget, advice);
+      // Over the budget (the estimate before the first iteration assumed typical trees and no
+      // textured materials): an error in the first iteration, which has nothing to keep; later,
+      // the render ends with the iterations so far and says why.
+      if (used > double(opt.memory_budget)) {
+        if (pass == 0)
+          check_memory("bpm's backward photons and trees at " + size, used, opt.memory_budget,
+                       advice);
+        return PassResult{false, 0, "", "memory"};
+      }
       lp.entry_bytes_limit = std::max<size_t>(1, size_t(double(opt.memory_budget) - used));
     }
     tot.build_s += since(t);

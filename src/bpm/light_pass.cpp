@@ -192,6 +192,10 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     auto t = std::chrono::steady_clock::now();
     const BatchResult b =
         trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, guide, buf);
+    if (b.kept == 0) {  // stopped before the batch began: the lists hold the last one's entries
+      res.cut = true;
+      break;
+    }
     first += b.kept;
     res.emitted += b.kept;
     res.cut = b.stopped;
@@ -208,6 +212,11 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
       for (const std::vector<CellScore>& s : buf->scores) guide->learn(s);
     res.apply_s += seconds_since(t);
     if (res.cut) break;
+    // A batch the entry limit ended: its lists go back too, so that the next batch has the whole
+    // limit (kept, they would leave it room for one chunk).
+    if (b.kept < count)
+      for (auto& by_slot : buf->chunks)
+        for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
   }
   size_t n_indirect = 0, covered = 0;
   for (size_t g = 0; g < n_bp; ++g)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "base/error.h"
 #include "film/image_io.h"
@@ -88,6 +89,11 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   write_exr(paths.exr, img, extra);
   write_png(paths.png, img);
   write_png_display(paths.error_png, relative_false_colour(film, film.total_rms_rgb()));
+  if (!film.has_bias() && !paths.bias_png.empty()) {
+    // No bias estimate (path, --debias): a bias PNG of an earlier render of OUT would not match.
+    std::error_code ec;
+    std::filesystem::remove(paths.bias_png, ec);
+  }
   if (film.has_bias() && !paths.bias_png.empty()) {
     // The bias alone, its noise taken out (what the total error holds of it).
     std::vector<float> bias = film.total_rms_rgb(), rms = film.rms_rgb();

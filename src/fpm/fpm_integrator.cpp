@@ -143,7 +143,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                     true);
         return;
       }
-      if (r.bias.is_finite())
+      if (r.bias.is_finite() && cs.filter_weight != 0 && recordable(r.L))
         film->add_bias(int(pixel % uint32_t(film->width())), int(pixel / uint32_t(film->width())),
                        spectrum_to_rgb(r.bias, wm.wl));
       record_pass(film, pixel, r.L, wm.wl, cs.filter_weight, ls.film.max_component_value);

@@ -34,6 +34,8 @@ class RenderControl {
 
   // Before pass `done` (0-based): false when the render must stop; stop_reason() says why.
   bool keep_going(int done);
+  // Ends the render for a reason of the integrator's own (PassResult::stop_reason).
+  void stop(const std::string& reason) { stop_reason_ = reason; }
   // After a pass: updates the sampling probabilities, prints progress, writes a checkpoint.
   // `rays` is the total traced so far; `extra` is appended to the progress line.
   void after_pass(int done, uint64_t rays, const std::string& extra = "");

@@ -8,7 +8,10 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
   for (int p = 0; control.keep_going(p); ++p) {
     PassResult r = pass(p, control);
     if (!r.completed) {
-      control.keep_going(p + 1);  // sets the stop reason: the interrupt or the time budget
+      if (r.stop_reason.empty())
+        control.keep_going(p + 1);  // sets the stop reason: the interrupt or the time budget
+      else
+        control.stop(r.stop_reason);
       break;
     }
     stats->passes = p + 1;

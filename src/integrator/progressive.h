@@ -29,6 +29,9 @@ struct PassResult {
   bool completed = true;  // false: the pass was abandoned (interrupted) and left the film as it was
   uint64_t rays = 0;      // rays traced so far in the render, for the progress line
   std::string progress;   // appended to the progress line
+  // With completed false: why the integrator ends the render (e.g. "memory"); empty: the
+  // interrupt or the time budget did.
+  std::string stop_reason;
 };
 
 // Renders pass `pass` (0-based; random streams and radii follow pass + first_iteration) into the
