@@ -118,7 +118,7 @@ BatchResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
   }
   auto full = [&] { return prm.entry_bytes_limit && entry_bytes.load() > prm.entry_bytes_limit; };
   const int kept = run_chunks_until(
-      n_chunks, true, [&] { return stop() || full(); },
+      n_chunks, [&] { return stop() || full(); },
       [&](int c) {
         LightCounters& lc = buf->counters.local();
         std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];

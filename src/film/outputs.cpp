@@ -67,12 +67,12 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
     values.push_back(std::move(v));
   };
   add("rms", scaled(film.rms(), imaging_ratio));
-  std::vector<float> rgb = film.rms_rgb();
+  const std::vector<float> rgb = film.rms_rgb(), total = film.total_rms_rgb();
   for (int c = 0; c < 3; ++c) add(std::string("rms.") + "RGB"[c], channel(rgb, c, imaging_ratio));
   add("passes", passes);
   if (film.has_bias()) {
     // The photon methods' bias estimate (signed) and the total error, noise and bias together.
-    std::vector<float> bias = film.bias_rgb(), total = film.total_rms_rgb();
+    std::vector<float> bias = film.bias_rgb();
     for (int c = 0; c < 3; ++c)
       add(std::string("bias.") + "RGB"[c], channel(bias, c, imaging_ratio));
     for (int c = 0; c < 3; ++c)
@@ -88,7 +88,7 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   for (size_t k = 0; k < names.size(); ++k) extra.push_back({names[k], &values[k]});
   write_exr(paths.exr, img, extra);
   write_png(paths.png, img);
-  write_png_display(paths.error_png, relative_false_colour(film, film.total_rms_rgb()));
+  write_png_display(paths.error_png, relative_false_colour(film, total));
   if (!film.has_bias() && !paths.bias_png.empty()) {
     // No bias estimate (path, --debias): a bias PNG of an earlier render of OUT would not match.
     std::error_code ec;
@@ -96,9 +96,9 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   }
   if (film.has_bias() && !paths.bias_png.empty()) {
     // The bias alone, its noise taken out (what the total error holds of it).
-    std::vector<float> bias = film.total_rms_rgb(), rms = film.rms_rgb();
+    std::vector<float> bias(total.size());
     for (size_t k = 0; k < bias.size(); ++k)
-      bias[k] = std::sqrt(std::fmax(0.0f, bias[k] * bias[k] - rms[k] * rms[k]));
+      bias[k] = std::sqrt(std::fmax(0.0f, total[k] * total[k] - rgb[k] * rgb[k]));
     write_png_display(paths.bias_png, relative_false_colour(film, bias));
   }
 }

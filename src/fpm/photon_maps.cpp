@@ -25,7 +25,7 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
   const int n_chunks = int((n_photons + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   maps->chunks.resize(size_t(n_chunks));
   auto stop_now = [&] { return stop && stop(); };
-  const int kept = run_chunks_until(n_chunks, true, stop_now, [&](int c) {
+  const int kept = run_chunks_until(n_chunks, stop_now, [&](int c) {
     LightCounters& lc = counters.local();
     ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
     ch.global.clear();

@@ -95,7 +95,11 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
   // only now and then (sampling probabilities every pass at first, then every fourth).
   bool adapt = opt_.adaptive && passes >= kWarmupPasses && (passes < 16 || passes % 4 == 0);
   // The total error: noise, and for the photon methods their bias estimate as well.
-  if (opt_.accuracy > 0 || print) delta_ = film_.relative_error_total();
+  if (opt_.accuracy > 0 || print) {
+    bias_ = film_.relative_error_bias();
+    delta_ =
+        std::sqrt(std::pow(film_.relative_error(), 2) + bias_ * bias_);  // relative_error_total
+  }
   if (adapt) update_probabilities();
   if (opt_.checkpoint && opt_.write_every_s > 0 && t - last_checkpoint_ >= opt_.write_every_s) {
     opt_.checkpoint(passes);
@@ -115,8 +119,7 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
     eta = buf;
   }
   char bias[32] = "";
-  if (film_.has_bias())
-    std::snprintf(bias, sizeof bias, " (bias %.4f)", film_.relative_error_bias());
+  if (film_.has_bias()) std::snprintf(bias, sizeof bias, " (bias %.4f)", bias_);
   std::fprintf(stderr, "\rbpm: %s %d%s  %.1f s  delta %.4f%s  %.2f Mrays/s%s%s   ", unit_, passes,
                budget, t, delta_, bias, t > 0 ? double(rays) / t * 1e-6 : 0.0, extra.c_str(),
                eta.c_str());

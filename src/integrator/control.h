@@ -64,7 +64,8 @@ class RenderControl {
   const char* unit_;
   std::chrono::steady_clock::time_point t0_;
   std::string stop_reason_ = "samples";
-  double delta_ = 0;
+  double delta_ = 0;  // the total error (Film::relative_error_total)
+  double bias_ = 0;   // its bias part
   double last_progress_ = -1, last_checkpoint_ = 0;
   std::vector<float> probability_;  // empty: every pixel every pass
 };

@@ -364,62 +364,57 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2
   }
   return s;
 }
-bool bsdf_all_traced(const Material& m) {
+namespace {
+
+// Whether every lobe of m is sharp, where sharp(roughness) says it of a microfacet lobe: delta
+// lobes (bsdf_is_specular) or traced ones (bsdf_all_traced).
+template <class Sharp>
+bool all_lobes(const Material& m, Sharp&& sharp) {
   struct V {
+    Sharp& sharp;
     bool operator()(const DiffuseMaterial&) const { return false; }
-    bool operator()(const ConductorMaterial& c) const { return c.roughness.traced(); }
-    bool operator()(const DielectricMaterial& d) const {
-      return d.eta == 1 || d.roughness.traced();
-    }
+    bool operator()(const ConductorMaterial& c) const { return sharp(c.roughness); }
+    bool operator()(const DielectricMaterial& d) const { return d.eta == 1 || sharp(d.roughness); }
     bool operator()(const ThinDielectricMaterial&) const { return true; }
     bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
     bool operator()(const PhongMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return true; }
     bool operator()(const CoatedDiffuseMaterial&) const { return false; }
+    // A sharp coat over a sharp conductor; otherwise the walk has rough exits.
     bool operator()(const CoatedConductorMaterial& c) const {
-      return c.layer.roughness.traced() && c.conductor.roughness.traced();
+      return sharp(c.layer.roughness) && sharp(c.conductor.roughness);
     }
   };
-  return std::visit(V{}, m);
+  return std::visit(V{sharp}, m);
+}
+
+const CoatLayer* coat_layer(const Material& m) {
+  if (const auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) return &d->layer;
+  if (const auto* c = std::get_if<CoatedConductorMaterial>(&m)) return &c->layer;
+  return nullptr;
+}
+
+}  // namespace
+
+bool bsdf_all_traced(const Material& m) {
+  return all_lobes(m, [](const Roughness& r) { return r.traced(); });
 }
 
 float bsdf_traced_part_probability(const Material& m, Vec3 wo) {
-  const CoatLayer* layer = nullptr;
-  if (const auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) layer = &d->layer;
-  if (const auto* c = std::get_if<CoatedConductorMaterial>(&m)) layer = &c->layer;
+  const CoatLayer* layer = coat_layer(m);
   if (!layer || !layer->roughness.traced() || bsdf_all_traced(m)) return 0;
   return std::fmax(0.25f, fresnel_dielectric(std::fabs(wo.z), layer->eta));
 }
 
 bool bsdf_part_has_nondelta(const Material& m, BsdfPart part) {
   if (part == BsdfPart::kGathered) return true;
-  if (part == BsdfPart::kTraced) {
-    if (const auto* d = std::get_if<CoatedDiffuseMaterial>(&m))
-      return !d->layer.roughness.effectively_smooth();
-    if (const auto* c = std::get_if<CoatedConductorMaterial>(&m))
-      return !c->layer.roughness.effectively_smooth();
-  }
+  if (part == BsdfPart::kTraced)
+    if (const CoatLayer* layer = coat_layer(m)) return !layer->roughness.effectively_smooth();
   return !bsdf_is_specular(m);
 }
 
 bool bsdf_is_specular(const Material& m) {
-  struct V {
-    bool operator()(const DiffuseMaterial&) const { return false; }
-    bool operator()(const ConductorMaterial& c) const { return c.roughness.effectively_smooth(); }
-    bool operator()(const DielectricMaterial& d) const {
-      return d.eta == 1 || d.roughness.effectively_smooth();
-    }
-    bool operator()(const ThinDielectricMaterial&) const { return true; }
-    bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
-    bool operator()(const PhongMaterial&) const { return false; }
-    bool operator()(const InterfaceMaterial&) const { return true; }
-    bool operator()(const CoatedDiffuseMaterial&) const { return false; }
-    // A smooth coat over a mirror is all delta lobes; otherwise the walk has glossy exits.
-    bool operator()(const CoatedConductorMaterial& c) const {
-      return c.layer.roughness.effectively_smooth() && c.conductor.roughness.effectively_smooth();
-    }
-  };
-  return std::visit(V{}, m);
+  return all_lobes(m, [](const Roughness& r) { return r.effectively_smooth(); });
 }
 
 }  // namespace bpm

@@ -25,16 +25,16 @@ namespace bpm {
 constexpr int kPhotonsPerChunk = 1024;
 
 // Runs body(c) for the chunks c in [0, n) in parallel, where a stop request can cut the loop
-// short: a chunk does not start once stop() is true (chunk 0 still does when first_always), and
-// the result is the number of leading chunks that ran. The caller keeps only those: the photons
-// kept are then a prefix of the photon sequence, the same whichever thread ran which chunk, and
-// the work of any later chunk that ran is the caller's to discard.
+// short: a chunk does not start once stop() is true (chunk 0 always runs: a pass or batch keeps
+// at least one), and the result is the number of leading chunks that ran. The caller keeps only
+// those: the photons kept are then a prefix of the photon sequence, the same whichever thread ran
+// which chunk, and the work of any later chunk that ran is the caller's to discard.
 template <class Body, class Stop>
-int run_chunks_until(int n, bool first_always, const Stop& stop, const Body& body) {
+int run_chunks_until(int n, const Stop& stop, const Body& body) {
   std::vector<uint8_t> ran(size_t(n), 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, n, 1), [&](const tbb::blocked_range<int>& r) {
     for (int c = r.begin(); c < r.end(); ++c) {
-      if ((c > 0 || !first_always) && stop()) continue;
+      if (c > 0 && stop()) continue;
       body(c);
       ran[size_t(c)] = 1;
     }
