@@ -121,7 +121,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     tot.eye_s += since(t);
     // An eye pass cut short (an interrupt, or the time budget after the first iteration) leaves
     // pixels without their estimate: the iteration is dropped.
-    if (!complete) return PassResult{false, 0, ""};
+    if (!complete) return PassResult{false, 0, "", ""};
 
     // 2. Per-object sphere trees over the backward photons.
     t = Clock::now();
@@ -159,7 +159,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     // less than half its photons is dropped; the first is always kept (an image needs one).
     if (light_result.cut && pass > 0 &&
         2 * light_result.emitted < uint64_t(s.photons_per_iteration))
-      return PassResult{false, 0, ""};
+      return PassResult{false, 0, "", ""};
     tot.add_light_pass(light_result);
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.

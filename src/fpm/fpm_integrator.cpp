@@ -109,7 +109,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
         [&] { return control.stop_requested(); }, &maps);
     tot.light_s += since(t);
     // After the first iteration, an eye pass would be cut at once: the iteration is dropped.
-    if (control.cut(pass)) return PassResult{false, 0, ""};
+    if (control.cut(pass)) return PassResult{false, 0, "", ""};
     if (emitted < n_photons) ++tot.iterations_cut;
     tot.emitted += emitted;
 
