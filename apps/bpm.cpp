@@ -46,6 +46,7 @@ struct RenderArgs {
   std::string radius_policy, tree;
   bool no_guide = false;
   bool debias = false;
+  std::string bias_model;
   int emission_samples = 0;
   float radius = -1;
   int photons = 0;
@@ -153,6 +154,8 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
       p->radius_policy =
           a.radius_policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
     if (a.photons > 0) p->photons_per_iteration = a.photons;
+    if (!a.bias_model.empty())
+      p->bias_model = a.bias_model == "r2" ? BiasModel::kSquare : BiasModel::kSquareAndLinear;
   }
   if (a.final_gather) opt.fpm.final_gather = true;
   if (a.debias) opt.bpm.debias = opt.fpm.debias = true;
@@ -430,8 +433,15 @@ int main(int argc, char** argv) {
       ->group(g);
   render
       ->add_flag("--debias", ra.debias,
-                 "bpm and fpm: record 2 L(r/sqrt 2) - L(r), the image less its bias estimate "
-                 "(the leading r^2 term of the radius bias); noisier, and without a bias estimate")
+                 "bpm and fpm: record the image less its bias estimate (2 L(r/sqrt 2) - L(r) "
+                 "under --bias-model r2); noisier, and without a bias estimate of its own")
+      ->group(g);
+  render
+      ->add_option("--bias-model", ra.bias_model,
+                   "bpm and fpm: how the radius bias is estimated: r2 (two radii, the leading r^2 "
+                   "term of a smooth density; default) or r2+r (three radii, also the r term of "
+                   "edges)")
+      ->check(CLI::IsMember({"r2", "r2+r"}))
       ->group(g);
   render
       ->add_option("--radius", ra.radius,

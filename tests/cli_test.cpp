@@ -160,6 +160,21 @@ TEST_F(Cli, MemoryBudgetIsCheckedBeforeAllocating) {
   EXPECT_EQ(rec["settings"]["memory_budget_bytes"].get<uint64_t>(), uint64_t(64) << 20);
 }
 
+// --bias-model reaches both photon methods and their JSON; an unknown model is refused.
+TEST_F(Cli, BiasModelIsChosenAndRecorded) {
+  std::string scene = write("s.pbrt", kTinyScene), out = (dir_ / "out.exr").string();
+  EXPECT_NE(run("render " + scene + " --integrator bpm --bias-model r3 -o " + out).exit_code, 0);
+  EXPECT_TRUE(outputs().empty());
+  for (const char* integrator : {"bpm", "fpm"}) {
+    CliRun r = run("render " + scene + " -q --integrator " + integrator +
+                   " --iterations 2 --photons 2000 --bias-model r2+r -o " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+    EXPECT_EQ(rec[integrator]["settings"]["bias_model"], "r2+r") << integrator;
+    EXPECT_TRUE(rec["result"].contains("relative_error_delta_bias")) << integrator;
+  }
+}
+
 TEST_F(Cli, BpmWritesItsStatistics) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r = run("render " + scene +

@@ -4,26 +4,24 @@
 #include <tbb/parallel_for.h>
 
 #include "integrator/progressive.h"
+#include "photons/density.h"
 
 namespace bpm {
 
-void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
-                          const std::vector<Spectrum>& flux_inner, uint64_t emitted,
+void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
-                          bool debias, Film* film, std::vector<double>* estimates,
-                          std::vector<uint32_t>* counts) {
+                          const PhotonSettings& settings, Film* film,
+                          std::vector<double>* estimates, std::vector<uint32_t>* counts) {
   const int w = film->width(), h = film->height();
   std::vector<Spectrum> photon_L(size_t(w) * size_t(h)), bias(size_t(w) * size_t(h));
   for (size_t g = 0; g < maps.photons.size(); ++g) {
     const BackwardPhoton& bp = maps.photons[g];
-    if (flux[g].is_black()) continue;
+    if (light.flux[g].is_black()) continue;
     // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
-    const float norm = float(1.0 / (kPi * double(bp.radius) * bp.radius * double(emitted)));
-    const Spectrum L = bp.tau * flux[g] * norm, L_inner = bp.tau * flux_inner[g] * (2 * norm);
-    photon_L[bp.pixel] += L;
-    // The bias of a density estimate over a smooth density grows as r^2 (its leading term), so
-    // L(r) - L(r / sqrt 2) is half of L(r)'s bias.
-    bias[bp.pixel] += (L - L_inner) * 2.0f;
+    const float norm = float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
+    const NestedSums sums{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
+    photon_L[bp.pixel] += bp.tau * sums.all * norm;
+    bias[bp.pixel] += bp.tau * radius_bias(sums, norm, settings.bias_model);
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y)
@@ -31,11 +29,12 @@ void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>&
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
         Spectrum L = eye.radiance[p] + photon_L[p];
-        if (debias)
+        if (settings.debias)
           L -= bias[p];
         else if (bias[p].is_finite() && eye.filter_weight[p] != 0 && recordable(L))
           film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
-        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, debias);
+        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value,
+                    settings.debias);
         if (estimates && L.is_finite()) {
           (*estimates)[p] += L.average();
           ++(*counts)[p];

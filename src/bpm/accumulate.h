@@ -7,19 +7,20 @@
 
 #include "bpm/backward_maps.h"
 #include "bpm/eye_pass.h"
+#include "bpm/light_pass.h"
 #include "film/film.h"
 
 namespace bpm {
 
-// flux[g]: the summed contributions backward photon g received from `emitted` photons, and
-// flux_inner[g] those from within r / sqrt 2: each pixel's bias estimate of the pass,
-// 2 (L(r) - L(r / sqrt 2)) over its photon part, goes to the film beside its estimate. When
-// `estimates` is given, each sampled pixel's estimate (the mean over its wavelengths) is added to
-// it and that pixel's count in `counts` incremented.
-void accumulate_iteration(const BackwardMaps& maps, const std::vector<Spectrum>& flux,
-                          const std::vector<Spectrum>& flux_inner, uint64_t emitted,
+// light.flux[g]: the summed contributions backward photon g received from light.emitted photons;
+// with those from the inner discs, each pixel's bias estimate of the pass over its photon part
+// (radius_bias under bias_model) goes to the film beside its estimate, or with `debias` is taken
+// from it. When `estimates` is given, each sampled pixel's estimate (the mean over its
+// wavelengths) is added to it and that pixel's count in `counts` incremented.
+void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
-                          bool debias, Film* film, std::vector<double>* estimates = nullptr,
+                          const PhotonSettings& settings, Film* film,
+                          std::vector<double>* estimates = nullptr,
                           std::vector<uint32_t>* counts = nullptr);
 
 }  // namespace bpm

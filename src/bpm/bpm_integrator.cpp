@@ -164,9 +164,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
-    accumulate_iteration(maps, light_result.flux, light_result.flux_inner, light_result.emitted,
-                         eye, wm.wl, ls.film.max_component_value, s.debias, film, &estimate_sum,
-                         &estimate_count);
+    accumulate_iteration(maps, light_result, eye, wm.wl, ls.film.max_component_value, s, film,
+                         &estimate_sum, &estimate_count);
     if (!guide.empty()) {
       guide.update();
       tot.guide_moved = guide.moved();

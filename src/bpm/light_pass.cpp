@@ -42,8 +42,10 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, hero_only);
-    const bool inner = 2 * length_squared(sp.p - bp.p) < bp.radius * bp.radius;
-    out[owner[bp.pixel]].push_back({g | (inner ? PhotonEntry::kInnerBit : 0u), value});
+    const float d2 = length_squared(sp.p - bp.p), r2 = bp.radius * bp.radius;
+    const uint32_t bits = (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) |
+                          (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
+    out[owner[bp.pixel]].push_back({g | bits, value});
     ++counters.entries;
     if (prm.pixel_weight)
       score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
@@ -153,15 +155,16 @@ BatchResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
 }
 
 // Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
-void apply_batch(const LightPassBuffers& buf, int slots, std::vector<Spectrum>* flux,
-                 std::vector<Spectrum>* flux_inner, std::vector<uint8_t>* hit) {
+void apply_batch(const LightPassBuffers& buf, int slots, LightPassResult* res,
+                 std::vector<uint8_t>* hit) {
   tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
     for (int slot = r.begin(); slot < r.end(); ++slot)
       for (const auto& by_slot : buf.chunks)
         for (const PhotonEntry& e : by_slot[size_t(slot)]) {
           const uint32_t g = e.backward_photon();
-          (*flux)[g] += e.value;
-          if (e.inner()) (*flux_inner)[g] += e.value;
+          res->flux[g] += e.value;
+          if (e.inner()) res->flux_inner[g] += e.value;
+          if (e.quarter()) res->flux_quarter[g] += e.value;
           (*hit)[g] = 1;
         }
   });
@@ -175,10 +178,11 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
                                LightPassBuffers* buf, EmissionGuide* guide) {
   const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
-  BPM_CHECK(n_bp < PhotonEntry::kInnerBit);  // the memory budget refuses far fewer
+  BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
   LightPassResult res;
   res.flux.assign(n_bp, Spectrum());
   res.flux_inner.assign(n_bp, Spectrum());
+  res.flux_quarter.assign(n_bp, Spectrum());
   std::vector<uint8_t> hit(n_bp, 0);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
@@ -207,7 +211,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
 
     t = std::chrono::steady_clock::now();
-    apply_batch(*buf, masks.slots(), &res.flux, &res.flux_inner, &hit);
+    apply_batch(*buf, masks.slots(), &res, &hit);
     if (guide && prm.pixel_weight)
       for (const std::vector<CellScore>& s : buf->scores) guide->learn(s);
     res.apply_s += seconds_since(t);

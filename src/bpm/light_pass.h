@@ -23,12 +23,15 @@ namespace bpm {
 
 struct PhotonEntry {
   // Index into BackwardMaps::photons, with kInnerBit set when the photon lies within r / sqrt 2 of
-  // the backward photon (the inner half of its disc, for the bias estimate: film.h, add_bias).
+  // the backward photon (the inner half of its disc) and kQuarterBit within r / 2 (the inner
+  // quarter), for the bias estimate (radius_bias in photons/density.h).
   uint32_t key;
   Spectrum value;  // flux * f * |cos_s| / |cos_g|, before 1 / (pi r^2 N)
-  static constexpr uint32_t kInnerBit = 1u << 31;
-  uint32_t backward_photon() const { return key & ~kInnerBit; }
+  static constexpr uint32_t kInnerBit = 1u << 31, kQuarterBit = 1u << 30;
+  static constexpr uint32_t kIndexMask = kQuarterBit - 1;
+  uint32_t backward_photon() const { return key & kIndexMask; }
   bool inner() const { return key & kInnerBit; }
+  bool quarter() const { return key & kQuarterBit; }
 };
 
 struct LightPassParams {
@@ -70,7 +73,8 @@ struct LightPassBuffers {
 
 struct LightPassResult {
   std::vector<Spectrum> flux;        // per backward photon: the sum of its entries' values
-  std::vector<Spectrum> flux_inner;  // the same over the entries of its inner half (inner())
+  std::vector<Spectrum> flux_inner;    // the same over the entries of its inner half (inner())
+  std::vector<Spectrum> flux_quarter;  // and of its inner quarter (quarter())
   uint64_t emitted = 0;              // photons emitted, N of eq. (2)
   bool cut = false;                  // a stop request ended the pass before all its photons
   int batches = 0;

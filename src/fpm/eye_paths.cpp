@@ -11,7 +11,7 @@ namespace bpm {
 namespace {
 
 // Radiance reflected at v toward wo from the map's photons of the accepted classes, eq. (2):
-// sum f dPhi / (pi r^2 N), and the estimate of its bias, 2 (L(r) - L(r / sqrt 2)). With knn > 0
+// sum f dPhi / (pi r^2 N), and the estimate of its bias (radius_bias). With knn > 0
 // the radius is the distance to the knn-th nearest photon within `radius` (Jensen's estimate),
 // else `radius`.
 struct Estimate {
@@ -37,18 +37,17 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
       r = std::sqrt(d2[size_t(prm.fpm->knn - 1)]) * 1.0001f;
     }
   }
-  Spectrum sum, inner;
+  NestedSums sums;
   map.tree.query_within(sp.p, r, [&](uint32_t i) {
     const ForwardPhoton& ph = map.photons[i];
     if (!usable(ph)) return;
     ++c.photons_used;
-    const Spectrum value = photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux) *
-                           hero_join_factor(eye_hero_only, ph.hero_only);
-    sum += value;
-    if (2 * length_squared(ph.p - sp.p) < r * r) inner += value;
+    sums.add(photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux) *
+                 hero_join_factor(eye_hero_only, ph.hero_only),
+             length_squared(ph.p - sp.p), r * r);
   });
   const float norm = float(1.0 / (kPi * double(r) * r * prm.emitted));
-  return {sum * norm, (sum - inner * 2.0f) * (2 * norm)};
+  return {sums.all * norm, radius_bias(sums, norm, prm.fpm->bias_model)};
 }
 
 bool any_class(PhotonClass) { return true; }

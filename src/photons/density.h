@@ -7,8 +7,33 @@
 #include <cmath>
 
 #include "materials/material.h"
+#include "photons/settings.h"
 
 namespace bpm {
+
+// One gathering's photon contributions summed over three nested discs: radius r, r / sqrt 2 (half
+// its area) and r / 2 (a quarter).
+struct NestedSums {
+  Spectrum all, half, quarter;
+  void add(const Spectrum& value, float d2, float r2) {
+    all += value;
+    if (2 * d2 < r2) half += value;
+    if (4 * d2 < r2) quarter += value;
+  }
+};
+
+// The bias of L(r) = all * norm from the estimates at the three radii (norm = 1 / (pi r^2 N)).
+// With s = 1 / sqrt 2, D1 = L(r) - L(s r) and D2 = L(s r) - L(s^2 r): for a bias a r^2, D1 is half
+// of it; for a r^2 + b r, solving the two differences gives -sqrt 2 D1 + (4 + 2 sqrt 2) D2 (2 D1
+// when D2 = D1 / 2, as r^2 alone gives; (2 + sqrt 2) D1 when D2 = s D1, as r alone gives). A linear
+// combination of unbiased estimates, so its mean over passes is as well.
+inline Spectrum radius_bias(const NestedSums& s, float norm, BiasModel model) {
+  const Spectrum L = s.all * norm, L_half = s.half * (2 * norm);
+  if (model == BiasModel::kSquare) return (L - L_half) * 2.0f;
+  const Spectrum L_quarter = s.quarter * (4 * norm);
+  constexpr float kSqrt2 = 1.41421356f;
+  return (L - L_half) * -kSqrt2 + (L_half - L_quarter) * (4 + 2 * kSqrt2);
+}
 
 inline Spectrum photon_contribution(const Material& m, Vec3 ng, Vec3 ns, Vec3 wo, Vec3 wi,
                                     const Spectrum& flux) {

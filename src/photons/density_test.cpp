@@ -41,5 +41,39 @@ TEST(PhotonContribution, LambertianShortcutEqualsTheBsdf) {
   EXPECT_GT(nonzero, 500);
 }
 
+// radius_bias from the sums a density gives over the three nested discs: one whose disc averages
+// are L0 + a rho^2 + b rho at radius rho. The three-radius model recovers a r^2 + b r exactly; the
+// two-radius one recovers a r^2 when b = 0, and sees 2 (1 - 1 / sqrt 2) = 0.586 of the r term.
+TEST(RadiusBias, ModelsRecoverTheTermsTheyAssume) {
+  const float r = 0.5f, norm = 0.01f, L0 = 2;
+  auto sums = [&](float a, float b) {
+    auto disc = [&](float rho) { return Spectrum(L0 + a * rho * rho + b * rho); };
+    // sum over a disc of radius rho = its average times pi rho^2 N = average / norm * (rho / r)^2
+    return NestedSums{disc(r) / norm, disc(r / std::sqrt(2.0f)) / (2 * norm),
+                      disc(r / 2) / (4 * norm)};
+  };
+  for (float a : {0.0f, 1.5f, -3.0f})
+    for (float b : {0.0f, 0.8f, -0.4f}) {
+      const float truth = a * r * r + b * r;
+      EXPECT_NEAR(radius_bias(sums(a, b), norm, BiasModel::kSquareAndLinear)[3], truth, 1e-4f)
+          << a << " " << b;
+      EXPECT_NEAR(radius_bias(sums(a, b), norm, BiasModel::kSquare)[3],
+                  a * r * r + 2 * (1 - 1 / std::sqrt(2.0f)) * b * r, 1e-4f)
+          << a << " " << b;
+    }
+}
+
+// NestedSums puts a contribution in every disc that holds it.
+TEST(RadiusBias, NestedSumsCountEachDisc) {
+  NestedSums s;
+  const float r2 = 1;
+  s.add(Spectrum(1), 0.2f, r2);   // within r / 2 (d^2 < 1/4)
+  s.add(Spectrum(2), 0.3f, r2);   // within r / sqrt 2 only
+  s.add(Spectrum(4), 0.9f, r2);   // within r only
+  EXPECT_FLOAT_EQ(s.all[0], 7);
+  EXPECT_FLOAT_EQ(s.half[0], 3);
+  EXPECT_FLOAT_EQ(s.quarter[0], 1);
+}
+
 }  // namespace
 }  // namespace bpm

@@ -8,6 +8,21 @@ namespace bpm {
 
 enum class RadiusPolicy { kFixed, kProgressive };
 
+// How the bias of a radius-r density estimate is estimated from the same photons gathered over
+// nested discs (PhotonSettings::bias_model).
+enum class BiasModel {
+  // Two radii: the bias as the leading r^2 term of a smooth density, 2 (L(r) - L(r / sqrt 2)).
+  kSquare,
+  // Three radii: a r^2 + b r fitted per estimate from L(r), L(r / sqrt 2) and L(r / 2), which also
+  // covers the r term of edges and caustic boundaries (where the density jumps).
+  kSquareAndLinear,
+};
+
+inline const char* to_string(BiasModel m) {
+  return m == BiasModel::kSquare ? "r2" : "r2+r";
+}
+
+
 struct PhotonSettings {
   // Integration radii in pixel footprints (the side of one pixel seen at the vertex): k0 for
   // caustic photons before the last diffuse vertex (bpm) or in the caustic map (fpm), k1 for the
@@ -21,9 +36,10 @@ struct PhotonSettings {
   // Photons count only where the normals of the photon's surface and of the gathering point agree
   // to within this cosine.
   float normal_cos = 0.5f;
-  // Record 2 L(r / sqrt 2) - L(r) for the photon estimates: the image less its bias estimate (the
-  // leading r^2 term; film.h, add_bias), noisier, and without a bias estimate of its own.
+  // Record the photon estimates less their bias estimate (2 L(r / sqrt 2) - L(r) under kSquare;
+  // film.h, add_bias): noisier, and without a bias estimate of its own.
   bool debias = false;
+  BiasModel bias_model = BiasModel::kSquare;
 };
 
 inline const char* to_string(RadiusPolicy p) {
