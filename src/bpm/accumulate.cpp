@@ -33,8 +33,7 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
           L -= bias[p];
         else if (bias[p].is_finite() && eye.filter_weight[p] != 0 && recordable(L))
           film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
-        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value,
-                    settings.debias);
+        record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
         if (estimates && L.is_finite()) {
           (*estimates)[p] += L.average();
           ++(*counts)[p];

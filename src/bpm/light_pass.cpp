@@ -43,8 +43,8 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, hero_only);
     const float d2 = length_squared(sp.p - bp.p), r2 = bp.radius * bp.radius;
-    const uint32_t bits = (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) |
-                          (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
+    const uint32_t bits =
+        (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
     out[owner[bp.pixel]].push_back({g | bits, value});
     ++counters.entries;
     if (prm.pixel_weight)

@@ -72,11 +72,11 @@ struct LightPassBuffers {
 };
 
 struct LightPassResult {
-  std::vector<Spectrum> flux;        // per backward photon: the sum of its entries' values
+  std::vector<Spectrum> flux;          // per backward photon: the sum of its entries' values
   std::vector<Spectrum> flux_inner;    // the same over the entries of its inner half (inner())
   std::vector<Spectrum> flux_quarter;  // and of its inner quarter (quarter())
-  uint64_t emitted = 0;              // photons emitted, N of eq. (2)
-  bool cut = false;                  // a stop request ended the pass before all its photons
+  uint64_t emitted = 0;                // photons emitted, N of eq. (2)
+  bool cut = false;                    // a stop request ended the pass before all its photons
   int batches = 0;
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;

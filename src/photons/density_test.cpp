@@ -67,9 +67,9 @@ TEST(RadiusBias, ModelsRecoverTheTermsTheyAssume) {
 TEST(RadiusBias, NestedSumsCountEachDisc) {
   NestedSums s;
   const float r2 = 1;
-  s.add(Spectrum(1), 0.2f, r2);   // within r / 2 (d^2 < 1/4)
-  s.add(Spectrum(2), 0.3f, r2);   // within r / sqrt 2 only
-  s.add(Spectrum(4), 0.9f, r2);   // within r only
+  s.add(Spectrum(1), 0.2f, r2);  // within r / 2 (d^2 < 1/4)
+  s.add(Spectrum(2), 0.3f, r2);  // within r / sqrt 2 only
+  s.add(Spectrum(4), 0.9f, r2);  // within r only
   EXPECT_FLOAT_EQ(s.all[0], 7);
   EXPECT_FLOAT_EQ(s.half[0], 3);
   EXPECT_FLOAT_EQ(s.quarter[0], 1);

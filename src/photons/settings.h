@@ -18,10 +18,7 @@ enum class BiasModel {
   kSquareAndLinear,
 };
 
-inline const char* to_string(BiasModel m) {
-  return m == BiasModel::kSquare ? "r2" : "r2+r";
-}
-
+inline const char* to_string(BiasModel m) { return m == BiasModel::kSquare ? "r2" : "r2+r"; }
 
 struct PhotonSettings {
   // Integration radii in pixel footprints (the side of one pixel seen at the vertex): k0 for
