@@ -7,6 +7,7 @@
 
 #include "camera/camera.h"
 #include "film/image_io.h"
+#include "integrator/progressive.h"
 #include "test_util.h"
 
 namespace bpm {
@@ -562,6 +563,24 @@ TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
 }
 
 // Same seed and budget give the same image whatever the number of threads.
+// The film's clamp (maxcomponentvalue) holds for debiased estimates too, which may be negative:
+// on the largest magnitude, keeping the sign and the colour's proportions.
+TEST(Film, RecordPassClampsDebiasedEstimates) {
+  const Wavelengths wl = sample_wavelengths(0.3f);
+  for (float v : {-1e6f, 1e6f, -2.0f}) {
+    Film film(1, 1);
+    record_pass(&film, 0, Spectrum(v), wl, 1, 10, true);
+    const Rgb c = film.image().at(0, 0);
+    const float m = std::fmax(c.max_component(), -c.min_component());
+    if (std::fabs(v) > 100) {
+      EXPECT_NEAR(m, 10, 1e-3) << v;
+    } else {
+      EXPECT_LT(m, 10) << v;
+    }
+    EXPECT_EQ(c[1] < 0, v < 0) << v;
+  }
+}
+
 TEST(Renderer, SameImageWithOneAndTwoThreads) {
   LoadedScene ls = load(R"(
     LookAt 0.5 0.5 -1.2  0.5 0.5 0  0 1 0

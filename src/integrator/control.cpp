@@ -112,10 +112,18 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
     std::snprintf(budget, sizeof budget, "/%d", opt_.spp);
   std::string eta;
   if (opt_.accuracy > 0 && delta_ > opt_.accuracy && passes >= kWarmupPasses) {
-    // delta falls as 1/sqrt(passes): the passes still needed, at the rate so far.
-    double more = double(passes) * (delta_ * delta_ / (opt_.accuracy * opt_.accuracy) - 1);
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "  %.0f s to delta %.3g", more * t / passes, opt_.accuracy);
+    // The noise falls as 1/sqrt(passes); the bias is held where it is (it stays with a fixed
+    // radius and shrinks with progressive ones, so this is the longest it takes): the passes
+    // still needed for noise^2 + bias^2 to reach the target, at the rate so far.
+    const double noise2 = delta_ * delta_ - bias_ * bias_,
+                 room = opt_.accuracy * opt_.accuracy - bias_ * bias_;
+    char buf[80];
+    if (room > 0)
+      std::snprintf(buf, sizeof buf, "  %.0f s to delta %.3g",
+                    std::fmax(0.0, double(passes) * (noise2 / room - 1)) * t / passes,
+                    opt_.accuracy);
+    else
+      std::snprintf(buf, sizeof buf, "  bias above delta %.3g", opt_.accuracy);
     eta = buf;
   }
   char bias[32] = "";

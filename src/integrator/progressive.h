@@ -77,13 +77,16 @@ class CameraSampler {
 
 // Records a pixel's estimate of this pass: the radiance at the pass's wavelengths as film colour.
 // A debiased estimate (PhotonSettings::debias) may be negative where the noise is: it is recorded
-// as it is (still not when it is not finite).
+// as it is (still not when it is not finite), with the clamp on its largest magnitude.
 inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wavelengths& wl,
                         float filter_weight, float max_component_value,
                         bool may_be_negative = false) {
   int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
   if (may_be_negative && L.is_finite()) {
-    film->add_sample(x, y, spectrum_to_rgb(L, wl), filter_weight);
+    Rgb c = spectrum_to_rgb(L, wl);
+    const float m = std::fmax(c.max_component(), -c.min_component());
+    if (m > max_component_value) c *= max_component_value / m;
+    film->add_sample(x, y, c, filter_weight);
   } else {
     if (!recordable(L)) film->drop_sample(x, y);
     film->add_sample(x, y, film_rgb(L, wl, max_component_value), filter_weight);
