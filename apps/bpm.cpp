@@ -15,6 +15,7 @@
 #include "film/image_compare.h"
 #include "film/image_io.h"
 #include "film/outputs.h"
+#include "render/checkpoint.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
@@ -57,6 +58,7 @@ struct RenderArgs {
   float adaptive_floor = 0.1f;
   int m_images = 4;
   std::string memory;  // --memory; empty: default_memory_budget()
+  std::string resume;  // --resume: a checkpoint file
 };
 
 // Bytes per pixel the outputs take while they are written (the image, its error channels and
@@ -234,6 +236,11 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
   rec["outputs"] = {
       {"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
   if (film.has_bias()) rec["outputs"]["bias_png"] = paths.bias_png;
+  if (opt.resume)
+    rec["resumed"] = {{"checkpoint", a.resume},
+                      {"passes_before", opt.resume->passes},
+                      {"note", "rays, times and statistics are this run's alone"}};
+  if (opt.save_state) rec["outputs"]["checkpoint"] = paths.checkpoint;
   rec["stages_s"] = {{"parse", t_parse},
                      {"build", t_build},
                      {"render", st.render_seconds},
@@ -269,14 +276,36 @@ int run_render(const RenderArgs& a) {
     std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n",
                  a.scene.c_str(), ls.scene.objects.size(), ls.scene.triangle_count(),
                  ls.scene.lights.size(), ls.film.width, ls.film.height, opt.integrator.c_str());
-  // The film and the images written from it must fit before anything is allocated.
+  // The film and the images written from it (and a checkpoint's copy of the film, when one is
+  // kept) must fit before anything is allocated.
   const double pixels = double(ls.film.width) * double(ls.film.height);
+  const bool keep_checkpoint = opt.write_every_s > 0 || !a.resume.empty();
   check_memory("a " + std::to_string(ls.film.width) + "x" + std::to_string(ls.film.height) +
                    " film with its outputs",
-               pixels * (double(Film::bytes_per_pixel(a.m_images)) + kOutputBytesPerPixel),
+               pixels * (double(Film::bytes_per_pixel(a.m_images)) * (keep_checkpoint ? 2 : 1) +
+                         kOutputBytesPerPixel),
                opt.memory_budget, "lower --resolution or --m-images, or raise --memory");
-  install_interrupt_handlers();
   Film film(ls.film.width, ls.film.height, a.m_images);
+  // A checkpoint is kept when outputs are written as the render goes, or when it resumes one
+  // (so that it can be resumed again); it is written every --write-every and at the end.
+  const nlohmann::json identity = render_identity(parsed.files, ls, opt, film.m_images());
+  Checkpoint resumed;
+  if (!a.resume.empty()) {
+    resumed = read_checkpoint(a.resume);
+    check_identity(resumed.identity, identity, a.resume);
+    ByteReader r(resumed.film, "checkpoint \"" + a.resume + "\"");
+    film.load(r);
+    opt.resume = &resumed.state;
+    if (!a.quiet)
+      std::fprintf(stderr, "bpm: resuming %s after %d %s\n", a.resume.c_str(), resumed.state.passes,
+                   opt.integrator == "path" ? "passes" : "iterations");
+  }
+  if (keep_checkpoint)
+    opt.save_state = [&](const RenderState& state) {
+      const std::vector<uint8_t> bytes = encode_checkpoint(identity, film, state);
+      write_bytes_atomic(paths.checkpoint, bytes.data(), bytes.size());
+    };
+  install_interrupt_handlers();
   // Intermediate outputs: the images so far and a JSON record that says the render is running.
   opt.checkpoint = [&](int passes) {
     write_images(paths, film, ls.film.imaging_ratio);
@@ -388,8 +417,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 64));
   render
       ->add_option("--write-every", ra.write_every,
-                   "Write the outputs so far every SECONDS (atomically)")
+                   "Write the outputs so far, and OUT.checkpoint to resume from, every SECONDS "
+                   "(atomically)")
       ->check(CLI::Range(0.1, 1e9));
+  render->add_option("--resume", ra.resume,
+                     "Go on from a checkpoint (OUT.checkpoint of --write-every) of the same "
+                     "render: the same scene, resolution, integrator and settings; --spp and "
+                     "--iterations count the passes before it too");
   render->add_option("--memory", ra.memory,
                      "Memory budget for the render's data (film, photon maps, trees, photon "
                      "entries), e.g. 512M or 8G; default: 3/4 of this machine's memory");

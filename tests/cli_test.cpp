@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -374,6 +375,83 @@ TEST_F(Cli, WriteEveryLeavesIntermediateOutputs) {
   auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
   EXPECT_EQ(rec["result"]["stop_reason"], "interrupted");
   EXPECT_EQ(rec["settings"]["adaptive"], true);
+}
+
+// A render killed (SIGKILL: no chance to write anything more) after it wrote a checkpoint, then
+// resumed from it with the same command line, ends with the image of a render never stopped.
+TEST_F(Cli, KilledRenderResumesToTheSameImage) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  for (auto [integrator, passes] : {std::pair{"path", "800"}, {"bpm", "250"}, {"fpm", "300"}}) {
+    const std::string name(integrator), straight = (dir_ / (name + "_straight.exr")).string(),
+                                        killed = (dir_ / (name + ".exr")).string();
+    const std::string common =
+        "render " + scene + " -q --integrator " + name + " --spp " + passes + " --photons 5000 ";
+    ASSERT_EQ(run(common + "-o " + straight).exit_code, 0) << integrator;
+
+    const fs::path checkpoint = dir_ / (name + ".checkpoint");
+    pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      int devnull = ::open("/dev/null", 1);
+      dup2(devnull, 2);
+      execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", integrator,
+            "--spp", passes, "--photons", "5000", "--write-every", "0.1", "-o", killed.c_str(),
+            nullptr);
+      _exit(127);
+    }
+    for (int i = 0; i < 2000 && !fs::exists(checkpoint); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(fs::exists(checkpoint)) << integrator;
+
+    CliRun r = run(common + "--resume " + checkpoint.string() + " -o " + killed);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto rec = nlohmann::json::parse(std::ifstream(dir_ / (name + ".json")));
+    EXPECT_EQ(rec["result"]["passes"], std::stoi(passes)) << integrator;
+    EXPECT_GT(rec["resumed"]["passes_before"].get<int>(), 0) << integrator;
+    EXPECT_EQ(read_exr(killed).rgb, read_exr(straight).rgb) << integrator;
+  }
+}
+
+// A checkpoint is refused, before anything is written, when it is of another render (naming what
+// differs), cut short, or not a checkpoint at all.
+TEST_F(Cli, ResumeRefusesAnotherRendersCheckpoint) {
+  std::string scene = write("s.pbrt", kTinyScene), out = (dir_ / "a.exr").string();
+  ASSERT_EQ(run("render " + scene +
+                " -q --integrator bpm --spp 3 --photons 2000 --write-every 100 "
+                "-o " +
+                out)
+                .exit_code,
+            0);
+  const std::string checkpoint = (dir_ / "a.checkpoint").string();
+  ASSERT_TRUE(fs::exists(checkpoint));
+  std::string other = write("other.pbrt", std::string(kTinyScene) + "Translate 0 0 1\n" +
+                                              "Shape \"sphere\" \"float radius\" 0.2\n");
+  const std::string b = (dir_ / "b.exr").string();
+  auto refused = [&](const std::string& args, const std::string& says) {
+    CliRun r = run("render " + args + " -q --spp 6 --photons 2000 -o " + b);
+    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(b)) << args;
+  };
+  refused(other + " --integrator bpm --resume " + checkpoint, "scene");
+  refused(scene + " --integrator fpm --resume " + checkpoint, "integrator");
+  refused(scene + " --integrator bpm --resolution 16x12 --resume " + checkpoint, "resolution");
+  refused(scene + " --integrator bpm --k1 5 --resume " + checkpoint, "k1");
+  {
+    std::ifstream in(checkpoint, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(dir_ / "cut.checkpoint", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  refused(scene + " --integrator bpm --resume " + (dir_ / "cut.checkpoint").string(), "corrupt");
+  refused(scene + " --integrator bpm --resume " + out, "not a bpm checkpoint");
+  // The same render goes on.
+  EXPECT_EQ(run("render " + scene + " -q --integrator bpm --spp 6 --photons 2000 --resume " +
+                checkpoint + " -o " + b)
+                .exit_code,
+            0);
 }
 
 TEST_F(Cli, AccuracyFlagStopsAtTheRequestedDelta) {

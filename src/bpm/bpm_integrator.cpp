@@ -184,8 +184,27 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     r.progress = progress;
     return r;
   };
+  // Carried from one iteration to the next: what the guide learnt and the pixels' running means
+  // (the pixel weights follow from them).
+  IntegratorState state;
+  state.save = [&](ByteWriter& w) {
+    w.put(uint8_t(!guide.empty()));
+    if (!guide.empty()) guide.save(w);
+    w.put_vector(estimate_sum);
+    w.put_vector(estimate_count);
+  };
+  state.load = [&](ByteReader& r) {
+    if (r.get<uint8_t>() != uint8_t(!guide.empty()))
+      throw Error(r.what() + " differs in guided emission (--no-guide)");
+    if (!guide.empty()) guide.load(r);
+    estimate_sum = r.get_vector<double>();
+    estimate_count = r.get_vector<uint32_t>();
+    if (estimate_sum.size() != n_pixels || estimate_count.size() != n_pixels)
+      throw Error(r.what() + " is truncated or corrupt (pixel estimates)");
+    if (!guide.empty()) update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
+  };
   RenderStats stats;
-  run_passes(opt, film, "iteration", iteration, &stats);
+  run_passes(opt, film, "iteration", iteration, &stats, state);
   for (const EyeCounters& c : eye_counters) tot.eye.add(c);
   for (const LightCounters& c : light.counters) tot.light.add(c);
   stats.rays = tot.eye.rays;

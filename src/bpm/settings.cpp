@@ -34,4 +34,20 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   return b;
 }
 
+nlohmann::json settings_json(const BpmSettings& s) {
+  return {{"diffuse_depth", s.diffuse_depth},
+          {"k0", s.k0},
+          {"k1", s.k1},
+          {"radius", s.radius},
+          {"radius_policy", to_string(s.radius_policy)},
+          {"alpha", s.alpha},
+          {"photons_per_iteration", s.photons_per_iteration},
+          {"normal_cos", s.normal_cos},
+          {"debias", s.debias},
+          {"bias_model", to_string(s.bias_model)},
+          {"tree", s.centre_tree ? "centres" : "spheres"},
+          {"guide_emission", s.guide_emission},
+          {"emission_samples", s.emission_samples}};
+}
+
 }  // namespace bpm

@@ -1,6 +1,8 @@
 // Settings of the backward photon mapping integrator, filled from the scene file's Integrator
 // line and the command line, and printed in the run's JSON record.
 #pragma once
+#include <nlohmann/json.hpp>
+
 #include "photons/settings.h"
 #include "scene/parsed_scene.h"
 
@@ -29,5 +31,8 @@ struct BpmSettings : PhotonSettings {
 // line gives diffuse depth 0, its radius and its photons per iteration); defaults for any other
 // integrator. A bad value is an error at its place in the file.
 BpmSettings bpm_settings_from_file(const SceneEntity& integrator);
+
+// The settings as the JSON record prints them (also a checkpoint's identity).
+nlohmann::json settings_json(const BpmSettings& s);
 
 }  // namespace bpm

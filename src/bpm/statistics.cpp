@@ -74,20 +74,7 @@ nlohmann::json light_json(const BpmTotals& t, int iterations) {
 
 nlohmann::json to_json(const BpmTotals& t, const BpmSettings& s, int iterations, size_t pixels) {
   return {
-      {"settings",
-       {{"diffuse_depth", s.diffuse_depth},
-        {"k0", s.k0},
-        {"k1", s.k1},
-        {"radius", s.radius},
-        {"radius_policy", to_string(s.radius_policy)},
-        {"alpha", s.alpha},
-        {"photons_per_iteration", s.photons_per_iteration},
-        {"normal_cos", s.normal_cos},
-        {"debias", s.debias},
-        {"bias_model", to_string(s.bias_model)},
-        {"tree", s.centre_tree ? "centres" : "spheres"},
-        {"guide_emission", s.guide_emission},
-        {"emission_samples", s.emission_samples}}},
+      {"settings", settings_json(s)},
       {"eye", eye_json(t, iterations, pixels)},
       {"maps",
        {{"peak_photon_bytes", t.peak_photon_bytes},

@@ -209,4 +209,33 @@ std::vector<int> Film::lit_pass_counts() const {
   return out;
 }
 
+void Film::save(ByteWriter& w) const {
+  w.put(int32_t(width_));
+  w.put(int32_t(height_));
+  w.put(int32_t(m_));
+  w.put_vector(pixels_);
+  w.put_vector(m_sum_);
+  w.put_vector(m_count_);
+}
+
+void Film::load(ByteReader& r) {
+  const int w = r.get<int32_t>(), h = r.get<int32_t>(), m = r.get<int32_t>();
+  if (w != width_ || h != height_)
+    throw Error(r.what() + " holds a " + std::to_string(w) + "x" + std::to_string(h) +
+                " film, this render's is " + std::to_string(width_) + "x" +
+                std::to_string(height_));
+  if (m != m_)
+    throw Error(r.what() + " keeps " + std::to_string(m) + " M-images, this render " +
+                std::to_string(m_) + " (--m-images)");
+  std::vector<Pixel> pixels = r.get_vector<Pixel>();
+  std::vector<double> m_sum = r.get_vector<double>();
+  std::vector<int> m_count = r.get_vector<int>();
+  if (pixels.size() != pixels_.size() || m_sum.size() != m_sum_.size() ||
+      m_count.size() != m_count_.size())
+    throw Error(r.what() + " is truncated or corrupt (film sizes)");
+  pixels_ = std::move(pixels);
+  m_sum_ = std::move(m_sum);
+  m_count_ = std::move(m_count);
+}
+
 }  // namespace bpm

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "base/bytes.h"
 #include "base/color.h"
 #include "base/spectrum.h"
 
@@ -132,6 +133,11 @@ class Film {
   std::vector<float> rms_m_images_rgb() const;
   std::vector<float> rms_m_images() const;
   double relative_error_m_images() const;
+
+  // Every per-pixel sum the film keeps, for a checkpoint; load() takes them back (between passes)
+  // into a film of the same size and M, and throws Error naming what differs otherwise.
+  void save(ByteWriter& w) const;
+  void load(ByteReader& r);
 
  private:
   static double luminance(const double* c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }

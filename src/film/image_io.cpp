@@ -132,11 +132,15 @@ Image read_exr(const std::string& path) {
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {
+  write_bytes_atomic(path, text.data(), text.size());
+}
+
+void write_bytes_atomic(const std::string& path, const void* data, size_t size) {
   std::string tmp = temporary_path(path);
   {
     std::ofstream out(tmp, std::ios::binary);
     if (!out) throw Error("cannot write \"" + path + "\"");
-    out << text;
+    out.write(static_cast<const char*>(data), std::streamsize(size));
     out.flush();
     if (!out) {
       std::filesystem::remove(tmp);

@@ -24,6 +24,7 @@ void write_png_display(const std::string& path, const Image& display);
 Image read_exr(const std::string& path);
 // Writes text atomically.
 void write_text_atomic(const std::string& path, const std::string& text);
+void write_bytes_atomic(const std::string& path, const void* data, size_t size);
 
 // Temporary name beside path, unique per process.
 std::string temporary_path(const std::string& path);

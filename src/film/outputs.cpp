@@ -14,7 +14,12 @@ OutputPaths output_paths(const std::string& exr) {
   if (exr.size() <= ext.size() || exr.compare(exr.size() - ext.size(), ext.size(), ext) != 0)
     throw Error("output file \"" + exr + "\" must end in .exr");
   std::string stem = exr.substr(0, exr.size() - ext.size());
-  return {exr, stem + ".png", stem + ".error.png", stem + ".json", stem + ".bias.png"};
+  return {exr,
+          stem + ".png",
+          stem + ".error.png",
+          stem + ".json",
+          stem + ".bias.png",
+          stem + ".checkpoint"};
 }
 
 // Per pixel, an error (R G B) relative to the pixel's value over the three channels (as eq. 4 per

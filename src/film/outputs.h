@@ -9,11 +9,12 @@ namespace bpm {
 
 struct OutputPaths {
   std::string exr, png, error_png, json;
-  std::string bias_png;  // written only for a film with a bias estimate (the photon methods)
+  std::string bias_png;    // written only for a film with a bias estimate (the photon methods)
+  std::string checkpoint;  // the state to resume from (render/checkpoint.h), when one is kept
 };
 
-// OUT.exr -> OUT.png, OUT.error.png, OUT.json, OUT.bias.png. Throws Error when the name does not
-// end in .exr.
+// OUT.exr -> OUT.png, OUT.error.png, OUT.json, OUT.bias.png, OUT.checkpoint. Throws Error when
+// the name does not end in .exr.
 OutputPaths output_paths(const std::string& exr_path);
 
 // Writes the EXR and the PNGs (the image, its total error, and with a bias estimate its bias),

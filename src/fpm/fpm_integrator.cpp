@@ -30,17 +30,7 @@ double ratio(double a, double b) { return b > 0 ? a / b : 0.0; }
 nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
   const LightCounters& lt = t.light;
   return {
-      {"settings",
-       {{"k0", s.k0},
-        {"k1", s.k1},
-        {"radius_policy", to_string(s.radius_policy)},
-        {"alpha", s.alpha},
-        {"photons_per_iteration", s.photons_per_iteration},
-        {"final_gather", s.final_gather},
-        {"knn", s.knn},
-        {"normal_cos", s.normal_cos},
-        {"debias", s.debias},
-        {"bias_model", to_string(s.bias_model)}}},
+      {"settings", settings_json(s)},
       {"light",
        {{"photons", lt.photons},
         {"light_rays", lt.light_rays},

@@ -12,4 +12,17 @@ FpmSettings fpm_settings_from_file(const SceneEntity& in) {
   return f;
 }
 
+nlohmann::json settings_json(const FpmSettings& s) {
+  return {{"k0", s.k0},
+          {"k1", s.k1},
+          {"radius_policy", to_string(s.radius_policy)},
+          {"alpha", s.alpha},
+          {"photons_per_iteration", s.photons_per_iteration},
+          {"final_gather", s.final_gather},
+          {"knn", s.knn},
+          {"normal_cos", s.normal_cos},
+          {"debias", s.debias},
+          {"bias_model", to_string(s.bias_model)}};
+}
+
 }  // namespace bpm

@@ -1,6 +1,8 @@
 // Settings of forward photon mapping: the photon settings it shares with bpm (k0 for the caustic
 // map, k1 for the global map, photons_per_iteration) and its own.
 #pragma once
+#include <nlohmann/json.hpp>
+
 #include "photons/settings.h"
 #include "scene/parsed_scene.h"
 
@@ -14,5 +16,8 @@ struct FpmSettings : PhotonSettings {
 // fpm's parameters on the file's Integrator line; defaults for any other integrator. A bad value
 // is an error at its place in the file.
 FpmSettings fpm_settings_from_file(const SceneEntity& integrator);
+
+// The settings as the JSON record prints them (also a checkpoint's identity).
+nlohmann::json settings_json(const FpmSettings& s);
 
 }  // namespace bpm

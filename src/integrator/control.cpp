@@ -101,10 +101,6 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
         std::sqrt(std::pow(film_.relative_error(), 2) + bias_ * bias_);  // relative_error_total
   }
   if (adapt) update_probabilities();
-  if (opt_.checkpoint && opt_.write_every_s > 0 && t - last_checkpoint_ >= opt_.write_every_s) {
-    opt_.checkpoint(passes);
-    last_checkpoint_ = t;
-  }
   if (!print) return;
   last_progress_ = t;
   char budget[32] = "";
@@ -147,6 +143,28 @@ double RenderControl::mean_sampling_probability() const {
   double s = 0;
   for (float p : probability_) s += p;
   return s / double(probability_.size());
+}
+
+bool RenderControl::checkpoint_due() {
+  const double t = elapsed();
+  if (!(opt_.write_every_s > 0) || t - last_checkpoint_ < opt_.write_every_s) return false;
+  last_checkpoint_ = t;
+  return true;
+}
+
+void RenderControl::save(ByteWriter& w) const {
+  w.put(delta_);
+  w.put(bias_);
+  w.put_vector(probability_);
+}
+
+void RenderControl::load(ByteReader& r) {
+  delta_ = r.get<double>();
+  bias_ = r.get<double>();
+  probability_ = r.get_vector<float>();
+  const size_t pixels = size_t(film_.width()) * size_t(film_.height());
+  if (!probability_.empty() && probability_.size() != pixels)
+    throw Error(r.what() + " is truncated or corrupt (sampling probabilities)");
 }
 
 void RenderControl::finish() {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "base/bytes.h"
 #include "film/film.h"
 
 namespace bpm {
@@ -36,7 +37,7 @@ class RenderControl {
   bool keep_going(int done);
   // Ends the render for a reason of the integrator's own (PassResult::stop_reason).
   void stop(const std::string& reason) { stop_reason_ = reason; }
-  // After a pass: updates the sampling probabilities, prints progress, writes a checkpoint.
+  // After a pass: updates the sampling probabilities, prints progress.
   // `rays` is the total traced so far; `extra` is appended to the progress line.
   void after_pass(int done, uint64_t rays, const std::string& extra = "");
   // Whether work of pass `pass` not yet started (tiles, chunks of photons) is to be left out: an
@@ -51,6 +52,13 @@ class RenderControl {
   bool sample_pixel(int pass, uint32_t pixel) const;
   // Call once at the end: finishes the progress line.
   void finish();
+  // After a pass: whether write_every_s has passed since the last checkpoint (then it starts
+  // counting again).
+  bool checkpoint_due();
+  // What the next passes depend on (the sampling probabilities; delta for the progress line), for
+  // resuming a render.
+  void save(ByteWriter& w) const;
+  void load(ByteReader& r);
 
   const std::string& stop_reason() const { return stop_reason_; }
   double elapsed() const;

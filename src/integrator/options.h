@@ -6,10 +6,19 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "integrator/counters.h"
 
 namespace bpm {
+
+// What a render needs, besides its film, to go on exactly where it stopped: the passes done, the
+// render control's state (sampling probabilities) and the integrator's (what bpm's guide has
+// learnt). Random streams are keyed by (seed, pass index), so nothing else carries over.
+struct RenderState {
+  int passes = 0;
+  std::vector<uint8_t> control, integrator;
+};
 
 struct IntegratorOptions {
   int spp = 16;             // passes (iterations for the photon integrators)
@@ -28,7 +37,13 @@ struct IntegratorOptions {
   // Bytes the render's own data may take (film, photon maps, trees, entries; base/memory.h);
   // 0: no budget.
   uint64_t memory_budget = 0;
+  // Every write_every_s: intermediate outputs (checkpoint), then, when set, the state to resume
+  // from (save_state), which is also called once when the render ends.
   std::function<void(int passes)> checkpoint;
+  std::function<void(const RenderState&)> save_state;
+  // Go on from this state (the film given to render() already holds its sums): passes continue
+  // from state.passes, and spp counts them too. Null: a fresh render.
+  const RenderState* resume = nullptr;
 };
 
 struct RenderStats {

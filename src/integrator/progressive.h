@@ -38,10 +38,18 @@ struct PassResult {
 // film, sampling the pixels control.sample_pixel chooses.
 using PassFunction = std::function<PassResult(int pass, const RenderControl& control)>;
 
-// Runs passes until a budget ends the render. `unit` names a pass in the progress line. Fills
-// the passes, stop reason, time, mean sampling probability and error delta of `stats`.
+// What an integrator carries from one pass to the next besides the film (bpm's guide), saved for
+// a checkpoint and loaded when resuming one; integrators without such state pass none.
+struct IntegratorState {
+  std::function<void(ByteWriter&)> save;
+  std::function<void(ByteReader&)> load;
+};
+
+// Runs passes until a budget ends the render (from opt.resume's state when given). `unit` names a
+// pass in the progress line. Fills the passes, stop reason, time, mean sampling probability and
+// error delta of `stats`. Calls opt.checkpoint and opt.save_state (integrator/options.h).
 void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
-                const PassFunction& pass, RenderStats* stats);
+                const PassFunction& pass, RenderStats* stats, const IntegratorState& state = {});
 
 // One pixel sample: its random stream, keyed by (seed, pass index, pixel), which has already
 // drawn the filter offset and the lens position; the camera ray; the filter weight.

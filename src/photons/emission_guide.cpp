@@ -102,4 +102,18 @@ void EmissionGuide::update() {
   guided_ = AliasTable(mixed);
 }
 
+void EmissionGuide::save(ByteWriter& w) const {
+  w.put_vector(score_sum_);
+  w.put_vector(photons_);
+}
+
+void EmissionGuide::load(ByteReader& r) {
+  std::vector<double> score_sum = r.get_vector<double>(), photons = r.get_vector<double>();
+  if (score_sum.size() != cells_ || photons.size() != cells_)
+    throw Error(r.what() + " was learnt on another scene's lights (emission guide cells)");
+  score_sum_ = std::move(score_sum);
+  photons_ = std::move(photons);
+  update();
+}
+
 }  // namespace bpm

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "base/bytes.h"
 #include "base/rng.h"
 #include "base/sampling.h"
 #include "scene/render_scene.h"
@@ -49,6 +50,10 @@ class EmissionGuide {
   // The share of photons guidance moves (total variation between the guided and unguided
   // densities): 0 before anything is learnt, at most 1/2 with the even mixture.
   double moved() const { return moved_; }
+  // What it has learnt, for a checkpoint; load() takes it back into a guide of the same scene and
+  // rebuilds the density from it, as update() had.
+  void save(ByteWriter& w) const;
+  void load(ByteReader& r);
 
  private:
   struct LightCells {

@@ -70,7 +70,8 @@ struct ParsedScene {
   std::map<std::string, SceneEntity> media;  // MakeNamedMedium; name is the "type" parameter
   std::vector<ShapeEntity> shapes;
   std::vector<LightEntity> lights;
-  std::string base_directory;  // of the main scene file
+  std::string base_directory;      // of the main scene file
+  std::vector<std::string> files;  // the scene files read: the main one, then each Include/Import
 };
 
 // Parses a scene file (following Include and Import). Throws Error with file:line:column.

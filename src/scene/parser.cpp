@@ -518,6 +518,7 @@ class Parser {
     if (peeked_) throw Error(d.loc, "internal: include with pending token");
     include_chain_.insert(ps);
     push_file(Tokenizer::from_file(ps, d.loc));
+    scene_->files.push_back(ps);
     return true;
   }
 };
@@ -528,6 +529,7 @@ ParsedScene parse_scene_file(const std::string& path) {
   ParsedScene scene;
   scene.base_directory = fs::path(path).parent_path().string();
   if (scene.base_directory.empty()) scene.base_directory = ".";
+  scene.files.push_back(path);
   Parser parser(&scene);
   parser.run(Tokenizer::from_file(path, FileLoc{path, 0, 0}));
   return scene;
