@@ -11,7 +11,7 @@ namespace bpm {
 void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film,
-                          std::vector<double>* estimates, std::vector<uint32_t>* counts) {
+                          std::vector<double>* estimates) {
   const int w = film->width(), h = film->height();
   std::vector<Spectrum> photon_L(size_t(w) * size_t(h)), bias(size_t(w) * size_t(h));
   for (size_t g = 0; g < maps.photons.size(); ++g) {
@@ -35,8 +35,8 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
           film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
         if (estimates && L.is_finite()) {
-          (*estimates)[p] += L.average();
-          ++(*counts)[p];
+          (*estimates)[2 * size_t(p)] += L.average();
+          (*estimates)[2 * size_t(p) + 1] += 1;
         }
       }
   });

@@ -15,12 +15,11 @@ namespace bpm {
 // light.flux[g]: the summed contributions backward photon g received from light.emitted photons;
 // with those from the inner discs, each pixel's bias estimate of the pass over its photon part
 // (radius_bias under bias_model) goes to the film beside its estimate, or with `debias` is taken
-// from it. When `estimates` is given, each sampled pixel's estimate (the mean over its
-// wavelengths) is added to it and that pixel's count in `counts` incremented.
+// from it. When `estimates` is given (2 per pixel), each sampled pixel's estimate (the mean over
+// its wavelengths) is added to its first and 1 to its second.
 void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film,
-                          std::vector<double>* estimates = nullptr,
-                          std::vector<uint32_t>* counts = nullptr);
+                          std::vector<double>* estimates = nullptr);
 
 }  // namespace bpm

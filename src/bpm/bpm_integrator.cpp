@@ -81,9 +81,10 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
   LightPassBuffers light;
   BpmTotals tot;
   // Guided emission learns from each iteration's photons, scored relative to the pixels they
-  // reach; the pixels' values are the running means of their estimates.
+  // reach; the pixels' values are the running means of their estimates. Both change at the end
+  // of a round (integrator/control.h): estimate_new holds the round's sums and counts until then.
   EmissionGuide guide = s.guide_emission ? EmissionGuide(scene) : EmissionGuide();
-  std::vector<double> estimate_sum(n_pixels, 0.0);
+  std::vector<double> estimate_sum(n_pixels, 0.0), estimate_new(2 * n_pixels, 0.0);
   std::vector<uint32_t> estimate_count(n_pixels, 0);
   std::vector<float> pixel_weight;
 
@@ -165,12 +166,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
     accumulate_iteration(maps, light_result, eye, wm.wl, ls.film.max_component_value, s, film,
-                         &estimate_sum, &estimate_count);
-    if (!guide.empty()) {
-      guide.update();
-      tot.guide_moved = guide.moved();
-      update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
-    }
+                         guide.empty() ? nullptr : &estimate_new);
     tot.accumulate_s += since(t);
     masks.rebuild(eye.cost_ns);
 
@@ -185,23 +181,45 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     return r;
   };
   // Carried from one iteration to the next: what the guide learnt and the pixels' running means
-  // (the pixel weights follow from them).
+  // (the pixel weights follow from them), merged at the end of each round.
   IntegratorState state;
+  if (!guide.empty()) {
+    state.learnt = [&](std::vector<double>* out) {
+      guide.take_learnt(out);
+      out->insert(out->end(), estimate_new.begin(), estimate_new.end());
+      std::fill(estimate_new.begin(), estimate_new.end(), 0.0);
+    };
+    state.merge = [&](const std::vector<double>& learnt) {
+      guide.merge(learnt.data());
+      tot.guide_moved = guide.moved();
+      const double* e = learnt.data() + 2 * guide.cells();
+      for (size_t p = 0; p < n_pixels; ++p) {
+        estimate_sum[p] += e[2 * p];
+        estimate_count[p] += uint32_t(e[2 * p + 1]);
+      }
+      update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
+    };
+  }
   state.save = [&](ByteWriter& w) {
     w.put(uint8_t(!guide.empty()));
-    if (!guide.empty()) guide.save(w);
+    if (guide.empty()) return;
+    guide.save(w);
     w.put_vector(estimate_sum);
     w.put_vector(estimate_count);
+    w.put_vector(estimate_new);
   };
   state.load = [&](ByteReader& r) {
     if (r.get<uint8_t>() != uint8_t(!guide.empty()))
       throw Error(r.what() + " differs in guided emission (--no-guide)");
-    if (!guide.empty()) guide.load(r);
+    if (guide.empty()) return;
+    guide.load(r);
     estimate_sum = r.get_vector<double>();
     estimate_count = r.get_vector<uint32_t>();
-    if (estimate_sum.size() != n_pixels || estimate_count.size() != n_pixels)
+    estimate_new = r.get_vector<double>();
+    if (estimate_sum.size() != n_pixels || estimate_count.size() != n_pixels ||
+        estimate_new.size() != 2 * n_pixels)
       throw Error(r.what() + " is truncated or corrupt (pixel estimates)");
-    if (!guide.empty()) update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
+    update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
   };
   RenderStats stats;
   run_passes(opt, film, "iteration", iteration, &stats, state);

@@ -40,8 +40,8 @@ inline Rgb film_rgb(const Spectrum& L, const Wavelengths& wl, float max_value) {
 
 class Film {
  public:
-  // m_images > 0 also keeps the paper's M intermediate images (section 4): pass j of a pixel goes
-  // to image j mod M, and the spread between the M images is a second error estimate.
+  // m_images > 0 also keeps the paper's M intermediate images (section 4): pass j goes to image
+  // j mod M (begin_pass), and the spread between the M images is a second error estimate.
   Film(int width, int height, int m_images = 0);
   int width() const { return width_; }
   int height() const { return height_; }
@@ -74,6 +74,10 @@ class Film {
   // Counts a sample of the pixel that was not recordable (and was recorded as black).
   void drop_sample(int x, int y) { ++pixels_[size_t(y) * width_ + x].dropped; }
   uint64_t dropped_samples() const;
+  // The render's index of the pass about to be recorded: it chooses each pixel's M-image (pass
+  // j goes to image j mod M), so that passes rendered apart (render/distributed.h) land where one
+  // process puts them.
+  void begin_pass(int index) { pass_index_ = index; }
   // Ends the current pass for one pixel: its pass estimate joins the running moments.
   void end_pass(int x, int y) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
@@ -89,7 +93,7 @@ class Film {
       p.sum_y += y_e;
       p.sum_y2 += y_e * y_e;
       if (m_ > 0) {
-        size_t k = 3 * ((size_t(y) * width_ + x) * size_t(m_) + size_t(p.passes % m_));
+        size_t k = 3 * ((size_t(y) * width_ + x) * size_t(m_) + size_t(pass_index_ % m_));
         for (int c = 0; c < 3; ++c) m_sum_[k + c] += e[c];
         ++m_count_[k / 3];
       }
@@ -158,6 +162,7 @@ class Film {
   int width_, height_;
   std::vector<Pixel> pixels_;
   int m_ = 0;
+  int pass_index_ = 0;
   std::vector<double> m_sum_;  // [pixel][image][channel]
   std::vector<int> m_count_;   // [pixel][image]
 };

@@ -16,6 +16,12 @@ constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
 constexpr int kWarmupPasses = 4;
 }  // namespace
 
+bool ends_round(int passes) {
+  int end = 0;
+  while (end < passes) end += std::clamp(end / 4, 1, 64);
+  return end == passes;
+}
+
 RenderControl::RenderControl(const IntegratorOptions& opt, const Film& film, const char* unit)
     : opt_(opt), film_(film), unit_(unit), t0_(std::chrono::steady_clock::now()) {}
 
@@ -91,16 +97,12 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
   int passes = done + 1;
   double t = elapsed();
   bool print = opt_.progress && (t - last_progress_ >= 0.5 || passes == opt_.spp);
-  // Each of these reads the whole film: the accuracy budget needs delta after every pass, the rest
-  // only now and then (sampling probabilities every pass at first, then every fourth).
-  bool adapt = opt_.adaptive && passes >= kWarmupPasses && (passes < 16 || passes % 4 == 0);
   // The total error: noise, and for the photon methods their bias estimate as well.
   if (opt_.accuracy > 0 || print) {
     bias_ = film_.relative_error_bias();
     delta_ =
         std::sqrt(std::pow(film_.relative_error(), 2) + bias_ * bias_);  // relative_error_total
   }
-  if (adapt) update_probabilities();
   if (!print) return;
   last_progress_ = t;
   char budget[32] = "";
@@ -143,6 +145,10 @@ double RenderControl::mean_sampling_probability() const {
   double s = 0;
   for (float p : probability_) s += p;
   return s / double(probability_.size());
+}
+
+void RenderControl::end_round(int passes) {
+  if (opt_.adaptive && passes >= kWarmupPasses) update_probabilities();
 }
 
 bool RenderControl::checkpoint_due() {

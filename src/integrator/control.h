@@ -28,6 +28,14 @@ inline double since(Clock::time_point t) {
 
 struct IntegratorOptions;
 
+// Passes are grouped into rounds. Within a round the passes are independent: the sampling
+// probabilities and what an integrator learns from its passes (bpm's guided emission) stay as
+// they were at the round's start; at its end what the round learnt is merged. A round is a
+// quarter of the passes before it (one pass each for the first eight, at most 64), and where
+// rounds end depends on the pass count alone, so that one process, or several sharing a round's
+// passes (render/distributed.h), render the same passes from the same state.
+bool ends_round(int passes);
+
 class RenderControl {
  public:
   // `unit` names a pass in the progress line ("pass" or "iteration").
@@ -37,9 +45,11 @@ class RenderControl {
   bool keep_going(int done);
   // Ends the render for a reason of the integrator's own (PassResult::stop_reason).
   void stop(const std::string& reason) { stop_reason_ = reason; }
-  // After a pass: updates the sampling probabilities, prints progress.
-  // `rays` is the total traced so far; `extra` is appended to the progress line.
+  // After a pass: prints progress. `rays` is the total traced so far; `extra` is appended to the
+  // progress line.
   void after_pass(int done, uint64_t rays, const std::string& extra = "");
+  // At the end of a round (ends_round(passes)): the sampling probabilities of the next one.
+  void end_round(int passes);
   // Whether work of pass `pass` not yet started (tiles, chunks of photons) is to be left out: an
   // interrupt, or the time budget spent. The time budget never cuts the first pass, so that a
   // render always has a complete image; a later pass cut by it ends the render.

@@ -26,6 +26,7 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
     return s;
   };
   for (int p = first; control.keep_going(p); ++p) {
+    film->begin_pass(opt.first_iteration + p);
     PassResult r = pass(p, control);
     if (!r.completed) {
       if (r.stop_reason.empty())
@@ -35,6 +36,14 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
       break;
     }
     stats->passes = p + 1;
+    if (ends_round(p + 1)) {
+      if (state.learnt) {
+        std::vector<double> learnt;
+        state.learnt(&learnt);
+        state.merge(learnt);
+      }
+      control.end_round(p + 1);
+    }
     control.after_pass(p, r.rays, r.progress);
     if (control.checkpoint_due()) {
       if (opt.checkpoint) opt.checkpoint(p + 1);

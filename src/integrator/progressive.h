@@ -43,6 +43,11 @@ using PassFunction = std::function<PassResult(int pass, const RenderControl& con
 struct IntegratorState {
   std::function<void(ByteWriter&)> save;
   std::function<void(ByteReader&)> load;
+  // What the integrator learnt during a round, as sums that add across processes (appended to
+  // the vector, then forgotten); merge takes such sums (its own, or every process's added) at
+  // the round's end. Unset for integrators that learn nothing.
+  std::function<void(std::vector<double>*)> learnt;
+  std::function<void(const std::vector<double>&)> merge;
 };
 
 // Runs passes until a budget ends the render (from opt.resume's state when given). `unit` names a

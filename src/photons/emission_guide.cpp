@@ -44,6 +44,8 @@ EmissionGuide::EmissionGuide(const RenderScene& scene) {
   guided_ = AliasTable(unguided_);
   score_sum_.assign(cells_, 0.0);
   photons_.assign(cells_, 0.0);
+  new_score_.assign(cells_, 0.0);
+  new_photons_.assign(cells_, 0.0);
 }
 
 EmissionDraw EmissionGuide::sample(Rng& rng) const {
@@ -77,12 +79,33 @@ EmissionDraw EmissionGuide::sample(Rng& rng) const {
 void EmissionGuide::learn(const std::vector<CellScore>& scores) {
   for (const CellScore& s : scores) {
     // A non-finite score (a numerical accident) would poison its cell's sum for good.
-    if (std::isfinite(s.score) && s.score >= 0) score_sum_[s.cell] += s.score;
-    photons_[s.cell] += 1;
+    if (std::isfinite(s.score) && s.score >= 0) new_score_[s.cell] += s.score;
+    new_photons_[s.cell] += 1;
   }
 }
 
+void EmissionGuide::take_learnt(std::vector<double>* out) {
+  out->insert(out->end(), new_score_.begin(), new_score_.end());
+  out->insert(out->end(), new_photons_.begin(), new_photons_.end());
+  std::fill(new_score_.begin(), new_score_.end(), 0.0);
+  std::fill(new_photons_.begin(), new_photons_.end(), 0.0);
+}
+
+void EmissionGuide::merge(const double* learnt) {
+  for (size_t c = 0; c < cells_; ++c) {
+    score_sum_[c] += learnt[c];
+    photons_[c] += learnt[cells_ + c];
+  }
+  rebuild();
+}
+
 void EmissionGuide::update() {
+  std::vector<double> learnt;
+  take_learnt(&learnt);
+  merge(learnt.data());
+}
+
+void EmissionGuide::rebuild() {
   if (cells_ == 0) return;
   // Learnt density: the unguided probability of a cell times the mean score of its photons.
   std::vector<double> learnt(cells_, 0.0);
@@ -103,17 +126,17 @@ void EmissionGuide::update() {
 }
 
 void EmissionGuide::save(ByteWriter& w) const {
-  w.put_vector(score_sum_);
-  w.put_vector(photons_);
+  for (const std::vector<double>* v : {&score_sum_, &photons_, &new_score_, &new_photons_})
+    w.put_vector(*v);
 }
 
 void EmissionGuide::load(ByteReader& r) {
-  std::vector<double> score_sum = r.get_vector<double>(), photons = r.get_vector<double>();
-  if (score_sum.size() != cells_ || photons.size() != cells_)
-    throw Error(r.what() + " was learnt on another scene's lights (emission guide cells)");
-  score_sum_ = std::move(score_sum);
-  photons_ = std::move(photons);
-  update();
+  for (std::vector<double>* v : {&score_sum_, &photons_, &new_score_, &new_photons_}) {
+    *v = r.get_vector<double>();
+    if (v->size() != cells_)
+      throw Error(r.what() + " was learnt on another scene's lights (emission guide cells)");
+  }
+  rebuild();
 }
 
 }  // namespace bpm

@@ -42,16 +42,23 @@ class EmissionGuide {
   size_t cells() const { return cells_; }
   // Draws the emission of one photon (six numbers from rng: two choose the cell).
   EmissionDraw sample(Rng& rng) const;
-  // Adds the scores of photons, in a fixed order (the sums must not depend on the thread count).
+  // Adds the scores of photons, in a fixed order (the sums must not depend on the thread count),
+  // to what was learnt since the last merge; sampling does not change until then.
   void learn(const std::vector<CellScore>& scores);
-  // Rebuilds the guided density from everything learnt so far; until a photon has scored, the
-  // density stays the unguided one.
+  // Appends what was learnt since the last merge (2 cells() sums that add across processes) and
+  // starts again from nothing.
+  void take_learnt(std::vector<double>* out);
+  // Adds learnt sums (take_learnt's, of one process or summed over several) and rebuilds the
+  // guided density from everything merged so far; until a photon has scored, the density stays
+  // the unguided one.
+  void merge(const double* learnt);
+  // take_learnt and merge of this guide alone.
   void update();
   // The share of photons guidance moves (total variation between the guided and unguided
   // densities): 0 before anything is learnt, at most 1/2 with the even mixture.
   double moved() const { return moved_; }
-  // What it has learnt, for a checkpoint; load() takes it back into a guide of the same scene and
-  // rebuilds the density from it, as update() had.
+  // What it has merged and what it learnt since, for a checkpoint; load() takes them back into a
+  // guide of the same scene and rebuilds the density as merge() had.
   void save(ByteWriter& w) const;
   void load(ByteReader& r);
 
@@ -63,7 +70,9 @@ class EmissionGuide {
   std::vector<LightCells> lights_;
   std::vector<float> unguided_;  // probability of each cell without guidance
   AliasTable guided_;            // drawn once per photon: two look-ups, not a binary search
-  std::vector<double> score_sum_, photons_;
+  void rebuild();
+  std::vector<double> score_sum_, photons_;      // merged
+  std::vector<double> new_score_, new_photons_;  // learnt since the last merge
   size_t cells_ = 0;
   double moved_ = 0;
 };

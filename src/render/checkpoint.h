@@ -3,7 +3,8 @@
 // length makes. A checkpoint holds
 //   - the render's identity: what must be the same for the resumed passes to continue the same
 //     estimate (the scene files' contents, resolution, integrator and its settings, seed, depth,
-//     filter, adaptive sampling, M-images); budgets (passes, time, accuracy) and threads may differ;
+//     filter, adaptive sampling, M-images); budgets (passes, time, accuracy) and threads may
+//     differ;
 //   - the film's sums (Film::save), and the render state (RenderState: passes done, sampling
 //     probabilities, what bpm's guide learnt).
 // Layout: "BPMCKPT\n", a format version, the identity as JSON text, the film, the state, then an
