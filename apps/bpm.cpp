@@ -15,7 +15,11 @@
 #include "film/image_compare.h"
 #include "film/image_io.h"
 #include "film/outputs.h"
+#include "integrator/team.h"
 #include "render/checkpoint.h"
+#ifdef BPM_HAVE_MPI
+#include "render/mpi_team.h"
+#endif
 #include "render/renderer.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
@@ -241,6 +245,10 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                       {"passes_before", opt.resume->passes},
                       {"note", "rays, times and statistics are this run's alone"}};
   if (opt.save_state) rec["outputs"]["checkpoint"] = paths.checkpoint;
+  if (opt.team) {
+    rec["settings"]["processes"] = opt.team->size();
+    rec["processes"] = st.processes;
+  }
   rec["stages_s"] = {{"parse", t_parse},
                      {"build", t_build},
                      {"render", st.render_seconds},
@@ -248,7 +256,10 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
   return rec;
 }
 
-int run_render(const RenderArgs& a) {
+// With several processes (mpirun), process 0 alone prints and writes; the others render.
+int run_render(RenderArgs a, Team* team, bool* rendering) {
+  const bool root = !team || team->rank() == 0;
+  if (!root) a.quiet = true;
   auto t_start = Clock::now();
   ParsedScene parsed = parse_scene_file(a.scene);
   const IntegratorSettings file_settings{bpm_settings_from_file(parsed.integrator),
@@ -300,7 +311,7 @@ int run_render(const RenderArgs& a) {
       std::fprintf(stderr, "bpm: resuming %s after %d %s\n", a.resume.c_str(), resumed.state.passes,
                    opt.integrator == "path" ? "passes" : "iterations");
   }
-  if (keep_checkpoint)
+  if (keep_checkpoint && root)
     opt.save_state = [&](const RenderState& state) {
       const std::vector<uint8_t> bytes = encode_checkpoint(identity, film, state);
       write_bytes_atomic(paths.checkpoint, bytes.data(), bytes.size());
@@ -319,7 +330,11 @@ int run_render(const RenderArgs& a) {
                      {"relative_error_delta_total", film.relative_error_total()}};
     write_text_atomic(paths.json, rec.dump(2) + "\n");
   };
+  opt.team = team;
+  if (!root) opt.checkpoint = nullptr;
+  *rendering = true;
   RenderStats st = render(ls, opt, &film);
+  if (!root) return 0;
 
   auto t3 = Clock::now();
   write_images(paths, film, ls.film.imaging_ratio);
@@ -516,15 +531,27 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+#ifdef BPM_HAVE_MPI
+  MpiSession mpi(&argc, &argv);
+  Team* team = mpi.team();
+#else
+  Team* team = nullptr;
+#endif
+  // Every process meets the same errors before the render (the same files and flags): process 0
+  // says them. An error during a render with other processes ends them all.
+  bool rendering = false;
+  auto fail = [&](const char* what) {
+    if (!team || team->rank() == 0 || rendering) std::fprintf(stderr, "bpm: error: %s\n", what);
+#ifdef BPM_HAVE_MPI
+    if (team && rendering) mpi.abort(1);
+#endif
+    return 1;
+  };
   try {
-    if (*render) return run_render(ra);
+    if (*render) return run_render(ra, team, &rendering);
     if (*compare) return run_compare(cmp_a, cmp_b);
-  } catch (const bpm::Error& e) {
-    std::fprintf(stderr, "bpm: error: %s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "bpm: error: %s\n", e.what());
-    return 1;
+    return fail(e.what());
   }
   return 0;
 }

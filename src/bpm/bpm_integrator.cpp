@@ -180,27 +180,42 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     r.progress = progress;
     return r;
   };
-  // Carried from one iteration to the next: what the guide learnt and the pixels' running means
-  // (the pixel weights follow from them), merged at the end of each round.
+  // Carried from one iteration to the next, and merged at the end of each round: which pixels see
+  // emission, what the guide learnt and the pixels' running means (the pixel weights follow from
+  // them).
   IntegratorState state;
-  if (!guide.empty()) {
-    state.learnt = [&](std::vector<double>* out) {
-      guide.take_learnt(out);
-      out->insert(out->end(), estimate_new.begin(), estimate_new.end());
-      std::fill(estimate_new.begin(), estimate_new.end(), 0.0);
-    };
-    state.merge = [&](const std::vector<double>& learnt) {
-      guide.merge(learnt.data());
-      tot.guide_moved = guide.moved();
-      const double* e = learnt.data() + 2 * guide.cells();
-      for (size_t p = 0; p < n_pixels; ++p) {
-        estimate_sum[p] += e[2 * p];
-        estimate_count[p] += uint32_t(e[2 * p + 1]);
-      }
-      update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
-    };
-  }
+  state.learnt = [&](std::vector<double>* out) {
+    for (uint8_t& saw : eye.saw_emission) {
+      out->push_back(saw);
+      saw = 0;
+    }
+    if (guide.empty()) return;
+    guide.take_learnt(out);
+    out->insert(out->end(), estimate_new.begin(), estimate_new.end());
+    std::fill(estimate_new.begin(), estimate_new.end(), 0.0);
+  };
+  state.merge = [&](const std::vector<double>& sums) {
+    for (size_t p = 0; p < n_pixels; ++p)
+      if (sums[p] > 0) eye.sees_emission[p] = 1;
+    if (guide.empty()) return;
+    // A round's sums are rounded to float precision before they join: processes add their
+    // shares in another order than one process adds passes, and a difference in the last bits
+    // of a sum would move a boundary of the guided density, so that the same seed would draw
+    // other photons.
+    std::vector<double> learnt(sums.size() - n_pixels);
+    for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[n_pixels + i]));
+    guide.merge(learnt.data());
+    tot.guide_moved = guide.moved();
+    const double* e = learnt.data() + 2 * guide.cells();
+    for (size_t p = 0; p < n_pixels; ++p) {
+      estimate_sum[p] += e[2 * p];
+      estimate_count[p] += uint32_t(e[2 * p + 1]);
+    }
+    update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
+  };
   state.save = [&](ByteWriter& w) {
+    w.put_vector(eye.sees_emission);
+    w.put_vector(eye.saw_emission);
     w.put(uint8_t(!guide.empty()));
     if (guide.empty()) return;
     guide.save(w);
@@ -209,6 +224,10 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     w.put_vector(estimate_new);
   };
   state.load = [&](ByteReader& r) {
+    eye.sees_emission = r.get_vector<uint8_t>();
+    eye.saw_emission = r.get_vector<uint8_t>();
+    if (eye.sees_emission.size() != n_pixels || eye.saw_emission.size() != n_pixels)
+      throw Error(r.what() + " is truncated or corrupt (pixels that see emission)");
     if (r.get<uint8_t>() != uint8_t(!guide.empty()))
       throw Error(r.what() + " differs in guided emission (--no-guide)");
     if (guide.empty()) return;

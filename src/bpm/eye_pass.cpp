@@ -175,7 +175,7 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             if (prm.emission_samples > 1 && px->sees_emission[pixel] && cs.filter_weight != 0)
               px->radiance[pixel] += more_emission_samples(scene, prm, camera, pass_index, pixel,
                                                            cs.filter_weight, r.emission, lists, ec);
-            if (!r.emission.is_black()) px->sees_emission[pixel] = 1;
+            if (!r.emission.is_black()) px->saw_emission[pixel] = 1;
             px->cost_ns[pixel] =
                 float(std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
           }

@@ -65,11 +65,17 @@ struct EyePixels {
   std::vector<float> filter_weight;  // of the pixel's camera sample
   std::vector<float> cost_ns;        // time spent on the pixel, to rebuild the masks
   std::vector<uint8_t> sampled;      // whether this iteration samples the pixel
-  // Whether any earlier sample of the pixel saw emission before its first diffuse vertex: such
-  // pixels take EyePassParams::emission_samples camera samples for it.
-  std::vector<uint8_t> sees_emission;
+  // Whether a sample of the pixel in an earlier round (integrator/control.h) saw emission before
+  // its first diffuse vertex: such pixels take EyePassParams::emission_samples camera samples for
+  // it. saw_emission marks those of this round, merged at its end.
+  std::vector<uint8_t> sees_emission, saw_emission;
   explicit EyePixels(size_t n)
-      : radiance(n), filter_weight(n), cost_ns(n), sampled(n, 0), sees_emission(n, 0) {}
+      : radiance(n),
+        filter_weight(n),
+        cost_ns(n),
+        sampled(n, 0),
+        sees_emission(n, 0),
+        saw_emission(n, 0) {}
 };
 
 // Per-thread state the eye pass fills.

@@ -1,5 +1,6 @@
 #include "film/film.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace bpm {
@@ -207,6 +208,36 @@ std::vector<int> Film::lit_pass_counts() const {
   std::vector<int> out(pixels_.size());
   for (size_t i = 0; i < pixels_.size(); ++i) out[i] = pixels_[i].lit_passes;
   return out;
+}
+
+void Film::add(const Film& o) {
+  BPM_CHECK(o.width_ == width_ && o.height_ == height_ && o.m_ == m_);
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    Pixel& p = pixels_[i];
+    const Pixel& q = o.pixels_[i];
+    for (int c = 0; c < 3; ++c) {
+      p.sum_wl[c] += q.sum_wl[c];
+      p.sum_e[c] += q.sum_e[c];
+      p.sum_e2[c] += q.sum_e2[c];
+      p.sum_b[c] += q.sum_b[c];
+      p.sum_b2[c] += q.sum_b2[c];
+    }
+    p.sum_w += q.sum_w;
+    p.sum_y += q.sum_y;
+    p.sum_y2 += q.sum_y2;
+    p.passes += q.passes;
+    p.lit_passes += q.lit_passes;
+    p.dropped += q.dropped;
+    p.bias_passes += q.bias_passes;
+  }
+  for (size_t i = 0; i < m_sum_.size(); ++i) m_sum_[i] += o.m_sum_[i];
+  for (size_t i = 0; i < m_count_.size(); ++i) m_count_[i] += o.m_count_[i];
+}
+
+void Film::clear() {
+  std::fill(pixels_.begin(), pixels_.end(), Pixel{});
+  std::fill(m_sum_.begin(), m_sum_.end(), 0.0);
+  std::fill(m_count_.begin(), m_count_.end(), 0);
 }
 
 void Film::save(ByteWriter& w) const {

@@ -138,6 +138,10 @@ class Film {
   std::vector<float> rms_m_images() const;
   double relative_error_m_images() const;
 
+  // Adds another film's sums (of other passes) to this one's, as if its passes had been recorded
+  // here; clear() forgets every pass. Both films must have the same size and M.
+  void add(const Film& other);
+  void clear();
   // Every per-pixel sum the film keeps, for a checkpoint; load() takes them back (between passes)
   // into a film of the same size and M, and throws Error naming what differs otherwise.
   void save(ByteWriter& w) const;

@@ -20,6 +20,8 @@ struct RenderState {
   std::vector<uint8_t> control, integrator;
 };
 
+class Team;  // integrator/team.h
+
 struct IntegratorOptions {
   int spp = 16;             // passes (iterations for the photon integrators)
   int first_iteration = 0;  // index of the first pass: random streams and radii follow it, so
@@ -44,6 +46,8 @@ struct IntegratorOptions {
   // Go on from this state (the film given to render() already holds its sums): passes continue
   // from state.passes, and spp counts them too. Null: a fresh render.
   const RenderState* resume = nullptr;
+  // Several processes render this image together (integrator/team.h); null: this one alone.
+  Team* team = nullptr;
 };
 
 struct RenderStats {
@@ -55,6 +59,8 @@ struct RenderStats {
   double render_seconds = 0;
   double relative_error = 0;  // eq. (4) over per-pass estimates
   nlohmann::json details;     // integrator-specific statistics
+  // With a team, in process 0: per process its passes, rays and seconds spent in passes.
+  nlohmann::json processes;
   uint64_t total_rays() const { return rays.total() + light_rays; }
 };
 

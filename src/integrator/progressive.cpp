@@ -1,30 +1,16 @@
 #include "integrator/progressive.h"
 
-namespace bpm {
+#include <algorithm>
 
-void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
-                const PassFunction& pass, RenderStats* stats, const IntegratorState& state) {
-  RenderControl control(opt, *film, unit);
-  int first = 0;
-  if (opt.resume) {
-    ByteReader c(opt.resume->control, "the checkpoint's render state");
-    control.load(c);
-    ByteReader i(opt.resume->integrator, "the checkpoint's integrator state");
-    if (state.load) state.load(i);
-    if (!i.at_end()) throw Error("the checkpoint's integrator state does not fit this integrator");
-    first = opt.resume->passes;
-  }
-  stats->passes = first;
-  auto snapshot = [&] {
-    RenderState s;
-    s.passes = stats->passes;
-    ByteWriter c, i;
-    control.save(c);
-    if (state.save) state.save(i);
-    s.control = c.take();
-    s.integrator = i.take();
-    return s;
-  };
+#include "integrator/team.h"
+
+namespace bpm {
+namespace {
+
+// run_passes in one process.
+void run_passes_alone(const IntegratorOptions& opt, Film* film, const PassFunction& pass,
+                      RenderStats* stats, const IntegratorState& state, RenderControl& control,
+                      const std::function<RenderState()>& snapshot, int first) {
   for (int p = first; control.keep_going(p); ++p) {
     film->begin_pass(opt.first_iteration + p);
     PassResult r = pass(p, control);
@@ -49,6 +35,131 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
       if (opt.checkpoint) opt.checkpoint(p + 1);
       if (opt.save_state) opt.save_state(snapshot());
     }
+  }
+}
+
+// run_passes with several processes (integrator/team.h): round by round, each round's passes
+// shared out, then the films gathered, what was learnt added up and merged, and process 0's
+// decisions (sampling probabilities, go on or stop) sent to every process.
+void run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunction& pass,
+                     RenderStats* stats, const IntegratorState& state, RenderControl& control,
+                     const std::function<RenderState()>& snapshot) {
+  Team& team = *opt.team;
+  const bool root = team.rank() == 0;
+  int passes = stats->passes;  // completed, over every process
+  std::string reason, progress;
+  uint64_t my_rays = 0;
+  int my_passes = 0;
+  double my_seconds = 0;
+  for (;;) {
+    std::vector<uint8_t> go{uint8_t(root && control.keep_going(passes))};
+    team.broadcast(&go);
+    if (!go[0]) break;
+    int end = passes + 1;
+    while (!ends_round(end)) ++end;
+    end = std::min(end, opt.spp);
+    const auto t = Clock::now();
+    int top = -1;  // the highest pass index this process completed
+    const int mine = team.share_passes(passes, end, [&](int p) {
+      film->begin_pass(opt.first_iteration + p);
+      PassResult r = pass(p, control);
+      if (!r.completed) {
+        if (reason.empty()) reason = r.stop_reason;
+        return false;
+      }
+      my_rays = r.rays;
+      progress = r.progress;
+      top = std::max(top, p);
+      return true;
+    });
+    my_seconds += since(t);
+    my_passes += mine;
+    // Completed passes and rays over every process; the next pass index after the highest done.
+    std::vector<double> counts{double(mine), double(my_rays)};
+    std::vector<double> tops{double(top)};
+    team.sum(&counts);
+    std::vector<std::vector<double>> all_tops = team.gather(tops);
+    const int completed = int(counts[0]);
+    int next = passes + completed;
+    for (const auto& row : all_tops) next = std::max(next, int(row[0]) + 1);
+    team.gather_film(film);
+    const bool cut = next - passes > completed || completed < end - passes;
+    passes = next;
+    stats->passes = passes;
+    if (ends_round(passes)) {
+      if (state.learnt) {
+        std::vector<double> learnt;
+        state.learnt(&learnt);
+        team.sum(&learnt);
+        state.merge(learnt);
+      }
+      if (root) control.end_round(passes);
+      ByteWriter w;
+      if (root) control.save(w);
+      std::vector<uint8_t> c = w.take();
+      team.broadcast(&c);
+      ByteReader r(c, "the render state of process 0");
+      if (!root) control.load(r);
+    }
+    if (root) {
+      control.after_pass(passes - 1, uint64_t(counts[1]), progress);
+      if (!cut && control.checkpoint_due()) {
+        if (opt.checkpoint) opt.checkpoint(passes);
+        if (opt.save_state) opt.save_state(snapshot());
+      }
+    }
+    // A cut pass ends the render, as in one process: the reason is its integrator's, or the
+    // interrupt or the time budget.
+    std::vector<uint8_t> stop{uint8_t(cut)};
+    team.broadcast(&stop);
+    if (stop[0]) {
+      if (root) {
+        if (reason.empty())
+          control.keep_going(passes);
+        else
+          control.stop(reason);
+      }
+      break;
+    }
+  }
+  std::vector<std::vector<double>> rows =
+      team.gather({double(my_passes), double(my_rays), my_seconds});
+  for (size_t r = 0; r < rows.size(); ++r)
+    stats->processes.push_back({{"rank", r},
+                                {"passes", int(rows[r][0])},
+                                {"rays", uint64_t(rows[r][1])},
+                                {"pass_seconds", rows[r][2]}});
+}
+
+}  // namespace
+
+void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
+                const PassFunction& pass, RenderStats* stats, const IntegratorState& state) {
+  RenderControl control(opt, *film, unit);
+  int first = 0;
+  if (opt.resume) {
+    ByteReader c(opt.resume->control, "the checkpoint's render state");
+    control.load(c);
+    ByteReader i(opt.resume->integrator, "the checkpoint's integrator state");
+    if (state.load) state.load(i);
+    if (!i.at_end()) throw Error("the checkpoint's integrator state does not fit this integrator");
+    first = opt.resume->passes;
+  }
+  stats->passes = first;
+  auto snapshot = [&] {
+    RenderState s;
+    s.passes = stats->passes;
+    ByteWriter c, i;
+    control.save(c);
+    if (state.save) state.save(i);
+    s.control = c.take();
+    s.integrator = i.take();
+    return s;
+  };
+  if (opt.team && opt.team->size() > 1) {
+    run_team_passes(opt, film, pass, stats, state, control, snapshot);
+  } else {
+    run_passes_alone(opt, film, pass, stats, state, control, snapshot, first);
   }
   control.finish();
   if (opt.save_state) opt.save_state(snapshot());

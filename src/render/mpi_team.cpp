@@ -1,0 +1,173 @@
+#include "render/mpi_team.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <future>
+#include <thread>
+
+#include "base/bytes.h"
+#include "base/error.h"
+
+namespace bpm {
+namespace {
+
+constexpr int kTagAsk = 1, kTagGive = 2, kTagFilm = 3;
+// MPI counts are ints: large buffers go in pieces.
+constexpr size_t kPiece = size_t(1) << 30;
+
+class MpiTeam : public Team {
+ public:
+  MpiTeam() {
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  }
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+
+  int share_passes(int begin, int end, const std::function<bool(int)>& run) override {
+    if (rank_ != 0) {
+      int done = 0, ok = 1;
+      for (;;) {
+        MPI_Send(&ok, 1, MPI_INT, 0, kTagAsk, MPI_COMM_WORLD);
+        int p = -1;
+        MPI_Recv(&p, 1, MPI_INT, 0, kTagGive, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        if (p < 0) return done;
+        ok = run(p) ? 1 : 0;
+        done += ok;
+      }
+    }
+    // Process 0 hands out passes in order and renders its own on a second thread meanwhile.
+    int next = begin, done = 0, waiting = size_ - 1;
+    bool stop = false;
+    auto give = [&] { return !stop && next < end ? next++ : -1; };
+    std::future<bool> own;
+    bool own_busy = false;
+    auto start_own = [&] {
+      const int p = give();
+      own_busy = p >= 0;
+      if (own_busy) own = std::async(std::launch::async, run, p);
+    };
+    start_own();
+    while (own_busy || waiting > 0) {
+      bool idle = true;
+      if (own_busy && own.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+        if (own.get())
+          ++done;
+        else
+          stop = true;
+        start_own();
+        idle = false;
+      }
+      int asked = 0;
+      MPI_Status st;
+      MPI_Iprobe(MPI_ANY_SOURCE, kTagAsk, MPI_COMM_WORLD, &asked, &st);
+      if (asked) {
+        int ok = 1;
+        MPI_Recv(&ok, 1, MPI_INT, st.MPI_SOURCE, kTagAsk, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+        if (!ok) stop = true;
+        int p = give();
+        MPI_Send(&p, 1, MPI_INT, st.MPI_SOURCE, kTagGive, MPI_COMM_WORLD);
+        if (p < 0) --waiting;
+        idle = false;
+      }
+      if (idle) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+    return done;
+  }
+
+  void gather_film(Film* film) override {
+    if (rank_ != 0) {
+      ByteWriter w;
+      film->save(w);
+      send_bytes(w.bytes(), 0);
+      film->clear();
+      return;
+    }
+    // In rank order, so that the sums do not depend on which process answers first.
+    Film other(film->width(), film->height(), film->m_images());
+    for (int r = 1; r < size_; ++r) {
+      const std::vector<uint8_t> bytes = recv_bytes(r);
+      ByteReader reader(bytes, "the film of process " + std::to_string(r));
+      other.load(reader);
+      film->add(other);
+    }
+  }
+
+  void sum(std::vector<double>* v) override {
+    for (size_t at = 0; at < v->size(); at += kPiece / sizeof(double)) {
+      const size_t n = std::min(kPiece / sizeof(double), v->size() - at);
+      MPI_Allreduce(MPI_IN_PLACE, v->data() + at, int(n), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    }
+  }
+
+  void broadcast(std::vector<uint8_t>* bytes) override {
+    uint64_t n = bytes->size();
+    MPI_Bcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    bytes->resize(n);
+    for (size_t at = 0; at < n; at += kPiece)
+      MPI_Bcast(bytes->data() + at, int(std::min<size_t>(kPiece, n - at)), MPI_BYTE, 0,
+                MPI_COMM_WORLD);
+  }
+
+  std::vector<std::vector<double>> gather(const std::vector<double>& mine) override {
+    const int n = int(mine.size());
+    std::vector<double> all(rank_ == 0 ? size_t(n) * size_t(size_) : 0);
+    MPI_Gather(mine.data(), n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    std::vector<std::vector<double>> rows;
+    if (rank_ == 0)
+      for (int r = 0; r < size_; ++r) rows.emplace_back(all.begin() + r * n, all.begin() + (r + 1) * n);
+    return rows;
+  }
+
+ private:
+  static void send_bytes(const std::vector<uint8_t>& bytes, int to) {
+    uint64_t n = bytes.size();
+    MPI_Send(&n, 1, MPI_UINT64_T, to, kTagFilm, MPI_COMM_WORLD);
+    for (size_t at = 0; at < n; at += kPiece)
+      MPI_Send(bytes.data() + at, int(std::min<size_t>(kPiece, n - at)), MPI_BYTE, to, kTagFilm,
+               MPI_COMM_WORLD);
+  }
+  static std::vector<uint8_t> recv_bytes(int from) {
+    uint64_t n = 0;
+    MPI_Recv(&n, 1, MPI_UINT64_T, from, kTagFilm, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    std::vector<uint8_t> bytes(n);
+    for (size_t at = 0; at < n; at += kPiece)
+      MPI_Recv(bytes.data() + at, int(std::min<size_t>(kPiece, n - at)), MPI_BYTE, from, kTagFilm,
+               MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    return bytes;
+  }
+  int rank_ = 0, size_ = 1;
+};
+
+// Whether a launcher started this process as part of a job (Open MPI, PMIx, PMI).
+bool started_by_launcher() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+
+}  // namespace
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+  if (!started_by_launcher()) return;
+  int provided = 0;
+  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+  initialised_ = true;
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size > 1) team_ = std::make_unique<MpiTeam>();
+}
+
+MpiSession::~MpiSession() {
+  if (initialised_) MPI_Finalize();
+}
+
+void MpiSession::abort(int code) {
+  if (initialised_) MPI_Abort(MPI_COMM_WORLD, code);
+  std::exit(code);
+}
+
+}  // namespace bpm
