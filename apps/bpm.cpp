@@ -304,8 +304,10 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
   if (!a.resume.empty()) {
     resumed = read_checkpoint(a.resume);
     check_identity(resumed.identity, identity, a.resume);
+    // The film's sums are process 0's alone (the others' films hold their passes until a round
+    // ends); every process takes the render state.
     ByteReader r(resumed.film, "checkpoint \"" + a.resume + "\"");
-    film.load(r);
+    if (root) film.load(r);
     opt.resume = &resumed.state;
     if (!a.quiet)
       std::fprintf(stderr, "bpm: resuming %s after %d %s\n", a.resume.c_str(), resumed.state.passes,
