@@ -84,9 +84,9 @@ int main(int argc, char** argv) {
   std::printf("%9s %8s %14s %11s\n", "processes", "threads", "iterations/s", "efficiency");
   double one = 0, procs = 0, threads = 0;
   for (const Config& c : configs) {
-    const double rate = run(base, c, oversubscribe, iterations,
-                            out_dir + "/p" + std::to_string(c.processes) + "t" +
-                                std::to_string(c.threads) + ".exr");
+    const double rate = run(
+        base, c, oversubscribe, iterations,
+        out_dir + "/p" + std::to_string(c.processes) + "t" + std::to_string(c.threads) + ".exr");
     if (c.processes == 1 && c.threads == 1) one = rate;
     if (c.processes == cores && c.threads == 1) procs = rate;
     if (c.processes == 1 && c.threads == cores) threads = rate;

@@ -101,9 +101,9 @@ void expect_same_image(const std::string& a_path, const std::string& b_path,
 
 TEST_F(Distributed, TwoProcessesRenderTheOneProcessImage) {
   for (auto [integrator, passes] : {std::pair{"path", "40"}, {"bpm", "30"}, {"fpm", "30"}}) {
-    const std::string name(integrator),
-        args = "render " + scene_ + " -q --integrator " + name + " --spp " + passes +
-               " --photons 5000 --threads 1 -o ";
+    const std::string name(integrator), args = "render " + scene_ + " -q --integrator " + name +
+                                               " --spp " + passes +
+                                               " --photons 5000 --threads 1 -o ";
     ASSERT_EQ(run("", args + path(name + "_1.exr")), 0) << integrator;
     ASSERT_EQ(run(kMpirun, args + path(name + "_2.exr")), 0) << integrator;
     expect_same_image(path(name + "_2.exr"), path(name + "_1.exr"), name);
@@ -118,6 +118,51 @@ TEST_F(Distributed, TwoProcessesRenderTheOneProcessImage) {
     EXPECT_EQ(sum, std::stoi(passes)) << integrator;
     EXPECT_EQ(rec["result"]["passes"], std::stoi(passes)) << integrator;
   }
+}
+
+// One process under mpirun is one process: the very same image, bit for bit.
+TEST_F(Distributed, OneProcessUnderMpirunIsTheSameRender) {
+  const std::string args =
+      "render " + scene_ + " -q --integrator bpm --spp 12 --photons 5000 --threads 1 -o ";
+  ASSERT_EQ(run("", args + path("plain.exr")), 0);
+  ASSERT_EQ(run("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 1 ",
+                args + path("mpi1.exr")),
+            0);
+  EXPECT_EQ(read_exr(path("mpi1.exr")).rgb, read_exr(path("plain.exr")).rgb);
+}
+
+// Budgets and signals as in one process: --time ends the job with every output written
+// (stop_reason "time"), and SIGTERM to mpirun reaches every process, whose passes end, and
+// process 0 still writes every output (stop_reason "interrupted").
+TEST_F(Distributed, TimeBudgetAndSigtermEndTheJobWithItsOutputs) {
+  const std::string args = "render " + scene_ + " -q --integrator bpm --photons 5000 --threads 1 ";
+  ASSERT_EQ(run(kMpirun, args + "--time 1 -o " + path("timed.exr")), 0);
+  nlohmann::json rec = record("timed.json");
+  EXPECT_EQ(rec["result"]["stop_reason"], "time");
+  EXPECT_GT(rec["result"]["passes"].get<int>(), 0);
+  EXPECT_TRUE(fs::exists(path("timed.png")));
+
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string cmd = std::string(
+                                "exec env OMPI_ALLOW_RUN_AS_ROOT=1 "
+                                "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe "
+                                "-n 2 ") +
+                            BPM_BINARY + " " + args + "--spp 1000000 -o " + path("stopped.exr") +
+                            " > /dev/null 2>&1";
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), nullptr);
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(fs::exists(path("stopped.json")));
+  rec = record("stopped.json");
+  EXPECT_EQ(rec["result"]["stop_reason"], "interrupted");
+  EXPECT_GT(rec["result"]["passes"].get<int>(), 0);
+  EXPECT_EQ(read_exr(path("stopped.exr")).width, 32);
 }
 
 // Sends SIGKILL to every process whose command line mentions `text` (mpirun may start its
@@ -136,8 +181,8 @@ void kill_all_mentioning(const std::string& text) {
 // A whole job killed (SIGKILL to mpirun and its processes) after a checkpoint, then resumed by
 // another job, ends with the image of one process never stopped.
 TEST_F(Distributed, KilledJobResumesToTheSameImage) {
-  const std::string args = "render " + scene_ +
-                           " -q --integrator bpm --spp 120 --photons 5000 --threads 1 -o ";
+  const std::string args =
+      "render " + scene_ + " -q --integrator bpm --spp 120 --photons 5000 --threads 1 -o ";
   ASSERT_EQ(run("", args + path("straight.exr")), 0);
   const fs::path checkpoint = dir_ / "job.checkpoint";
   pid_t pid = fork();

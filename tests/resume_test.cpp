@@ -13,7 +13,8 @@ namespace {
 
 using test::load;
 
-// A glass sphere on a floor under a small light, in a corner of two walls.
+// A glass sphere on a floor under a small light the camera sees (so that bpm's pixels that see
+// emission take more samples), in a corner of two walls.
 const char* kScene = R"(
 LookAt 0 1.6 -1.8  0 0.3 0.3  0 1 0
 Camera "perspective" "float fov" 45
@@ -22,9 +23,9 @@ PixelFilter "box"
 Integrator "path" "integer maxdepth" 5
 WorldBegin
 AttributeBegin
-AreaLightSource "diffuse" "rgb L" [40 40 40]
+AreaLightSource "diffuse" "rgb L" [40 40 40] "bool twosided" true
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-0.2 2.2 0.1  0.2 2.2 0.1  0.2 2.2 0.5  -0.2 2.2 0.5]
+  "point3 P" [-0.3 1.1 1.1  0.3 1.1 1.1  0.3 1.1 1.4  -0.3 1.1 1.4]
 AttributeEnd
 Material "diffuse" "rgb reflectance" [0.7 0.6 0.5]
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
