@@ -131,6 +131,21 @@ TEST_F(Distributed, OneProcessUnderMpirunIsTheSameRender) {
   EXPECT_EQ(read_exr(path("mpi1.exr")).rgb, read_exr(path("plain.exr")).rgb);
 }
 
+// A job that ends inside a round (20 passes: the round runs from 18 to 22) and is extended to 40
+// by another job from its final checkpoint gives one process's 40-pass image: the final
+// checkpoint keeps what every process learnt in the unfinished round, and the extending job
+// counts it once.
+TEST_F(Distributed, JobEndingInsideARoundExtendsExactly) {
+  const std::string args = "render " + scene_ + " -q --integrator bpm --photons 5000 --threads 1 ";
+  ASSERT_EQ(run("", args + "--spp 40 -o " + path("long.exr")), 0);
+  ASSERT_EQ(run(kMpirun, args + "--spp 20 --write-every 1000 -o " + path("job.exr")), 0);
+  ASSERT_EQ(
+      run(kMpirun, args + "--spp 40 --resume " + path("job.checkpoint") + " -o " + path("job.exr")),
+      0);
+  EXPECT_EQ(record("job.json")["resumed"]["passes_before"], 20);
+  expect_same_image(path("job.exr"), path("long.exr"), "extended job");
+}
+
 // Budgets and signals as in one process: --time ends the job with every output written
 // (stop_reason "time"), and SIGTERM to mpirun reaches every process, whose passes end, and
 // process 0 still writes every output (stop_reason "interrupted").

@@ -213,6 +213,13 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     }
     update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
   };
+  state.keep_learnt = [&](const std::vector<double>& sums) {
+    for (size_t p = 0; p < n_pixels; ++p) eye.saw_emission[p] = sums[p] > 0;
+    if (guide.empty()) return;
+    guide.keep_learnt(sums.data() + n_pixels);
+    const double* e = sums.data() + n_pixels + 2 * guide.cells();
+    estimate_new.assign(e, e + 2 * n_pixels);
+  };
   state.save = [&](ByteWriter& w) {
     w.put_vector(eye.sees_emission);
     w.put_vector(eye.saw_emission);

@@ -122,6 +122,14 @@ void run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
       break;
     }
   }
+  // Ended inside a round: what every process learnt in it goes to process 0's state unmerged, so
+  // that its final checkpoint resumes the round as one process would.
+  if (!ends_round(passes) && state.learnt && state.keep_learnt) {
+    std::vector<double> learnt;
+    state.learnt(&learnt);
+    team.sum(&learnt);
+    if (root) state.keep_learnt(learnt);
+  }
   std::vector<std::vector<double>> rows =
       team.gather({double(my_passes), double(my_rays), my_seconds});
   for (size_t r = 0; r < rows.size(); ++r)
@@ -143,6 +151,12 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
     ByteReader i(opt.resume->integrator, "the checkpoint's integrator state");
     if (state.load) state.load(i);
     if (!i.at_end()) throw Error("the checkpoint's integrator state does not fit this integrator");
+    // What the checkpoint had learnt inside its round is process 0's to bring to the round's end
+    // (each process adds its own share there): the others forget it.
+    if (opt.team && opt.team->rank() != 0 && state.learnt) {
+      std::vector<double> forgotten;
+      state.learnt(&forgotten);
+    }
     first = opt.resume->passes;
   }
   stats->passes = first;

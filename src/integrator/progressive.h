@@ -48,6 +48,9 @@ struct IntegratorState {
   // the round's end. Unset for integrators that learn nothing.
   std::function<void(std::vector<double>*)> learnt;
   std::function<void(const std::vector<double>&)> merge;
+  // Takes such sums back as learnt and not yet merged: when several processes end inside a
+  // round, process 0 keeps everyone's share for its final checkpoint.
+  std::function<void(const std::vector<double>&)> keep_learnt;
 };
 
 // Runs passes until a budget ends the render (from opt.resume's state when given). `unit` names a

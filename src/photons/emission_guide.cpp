@@ -91,6 +91,11 @@ void EmissionGuide::take_learnt(std::vector<double>* out) {
   std::fill(new_photons_.begin(), new_photons_.end(), 0.0);
 }
 
+void EmissionGuide::keep_learnt(const double* learnt) {
+  new_score_.assign(learnt, learnt + cells_);
+  new_photons_.assign(learnt + cells_, learnt + 2 * cells_);
+}
+
 void EmissionGuide::merge(const double* learnt) {
   for (size_t c = 0; c < cells_; ++c) {
     score_sum_[c] += learnt[c];

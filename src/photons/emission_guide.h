@@ -52,6 +52,8 @@ class EmissionGuide {
   // guided density from everything merged so far; until a photon has scored, the density stays
   // the unguided one.
   void merge(const double* learnt);
+  // Sets what was learnt since the last merge to take_learnt's layout of sums (taken back).
+  void keep_learnt(const double* learnt);
   // take_learnt and merge of this guide alone.
   void update();
   // The share of photons guidance moves (total variation between the guided and unguided
