@@ -288,12 +288,14 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
                  a.scene.c_str(), ls.scene.objects.size(), ls.scene.triangle_count(),
                  ls.scene.lights.size(), ls.film.width, ls.film.height, opt.integrator.c_str());
   // The film and the images written from it (and a checkpoint's copy of the film, when one is
-  // kept) must fit before anything is allocated.
+  // kept; with other processes, the film process 0 receives and the one it adds) must fit before
+  // anything is allocated.
   const double pixels = double(ls.film.width) * double(ls.film.height);
   const bool keep_checkpoint = opt.write_every_s > 0 || !a.resume.empty();
   check_memory("a " + std::to_string(ls.film.width) + "x" + std::to_string(ls.film.height) +
                    " film with its outputs",
-               pixels * (double(Film::bytes_per_pixel(a.m_images)) * (keep_checkpoint ? 2 : 1) +
+               pixels * (double(Film::bytes_per_pixel(a.m_images)) *
+                             (1 + (keep_checkpoint ? 1 : 0) + (team ? 2 : 0)) +
                          kOutputBytesPerPixel),
                opt.memory_budget, "lower --resolution or --m-images, or raise --memory");
   Film film(ls.film.width, ls.film.height, a.m_images);
@@ -308,6 +310,7 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
     // ends); every process takes the render state.
     ByteReader r(resumed.film, "checkpoint \"" + a.resume + "\"");
     if (root) film.load(r);
+    std::vector<uint8_t>().swap(resumed.film);
     opt.resume = &resumed.state;
     if (!a.quiet)
       std::fprintf(stderr, "bpm: resuming %s after %d %s\n", a.resume.c_str(), resumed.state.passes,
@@ -539,13 +542,25 @@ int main(int argc, char** argv) {
 #else
   Team* team = nullptr;
 #endif
-  // Every process meets the same errors before the render (the same files and flags): process 0
-  // says them. An error during a render with other processes ends them all.
+  // With other processes, an error in one ends them all (they would wait for it forever). Most
+  // errors before the render meet every process alike (the same files and flags): the others
+  // give process 0 half a second to say it and end the job, and say it themselves, naming their
+  // process, when the error is theirs alone (a file missing on one machine).
   bool rendering = false;
   auto fail = [&](const char* what) {
-    if (!team || team->rank() == 0 || rendering) std::fprintf(stderr, "bpm: error: %s\n", what);
+    if (!team) {
+      std::fprintf(stderr, "bpm: error: %s\n", what);
+      return 1;
+    }
 #ifdef BPM_HAVE_MPI
-    if (team && rendering) mpi.abort(1);
+    if (team->rank() == 0) {
+      std::fprintf(stderr, "bpm: error: %s\n", what);
+    } else {
+      if (!rendering) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      std::fprintf(stderr, "bpm: error (process %d): %s\n", team->rank(), what);
+    }
+    std::fflush(stderr);
+    mpi.abort(1);
 #endif
     return 1;
   };

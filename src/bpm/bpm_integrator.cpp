@@ -40,7 +40,12 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
       total += sum[p] / count[p];
       ++seen;
     }
-  if (seen == 0 || !(total > 0)) return;
+  // Nothing to weigh by (no estimate yet, or means that are not positive under --debias): no
+  // weights, the same whatever was there before (a resumed render recomputes them).
+  if (seen == 0 || !(total > 0)) {
+    weight->clear();
+    return;
+  }
   const double floor = 0.1 * total / double(seen);
   weight->assign(sum.size(), float(1 / floor));
   for (size_t p = 0; p < sum.size(); ++p)

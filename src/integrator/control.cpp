@@ -33,9 +33,17 @@ bool RenderControl::out_of_time() const {
   return opt_.time_limit_s > 0 && elapsed() >= opt_.time_limit_s;
 }
 
-bool RenderControl::stop_requested() const { return interrupted() || out_of_time(); }
+bool RenderControl::stop_requested() const {
+  const bool stop = interrupted() || out_of_time();
+  if (stop) cut_seen_ = true;
+  return stop;
+}
 
-bool RenderControl::cut(int pass) const { return interrupted() || (pass > 0 && out_of_time()); }
+bool RenderControl::cut(int pass) const {
+  const bool cut = interrupted() || (pass > 0 && out_of_time());
+  if (cut) cut_seen_ = true;
+  return cut;
+}
 
 bool RenderControl::keep_going(int done) {
   if (interrupt_flag().load()) {

@@ -10,6 +10,7 @@
 // pixel starves and the error estimate of every pixel stays alive; it is 1 for a pixel whose
 // passes have all been black, which has no error estimate at all.
 #pragma once
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -58,6 +59,9 @@ class RenderControl {
   bool out_of_time() const;
   // An interrupt or the time budget, in any pass: what a light pass asks before each chunk.
   bool stop_requested() const;
+  // Whether cut() or stop_requested() has said yes: a pass may then be incomplete (tiles left
+  // out, a light pass ended early), and the render's state is not one to resume exactly from.
+  bool cut_a_pass() const { return cut_seen_.load(); }
   // Whether the pass samples the pixel (always, without adaptive sampling).
   bool sample_pixel(int pass, uint32_t pixel) const;
   // Call once at the end: finishes the progress line.
@@ -86,6 +90,7 @@ class RenderControl {
   double bias_ = 0;   // its bias part
   double last_progress_ = -1, last_checkpoint_ = 0;
   std::vector<float> probability_;  // empty: every pixel every pass
+  mutable std::atomic<bool> cut_seen_{false};
 };
 
 }  // namespace bpm

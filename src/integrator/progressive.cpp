@@ -41,13 +41,15 @@ void run_passes_alone(const IntegratorOptions& opt, Film* film, const PassFuncti
 // run_passes with several processes (integrator/team.h): round by round, each round's passes
 // shared out, then the films gathered, what was learnt added up and merged, and process 0's
 // decisions (sampling probabilities, go on or stop) sent to every process.
-void run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunction& pass,
+// Returns whether a pass of any process was cut short (an interrupt, the time budget).
+bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunction& pass,
                      RenderStats* stats, const IntegratorState& state, RenderControl& control,
                      const std::function<RenderState()>& snapshot) {
   Team& team = *opt.team;
   const bool root = team.rank() == 0;
   int passes = stats->passes;  // completed, over every process
   std::string reason, progress;
+  bool any_cut = false;
   uint64_t my_rays = 0;
   int my_passes = 0;
   double my_seconds = 0;
@@ -59,32 +61,32 @@ void run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
     while (!ends_round(end)) ++end;
     end = std::min(end, opt.spp);
     const auto t = Clock::now();
-    int top = -1;  // the highest pass index this process completed
+    // A pass cut short (or dropped) is not counted, and no process is given another: the render
+    // stops after this round, as one process stops after its pass.
     const int mine = team.share_passes(passes, end, [&](int p) {
       film->begin_pass(opt.first_iteration + p);
       PassResult r = pass(p, control);
-      if (!r.completed) {
-        if (reason.empty()) reason = r.stop_reason;
+      if (!r.completed || control.cut_a_pass()) {
+        if (!r.completed && reason.empty()) reason = r.stop_reason;
         return false;
       }
       my_rays = r.rays;
       progress = r.progress;
-      top = std::max(top, p);
       return true;
     });
     my_seconds += since(t);
     my_passes += mine;
-    // Completed passes and rays over every process; the next pass index after the highest done.
-    std::vector<double> counts{double(mine), double(my_rays)};
-    std::vector<double> tops{double(top)};
+    // Over every process: completed passes, rays, cut passes, and integrator stop reasons (the
+    // one there is: "memory").
+    std::vector<double> counts{double(mine), double(my_rays), double(control.cut_a_pass()),
+                               double(reason == "memory")};
     team.sum(&counts);
-    std::vector<std::vector<double>> all_tops = team.gather(tops);
     const int completed = int(counts[0]);
-    int next = passes + completed;
-    for (const auto& row : all_tops) next = std::max(next, int(row[0]) + 1);
     team.gather_film(film);
-    const bool cut = next - passes > completed || completed < end - passes;
-    passes = next;
+    any_cut = any_cut || counts[2] > 0;
+    if (counts[3] > 0 && reason.empty()) reason = "memory";
+    const bool cut = completed < end - passes;
+    passes += completed;
     stats->passes = passes;
     if (ends_round(passes)) {
       if (state.learnt) {
@@ -137,6 +139,7 @@ void run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
                                 {"passes", int(rows[r][0])},
                                 {"rays", uint64_t(rows[r][1])},
                                 {"pass_seconds", rows[r][2]}});
+  return any_cut;
 }
 
 }  // namespace
@@ -170,13 +173,18 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
     s.integrator = i.take();
     return s;
   };
+  bool cut = false;
   if (opt.team && opt.team->size() > 1) {
-    run_team_passes(opt, film, pass, stats, state, control, snapshot);
+    cut = run_team_passes(opt, film, pass, stats, state, control, snapshot);
   } else {
     run_passes_alone(opt, film, pass, stats, state, control, snapshot, first);
+    cut = control.cut_a_pass();
   }
   control.finish();
-  if (opt.save_state) opt.save_state(snapshot());
+  // The final state, unless a pass was cut short: the film then holds part of a pass (or bpm's
+  // guide learnt from a dropped iteration), and the last checkpoint written between whole passes
+  // is the one to resume exactly from.
+  if (opt.save_state && !cut) opt.save_state(snapshot());
   stats->stop_reason = control.stop_reason();
   stats->mean_sampling_probability = control.mean_sampling_probability();
   stats->render_seconds = control.elapsed();

@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
-#include <future>
+#include <mutex>
 #include <thread>
 
 #include "base/bytes.h"
@@ -39,48 +40,58 @@ class MpiTeam : public Team {
         done += ok;
       }
     }
-    // Process 0 hands out passes in order and renders its own on a second thread meanwhile.
-    int next = begin, done = 0, waiting = size_ - 1;
+    // Process 0 renders its passes on this thread (always the same one, so that per-thread
+    // storage does not grow) while a second thread hands out passes to the others; only one of
+    // the two calls MPI meanwhile (MPI_THREAD_SERIALIZED).
+    std::mutex m;
+    int next = begin;
     bool stop = false;
-    auto give = [&] { return !stop && next < end ? next++ : -1; };
-    std::future<bool> own;
-    bool own_busy = false;
-    auto start_own = [&] {
-      const int p = give();
-      own_busy = p >= 0;
-      if (own_busy) own = std::async(std::launch::async, run, p);
+    auto give = [&] {
+      std::lock_guard<std::mutex> lock(m);
+      return !stop && next < end ? next++ : -1;
     };
-    start_own();
-    while (own_busy || waiting > 0) {
-      bool idle = true;
-      if (own_busy && own.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-        if (own.get())
-          ++done;
-        else
-          stop = true;
-        start_own();
-        idle = false;
-      }
-      int asked = 0;
-      MPI_Status st;
-      MPI_Iprobe(MPI_ANY_SOURCE, kTagAsk, MPI_COMM_WORLD, &asked, &st);
-      if (asked) {
+    auto halt = [&] {
+      std::lock_guard<std::mutex> lock(m);
+      stop = true;
+    };
+    std::thread server([&] {
+      for (int waiting = size_ - 1; waiting > 0;) {
+        int asked = 0;
+        MPI_Status st;
+        MPI_Iprobe(MPI_ANY_SOURCE, kTagAsk, MPI_COMM_WORLD, &asked, &st);
+        if (!asked) {
+          std::this_thread::sleep_for(std::chrono::microseconds(100));
+          continue;
+        }
         int ok = 1;
         MPI_Recv(&ok, 1, MPI_INT, st.MPI_SOURCE, kTagAsk, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-        if (!ok) stop = true;
+        if (!ok) halt();
         int p = give();
         MPI_Send(&p, 1, MPI_INT, st.MPI_SOURCE, kTagGive, MPI_COMM_WORLD);
         if (p < 0) --waiting;
-        idle = false;
       }
-      if (idle) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    });
+    int done = 0;
+    try {
+      for (int p; (p = give()) >= 0;) {
+        if (run(p))
+          ++done;
+        else
+          halt();
+      }
+    } catch (...) {
+      halt();
+      server.join();
+      throw;
     }
+    server.join();
     return done;
   }
 
   void gather_film(Film* film) override {
     if (rank_ != 0) {
       ByteWriter w;
+      w.reserve(film->bytes() + 64);
       film->save(w);
       send_bytes(w.bytes(), 0);
       film->clear();
@@ -96,10 +107,14 @@ class MpiTeam : public Team {
     }
   }
 
+  // Reduced into process 0 and sent from there, so that every process has the very same bits
+  // (an all-reduce may add in another order in each process).
   void sum(std::vector<double>* v) override {
     for (size_t at = 0; at < v->size(); at += kPiece / sizeof(double)) {
-      const size_t n = std::min(kPiece / sizeof(double), v->size() - at);
-      MPI_Allreduce(MPI_IN_PLACE, v->data() + at, int(n), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+      const int n = int(std::min(kPiece / sizeof(double), v->size() - at));
+      MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : v->data() + at, v->data() + at, n, MPI_DOUBLE, MPI_SUM,
+                 0, MPI_COMM_WORLD);
+      MPI_Bcast(v->data() + at, n, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     }
   }
 
@@ -159,8 +174,14 @@ MpiSession::MpiSession(int* argc, char*** argv) {
   // rendering processes' time. A value the user set stays.
   setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
   int provided = 0;
-  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+  MPI_Init_thread(argc, argv, MPI_THREAD_SERIALIZED, &provided);
   initialised_ = true;
+  if (provided < MPI_THREAD_SERIALIZED) {
+    std::fprintf(stderr,
+                 "bpm: error: this MPI library cannot be called from two threads in turn "
+                 "(MPI_THREAD_SERIALIZED), which distributed rendering needs\n");
+    MPI_Abort(MPI_COMM_WORLD, 1);
+  }
   int size = 1;
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (size > 1) team_ = std::make_unique<MpiTeam>();

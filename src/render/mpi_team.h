@@ -1,7 +1,7 @@
 // The processes of an Open MPI job as a Team (integrator/team.h). Built only where MPI is found
 // (BPM_HAVE_MPI). MpiSession initialises MPI for the program's lifetime when it runs under
-// mpirun; only the main thread calls MPI (process 0 renders its passes on a second thread while
-// the main one hands out passes).
+// mpirun. While passes are shared out, process 0 renders on its main thread and a second thread
+// hands out passes; the two never call MPI at once (MPI_THREAD_SERIALIZED).
 #pragma once
 #include <memory>
 
