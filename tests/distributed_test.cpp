@@ -27,29 +27,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* kScene = R"(
-LookAt 0 1.6 -1.8  0 0.3 0.3  0 1 0
-Camera "perspective" "float fov" 45
-Film "rgb" "integer xresolution" 32 "integer yresolution" 24
-PixelFilter "box"
-Integrator "path" "integer maxdepth" 5
-WorldBegin
-AttributeBegin
-AreaLightSource "diffuse" "rgb L" [40 40 40]
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-0.2 2.2 0.1  0.2 2.2 0.1  0.2 2.2 0.5  -0.2 2.2 0.5]
-AttributeEnd
-Material "diffuse" "rgb reflectance" [0.7 0.6 0.5]
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-2 0 -2  2 0 -2  2 0 2  -2 0 2]
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-2 0 1.5  2 0 1.5  2 2.5 1.5  -2 2.5 1.5]
-AttributeBegin
-Material "dielectric" "float eta" 1.5
-Translate 0 0.4 0.4
-Shape "sphere" "float radius" 0.4
-AttributeEnd
-)";
+// The scene of resume_test.cpp.
+const std::string kScene = test::glass_corner_scene(32, 24);
 
 // mpirun refuses to run as root without these (CI machines run as root).
 const char* kMpirun =

@@ -13,31 +13,7 @@ namespace {
 
 using test::load;
 
-// A glass sphere on a floor under a small light the camera sees (so that bpm's pixels that see
-// emission take more samples), in a corner of two walls.
-const char* kScene = R"(
-LookAt 0 1.6 -1.8  0 0.3 0.3  0 1 0
-Camera "perspective" "float fov" 45
-Film "rgb" "integer xresolution" 24 "integer yresolution" 18 "string filename" "t.exr"
-PixelFilter "box"
-Integrator "path" "integer maxdepth" 5
-WorldBegin
-AttributeBegin
-AreaLightSource "diffuse" "rgb L" [40 40 40] "bool twosided" true
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-0.3 1.1 1.1  0.3 1.1 1.1  0.3 1.1 1.4  -0.3 1.1 1.4]
-AttributeEnd
-Material "diffuse" "rgb reflectance" [0.7 0.6 0.5]
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-2 0 -2  2 0 -2  2 0 2  -2 0 2]
-Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
-  "point3 P" [-2 0 1.5  2 0 1.5  2 2.5 1.5  -2 2.5 1.5]
-AttributeBegin
-Material "dielectric" "float eta" 1.5
-Translate 0 0.4 0.4
-Shape "sphere" "float radius" 0.4
-AttributeEnd
-)";
+const std::string kScene = test::glass_corner_scene(24, 18);
 
 RenderOptions options(const LoadedScene& ls, const std::string& integrator, int passes) {
   RenderOptions opt = quiet_options(ls, integrator, passes, 7);

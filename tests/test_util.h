@@ -23,6 +23,35 @@ inline Film render_film(const LoadedScene& ls, int spp, int threads = 0, uint64_
   return film;
 }
 
+// A glass sphere on a floor under a small light the camera sees (so that bpm's pixels that see
+// emission take more samples), in a corner of two walls: caustics, indirect light and direct
+// emission in a few pixels, for tests of how renders are made (resumed, distributed).
+inline std::string glass_corner_scene(int width, int height) {
+  return R"(LookAt 0 1.6 -1.8  0 0.3 0.3  0 1 0
+Camera "perspective" "float fov" 45
+Film "rgb" "integer xresolution" )" +
+         std::to_string(width) + " \"integer yresolution\" " + std::to_string(height) + R"(
+PixelFilter "box"
+Integrator "path" "integer maxdepth" 5
+WorldBegin
+AttributeBegin
+AreaLightSource "diffuse" "rgb L" [40 40 40] "bool twosided" true
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [-0.3 1.1 1.1  0.3 1.1 1.1  0.3 1.1 1.4  -0.3 1.1 1.4]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.7 0.6 0.5]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [-2 0 -2  2 0 -2  2 0 2  -2 0 2]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [-2 0 1.5  2 0 1.5  2 2.5 1.5  -2 2.5 1.5]
+AttributeBegin
+Material "dielectric" "float eta" 1.5
+Translate 0 0.4 0.4
+Shape "sphere" "float radius" 0.4
+AttributeEnd
+)";
+}
+
 // The folder with the public scenes and pbrt-v4 references, or "" when absent.
 inline std::string shared_dir() {
   std::filesystem::path p = std::filesystem::path(BPM_SOURCE_DIR) / ".." / "shared";
