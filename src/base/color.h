@@ -77,6 +77,11 @@ class SpectrumCurve {
   float max_value() const;
   SpectrumCurve scaled(float s) const;
   bool is_black() const { return kind_ == Kind::kZero || scale_ == 0; }
+  // The same values at every wavelength, by construction (same kind, parameters and table).
+  bool same_curve(const SpectrumCurve& o) const {
+    return kind_ == o.kind_ && scale_ == o.scale_ && coeff_ == o.coeff_ &&
+           times_d65_ == o.times_d65_ && table_ == o.table_;
+  }
   bool is_constant() const { return kind_ == Kind::kZero || kind_ == Kind::kConstant; }
 
  private:

@@ -43,14 +43,16 @@ struct Channels {
       if (v != 0) return false;
     return true;
   }
+  // As std::fmax and std::fmin over the channels (a NaN channel is ignored unless all are NaN),
+  // written out so that they compile to max and min instructions instead of library calls.
   float max_component() const {
     float m = c[0];
-    for (float v : c) m = std::fmax(m, v);
+    for (float v : c) m = v > m || m != m ? v : m;
     return m;
   }
   float min_component() const {
     float m = c[0];
-    for (float v : c) m = std::fmin(m, v);
+    for (float v : c) m = v < m || m != m ? v : m;
     return m;
   }
   float average() const {
@@ -70,7 +72,7 @@ struct Channels {
   // Negative values set to zero.
   Channels clamped_zero() const {
     Channels r = *this;
-    for (float& v : r.c) v = std::fmax(0.0f, v);
+    for (float& v : r.c) v = v > 0 ? v : 0.0f;  // NaN to 0, as std::fmax(0, v)
     return r;
   }
   bool has_negative() const {

@@ -81,9 +81,14 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
   EyePixels eye(n_pixels);
   tbb::enumerable_thread_specific<ObjectPhotonLists> thread_lists(
       [&] { return ObjectPhotonLists(scene.objects.size()); });
-  tbb::enumerable_thread_specific<EyeCounters> eye_counters;
+  EyeCounters eye_exemplar;
+  eye_exemplar.rays.observer = opt.eye_ray_observer;
+  tbb::enumerable_thread_specific<EyeCounters> eye_counters(eye_exemplar);
   BackwardMaps maps;
   LightPassBuffers light;
+  LightCounters light_exemplar;
+  light_exemplar.observer = opt.light_ray_observer;
+  light.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
   BpmTotals tot;
   // Guided emission learns from each iteration's photons, scored relative to the pixels they
   // reach; the pixels' values are the running means of their estimates. Both change at the end

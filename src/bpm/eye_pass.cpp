@@ -44,7 +44,6 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray,
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only) {
-  const Wavelengths& wl = prm.materials->wl;
   PathState s{ray};
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
@@ -76,7 +75,8 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, !last, wl, rng, counters.rays, choice.part);
+                                        v.wo_local, !last, *prm.materials, rng, counters.rays,
+                                        choice.part);
       // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
       // vertex is also the last: two backward photons, one per radius.
       auto store = [&](uint8_t accepts) {
@@ -104,7 +104,8 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
         !is_diffuse && diffuse == 0 && bsdf_part_has_nondelta(v.m(), choice.part);
     if (direct_here)
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, wl, rng, counters.rays, choice.part);
+                                        v.wo_local, true, *prm.materials, rng, counters.rays,
+                                        choice.part);
     float uc = rng.uniform();
     Vec2 u{rng.uniform(), rng.uniform()};
     // Radiance-mode sampling; for a non-reciprocal BSDF the lobe drawn is the light-direction one

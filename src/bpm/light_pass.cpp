@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include "base/error.h"
 #include "photons/density.h"
@@ -34,11 +35,9 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + bounces > prm.max_depth) return;
     if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
-    Material storage;
-    const Material& m =
-        prm.photon_materials.empty()
-            ? prm.materials->at(int(bp.material), TextureContext{bp.p, bp.uv}, storage)
-            : prm.photon_materials[g];
+    // Resolved per backward photon when any material is textured (resolve_photon_materials).
+    const Material& m = prm.photon_materials.empty() ? prm.materials->materials[bp.material]
+                                                     : prm.photon_materials[g];
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, hero_only);
@@ -59,7 +58,9 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
 void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
   prm->photon_materials.clear();
   const WavelengthMaterials& wm = *prm->materials;
-  if (std::none_of(wm.textured.begin(), wm.textured.end(), [](char t) { return t != 0; })) return;
+  if (!wm.per_point &&
+      std::none_of(wm.textured.begin(), wm.textured.end(), [](char t) { return t != 0; }))
+    return;
   prm->photon_materials.resize(maps.photons.size());
   tbb::parallel_for(size_t(0), maps.photons.size(), [&](size_t g) {
     const BackwardPhoton& bp = maps.photons[g];
@@ -76,7 +77,8 @@ float trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Lig
   float score = 0;
   trace_light_path(scene, *prm.materials, prm.max_depth, 1, e, rng, counters,
                    [&](const PhotonHit& h) {
-                     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
+                     static const bool nog = getenv("NOGATHER") != nullptr;
+                     if (!nog && h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
                        score += gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls,
                                               h.bounces, h.hero_only, out, counters);
                    });

@@ -58,7 +58,6 @@ bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
 
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
                                 const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c) {
-  const Wavelengths& wl = prm.materials->wl;
   PathState s{ray};
   Spectrum L, bias;
   int depth = 0;
@@ -90,8 +89,9 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
       // counted), caustics from the caustic map.
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, false, wl, rng, c.rays, choice.part);
+      L +=
+          s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                       v.wo_local, false, *prm.materials, rng, c.rays, choice.part);
       gather(maps.caustic, s.length * prm.radius_per_length0, caustic_class);
       if (!prm.fpm->final_gather) {
         gather(maps.global, r1, indirect_class);
@@ -106,7 +106,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
         !is_diffuse && !gathering && bsdf_part_has_nondelta(v.m(), choice.part);
     if (direct_here)
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, wl, rng, c.rays, choice.part);
+                                        v.wo_local, true, *prm.materials, rng, c.rays, choice.part);
     Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
     float uc = rng.uniform();
     auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);

@@ -8,15 +8,17 @@ namespace bpm {
 
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
-                             bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters,
-                             BsdfPart part) {
+                             bool use_mis, const WavelengthMaterials& wm, Rng& rng,
+                             PathCounters& counters, BsdfPart part) {
+  const Wavelengths& wl = wm.wl;
   if (scene.lights.empty()) return {};
   float pmf;
   float ul = rng.uniform();
   int li = scene.light_distribution.sample(ul, &pmf);
   const Light& light = scene.lights[li];
   Vec2 u{rng.uniform(), rng.uniform()};
-  auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info, wl);
+  auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info, wl,
+                            wm.light_spectrum(li));
   if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
   Vec3 wi_local = frame.to_local(ls->wi);
   Spectrum f =

@@ -16,8 +16,8 @@ namespace bpm {
 // Only the lobes of `part` reflect it (BsdfPart).
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
-                             bool use_mis, const Wavelengths& wl, Rng& rng, PathCounters& counters,
-                             BsdfPart part = BsdfPart::kAll);
+                             bool use_mis, const WavelengthMaterials& wm, Rng& rng,
+                             PathCounters& counters, BsdfPart part = BsdfPart::kAll);
 
 // How emission found by the next ray of a path counts: in full (seen from the camera or through
 // specular vertices only), by the power heuristic against next-event estimation at the previous

@@ -48,6 +48,10 @@ struct IntegratorOptions {
   const RenderState* resume = nullptr;
   // Several processes render this image together (integrator/team.h); null: this one alone.
   Team* team = nullptr;
+  // Benchmarks only: sees every ray the passes trace, eye and light rays apart (bpm). Null in
+  // renders; called from every rendering thread, so render with one thread when it is set.
+  RayObserver* eye_ray_observer = nullptr;
+  RayObserver* light_ray_observer = nullptr;
 };
 
 struct RenderStats {

@@ -86,7 +86,13 @@ SphereWorld sphere_world(const Sphere& s) {
 }  // namespace
 
 std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref,
-                                          Vec2 u, const SceneBoundsInfo&, const Wavelengths& wl) {
+                                          Vec2 u, const SceneBoundsInfo&, const Wavelengths& wl,
+                                          const Spectrum* spectrum) {
+  // area_light_radiance, with the spectrum the caller evaluated when it has it.
+  auto radiance = [&](Vec3 n, Vec2 uv, Vec3 w) {
+    if (!spectrum || l.image) return area_light_radiance(l, n, uv, w, wl);
+    return l.two_sided || dot(n, w) > 0 ? *spectrum : Spectrum{};
+  };
   LightLiSample ls;
   if (auto* s = std::get_if<Sphere>(shape)) {
     SphereWorld sw = sphere_world(*s);
@@ -109,7 +115,7 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
       ls.p_light = sp.p;
       ls.n_light = sp.ng;
       ls.p_light_error = sp.error;
-      ls.radiance = area_light_radiance(l, sp.ng, sp.uv, -w, wl);
+      ls.radiance = radiance(sp.ng, sp.uv, -w);
       ls.pdf_solid_angle = uniform_cone_pdf_solid_angle(cos_max);
       if (ls.radiance.is_black()) return std::nullopt;
       return ls;
@@ -125,7 +131,7 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
   ls.p_light = as.p;
   ls.n_light = as.n;
   ls.p_light_error = as.error;
-  ls.radiance = area_light_radiance(l, as.n, as.uv, -ls.wi, wl);
+  ls.radiance = radiance(as.n, as.uv, -ls.wi);
   ls.pdf_solid_angle = as.pdf_area * d2 / cos_l;
   if (ls.radiance.is_black()) return std::nullopt;
   return ls;
@@ -148,8 +154,8 @@ float pdf_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec
 }
 
 std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape, Vec2 u_pos,
-                                          Vec2 u_dir, const SceneBoundsInfo&,
-                                          const Wavelengths& wl) {
+                                          Vec2 u_dir, const SceneBoundsInfo&, const Wavelengths& wl,
+                                          const Spectrum* spectrum) {
   LightLeSample s;
   AreaSample as = sample_area(l, *shape, u_pos);
   // Cosine-weighted about the normal; a two-sided emitter picks its side with probability 1/2.
@@ -171,8 +177,13 @@ std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape
   s.origin = as.p;
   s.n_light = as.n;
   s.origin_error = as.error;
-  s.flux =
-      area_light_radiance(l, as.n, as.uv, s.direction, wl) * (w_local.z / (as.pdf_area * pdf_dir));
+  // area_light_radiance, with the spectrum the caller evaluated when it has it.
+  Spectrum L;
+  if (!spectrum || l.image)
+    L = area_light_radiance(l, as.n, as.uv, s.direction, wl);
+  else if (l.two_sided || dot(as.n, s.direction) > 0)
+    L = *spectrum;
+  s.flux = L * (w_local.z / (as.pdf_area * pdf_dir));
   return s;
 }
 

@@ -31,7 +31,9 @@ Spectrum environment_radiance(const Light& light, Vec3 w, const Wavelengths& wl)
 
 std::optional<LightLiSample> light_sample_li(const Light& light, const Shape* shape, Vec3 p_ref,
                                              Vec2 u, const SceneBoundsInfo& bounds,
-                                             const Wavelengths& wl) {
+                                             const Wavelengths& wl, const Spectrum* spectrum) {
+  if (const auto* area = std::get_if<AreaLight>(&light))
+    return sample_li_of(*area, shape, p_ref, u, bounds, wl, spectrum);
   return std::visit([&](const auto& x) { return sample_li_of(x, shape, p_ref, u, bounds, wl); },
                     light);
 }
@@ -51,7 +53,9 @@ float light_pdf_li(const Light& light, const Shape* shape, Vec3 p_ref, Vec3 wi, 
 
 std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* shape, Vec2 u_pos,
                                              Vec2 u_dir, const SceneBoundsInfo& bounds,
-                                             const Wavelengths& wl) {
+                                             const Wavelengths& wl, const Spectrum* spectrum) {
+  if (const auto* area = std::get_if<AreaLight>(&light))
+    return sample_le_of(*area, shape, u_pos, u_dir, bounds, wl, spectrum);
   return std::visit([&](const auto& x) { return sample_le_of(x, shape, u_pos, u_dir, bounds, wl); },
                     light);
 }

@@ -156,9 +156,11 @@ bool light_is_environment(const Light& l);
 // direction the escaping ray travels); zero for other lights.
 Spectrum environment_radiance(const Light& l, Vec3 w, const Wavelengths& wl);
 
-// The shape is needed only for area lights (pass the object's shape).
+// The shape is needed only for area lights (pass the object's shape). `spectrum` as for
+// light_sample_le.
 std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec2 u,
-                                             const SceneBoundsInfo& bounds, const Wavelengths& wl);
+                                             const SceneBoundsInfo& bounds, const Wavelengths& wl,
+                                             const Spectrum* spectrum = nullptr);
 // Solid-angle density of light_sample_li choosing direction wi that reaches the light at
 // p_light (area lights) or escapes (infinite lights).
 float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
@@ -166,10 +168,13 @@ float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3
 // Radiance leaving an area light at a point with geometric normal n and surface coordinates uv
 // toward w.
 Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl);
-// Samples an emitted photon; u_pos picks the point, u_dir the direction.
+// Samples an emitted photon; u_pos picks the point, u_dir the direction. `spectrum`, when given,
+// is an area light's (without an image) radiance spectrum at wl, evaluated once by the caller for
+// many photons; other lights ignore it.
 std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape, Vec2 u_pos,
                                              Vec2 u_dir, const SceneBoundsInfo& bounds,
-                                             const Wavelengths& wl);
+                                             const Wavelengths& wl,
+                                             const Spectrum* spectrum = nullptr);
 // Total emitted power as a colour (the light's RGB times its geometric factor), used by the
 // power light sampler.
 Rgb light_power(const Light& l, const SceneBoundsInfo& bounds);

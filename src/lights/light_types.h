@@ -90,12 +90,14 @@ Spectrum environment_radiance_of(const ImageInfiniteLight& l, Vec3 w, const Wave
 // ---- area_light.cpp ----
 std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref,
                                           Vec2 u, const SceneBoundsInfo& bounds,
-                                          const Wavelengths& wl);
+                                          const Wavelengths& wl,
+                                          const Spectrum* spectrum = nullptr);
 float pdf_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
                 Vec3 n_light);
 std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape, Vec2 u_pos,
                                           Vec2 u_dir, const SceneBoundsInfo& bounds,
-                                          const Wavelengths& wl);
+                                          const Wavelengths& wl,
+                                          const Spectrum* spectrum = nullptr);
 Rgb power_of(const AreaLight& l, const SceneBoundsInfo& bounds);
 
 }  // namespace bpm

@@ -27,7 +27,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     keep_hero_wavelength_at(v, s);
     if (!bsdf_is_specular(v.m()))
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, wl, rng, counters);
+                                        v.wo_local, true, materials, rng, counters);
 
     float uc = rng.uniform();
     Vec2 u{rng.uniform(), rng.uniform()};

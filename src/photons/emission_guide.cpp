@@ -1,6 +1,7 @@
 #include "photons/emission_guide.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace bpm {
@@ -28,7 +29,8 @@ EmissionGuide::EmissionGuide(const RenderScene& scene) {
     for (const Light& l : scene.lights) {
       int p = has_one_position(l) ? 1 : pos;
       int d = std::holds_alternative<DistantLight>(l) ? 1 : (has_one_position(l) ? 2 * dir : dir);
-      lights_.push_back({uint32_t(total), p, d});
+      lights_.push_back(
+          {uint32_t(total), p, d, std::countr_zero(unsigned(p)), std::countr_zero(unsigned(d))});
       total += size_t(p * p) * size_t(d * d);
     }
     cells_ = total;
@@ -60,15 +62,15 @@ EmissionDraw EmissionGuide::sample(Rng& rng) const {
   const LightCells& lc = lights_[size_t(li)];
   uint32_t local = cell - lc.first;
   const uint32_t dir_cells = uint32_t(lc.dir_res * lc.dir_res);
-  const uint32_t pos_cell = local / dir_cells, dir_cell = local % dir_cells;
-  auto in_cell = [&](uint32_t index, int res) {
-    float x = (float(index % uint32_t(res)) + rng.uniform()) / float(res);
-    float y = (float(index / uint32_t(res)) + rng.uniform()) / float(res);
+  const uint32_t pos_cell = local >> (2 * lc.dir_bits), dir_cell = local & (dir_cells - 1);
+  auto in_cell = [&](uint32_t index, int res, int bits) {
+    float x = (float(index & uint32_t(res - 1)) + rng.uniform()) / float(res);
+    float y = (float(index >> bits) + rng.uniform()) / float(res);
     return Vec2{std::min(x, 0x1.fffffep-1f), std::min(y, 0x1.fffffep-1f)};
   };
   d.light = li;
-  d.u_pos = in_cell(pos_cell, lc.pos_res);
-  d.u_dir = in_cell(dir_cell, lc.dir_res);
+  d.u_pos = in_cell(pos_cell, lc.pos_res, lc.pos_bits);
+  d.u_dir = in_cell(dir_cell, lc.dir_res, lc.dir_bits);
   d.cell = cell;
   const float unguided = unguided_[cell];
   d.light_pmf = unguided * float(lc.pos_res * lc.pos_res) * float(dir_cells);

@@ -66,8 +66,9 @@ class EmissionGuide {
 
  private:
   struct LightCells {
-    uint32_t first;  // index of the light's first cell
-    int pos_res, dir_res;
+    uint32_t first;          // index of the light's first cell
+    int pos_res, dir_res;    // powers of two
+    int pos_bits, dir_bits;  // their base-2 logarithms: cells are found by shifts, not divisions
   };
   std::vector<LightCells> lights_;
   std::vector<float> unguided_;  // probability of each cell without guidance

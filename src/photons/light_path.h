@@ -117,8 +117,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
   if (scene.lights.empty() || max_depth < min_eye_vertices || e.light_pmf == 0 || e.weight == 0)
     return;
   const Light& light = scene.lights[size_t(e.light)];
-  auto le =
-      light_sample_le(light, scene.light_shape(light), e.u_pos, e.u_dir, scene.bounds_info, wm.wl);
+  auto le = light_sample_le(light, scene.light_shape(light), e.u_pos, e.u_dir, scene.bounds_info,
+                            wm.wl, wm.light_spectrum(e.light));
   if (!le || le->flux.is_black()) return;
   bool has_surface = length_squared(le->n_light) > 0;
   PathState s{

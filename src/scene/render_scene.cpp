@@ -43,4 +43,10 @@ int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx
   return material;
 }
 
+const Material& WavelengthMaterials::resolve_into(int material, const TextureContext& ctx,
+                                                  Material& storage) const {
+  storage = material_at(*scene, material, wl, ctx);
+  return storage;
+}
+
 }  // namespace bpm

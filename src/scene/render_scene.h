@@ -136,6 +136,8 @@ struct WavelengthMaterials {
   Wavelengths wl;
   std::vector<Material> materials;
   std::vector<char> textured;
+  std::vector<int> light_spectrum_index;  // per light, into light_spectra; -1: none
+  std::vector<Spectrum> light_spectra;
   const RenderScene* scene;
   bool per_point = false;  // every material resolved at each point (no copies made)
   WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths)
@@ -145,6 +147,27 @@ struct WavelengthMaterials {
       textured.push_back(material_is_textured(d));
       materials.push_back(textured.back() ? Material{} : resolve_material(d, wl));
     }
+    // An area light without an image emits one spectrum all over: evaluated here once, not for
+    // every photon and shadow ray. The lights of one emissive mesh, one after the other, share
+    // their curve and so one entry.
+    light_spectrum_index.assign(s.lights.size(), -1);
+    const SpectrumCurve* last = nullptr;
+    for (size_t i = 0; i < s.lights.size(); ++i) {
+      const auto* a = std::get_if<AreaLight>(&s.lights[i]);
+      if (!a || a->image) continue;
+      if (!last || !a->radiance.same_curve(*last)) {
+        light_spectra.push_back(a->radiance.sample(wl));
+        last = &a->radiance;
+      }
+      light_spectrum_index[i] = int(light_spectra.size()) - 1;
+    }
+  }
+  // Light `light`'s emission spectrum at wl when it is the same all over the light (see
+  // light_sample_le); null otherwise, and for single paths.
+  const Spectrum* light_spectrum(int light) const {
+    const size_t i = size_t(light);
+    if (i >= light_spectrum_index.size() || light_spectrum_index[i] < 0) return nullptr;
+    return &light_spectra[size_t(light_spectrum_index[i])];
   }
   // For a single path (the path tracer draws wavelengths per pixel sample): copies of every
   // material would cost more than resolving the few the path meets.
@@ -156,11 +179,12 @@ struct WavelengthMaterials {
   // made in storage.
   const Material& at(int material, const TextureContext& ctx, Material& storage) const {
     if (!per_point && !textured[size_t(material)]) return materials[size_t(material)];
-    storage = material_at(*scene, material, wl, ctx);
-    return storage;
+    return resolve_into(material, ctx, storage);
   }
 
  private:
+  // at()'s slow path, out of line so that the common case inlines.
+  const Material& resolve_into(int material, const TextureContext& ctx, Material& storage) const;
   WavelengthMaterials(const RenderScene& s, const Wavelengths& wavelengths, bool)
       : wl(wavelengths), scene(&s), per_point(true) {}
 };

@@ -148,8 +148,11 @@ SurfacePoint analytic_point(const Shape& shape, Vec3 p_hit) {
     float phi = float(phi_of(po.x, po.y));
     // pbrt-v4: v runs from the z_min cap (0) to the z_max cap (1).
     float theta = std::acos(std::clamp(po.z / s->radius, -1.0f, 1.0f));
-    float theta_min = std::acos(std::clamp(s->z_min / s->radius, -1.0f, 1.0f));
-    float theta_max = std::acos(std::clamp(s->z_max / s->radius, -1.0f, 1.0f));
+    // (acos(-1) and acos(1) for the poles of a sphere without caps.)
+    float theta_min =
+        s->z_min <= -s->radius ? kPi : std::acos(std::clamp(s->z_min / s->radius, -1.0f, 1.0f));
+    float theta_max =
+        s->z_max >= s->radius ? 0.0f : std::acos(std::clamp(s->z_max / s->radius, -1.0f, 1.0f));
     sp.uv = {phi / s->phi_max,
              theta_max != theta_min ? (theta - theta_min) / (theta_max - theta_min) : 0.0f};
     return sp;
