@@ -7,7 +7,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 
 #include "base/error.h"
 #include "photons/density.h"
@@ -77,8 +76,7 @@ float trace_photon(const RenderScene& scene, const BackwardMaps& maps, const Lig
   float score = 0;
   trace_light_path(scene, *prm.materials, prm.max_depth, 1, e, rng, counters,
                    [&](const PhotonHit& h) {
-                     static const bool nog = getenv("NOGATHER") != nullptr;
-                     if (!nog && h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
+                     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
                        score += gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls,
                                               h.bounces, h.hero_only, out, counters);
                    });
