@@ -118,7 +118,18 @@ Image reference_for(const SceneEntry& e, const LoadedScene& ls, double seconds) 
   fs::create_directories("equal_time_references");
   std::string stem = "equal_time_references/" + e.name + "_" + std::to_string(ls.film.width) + "x" +
                      std::to_string(ls.film.height);
-  if (fs::exists(stem + ".exr")) return read_exr(stem + ".exr");
+  if (fs::exists(stem + ".exr")) {
+    // Kept from an earlier run: say how it was made (its own JSON), whatever --reference-time is.
+    std::ifstream in(stem + ".json");
+    const nlohmann::json how = nlohmann::json::parse(in, nullptr, false);
+    if (how.is_object() && how.contains("seconds"))
+      std::printf("  reference kept: %s, %s for %.0f s (%d passes, delta %.4f)\n", stem.c_str(),
+                  how.value("integrator", std::string("?")).c_str(), how.value("seconds", 0.0),
+                  how.value("passes", 0), how.value("relative_error_delta", 0.0));
+    else
+      std::printf("  reference kept: %s (no JSON beside it)\n", stem.c_str());
+    return read_exr(stem + ".exr");
+  }
   RenderStats st;
   Image img = render_ours(ls, e.reference, seconds, 0x5eed, &st);
   write_exr(stem + ".exr", img);
@@ -257,8 +268,10 @@ int main(int argc, char** argv) {
       return help ? 0 : 2;
     }
   }
-  std::printf("== equal time: %.0f s each; reference: a %.0f s render with its own seed ==\n",
-              seconds, reference_s);
+  std::printf(
+      "== equal time: %.0f s each; reference: a render with its own seed, kept or made for %.0f "
+      "s ==\n",
+      seconds, reference_s);
   std::printf("  %-28s %7s %10s %12s %12s   %s\n", "integrator", "s", "samples", "relMSE",
               "relMSE 99.9%", "mean / reference R G B");
   for (const SceneEntry& e : default_scenes()) {
