@@ -6,9 +6,10 @@
 
 namespace bpm {
 
-Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl) {
+Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl,
+                             const Spectrum* spectrum) {
   if (!l.two_sided && dot(n, w) <= 0) return {};
-  if (!l.image) return l.radiance.sample(wl);
+  if (!l.image) return spectrum ? *spectrum : l.radiance.sample(wl);
   return illuminant_texel(l.image->lookup({uv.x, 1 - uv.y}, TexFilter::kBilinear, TexWrap::kClamp),
                           l.image_scale, wl);
 }
@@ -88,11 +89,6 @@ SphereWorld sphere_world(const Sphere& s) {
 std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref,
                                           Vec2 u, const SceneBoundsInfo&, const Wavelengths& wl,
                                           const Spectrum* spectrum) {
-  // area_light_radiance, with the spectrum the caller evaluated when it has it.
-  auto radiance = [&](Vec3 n, Vec2 uv, Vec3 w) {
-    if (!spectrum || l.image) return area_light_radiance(l, n, uv, w, wl);
-    return l.two_sided || dot(n, w) > 0 ? *spectrum : Spectrum{};
-  };
   LightLiSample ls;
   if (auto* s = std::get_if<Sphere>(shape)) {
     SphereWorld sw = sphere_world(*s);
@@ -115,7 +111,7 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
       ls.p_light = sp.p;
       ls.n_light = sp.ng;
       ls.p_light_error = sp.error;
-      ls.radiance = radiance(sp.ng, sp.uv, -w);
+      ls.radiance = area_light_radiance(l, sp.ng, sp.uv, -w, wl, spectrum);
       ls.pdf_solid_angle = uniform_cone_pdf_solid_angle(cos_max);
       if (ls.radiance.is_black()) return std::nullopt;
       return ls;
@@ -131,7 +127,7 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
   ls.p_light = as.p;
   ls.n_light = as.n;
   ls.p_light_error = as.error;
-  ls.radiance = radiance(as.n, as.uv, -ls.wi);
+  ls.radiance = area_light_radiance(l, as.n, as.uv, -ls.wi, wl, spectrum);
   ls.pdf_solid_angle = as.pdf_area * d2 / cos_l;
   if (ls.radiance.is_black()) return std::nullopt;
   return ls;
@@ -177,13 +173,8 @@ std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape
   s.origin = as.p;
   s.n_light = as.n;
   s.origin_error = as.error;
-  // area_light_radiance, with the spectrum the caller evaluated when it has it.
-  Spectrum L;
-  if (!spectrum || l.image)
-    L = area_light_radiance(l, as.n, as.uv, s.direction, wl);
-  else if (l.two_sided || dot(as.n, s.direction) > 0)
-    L = *spectrum;
-  s.flux = L * (w_local.z / (as.pdf_area * pdf_dir));
+  s.flux = area_light_radiance(l, as.n, as.uv, s.direction, wl, spectrum) *
+           (w_local.z / (as.pdf_area * pdf_dir));
   return s;
 }
 

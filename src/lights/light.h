@@ -166,8 +166,10 @@ std::optional<LightLiSample> light_sample_li(const Light& l, const Shape* shape,
 float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
                    Vec3 n_light);
 // Radiance leaving an area light at a point with geometric normal n and surface coordinates uv
-// toward w.
-Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl);
+// toward w. `spectrum`: the light's radiance spectrum at wl when the caller evaluated it ahead
+// (WavelengthMaterials::light_spectrum; ignored for an image light).
+Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl,
+                             const Spectrum* spectrum = nullptr);
 // Samples an emitted photon; u_pos picks the point, u_dir the direction. `spectrum`, when given,
 // is an area light's (without an image) radiance spectrum at wl, evaluated once by the caller for
 // many photons; other lights ignore it.
