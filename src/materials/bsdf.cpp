@@ -357,8 +357,11 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2
     return std::nullopt;
   if (s) {
     // A layered material's walk gives an exact weight but no density; MIS takes its estimate.
+    // Light paths never weigh their samples (importance transport): they skip the estimate, which
+    // costs a few walks of its own.
     bool layered = std::visit([](const auto& x) { return kLayered<std::decay_t<decltype(x)>>; }, m);
-    bool estimated = layered && !s->is_specular() && part != BsdfPart::kTraced;
+    bool estimated = layered && !s->is_specular() && part != BsdfPart::kTraced &&
+                     mode == TransportMode::kRadiance;
     s->mis_pdf = estimated ? bsdf_pdf(m, wo, s->wi, mode, part) : s->pdf_solid_angle;
     if (!s->is_specular() && bsdf_all_traced(m)) s->flags |= kTraced;
   }

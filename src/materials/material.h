@@ -188,7 +188,9 @@ struct BsdfSample {
   float eta = 1;  // relative index of refraction across the boundary, 1 for reflection
   // The density to use in multiple importance sampling. It equals pdf_solid_angle except for
   // layered materials, whose sample weight f / pdf is exact while their density is only
-  // estimated (pbrt-v4's pdfIsProportional): bsdf_sample fills it.
+  // estimated (pbrt-v4's pdfIsProportional): bsdf_sample fills it. Only camera paths (radiance
+  // transport) get the estimate; in importance transport, where nothing weighs light paths'
+  // samples, it is pdf_solid_angle.
   float mis_pdf = 0;
   bool is_specular() const { return flags & kSpecular; }
   bool is_traced() const { return flags & (kSpecular | kTraced); }

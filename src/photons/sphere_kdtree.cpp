@@ -1,5 +1,7 @@
 #include "photons/sphere_kdtree.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <optional>
 
@@ -13,6 +15,9 @@ namespace {
 constexpr float kTraversalCost = 24;
 constexpr size_t kMinLeaf = 8;
 constexpr int kMaxDepth = 48;
+// Cells with at least this many spheres build their two halves as separate tasks (a scene whose
+// photons lie mostly on one object would otherwise build its tree on one thread).
+constexpr size_t kParallelMin = 16384;
 
 int longest_axis(const Bounds3& b) {
   Vec3 d = b.hi - b.lo;
@@ -119,11 +124,33 @@ void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int dept
   Bounds3 lcell = cell, rcell = cell;
   lcell.hi[axis] = split;
   rcell.lo[axis] = split;
-  build_node(left, lcell, depth + 1, spheres);
-  std::vector<uint32_t>().swap(left);
-  uint32_t right_index = uint32_t(nodes_.size());
-  build_node(right, rcell, depth + 1, spheres);
+  uint32_t right_index;
+  if (n >= kParallelMin) {
+    // Both halves as subtrees of their own, appended in the order the serial build lays them out:
+    // the tree is the same whatever the threads did.
+    SphereKdTree l, r;
+    tbb::parallel_invoke([&] { l.build_node(left, lcell, depth + 1, spheres); },
+                         [&] { r.build_node(right, rcell, depth + 1, spheres); });
+    append(l);
+    right_index = uint32_t(nodes_.size());
+    append(r);
+  } else {
+    build_node(left, lcell, depth + 1, spheres);
+    std::vector<uint32_t>().swap(left);
+    right_index = uint32_t(nodes_.size());
+    build_node(right, rcell, depth + 1, spheres);
+  }
   nodes_[self] = {split, uint32_t(axis), right_index, 0};
+}
+
+void SphereKdTree::append(const SphereKdTree& sub) {
+  const uint32_t node_base = uint32_t(nodes_.size()), item_base = uint32_t(items_.size());
+  for (Node node : sub.nodes_) {
+    node.a += node.axis == kLeaf ? item_base : node_base;
+    nodes_.push_back(node);
+  }
+  items_.insert(items_.end(), sub.items_.begin(), sub.items_.end());
+  spheres_.insert(spheres_.end(), sub.spheres_.begin(), sub.spheres_.end());
 }
 
 size_t SphereKdTree::bytes() const {

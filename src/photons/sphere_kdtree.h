@@ -56,6 +56,8 @@ class SphereKdTree {
   };
   void build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth,
                   const std::vector<SphereRef>& spheres);
+  // Appends a subtree built on its own (its node and item indices shifted).
+  void append(const SphereKdTree& sub);
   std::vector<Node> nodes_;
   std::vector<uint32_t> items_;     // sphere index per leaf slot
   std::vector<SphereRef> spheres_;  // copy per leaf slot, for locality

@@ -2,6 +2,7 @@
 #include "photons/sphere_kdtree.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 
@@ -98,6 +99,28 @@ TEST(SphereKdTree, PhotonsOnAWallAcrossTheLongestAxisStillSplit) {
   }
   // About 7 spheres contain a point; a leaf of a few hundred is the tree's cost trade-off.
   EXPECT_LT(worst, 1000u);
+}
+
+// Large cells build their halves as parallel tasks: the tree, and so the order in which a query
+// reports spheres, must be the one a single thread builds.
+TEST(SphereKdTree, ThreadsDoNotChangeTheTree) {
+  Rng rng(stream_key(8, 0));
+  std::vector<SphereRef> spheres = random_spheres(rng, 100000);
+  SphereKdTree one, many;
+  tbb::task_arena(1).execute([&] { one.build(spheres); });
+  tbb::task_arena(4).execute([&] { many.build(spheres); });
+  EXPECT_EQ(one.bytes(), many.bytes());
+  EXPECT_EQ(one.reference_count(), many.reference_count());
+  size_t found = 0;
+  for (int q = 0; q < 2000; ++q) {
+    Vec3 p(rng.uniform() * 10, rng.uniform() * 10, rng.uniform() * 0.05f);
+    std::vector<uint32_t> a, b;
+    one.query(p, [&](uint32_t i) { a.push_back(i); });
+    many.query(p, [&](uint32_t i) { b.push_back(i); });
+    ASSERT_EQ(a, b) << "query " << q;  // same spheres in the same order
+    found += a.size();
+  }
+  EXPECT_GT(found, 2000u);
 }
 
 TEST(SphereKdTree, IdenticalSpheresDoNotRecurseForever) {
