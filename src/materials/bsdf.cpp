@@ -114,11 +114,12 @@ std::optional<BsdfSample> sample_of(const ConductorMaterial& m, Vec3 wo, float, 
   Vec3 wm = d.sample_wm(wo, u);
   Vec3 wi = reflect(wo, wm);
   if (!same_hemisphere(wo, wi)) return std::nullopt;
-  float pdf = d.d_visible(wo, wm) / (4 * absdot(wo, wm));
+  const float d_wm = d.d(wm), lambda_o = d.lambda(wo);
+  float pdf = TrowbridgeReitz::d_visible(wo, wm, d_wm, lambda_o) / (4 * absdot(wo, wm));
   float co = std::fabs(wo.z), ci = std::fabs(wi.z);
   if (ci == 0 || pdf == 0) return std::nullopt;
   Spectrum F = fresnel_complex(absdot(wo, wm), m.eta, m.k);
-  return BsdfSample{F * (d.d(wm) * d.g(wo, wi) / (4 * co * ci)), wi, pdf, kReflection | kGlossy};
+  return BsdfSample{F * (d_wm * d.g(lambda_o, wi) / (4 * co * ci)), wi, pdf, kReflection | kGlossy};
 }
 
 // ---- dielectric ----
@@ -202,12 +203,13 @@ std::optional<BsdfSample> dielectric_sample(const DielectricMaterial& m, Vec3 wo
   float R = fresnel_dielectric(dot(wo, wm), m.eta), T = 1 - R;
   float pr = (lobes & kReflection) ? R : 0, pt = (lobes & kTransmission) ? T : 0;
   if (pr + pt == 0) return std::nullopt;
-  float dvis = d.d_visible(wo, wm);
+  const float d_wm = d.d(wm), lambda_o = d.lambda(wo);
+  float dvis = TrowbridgeReitz::d_visible(wo, wm, d_wm, lambda_o);
   if (uc < pr / (pr + pt)) {
     Vec3 wi = reflect(wo, wm);
     if (!same_hemisphere(wo, wi)) return std::nullopt;
     float pdf = dvis / (4 * absdot(wo, wm)) * pr / (pr + pt);
-    Spectrum f(d.d(wm) * d.g(wo, wi) * R / std::fabs(4 * wi.z * wo.z));
+    Spectrum f(d_wm * d.g(lambda_o, wi) * R / std::fabs(4 * wi.z * wo.z));
     return BsdfSample{f, wi, pdf, kReflection | kGlossy};
   }
   Vec3 wi;
@@ -219,7 +221,7 @@ std::optional<BsdfSample> dielectric_sample(const DielectricMaterial& m, Vec3 wo
   float dwm_dwi = absdot(wi, wm) / denom;
   float pdf = dvis * dwm_dwi * pt / (pr + pt);
   float ft =
-      T * d.d(wm) * d.g(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
+      T * d_wm * d.g(lambda_o, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi.z * wo.z * denom));
   if (mode == TransportMode::kRadiance) ft /= etap * etap;
   return BsdfSample{Spectrum(ft), wi, pdf, kTransmission | kGlossy, etap};
 }

@@ -23,29 +23,45 @@ inline bool same_hemisphere(Vec3 a, Vec3 b) { return a.z * b.z > 0; }
 
 class TrowbridgeReitz {
  public:
-  TrowbridgeReitz(float ax, float ay) : ax_(std::fmax(ax, 1e-4f)), ay_(std::fmax(ay, 1e-4f)) {}
+  TrowbridgeReitz(float ax, float ay)
+      : ax_(std::fmax(ax, 1e-4f)), ay_(std::fmax(ay, 1e-4f)), isotropic_(ax_ == ay_) {}
 
   float d(Vec3 wm) const {
     float t2 = tan2_theta(wm);
     if (std::isinf(t2)) return 0;
     float c4 = cos2_theta(wm) * cos2_theta(wm);
     if (c4 < 1e-16f) return 0;
-    float cp = cos_phi(wm), sp = sin_phi(wm);
-    float e = t2 * (cp * cp / (ax_ * ax_) + sp * sp / (ay_ * ay_));
+    // cos^2 phi + sin^2 phi = 1: an isotropic lobe needs no azimuth.
+    float e;
+    if (isotropic_) {
+      e = t2 / (ax_ * ax_);
+    } else {
+      float cp = cos_phi(wm), sp = sin_phi(wm);
+      e = t2 * (cp * cp / (ax_ * ax_) + sp * sp / (ay_ * ay_));
+    }
     return 1 / (kPi * ax_ * ay_ * c4 * (1 + e) * (1 + e));
   }
   float lambda(Vec3 w) const {
     float t2 = tan2_theta(w);
     if (std::isinf(t2)) return 0;
-    float cp = cos_phi(w), sp = sin_phi(w);
-    float a2 = ax_ * ax_ * cp * cp + ay_ * ay_ * sp * sp;
+    float a2;
+    if (isotropic_) {
+      a2 = ax_ * ax_;
+    } else {
+      float cp = cos_phi(w), sp = sin_phi(w);
+      a2 = ax_ * ax_ * cp * cp + ay_ * ay_ * sp * sp;
+    }
     return (std::sqrt(1 + a2 * t2) - 1) / 2;
   }
   float g1(Vec3 w) const { return 1 / (1 + lambda(w)); }
-  float g(Vec3 wo, Vec3 wi) const { return 1 / (1 + lambda(wo) + lambda(wi)); }
+  float g(Vec3 wo, Vec3 wi) const { return g(lambda(wo), wi); }
+  // The same, with lambda(wo) at hand.
+  float g(float lambda_wo, Vec3 wi) const { return 1 / (1 + lambda_wo + lambda(wi)); }
   // Density of visible normals wm seen from w.
-  float d_visible(Vec3 w, Vec3 wm) const {
-    return g1(w) / std::fabs(w.z) * d(wm) * std::fabs(dot(w, wm));
+  float d_visible(Vec3 w, Vec3 wm) const { return d_visible(w, wm, d(wm), lambda(w)); }
+  // The same, from d(wm) and lambda(w) at hand (a sample's value needs them again).
+  static float d_visible(Vec3 w, Vec3 wm, float d_wm, float lambda_w) {
+    return d_wm * std::fabs(dot(w, wm)) / ((1 + lambda_w) * std::fabs(w.z));
   }
   Vec3 sample_wm(Vec3 w, Vec2 u) const {
     Vec3 wh = normalize(Vec3(ax_ * w.x, ay_ * w.y, w.z));
@@ -64,6 +80,7 @@ class TrowbridgeReitz {
 
  private:
   float ax_, ay_;
+  bool isotropic_;
 };
 
 }  // namespace bpm
