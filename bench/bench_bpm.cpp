@@ -1,11 +1,13 @@
 // Figures for the backward photon mapping integrator (prints them; never fails):
 //   1. trees: the kd-tree over whole integration spheres against the kd-tree over centres on the
 //      backward photon maps of a real render: build time, queries per second, light pass time;
-//   2. rays: eye-pass and light-pass rays per second beside bare Embree casting the same rays;
+//   2. rays: eye-pass and light-pass rays per second beside bare Embree casting the same rays,
+//      and the light pass's time per photon beside pbrt-v4's sppm photon pass on the same scene
+//      file (when ../shared/tools/pbrt-v4/pbrt or --pbrt is there);
 //   3. equal time: relative MSE of bpm and path at equal render times against a converged
 //      reference (path with a long budget, cached next to the binary).
 //   bench_bpm [scene.pbrt] [--res WxH] [--iterations N] [--times 30,60] [--reference-time S]
-//             [--only trees|rays|equal-time|reference]
+//             [--only trees|rays|equal-time|reference] [--pbrt PATH]
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -25,6 +27,7 @@
 #include "camera/camera.h"
 #include "embree_replay.h"
 #include "film/image_io.h"
+#include "pbrt_runner.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 
@@ -89,7 +92,43 @@ void trees(const LoadedScene& ls, int iterations, int threads, const BpmSettings
   std::printf("images identical: %s\n", images[0].rgb == images[1].rgb ? "yes" : "NO");
 }
 
-void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) {
+// pbrt-v4's sppm photon pass on the same scene file at the same resolution and iterations: two
+// runs that differ only in photons per iteration, so that the difference of their wall times and
+// of their ray counts (--stats) is the cost of the extra photons alone.
+struct PbrtPhotonCost {
+  double us_per_photon = -1, rays_per_photon = -1;
+};
+PbrtPhotonCost pbrt_photon_cost(const std::string& pbrt, const std::string& scene_path,
+                                const LoadedScene& ls, int iterations, int photons, int threads) {
+  const Vec3 diag = ls.scene.bounds.hi - ls.scene.bounds.lo;
+  const int few = std::max(1, photons / 10), many = few + photons;
+  const std::string film = film_at_resolution(scene_path, ls.film.width, ls.film.height);
+  double t[2], rays[2], paths[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string integrator =
+        "Integrator \"sppm\" \"integer maxdepth\" " + std::to_string(ls.render.max_depth) +
+        " \"float radius\" " + std::to_string(0.002f * length(diag)) +
+        " \"integer photonsperiteration\" " + std::to_string(k ? many : few);
+    const std::string copy =
+        scene_copy_with(scene_path, {{"Integrator", integrator}, {"Film", film}}, "bench_bpm");
+    std::string stats;
+    t[k] = run_pbrt(pbrt, copy, iterations, ".bench_bpm_pbrt.exr", threads, &stats);
+    std::filesystem::remove(copy);
+    rays[k] = pbrt_stat(stats, "Regular ray intersection tests");
+    paths[k] = pbrt_stat(stats, "Photon paths followed");
+  }
+  std::filesystem::remove(".bench_bpm_pbrt.exr");
+  PbrtPhotonCost c;
+  if (t[0] < 0 || t[1] < 0) return c;
+  const double extra = double(many - few) * iterations;
+  c.us_per_photon = (t[1] - t[0]) / extra * 1e6;
+  if (rays[0] >= 0 && rays[1] >= 0 && paths[1] - paths[0] > 0)
+    c.rays_per_photon = (rays[1] - rays[0]) / (paths[1] - paths[0]);
+  return c;
+}
+
+void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
+          const BpmSettings& bs, int hw, const std::string& pbrt) {
   std::printf("\n== eye and light passes against bare Embree on the same rays ==\n");
   int w = ls.film.width, h = ls.film.height;
   // The rays of the very render that is timed (one thread records them; the rays do not depend
@@ -107,33 +146,53 @@ void rays(const LoadedScene& ls, int iterations, const BpmSettings& bs, int hw) 
   std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays (%d iterations)\n",
               eye_log.closest_rays.size(), eye_log.shadow_rays.size(),
               light_log.closest_rays.size(), iterations);
-  // The machine's speed drifts: each repeat times the passes and, right after, Embree; the
-  // medians of the repeats are printed.
+  if (pbrt.empty())
+    std::printf(
+        "pbrt-v4 not found (../shared/tools/pbrt-v4/pbrt or --pbrt): no photon pass anchor\n");
+  // The machine's speed drifts: each repeat times the passes, right after them Embree, then
+  // pbrt-v4's photon pass; the medians of the repeats are printed.
   constexpr int kRepeats = 3;
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
   };
   for (int threads : {1, hw}) {
-    std::vector<double> eye, eye_embree, eye_share, light, light_embree, light_share;
+    std::vector<double> eye, eye_embree, eye_share, light, light_embree, light_share, us_photon,
+        rays_photon, pbrt_us, pbrt_rays;
     for (int r = 0; r < kRepeats; ++r) {
       Film film(w, h);
       RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
       const auto& d = st.details;
       const double light_s =
           d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+      const double photons = double(d["light"]["photons"].get<uint64_t>()),
+                   light_rays = double(d["light"]["light_rays"].get<uint64_t>());
       eye.push_back(d["eye"]["rays_per_second"].get<double>());
-      light.push_back(double(d["light"]["light_rays"].get<uint64_t>()) / light_s);
+      light.push_back(light_rays / light_s);
+      us_photon.push_back(light_s / photons * 1e6);
+      rays_photon.push_back(light_rays / photons);
       eye_embree.push_back(embree_replay(ls.scene, eye_log, threads));
       light_embree.push_back(embree_replay(ls.scene, light_log, threads));
       eye_share.push_back(eye.back() / eye_embree.back());
       light_share.push_back(light.back() / light_embree.back());
+      if (!pbrt.empty()) {
+        PbrtPhotonCost c =
+            pbrt_photon_cost(pbrt, scene_path, ls, iterations, bs.photons_per_iteration, threads);
+        pbrt_us.push_back(c.us_per_photon);
+        pbrt_rays.push_back(c.rays_per_photon);
+      }
     }
     std::printf(
         "threads %2d: eye %.2f Mrays/s vs Embree %.2f (%.0f%%); light %.2f Mrays/s vs Embree "
         "%.2f (%.0f%%)  [medians of %d]\n",
         threads, median(eye) * 1e-6, median(eye_embree) * 1e-6, 100 * median(eye_share),
         median(light) * 1e-6, median(light_embree) * 1e-6, 100 * median(light_share), kRepeats);
+    std::printf("            light pass %.3f us per photon (%.2f rays each)", median(us_photon),
+                median(rays_photon));
+    if (!pbrt_us.empty() && median(pbrt_us) > 0)
+      std::printf("; pbrt-v4 sppm photon pass %.3f us per photon (%.2f rays each): %.2fx bpm's",
+                  median(pbrt_us), median(pbrt_rays), median(pbrt_us) / median(us_photon));
+    std::printf("\n");
     if (hw == 1) break;
   }
 }
@@ -180,6 +239,7 @@ void equal_time(const LoadedScene& ls, const std::string& scene_path,
 
 int main(int argc, char** argv) {
   std::string scene_path = std::string(BPM_SOURCE_DIR) + "/scenes/caustic-sphere.pbrt", only;
+  std::string pbrt = default_pbrt_path();
   int w = 160, h = 120, iterations = 32;
   double reference_s = 600;
   std::vector<double> times = {30, 60};
@@ -193,6 +253,8 @@ int main(int argc, char** argv) {
       reference_s = std::atof(next().c_str());
     else if (!std::strcmp(argv[i], "--only"))
       only = next();
+    else if (!std::strcmp(argv[i], "--pbrt"))
+      pbrt = next();
     else if (!std::strcmp(argv[i], "--times")) {
       times.clear();
       std::stringstream ss(next());
@@ -211,7 +273,7 @@ int main(int argc, char** argv) {
       scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1,
       bs.photons_per_iteration);
   if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
-  if (only.empty() || only == "rays") rays(ls, iterations, bs, hw);
+  if (only.empty() || only == "rays") rays(ls, scene_path, iterations, bs, hw, pbrt);
   if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);
   if (only == "reference") equal_time(ls, scene_path, {}, reference_s, bs);
   return 0;

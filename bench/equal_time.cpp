@@ -15,8 +15,6 @@
 // whole run, start-up included, takes --time seconds. sppm's radius is stated in the table: 0.002
 // of the scene's bounding-box diagonal. References are made once, with their own seed, and kept in
 // equal_time_references/ in the working folder (a JSON beside each says how it was made).
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -33,6 +31,7 @@
 
 #include "film/image_compare.h"
 #include "film/image_io.h"
+#include "pbrt_runner.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 
@@ -145,49 +144,6 @@ Image reference_for(const SceneEntry& e, const LoadedScene& ls, double seconds) 
   return img;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-// A copy of the scene file beside it (so that relative paths still resolve) whose Integrator
-// directive is `integrator`.
-std::string scene_with_integrator(const std::string& path, const std::string& integrator) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string s = text.str(), out;
-  std::istringstream lines(s);
-  bool skipping = false, placed = false;
-  for (std::string line; std::getline(lines, line);) {
-    std::string t = line.substr(line.find_first_not_of(" \t") == std::string::npos
-                                    ? line.size()
-                                    : line.find_first_not_of(" \t"));
-    bool directive = !t.empty() && std::isupper(static_cast<unsigned char>(t[0]));
-    if (directive) skipping = t.rfind("Integrator", 0) == 0;
-    if (!placed && t.rfind("WorldBegin", 0) == 0) {
-      out += integrator + "\n";
-      placed = true;
-    }
-    if (!skipping) out += line + "\n";
-  }
-  std::string copy =
-      (fs::path(path).parent_path() / (".equal_time_" + std::to_string(::getpid()) + ".pbrt"))
-          .string();
-  write_text_atomic(copy, out);
-  return copy;
-}
-
-// Runs pbrt-v4; returns its wall time, or a negative value when it failed.
-double run_pbrt(const std::string& pbrt, const std::string& scene, int spp,
-                const std::string& out) {
-  std::string cmd = pbrt + " --quiet --nthreads 2 --seed 7 --spp " + std::to_string(spp) +
-                    " --outfile " + out + " " + scene + " > /dev/null 2>&1";
-  auto t = std::chrono::steady_clock::now();
-  int rc = std::system(cmd.c_str());
-  double s = seconds_since(t);
-  return rc == 0 ? s : -1;
-}
-
 void row(const std::string& who, double seconds, const std::string& samples, const Metrics& m) {
   std::printf("  %-28s %7.1f %10s %12.3e %12.3e   %6.3f %6.3f %6.3f\n", who.c_str(), seconds,
               samples.c_str(), m.rel_mse, m.rel_mse_trimmed, m.ratio[0], m.ratio[1], m.ratio[2]);
@@ -210,11 +166,15 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
            " \"float radius\" " + std::to_string(radius)},
   };
   for (const Variant& v : variants) {
-    std::string copy = scene_with_integrator(e.path, v.line);
+    std::string copy =
+        scene_copy_with(e.path,
+                        {{"Integrator", v.line},
+                         {"Film", film_at_resolution(e.path, ls.film.width, ls.film.height)}},
+                        "equal_time");
     // Calibration: wall time = start-up + cost * samples, from runs of 1 and 4 samples. When the
     // difference drowns in the start-up's noise, the whole time of 4 samples counts as their cost
     // (fewer samples rather than a run far over the budget).
-    double t1 = run_pbrt(pbrt, copy, 1, out), t4 = run_pbrt(pbrt, copy, 4, out);
+    double t1 = run_pbrt(pbrt, copy, 1, out, 2), t4 = run_pbrt(pbrt, copy, 4, out, 2);
     if (t1 < 0 || t4 < 0) {
       std::printf("  %-28s failed to run\n", v.label.c_str());
       fs::remove(copy);
@@ -223,11 +183,15 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
     double per_sample = (t4 - t1) / 3, startup = std::max(0.0, t1 - per_sample);
     if (per_sample < 0.1 * t4 / 4) per_sample = t4 / 4, startup = 0;
     int spp = std::max(1, int((seconds - startup) / per_sample));
-    double t = run_pbrt(pbrt, copy, spp, out);
+    double t = run_pbrt(pbrt, copy, spp, out, 2);
     fs::remove(copy);
     if (t < 0) continue;
     Image img = read_exr(out);
-    if (img.width != ref.width || img.height != ref.height) continue;
+    if (img.width != ref.width || img.height != ref.height) {
+      std::printf("  %-28s wrote %dx%d, not the reference's %dx%d\n", v.label.c_str(), img.width,
+                  img.height, ref.width, ref.height);
+      continue;
+    }
     row(v.label, t, std::to_string(spp) + " spp", measure(img, ref));
   }
   fs::remove(out);
@@ -238,11 +202,9 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   double seconds = 60, reference_s = 600;
-  std::string only, pbrt, res;
+  std::string only, res;
   bool references_only = false;
-  const fs::path default_pbrt =
-      fs::path(BPM_SOURCE_DIR) / ".." / "shared" / "tools" / "pbrt-v4" / "pbrt";
-  if (fs::exists(default_pbrt)) pbrt = default_pbrt.lexically_normal().string();
+  std::string pbrt = default_pbrt_path();
   for (int i = 1; i < argc; ++i) {
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
     if (!std::strcmp(argv[i], "--time"))
