@@ -29,7 +29,7 @@ int longest_axis(const Bounds3& b) {
 void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids) {
   nodes_.clear();
   items_.clear();
-  spheres_.clear();
+  for (auto* v : {&x_, &y_, &z_, &r2_}) v->clear();
   input_count_ = spheres.size();
   if (spheres.empty()) return;
   std::vector<uint32_t> order(spheres.size());
@@ -41,6 +41,12 @@ void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vecto
   }
   nodes_.reserve(2 * spheres.size() / kMinLeaf + 1);
   build_node(order, cell, 0, spheres);
+  for (uint32_t k = 0; k < kPad; ++k) {
+    x_.push_back(0);
+    y_.push_back(0);
+    z_.push_back(0);
+    r2_.push_back(-1);  // no squared distance is below it
+  }
   nodes_.shrink_to_fit();
   if (ids)
     for (uint32_t& item : items_) item = (*ids)[item];
@@ -52,10 +58,7 @@ void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int dept
   nodes_.push_back({});
   auto make_leaf = [&] {
     nodes_[self] = {0, kLeaf, uint32_t(items_.size()), uint32_t(ids.size())};
-    for (uint32_t i : ids) {
-      items_.push_back(i);
-      spheres_.push_back(spheres[i]);
-    }
+    for (uint32_t i : ids) add_slot(i, spheres[i]);
   };
   size_t n = ids.size();
   if (n <= kMinLeaf || depth >= kMaxDepth) return make_leaf();
@@ -150,11 +153,23 @@ void SphereKdTree::append(const SphereKdTree& sub) {
     nodes_.push_back(node);
   }
   items_.insert(items_.end(), sub.items_.begin(), sub.items_.end());
-  spheres_.insert(spheres_.end(), sub.spheres_.begin(), sub.spheres_.end());
+  x_.insert(x_.end(), sub.x_.begin(), sub.x_.end());
+  y_.insert(y_.end(), sub.y_.begin(), sub.y_.end());
+  z_.insert(z_.end(), sub.z_.begin(), sub.z_.end());
+  r2_.insert(r2_.end(), sub.r2_.begin(), sub.r2_.end());
+}
+
+void SphereKdTree::add_slot(uint32_t item, const SphereRef& s) {
+  items_.push_back(item);
+  x_.push_back(s.c.x);
+  y_.push_back(s.c.y);
+  z_.push_back(s.c.z);
+  r2_.push_back(s.r * s.r);
 }
 
 size_t SphereKdTree::bytes() const {
-  return nodes_.size() * sizeof(Node) + items_.size() * (sizeof(uint32_t) + sizeof(SphereRef));
+  return nodes_.size() * sizeof(Node) + items_.size() * sizeof(uint32_t) +
+         (x_.size() + y_.size() + z_.size() + r2_.size()) * sizeof(float);
 }
 
 double SphereKdTree::duplication() const {
