@@ -90,8 +90,7 @@ inline double run_pbrt(const std::string& pbrt, const std::string& scene, int sp
   for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
     if (stats) stats->append(buf, n);
   const int rc = ::pclose(p);
-  const double s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   return rc == 0 ? s : -1;
 }
 
