@@ -1,5 +1,8 @@
 #include "bpm/masks.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <numeric>
 
@@ -25,7 +28,11 @@ PixelMasks::PixelMasks(int width, int height, int slots)
 
 void PixelMasks::rebuild(const std::vector<float>& cost) {
   BPM_CHECK(cost.size() == owner_.size());
-  for (int b = 0; b < block_count(); ++b) assign_block(b, &cost);
+  // Blocks own disjoint pixels and lists: they are rebuilt in parallel, each as it would be alone.
+  tbb::parallel_for(tbb::blocked_range<int>(0, block_count(), 1),
+                    [&](const tbb::blocked_range<int>& r) {
+                      for (int b = r.begin(); b < r.end(); ++b) assign_block(b, &cost);
+                    });
 }
 
 void PixelMasks::assign_block(int b, const std::vector<float>* cost) {
