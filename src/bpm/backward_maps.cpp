@@ -21,13 +21,20 @@ uint32_t spread_bits(uint32_t v) {
   return v;
 }
 
-// Sorts one object's backward photons along a Morton curve through their bounds (ties, which
-// photons in one of its 2^30 cells are, by key(): the order does not depend on the threads). A
-// query's leaf then names photons that lie together in memory; in pixel order each one it accepts
-// was a cache miss.
-void sort_in_space(BackwardPhoton* photons, size_t n) {
+// Gathers one object's backward photons from the threads' lists into dst, sorted along a Morton
+// curve through their bounds (ties, which photons in one of its 2^30 cells are, by key(): the
+// order does not depend on the threads). A query's leaf then names photons that lie together in
+// memory; in pixel order each one it accepts was a cache miss. Returns how many there were.
+size_t gather_in_space(const std::vector<ObjectPhotonLists*>& per_thread, uint32_t o,
+                       BackwardPhoton* dst) {
   Bounds3 b;
-  for (size_t k = 0; k < n; ++k) b.expand(photons[k].p);
+  size_t n = 0;
+  for (const ObjectPhotonLists* l : per_thread)
+    if (o < l->size())
+      for (const BackwardPhoton& bp : (*l)[o]) {
+        b.expand(bp.p);
+        ++n;
+      }
   const Vec3 extent = b.hi - b.lo;
   auto cell = [](float x, float lo, float size) {
     return size > 0 ? uint32_t(std::clamp((x - lo) / size * 1024.0f, 0.0f, 1023.0f)) : 0u;
@@ -35,22 +42,22 @@ void sort_in_space(BackwardPhoton* photons, size_t n) {
   struct Item {
     uint32_t code;
     uint64_t key;
-    uint32_t index;
+    const BackwardPhoton* photon;
   };
-  std::vector<Item> items(n);
-  for (size_t k = 0; k < n; ++k) {
-    const Vec3 p = photons[k].p;
-    items[k] = {spread_bits(cell(p.x, b.lo.x, extent.x)) |
-                    spread_bits(cell(p.y, b.lo.y, extent.y)) << 1 |
-                    spread_bits(cell(p.z, b.lo.z, extent.z)) << 2,
-                photons[k].key(), uint32_t(k)};
-  }
+  std::vector<Item> items;
+  items.reserve(n);
+  for (const ObjectPhotonLists* l : per_thread)
+    if (o < l->size())
+      for (const BackwardPhoton& bp : (*l)[o])
+        items.push_back({spread_bits(cell(bp.p.x, b.lo.x, extent.x)) |
+                             spread_bits(cell(bp.p.y, b.lo.y, extent.y)) << 1 |
+                             spread_bits(cell(bp.p.z, b.lo.z, extent.z)) << 2,
+                         bp.key(), &bp});
   std::sort(items.begin(), items.end(), [](const Item& a, const Item& c) {
     return a.code != c.code ? a.code < c.code : a.key < c.key;
   });
-  std::vector<BackwardPhoton> sorted(n);
-  for (size_t k = 0; k < n; ++k) sorted[k] = photons[items[k].index];
-  std::copy(sorted.begin(), sorted.end(), photons);
+  for (size_t k = 0; k < n; ++k) dst[k] = *items[k].photon;
+  return n;
 }
 
 }  // namespace
@@ -89,15 +96,9 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
   });
   auto build_one = [&](uint32_t o) {
     BackwardPhoton* dst = maps->photons.data() + maps->object_begin[o];
-    size_t n = 0;
-    for (ObjectPhotonLists* l : per_thread) {
-      if (o >= l->size()) continue;
-      std::vector<BackwardPhoton>& src = (*l)[o];
-      std::copy(src.begin(), src.end(), dst + n);
-      n += src.size();
-      std::vector<BackwardPhoton>().swap(src);
-    }
-    sort_in_space(dst, n);
+    const size_t n = gather_in_space(per_thread, o, dst);
+    for (ObjectPhotonLists* l : per_thread)
+      if (o < l->size()) std::vector<BackwardPhoton>().swap((*l)[o]);
     for (int c = 0; c < 2; ++c) {
       const uint8_t accepts = c == 0 ? kAcceptsCaustic : kAcceptsIndirect;
       std::vector<SphereRef> spheres;
