@@ -111,6 +111,7 @@ PbrtPhotonCost pbrt_photon_cost(const std::string& pbrt, const std::string& scen
         " \"integer photonsperiteration\" " + std::to_string(k ? many : few);
     const std::string copy =
         scene_copy_with(scene_path, {{"Integrator", integrator}, {"Film", film}}, "bench_bpm");
+    if (copy.empty()) return {};
     std::string stats;
     t[k] = run_pbrt(pbrt, copy, iterations, ".bench_bpm_pbrt.exr", threads, &stats);
     std::filesystem::remove(copy);
@@ -178,8 +179,8 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
       if (!pbrt.empty()) {
         PbrtPhotonCost c =
             pbrt_photon_cost(pbrt, scene_path, ls, iterations, bs.photons_per_iteration, threads);
-        pbrt_us.push_back(c.us_per_photon);
-        pbrt_rays.push_back(c.rays_per_photon);
+        if (c.us_per_photon > 0) pbrt_us.push_back(c.us_per_photon);
+        if (c.rays_per_photon > 0) pbrt_rays.push_back(c.rays_per_photon);
       }
     }
     std::printf(
@@ -189,9 +190,13 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
         median(light) * 1e-6, median(light_embree) * 1e-6, 100 * median(light_share), kRepeats);
     std::printf("            light pass %.3f us per photon (%.2f rays each)", median(us_photon),
                 median(rays_photon));
-    if (!pbrt_us.empty() && median(pbrt_us) > 0)
-      std::printf("; pbrt-v4 sppm photon pass %.3f us per photon (%.2f rays each): %.2fx bpm's",
-                  median(pbrt_us), median(pbrt_rays), median(pbrt_us) / median(us_photon));
+    if (!pbrt_us.empty()) {
+      std::printf("; pbrt-v4 sppm photon pass %.3f us per photon", median(pbrt_us));
+      if (!pbrt_rays.empty()) std::printf(" (%.2f rays each)", median(pbrt_rays));
+      std::printf(": %.2fx bpm's", median(pbrt_us) / median(us_photon));
+    } else if (!pbrt.empty()) {
+      std::printf("; pbrt-v4 failed to run");
+    }
     std::printf("\n");
     if (hw == 1) break;
   }

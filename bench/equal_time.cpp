@@ -171,6 +171,10 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
                         {{"Integrator", v.line},
                          {"Film", film_at_resolution(e.path, ls.film.width, ls.film.height)}},
                         "equal_time");
+    if (copy.empty()) {
+      std::printf("  %-28s no WorldBegin in %s\n", v.label.c_str(), e.path.c_str());
+      continue;
+    }
     // Calibration: wall time = start-up + cost * samples, from runs of 1 and 4 samples. When the
     // difference drowns in the start-up's noise, the whole time of 4 samples counts as their cost
     // (fewer samples rather than a run far over the budget).

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -27,15 +28,20 @@ inline std::string default_pbrt_path() {
 // The lines of the scene file, with each directive's parameters (which may go on over further
 // lines) kept with it: calls line(name, text) for every line, name being the directive the line
 // belongs to ("" before the first).
+// A line whose first non-blank character is a capital letter starts a directive (its name is the
+// letters that follow); any other line (parameters, brackets, comments, blank lines) belongs to
+// the directive before it. Enough for scene files that put one directive on a line.
 template <class Line>
 void for_each_directive_line(const std::string& path, const Line& line) {
   std::ifstream in(path);
   std::string name;
   for (std::string l; std::getline(in, l);) {
     const size_t first = l.find_first_not_of(" \t");
-    // A directive starts with a capital letter.
-    if (first != std::string::npos && std::isupper(static_cast<unsigned char>(l[first])))
-      name = l.substr(first, l.find_first_of(" \t\"", first) - first);
+    if (first != std::string::npos && std::isupper(static_cast<unsigned char>(l[first]))) {
+      size_t end = first;
+      while (end < l.size() && std::isalpha(static_cast<unsigned char>(l[end]))) ++end;
+      name = l.substr(first, end - first);
+    }
     line(name, l);
   }
 }
@@ -55,7 +61,8 @@ inline std::string film_at_resolution(const std::string& path, int w, int h) {
 
 // A copy of the scene file beside it (so that relative paths still resolve), named with `tag` and
 // the process id, in which each directive named in `lines` (for example "Integrator" or "Film")
-// is dropped and the given text is put before WorldBegin instead. The caller removes it.
+// is dropped and the given text is put before WorldBegin instead. The caller removes it. Returns
+// "" (and writes nothing) when the file has no WorldBegin.
 inline std::string scene_copy_with(const std::string& path,
                                    const std::map<std::string, std::string>& lines,
                                    const std::string& tag) {
@@ -68,6 +75,7 @@ inline std::string scene_copy_with(const std::string& path,
     }
     if (!lines.count(name)) out += l + "\n";
   });
+  if (!placed) return "";
   const std::string copy = (std::filesystem::path(path).parent_path() /
                             ("." + tag + "_" + std::to_string(::getpid()) + ".pbrt"))
                                .string();
@@ -80,9 +88,10 @@ inline std::string scene_copy_with(const std::string& path,
 // appended to *stats.
 inline double run_pbrt(const std::string& pbrt, const std::string& scene, int spp,
                        const std::string& out, int threads, std::string* stats = nullptr) {
-  const std::string cmd = pbrt + " --quiet --nthreads " + std::to_string(threads) +
-                          " --seed 7 --spp " + std::to_string(spp) + " --outfile " + out +
-                          (stats ? " --stats " : " ") + scene + " 2>&1";
+  auto quoted = [](const std::string& p) { return "'" + p + "'"; };
+  const std::string cmd = quoted(pbrt) + " --quiet --nthreads " + std::to_string(threads) +
+                          " --seed 7 --spp " + std::to_string(spp) + " --outfile " + quoted(out) +
+                          (stats ? " --stats " : " ") + quoted(scene) + " 2>&1";
   const auto t = std::chrono::steady_clock::now();
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return -1;

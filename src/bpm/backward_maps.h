@@ -14,7 +14,8 @@
 namespace bpm {
 
 struct BackwardMaps {
-  std::vector<BackwardPhoton> photons;  // object by object; within an object sorted by key()
+  // Object by object; within an object along a Morton curve, ties by key().
+  std::vector<BackwardPhoton> photons;
   std::vector<uint32_t>
       object_begin;  // photons of object o: [object_begin[o], object_begin[o + 1])
   bool centre_tree = false;

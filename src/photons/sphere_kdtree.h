@@ -36,7 +36,8 @@ class SphereKdTree {
     const uint32_t begin = nodes_[n].a, end = begin + nodes_[n].b;
 #if defined(__SSE2__)
     // Four spheres per step (the arrays are padded, so a step may read past the leaf); the same
-    // float operations as the scalar test below, so the same spheres are found, in slot order.
+    // float operations as the scalar test below, so the same spheres are found, in slot order
+    // (where the compiler contracts neither into fused multiply-adds: the default build has none).
     const __m128 px = _mm_set1_ps(p.x), py = _mm_set1_ps(p.y), pz = _mm_set1_ps(p.z);
     for (uint32_t k = begin; k < end; k += 4) {
       const __m128 dx = _mm_sub_ps(px, _mm_loadu_ps(&x_[k]));
