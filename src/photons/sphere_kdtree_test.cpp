@@ -53,6 +53,30 @@ TEST(SphereKdTree, MatchesBruteForce) {
     check_against_brute_force<SphereKdTree>("sphere tree", n);
 }
 
+// A tree built again over fewer spheres finds only the new ones (its leaf arrays, padded for the
+// four-wide test, start over), and a leaf's last spheres are found whatever the leaf's size.
+TEST(SphereKdTree, RebuiltOverFewerSpheresFindsOnlyThose) {
+  Rng rng(stream_key(9, 1));
+  SphereKdTree tree;
+  tree.build(random_spheres(rng, 5000));
+  for (int n : {7, 1, 3, 5, 0}) {
+    std::vector<SphereRef> spheres;
+    for (int i = 0; i < n; ++i) spheres.push_back({Vec3(float(i), 0, 0), 0.75f});
+    tree.build(spheres);
+    for (int i = 0; i < n; ++i) {
+      std::vector<uint32_t> got;
+      tree.query(Vec3(float(i) + 0.5f, 0, 0), [&](uint32_t k) { got.push_back(k); });
+      std::sort(got.begin(), got.end());
+      std::vector<uint32_t> expected = {uint32_t(i)};
+      if (i + 1 < n) expected.push_back(uint32_t(i + 1));
+      EXPECT_EQ(got, expected) << "n=" << n << " at " << i;
+    }
+  }
+  int found = 0;
+  tree.query(Vec3(0, 0, 0), [&](uint32_t) { ++found; });
+  EXPECT_EQ(found, 0);
+}
+
 TEST(CentreKdTree, MatchesBruteForce) {
   for (int n : {0, 1, 3, 50, 1000, 20000})
     check_against_brute_force<CentreKdTree>("centre tree", n);
