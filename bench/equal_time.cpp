@@ -165,12 +165,10 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
        "Integrator \"sppm\" \"integer maxdepth\" " + std::to_string(maxdepth) +
            " \"float radius\" " + std::to_string(radius)},
   };
+  const std::string film = film_at_resolution(e.path, ls.film.width, ls.film.height);
   for (const Variant& v : variants) {
     std::string copy =
-        scene_copy_with(e.path,
-                        {{"Integrator", v.line},
-                         {"Film", film_at_resolution(e.path, ls.film.width, ls.film.height)}},
-                        "equal_time");
+        scene_copy_with(e.path, {{"Integrator", v.line}, {"Film", film}}, "equal_time");
     if (copy.empty()) {
       std::printf("  %-28s no WorldBegin in %s\n", v.label.c_str(), e.path.c_str());
       continue;

@@ -30,19 +30,6 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                     std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   float score = 0;
   ++counters.queries;
-  // The backward photons found are fetched together before any is used: each record is likely a
-  // cache miss, and their misses then overlap.
-  constexpr int kFetched = 32;
-  uint32_t found[kFetched];
-  int n_found = 0;
-  std::vector<uint32_t> more;
-  maps.query(object, cls, sp.p, [&](uint32_t g) {
-    if (n_found == kFetched) return more.push_back(g);
-    found[n_found++] = g;
-    const char* record = reinterpret_cast<const char*>(&maps.photons[g]);
-    __builtin_prefetch(record);
-    __builtin_prefetch(record + sizeof(BackwardPhoton) - 1);
-  });
   auto use = [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + bounces > prm.max_depth) return;
@@ -62,8 +49,23 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
       score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
                (kPi * bp.radius * bp.radius);
   };
-  for (int k = 0; k < n_found; ++k) use(found[k]);
-  for (uint32_t g : more) use(g);
+  // The backward photons found are fetched in groups before any is used: each record is likely a
+  // cache miss, and their misses then overlap. They are used in the order the query found them.
+  constexpr int kFetched = 32;
+  uint32_t found[kFetched];
+  int n_found = 0;
+  auto use_found = [&] {
+    for (int k = 0; k < n_found; ++k) use(found[k]);
+    n_found = 0;
+  };
+  maps.query(object, cls, sp.p, [&](uint32_t g) {
+    if (n_found == kFetched) use_found();
+    found[n_found++] = g;
+    const char* record = reinterpret_cast<const char*>(&maps.photons[g]);
+    __builtin_prefetch(record);
+    __builtin_prefetch(record + sizeof(BackwardPhoton) - 1);
+  });
+  use_found();
   return score;
 }
 

@@ -44,12 +44,8 @@ void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vecto
   }
   nodes_.reserve(2 * spheres.size() / kMinLeaf + 1);
   build_node(order, cell, 0, spheres);
-  for (uint32_t k = 0; k < kPad; ++k) {
-    x_.push_back(0);
-    y_.push_back(0);
-    z_.push_back(0);
-    r2_.push_back(-1);  // no squared distance is below it
-  }
+  for (auto* v : {&x_, &y_, &z_}) v->resize(v->size() + kPad, 0.0f);
+  r2_.resize(r2_.size() + kPad, -1.0f);  // no squared distance is below it
   nodes_.shrink_to_fit();
   if (ids)
     for (uint32_t& item : items_) item = (*ids)[item];
