@@ -1,13 +1,12 @@
 #include "textures/texture.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <mutex>
 
 #include "base/error.h"
+#include "textures/image_file.h"
 
 namespace bpm {
 namespace {
@@ -80,34 +79,21 @@ std::shared_ptr<const TexImage> load_texture_image(const std::string& path,
 
 std::shared_ptr<const TexImage> read_texture_image(const std::string& path,
                                                    const TexEncoding& encoding) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error("cannot read image \"" + path + "\": " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1)
-    throw Error("image \"" + path + "\" has no usable pixels");
-  // A header can claim any size: more than 2^28 values (1 GiB of floats) is refused, not allocated.
-  if (double(spec.width) * spec.height * spec.nchannels > double(1 << 28))
-    throw Error("image \"" + path + "\" is too large (" + std::to_string(spec.width) + " x " +
-                std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) + ")");
+  // More than 2^28 values (1 GiB of floats) is refused, not allocated.
+  const ImageFile file = read_image_file(path, double(1 << 28));
   auto img = std::make_shared<TexImage>();
   img->path = path;
-  img->width = spec.width;
-  img->height = spec.height;
-  const int n = spec.nchannels;
-  std::vector<float> all(size_t(spec.width) * spec.height * n);
-  if (!in->read_image(0, 0, 0, n, OIIO::TypeDesc::FLOAT, all.data()))
-    throw Error("cannot read image \"" + path + "\": " + in->geterror());
-  in->close();
+  img->width = file.width;
+  img->height = file.height;
+  const int n = file.channels;
+  const std::vector<float>& all = file.values;
   // Grey (one channel, or grey plus alpha) stays one channel; otherwise R, G, B.
   img->channels = n < 3 ? 1 : 3;
-  const bool is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
-                        spec.format.basetype == OIIO::TypeDesc::HALF ||
-                        spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  img->texels.resize(size_t(spec.width) * spec.height * img->channels);
-  for (size_t i = 0, count = size_t(spec.width) * spec.height; i < count; ++i)
+  img->texels.resize(size_t(file.width) * file.height * img->channels);
+  for (size_t i = 0, count = size_t(file.width) * file.height; i < count; ++i)
     for (int c = 0; c < img->channels; ++c) {
       float v = all[i * n + c];
-      if (!is_float) {
+      if (!file.is_float) {
         if (encoding.kind == TexEncoding::Kind::kSrgb)
           v = srgb_to_linear(v);
         else if (encoding.kind == TexEncoding::Kind::kGamma)

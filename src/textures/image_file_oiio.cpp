@@ -1,0 +1,41 @@
+// The image reader module (see image_file.h): OpenImageIO behind one C entry point. Built as
+// libbpm_image_reader.so, not into bpmcore.
+#include <OpenImageIO/imageio.h>
+
+#include "textures/image_file.h"
+
+extern "C" bool bpm_read_image_file(const char* path, double max_values, bpm::ImageFile* out,
+                                    std::string* error) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    *error = "cannot read image \"" + std::string(path) + "\": " + OIIO::geterror();
+    return false;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
+    *error = "image \"" + std::string(path) + "\" has no usable pixels";
+    return false;
+  }
+  // A header can claim any size: a huge one is refused, not allocated.
+  if (double(spec.width) * spec.height * spec.nchannels > max_values) {
+    *error = "image \"" + std::string(path) + "\" is too large (" + std::to_string(spec.width) +
+             " x " + std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) + ")";
+    return false;
+  }
+  out->width = spec.width;
+  out->height = spec.height;
+  out->channels = spec.nchannels;
+  out->is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
+                  spec.format.basetype == OIIO::TypeDesc::HALF ||
+                  spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+  out->values.resize(size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out->values.data())) {
+    *error = "cannot read image \"" + std::string(path) + "\": " + in->geterror();
+    return false;
+  }
+  in->close();
+  return true;
+}
+
+// The declaration in image_file.h must match what bpm_read_image_file is.
+static_assert(std::is_same_v<decltype(bpm_read_image_file), bpm::ReadImageFileFn>);
