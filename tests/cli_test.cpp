@@ -89,6 +89,41 @@ TEST_F(Cli, RendersAllOutputs) {
   EXPECT_GT(rec["rays"]["total"].get<uint64_t>(), 32u * 24u * 3u);
 }
 
+// OpenImageIO (about 250 libraries, 0.2 s at every start) is loaded only when a scene reads an
+// image (textures/image_file.h): the program does not need it, and still reads image textures.
+TEST_F(Cli, StartsWithoutOpenImageIOAndStillReadsImages) {
+  // The dynamic loader lists the libraries the program needs, and exits (what ldd does).
+  const std::string listed = (dir_ / "libraries.txt").string();
+  ASSERT_EQ(std::system(
+                ("LD_TRACE_LOADED_OBJECTS=1 " + std::string(BPM_BINARY) + " > " + listed).c_str()),
+            0);
+  std::stringstream libraries;
+  libraries << std::ifstream(listed).rdbuf();
+  EXPECT_NE(libraries.str().find("libembree3"), std::string::npos) << libraries.str();
+  EXPECT_EQ(libraries.str().find("OpenImageIO"), std::string::npos) << libraries.str();
+  // A sphere textured with a white image renders brighter than one with a black image.
+  double mean[2];
+  for (int white = 0; white < 2; ++white) {
+    Image texture{2, 2, std::vector<float>(12, float(white))};
+    const std::string name = white ? "white" : "black";
+    const std::string png = (dir_ / (name + ".png")).string();
+    write_png(png, texture);
+    const std::string plain = "Material \"diffuse\"";
+    std::string scene = kTinyScene;
+    scene.replace(scene.find(plain), plain.size(),
+                  "Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"" + png + "\"\n" +
+                      plain + " \"texture reflectance\" \"t\"");
+    const std::string out = (dir_ / (name + ".exr")).string();
+    CliRun r = run("render " + write("textured.pbrt", scene) + " -q -o " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    Image img = read_exr(out);
+    mean[white] = 0;
+    for (float v : img.rgb) mean[white] += v / double(img.rgb.size());
+  }
+  EXPECT_EQ(mean[0], 0);
+  EXPECT_GT(mean[1], 0.01);
+}
+
 TEST_F(Cli, ResolutionFlagOverridesTheFile) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r =

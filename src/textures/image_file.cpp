@@ -27,11 +27,13 @@ Reader load_reader() {
   const fs::path program = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) places.push_back(program.parent_path() / kImageReaderModule);
 #ifdef BPM_MODULE_DIR
-  places.push_back(fs::path(BPM_MODULE_DIR) / kImageReaderModule);
+  const fs::path built = fs::path(BPM_MODULE_DIR) / kImageReaderModule;
+  if (places.empty() || fs::weakly_canonical(built, ec) != fs::weakly_canonical(places[0], ec))
+    places.push_back(built);
 #endif
   for (const fs::path& place : places) {
     if (!fs::exists(place, ec)) {
-      r.why_not += "\n  " + place.string() + ": not there";
+      r.why_not += "\n  " + place.string() + ": " + (ec ? ec.message() : "not there");
       continue;
     }
     void* module = ::dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -42,7 +44,9 @@ Reader load_reader() {
     }
     r.read = reinterpret_cast<ReadImageFileFn*>(::dlsym(module, kImageReaderEntry));
     if (r.read) return r;
-    r.why_not += "\n  " + place.string() + ": has no " + kImageReaderEntry;
+    r.why_not += "\n  " + place.string() + ": has no " + kImageReaderEntry +
+                 " (a module of another bpm version)";
+    ::dlclose(module);
   }
   return r;
 }

@@ -22,10 +22,12 @@ struct ImageFile {
 // the reader module cannot be found or loaded.
 ImageFile read_image_file(const std::string& path, double max_values);
 
-// The module's name, and its entry point (extern "C", so that dlsym finds it by this name).
+// The module's name, and its entry point (extern "C", so that dlsym finds it by this name). The
+// entry's name carries a version: change it with ImageFile or the signature, so that a module
+// left from another build is refused rather than called with the wrong layout.
 inline constexpr const char* kImageReaderModule = "libbpm_image_reader.so";
 using ReadImageFileFn = bool(const char* path, double max_values, ImageFile* out,
                              std::string* error);
-inline constexpr const char* kImageReaderEntry = "bpm_read_image_file";
+inline constexpr const char* kImageReaderEntry = "bpm_read_image_file_v1";
 
 }  // namespace bpm

@@ -2,10 +2,12 @@
 // libbpm_image_reader.so, not into bpmcore.
 #include <OpenImageIO/imageio.h>
 
+#include <type_traits>
+
 #include "textures/image_file.h"
 
-extern "C" bool bpm_read_image_file(const char* path, double max_values, bpm::ImageFile* out,
-                                    std::string* error) {
+extern "C" bool bpm_read_image_file_v1(const char* path, double max_values, bpm::ImageFile* out,
+                                       std::string* error) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     *error = "cannot read image \"" + std::string(path) + "\": " + OIIO::geterror();
@@ -37,5 +39,5 @@ extern "C" bool bpm_read_image_file(const char* path, double max_values, bpm::Im
   return true;
 }
 
-// The declaration in image_file.h must match what bpm_read_image_file is.
-static_assert(std::is_same_v<decltype(bpm_read_image_file), bpm::ReadImageFileFn>);
+// The declaration in image_file.h must match the definition.
+static_assert(std::is_same_v<decltype(bpm_read_image_file_v1), bpm::ReadImageFileFn>);
