@@ -217,6 +217,8 @@ RenderScene::RenderScene(RenderScene&&) noexcept = default;
 RenderScene& RenderScene::operator=(RenderScene&&) noexcept = default;
 
 void RenderScene::commit() {
+  for (Object& o : objects)
+    if (auto* m = std::get_if<TriangleMesh>(&o.shape)) m->compute_face_normals();
   bounds = Bounds3();
   for (const Object& o : objects)
     for (int p = 0; p < primitive_count(o.shape); ++p) bounds.expand(world_bounds(o.shape, p));

@@ -107,6 +107,12 @@ namespace {
 // rounding of the intersection, the barycentric interpolation and the transforms.
 constexpr float kPointErrorScale = 2e-5f;
 
+Vec3 face_normal(Vec3 p0, Vec3 p1, Vec3 p2) {
+  Vec3 ng = cross(p0 - p2, p1 - p2);
+  float len = length(ng);
+  return len > 0 ? ng / len : Vec3(0, 0, 1);
+}
+
 SurfacePoint mesh_point(const TriangleMesh& m, int prim, Vec2 b) {
   uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1], i2 = m.indices[3 * prim + 2];
   Vec3 p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
@@ -115,9 +121,7 @@ SurfacePoint mesh_point(const TriangleMesh& m, int prim, Vec2 b) {
   sp.p = p0 * b0 + p1 * b.x + p2 * b.y;
   sp.error = kPointErrorScale *
              std::max({max_abs_component(p0), max_abs_component(p1), max_abs_component(p2)});
-  Vec3 ng = cross(p0 - p2, p1 - p2);
-  float len = length(ng);
-  ng = len > 0 ? ng / len : Vec3(0, 0, 1);
+  Vec3 ng = m.face_normals.empty() ? face_normal(p0, p1, p2) : m.face_normals[size_t(prim)];
   if (m.flip_normal) ng = -ng;
   sp.ng = sp.ns = ng;
   if (!m.normals.empty()) {
@@ -182,6 +186,13 @@ SurfacePoint analytic_point(const Shape& shape, Vec3 p_hit) {
 }
 
 }  // namespace
+
+void TriangleMesh::compute_face_normals() {
+  face_normals.resize(size_t(triangle_count()));
+  for (size_t t = 0; t < face_normals.size(); ++t)
+    face_normals[t] = face_normal(positions[indices[3 * t]], positions[indices[3 * t + 1]],
+                                  positions[indices[3 * t + 2]]);
+}
 
 SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) {
   if (auto* m = std::get_if<TriangleMesh>(&shape)) return mesh_point(*m, prim, bary);

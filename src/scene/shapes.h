@@ -17,7 +17,11 @@ struct TriangleMesh {
   // pbrt-v4: the geometric normal is cross(p0 - p2, p1 - p2), negated when ReverseOrientation
   // and the transform's handedness say so, unless per-vertex normals decide its side.
   bool flip_normal = false;
+  // Each triangle's unit cross(p0 - p2, p1 - p2) before flip_normal, so that a hit does not
+  // compute it (RenderScene::commit fills it; surface_point computes it when it is empty).
+  std::vector<Vec3> face_normals;
   int triangle_count() const { return int(indices.size() / 3); }
+  void compute_face_normals();
 };
 
 struct Sphere {
