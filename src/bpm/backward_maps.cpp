@@ -123,6 +123,14 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
         for (size_t k; (k = next.fetch_add(1)) < order.size();) build_one(order[k]);
       },
       tbb::simple_partitioner());
+  // Buckets: every node of a sphere tree (only leaves are used), one per non-empty centre tree.
+  const size_t trees = 2 * object_count;
+  maps->first_bucket.assign(trees + 1, 0);
+  for (size_t t = 0; t < trees; ++t) {
+    const uint32_t n =
+        centre_tree ? (maps->centre_trees[t].empty() ? 0 : 1) : maps->sphere_trees[t].node_count();
+    maps->first_bucket[t + 1] = maps->first_bucket[t] + n;
+  }
 }
 
 }  // namespace bpm

@@ -35,6 +35,27 @@ struct BackwardMaps {
     else
       sphere_trees[t].query(p, f);
   }
+  // Queries grouped by bucket are answered from cache (the light pass gathers its hits bucket by
+  // bucket): a bucket is a leaf of a sphere tree, or a whole centre tree. Buckets are numbered
+  // over all trees, tree by tree; first_bucket has one more entry than there are trees.
+  static constexpr uint32_t kNoBucket = ~0u;  // the tree is empty: the query finds nothing
+  std::vector<uint32_t> first_bucket;
+  uint32_t bucket_count() const { return first_bucket.empty() ? 0 : first_bucket.back(); }
+  uint32_t bucket_of(int object, PhotonClass cls, Vec3 p) const {
+    const size_t t = 2 * size_t(object) + size_t(tree_class(cls));
+    if (first_bucket[t] == first_bucket[t + 1]) return kNoBucket;
+    return centre_tree ? first_bucket[t] : first_bucket[t] + sphere_trees[t].leaf_of(p);
+  }
+  // query() for a point of bucket b (bucket_of(object, cls, p), not kNoBucket): the same photons,
+  // in the same order.
+  template <class F>
+  void query_bucket(uint32_t b, int object, PhotonClass cls, Vec3 p, F&& f) const {
+    const size_t t = 2 * size_t(object) + size_t(tree_class(cls));
+    if (centre_tree)
+      centre_trees[t].query(p, f);
+    else
+      sphere_trees[t].query_leaf(b - first_bucket[t], p, f);
+  }
   size_t photon_bytes() const { return photons.size() * sizeof(BackwardPhoton); }
   size_t tree_bytes() const;
 };

@@ -21,26 +21,28 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// Adds the entries of one diffuse hit: the photon arrives at sp along -wi with `flux`. Returns
-// the sum of the entries' contributions to their pixels (per unit of 1 / N), each times the
-// pixel's weight, when prm.pixel_weight is set.
+// Adds the entries of one diffuse hit (its query was counted when it was recorded). Returns the
+// sum of the entries' contributions to their pixels (per unit of 1 / N), each times the pixel's
+// weight, when prm.pixel_weight is set.
 float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
-                    const std::vector<uint16_t>& owner, int object, const SurfacePoint& sp, Vec3 wi,
-                    const Spectrum& flux, PhotonClass cls, int bounces, bool hero_only,
+                    const std::vector<uint16_t>& owner, const PendingHit& h,
                     std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
+  const int bounces = h.bounces;
+  const Vec3 wi = h.wi;
+  const Spectrum& flux = h.flux;
+  const bool hero_only = h.hero_only;
   float score = 0;
-  ++counters.queries;
   auto use = [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + bounces > prm.max_depth) return;
-    if (dot(bp.ng, sp.ng) < prm.normal_cos) return;
+    if (dot(bp.ng, h.ng) < prm.normal_cos) return;
     // Resolved per backward photon when any material is textured (resolve_photon_materials).
     const Material& m = prm.photon_materials.empty() ? prm.materials->materials[bp.material]
                                                      : prm.photon_materials[g];
     Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, hero_only);
-    const float d2 = length_squared(sp.p - bp.p), r2 = bp.radius * bp.radius;
+    const float d2 = length_squared(h.p - bp.p), r2 = bp.radius * bp.radius;
     const uint32_t bits =
         (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
     out[owner[bp.pixel]].push_back({g | bits, value});
@@ -58,7 +60,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     for (int k = 0; k < n_found; ++k) use(found[k]);
     n_found = 0;
   };
-  maps.query(object, cls, sp.p, [&](uint32_t g) {
+  maps.query_bucket(h.bucket, h.object, h.cls, h.p, [&](uint32_t g) {
     if (n_found == kFetched) use_found();
     found[n_found++] = g;
     const char* record = reinterpret_cast<const char*>(&maps.photons[g]);
@@ -85,22 +87,6 @@ void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
   });
 }
 
-float trace_photon(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                   const std::vector<uint16_t>& owner, const EmissionDraw& e, Rng& rng,
-                   std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
-  // A backward photon adds at least one eye vertex; direct photons are never used (next-event
-  // estimation counts direct light).
-  float score = 0;
-  trace_light_path(scene, *prm.materials, prm.max_depth, 1, e, rng, counters,
-                   [&](const PhotonHit& h) {
-                     if (h.cls != PhotonClass::kDirect && maps.has_photons(h.object))
-                       score += gather_at_hit(maps, prm, owner, h.object, h.sp, h.wi, h.flux, h.cls,
-                                              h.bounces, h.hero_only, out, counters);
-                   });
-  // The score as if the photon had been emitted without guidance.
-  return e.weight > 0 ? score / e.weight : 0;
-}
-
 namespace {
 
 // Bytes the entry lists of one chunk hold.
@@ -110,81 +96,136 @@ size_t chunk_bytes(const std::vector<std::vector<PhotonEntry>>& by_slot) {
   return b;
 }
 
-struct BatchResult {
-  uint64_t kept = 0;     // photons traced into the lists, from the batch's first one
-  bool stopped = false;  // prm.stop ended the batch (and the pass)
+struct TraceResult {
+  uint64_t kept = 0;     // photons traced, from the batch's first one
+  int chunks = 0;        // the chunks that traced them
+  bool stopped = false;  // prm.stop ended the trace (and the pass)
 };
 
-// Phase one of a batch: every chunk traces its photons into its own lists. The photons kept are
-// all `count`, or a prefix of whole chunks when prm.stop or prm.entry_bytes_limit ended the batch
-// early (the lists of the chunks past them are emptied). The first chunk always runs, except
-// after a stop request in a later batch.
-BatchResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
-                        const LightPassParams& prm, const PixelMasks& masks, uint64_t seed,
-                        int pass_index, uint64_t first_photon, uint64_t count,
-                        const EmissionGuide* guide, LightPassBuffers* buf) {
-  const int slots = masks.slots();
+// Trace: every chunk traces its photons and records their hits and emissions. The photons kept
+// are all `count`, or a prefix of whole chunks when prm.stop ended the trace. The first chunk
+// always runs, except after a stop request in a later batch.
+TraceResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
+                        const LightPassParams& prm, uint64_t seed, int pass_index,
+                        uint64_t first_photon, uint64_t count, const EmissionGuide* guide,
+                        LightPassBuffers* buf) {
   const int n_chunks = int((count + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   auto stop = [&] { return prm.stop && prm.stop(); };
   // A pass keeps at least its first chunk: N of eq. (2) is never zero.
-  if (first_photon > 0 && stop()) return {0, true};
-  // What every chunk's lists hold now (they keep their capacity from earlier batches). Every chunk
-  // has its slots, also one that does not run (phase two reads them all).
-  std::atomic<size_t> entry_bytes{0};
-  for (auto& by_slot : buf->chunks) {
-    by_slot.resize(size_t(slots));
-    entry_bytes += chunk_bytes(by_slot);
+  if (first_photon > 0 && stop()) return {0, 0, true};
+  if (buf->hits.size() < size_t(n_chunks)) {
+    buf->hits.resize(size_t(n_chunks));
+    buf->emitted.resize(size_t(n_chunks));
   }
-  auto full = [&] { return prm.entry_bytes_limit && entry_bytes.load() > prm.entry_bytes_limit; };
-  const int kept = run_chunks_until(
-      n_chunks, [&] { return stop() || full(); },
-      [&](int c) {
-        LightCounters& lc = buf->counters.local();
-        std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(c)];
-        const size_t bytes_before = chunk_bytes(by_slot);
-        for (auto& v : by_slot) v.clear();
-        std::vector<CellScore>& scores = buf->scores[size_t(c)];
-        scores.clear();
-        uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-        uint64_t last = std::min(first + kPhotonsPerChunk, count);
-        for (uint64_t k = first; k < last; ++k) {
-          uint64_t index = first_photon + k;
-          Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), index, 1));
-          const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
-          float score = trace_photon(scene, maps, prm, masks.owner(), e, rng, by_slot, lc);
-          if (guide && prm.pixel_weight) scores.push_back({e.cell, score});
-        }
-        entry_bytes += chunk_bytes(by_slot) - bytes_before;
-      });
-  BatchResult r;
-  r.kept = std::min(count, uint64_t(kept) * kPhotonsPerChunk);
-  r.stopped = kept < n_chunks && stop();
-  const bool full_batch_cut = kept < n_chunks && !r.stopped;
-  for (int c = kept; c < int(buf->chunks.size()); ++c) {
-    for (auto& v : buf->chunks[size_t(c)]) {
-      v.clear();
-      // Past a batch the entry limit ended, the memory goes back, so that the next one fits.
-      if (full_batch_cut) v.shrink_to_fit();
+  const bool scored = guide && prm.pixel_weight;
+  const int kept = run_chunks_until(n_chunks, stop, [&](int c) {
+    LightCounters& lc = buf->counters.local();
+    std::vector<PendingHit>& hits = buf->hits[size_t(c)];
+    std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
+    hits.clear();
+    emitted.clear();
+    const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+    const uint64_t last = std::min(first + kPhotonsPerChunk, count);
+    for (uint64_t k = first; k < last; ++k) {
+      Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), first_photon + k, 1));
+      const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
+      const uint32_t photon = uint32_t(k - first);
+      // A backward photon adds at least one eye vertex; direct photons are never used
+      // (next-event estimation counts direct light).
+      trace_light_path(scene, *prm.materials, prm.max_depth, 1, e, rng, lc,
+                       [&](const PhotonHit& h) {
+                         if (h.cls == PhotonClass::kDirect || !maps.has_photons(h.object)) return;
+                         ++lc.queries;
+                         const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
+                         if (bucket == BackwardMaps::kNoBucket) return;
+                         hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object,
+                                         int16_t(h.bounces), h.cls, h.hero_only});
+                       });
+      if (scored) emitted.push_back({e.cell, e.weight});
     }
-    buf->scores[size_t(c)].clear();
-  }
-  return r;
+  });
+  return {std::min(count, uint64_t(kept) * kPhotonsPerChunk), kept, kept < n_chunks};
 }
 
-// Phase two: each slot applies the entries of its own pixels, chunk by chunk in order.
-void apply_batch(const LightPassBuffers& buf, int slots, LightPassResult* res,
-                 std::vector<uint8_t>* hit) {
+// The hits of the first `chunks` chunks in bucket order, and within a bucket in chunk and photon
+// order (a counting sort).
+void sort_hits(const BackwardMaps& maps, int chunks, LightPassBuffers* buf) {
+  std::vector<uint32_t>& start = buf->bucket_start;
+  start.assign(size_t(maps.bucket_count()) + 1, 0);
+  size_t total = 0;
+  for (int c = 0; c < chunks; ++c) {
+    for (const PendingHit& h : buf->hits[size_t(c)]) ++start[h.bucket + 1];
+    total += buf->hits[size_t(c)].size();
+  }
+  for (size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+  buf->order.resize(total);
+  for (int c = 0; c < chunks; ++c)
+    for (PendingHit& h : buf->hits[size_t(c)]) buf->order[start[h.bucket]++] = &h;
+}
+
+// Gather: gather chunks from `first` on (kHitsPerGather hits of `order` each) add their entries
+// to their own lists, until all have run or the entries, over `fixed_bytes` for the hits, reach
+// the memory limit (the first always runs). Returns how many ran, a prefix; the lists of any past
+// them are emptied (they run again in the next round).
+int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const PixelMasks& masks,
+                 int first, int n_gather, size_t fixed_bytes, LightPassBuffers* buf) {
+  std::atomic<size_t> bytes{fixed_bytes};
+  for (auto& by_slot : buf->chunks) {
+    by_slot.resize(size_t(masks.slots()));
+    bytes += chunk_bytes(by_slot);
+  }
+  auto full = [&] { return prm.entry_bytes_limit && bytes.load() > prm.entry_bytes_limit; };
+  const size_t n_hits = buf->order.size();
+  const int kept = run_chunks_until(n_gather - first, full, [&](int i) {
+    LightCounters& lc = buf->counters.local();
+    std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(first + i)];
+    const size_t bytes_before = chunk_bytes(by_slot);
+    for (auto& v : by_slot) v.clear();
+    const size_t begin = size_t(first + i) * kHitsPerGather;
+    const size_t end = std::min(n_hits, begin + kHitsPerGather);
+    for (size_t k = begin; k < end; ++k) {
+      // The hits lie in their chunks' lists, read here out of order: fetched a few ahead.
+      if (k + 4 < end) {
+        const char* next = reinterpret_cast<const char*>(buf->order[k + 4]);
+        __builtin_prefetch(next);
+        __builtin_prefetch(next + sizeof(PendingHit) - 1);
+      }
+      PendingHit& h = *buf->order[k];
+      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot, lc);
+    }
+    bytes += chunk_bytes(by_slot) - bytes_before;
+  });
+  for (int g = first + kept; g < n_gather; ++g)
+    for (auto& v : buf->chunks[size_t(g)]) v.clear();
+  return kept;
+}
+
+// Apply: each slot applies the entries of its own pixels, gather chunk by gather chunk in order.
+void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots, LightPassResult* res,
+                   std::vector<uint8_t>* hit) {
   tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
     for (int slot = r.begin(); slot < r.end(); ++slot)
-      for (const auto& by_slot : buf.chunks)
-        for (const PhotonEntry& e : by_slot[size_t(slot)]) {
-          const uint32_t g = e.backward_photon();
-          res->flux[g] += e.value;
-          if (e.inner()) res->flux_inner[g] += e.value;
-          if (e.quarter()) res->flux_quarter[g] += e.value;
-          (*hit)[g] = 1;
+      for (int g = begin; g < end; ++g)
+        for (const PhotonEntry& e : buf.chunks[size_t(g)][size_t(slot)]) {
+          const uint32_t b = e.backward_photon();
+          res->flux[b] += e.value;
+          if (e.inner()) res->flux_inner[b] += e.value;
+          if (e.quarter()) res->flux_quarter[b] += e.value;
+          (*hit)[b] = 1;
         }
   });
+}
+
+// Photons per batch: kPhotonsPerBatch, or under a memory limit the whole chunks (at least one)
+// whose hits, max_depth + 1 per photon at most, fit in half of it.
+uint64_t batch_photons(const LightPassParams& prm) {
+  if (!prm.entry_bytes_limit) return kPhotonsPerBatch;
+  const double per_photon =
+      double(prm.max_depth + 1) * double(sizeof(PendingHit) + sizeof(PendingHit*)) +
+      double(sizeof(EmittedPhoton));
+  const uint64_t chunks =
+      uint64_t(0.5 * double(prm.entry_bytes_limit) / per_photon) / uint64_t(kPhotonsPerChunk);
+  return std::clamp<uint64_t>(chunks * kPhotonsPerChunk, kPhotonsPerChunk, kPhotonsPerBatch);
 }
 
 }  // namespace
@@ -201,43 +242,72 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
   res.flux_inner.assign(n_bp, Spectrum());
   res.flux_quarter.assign(n_bp, Spectrum());
   std::vector<uint8_t> hit(n_bp, 0);
+  const uint64_t batch = batch_photons(prm);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   for (uint64_t first = 0; first < total;) {
-    const uint64_t count = std::min(kPhotonsPerBatch, total - first);
-    // Sized for a whole batch, so that a shorter last batch keeps the lists' memory (its chunks
-    // past `count` stay empty).
-    const uint64_t batch = std::min(kPhotonsPerBatch, total);
-    buf->chunks.resize(size_t((batch + kPhotonsPerChunk - 1) / kPhotonsPerChunk));
-    buf->scores.resize(buf->chunks.size());
+    const uint64_t count = std::min(batch, total - first);
     auto t = std::chrono::steady_clock::now();
-    const BatchResult b =
-        trace_batch(scene, maps, prm, masks, seed, pass_index, first, count, guide, buf);
-    if (b.kept == 0) {  // stopped before the batch began: the lists hold the last one's entries
+    const TraceResult tr =
+        trace_batch(scene, maps, prm, seed, pass_index, first, count, guide, buf);
+    if (tr.kept == 0) {  // stopped before the batch began
       res.cut = true;
       break;
     }
-    first += b.kept;
-    res.emitted += b.kept;
-    res.cut = b.stopped;
-    ++res.batches;
-    res.trace_s += seconds_since(t);
-    size_t entry_bytes = 0;
-    for (const auto& by_slot : buf->chunks)
-      for (const auto& v : by_slot) entry_bytes += v.capacity() * sizeof(PhotonEntry);
-    res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
-
+    first += tr.kept;
+    res.emitted += tr.kept;
+    res.cut = tr.stopped;
+    sort_hits(maps, tr.chunks, buf);
+    size_t hit_bytes = buf->order.capacity() * sizeof(PendingHit*);
+    for (int c = 0; c < tr.chunks; ++c)
+      hit_bytes += buf->hits[size_t(c)].capacity() * sizeof(PendingHit) +
+                   buf->emitted[size_t(c)].capacity() * sizeof(EmittedPhoton);
+    const int n_gather = int((buf->order.size() + kHitsPerGather - 1) / kHitsPerGather);
+    if (buf->chunks.size() < size_t(n_gather)) buf->chunks.resize(size_t(n_gather));
+    // Rounds of gather and apply: one, unless the entries reach the memory limit; a round keeps a
+    // prefix of the gather chunks and the next goes on from there, so that the entries are
+    // applied in the same order whatever the rounds.
+    for (int done = 0; done < n_gather;) {
+      const int kept = gather_round(maps, prm, masks, done, n_gather, hit_bytes, buf);
+      res.trace_s += seconds_since(t);
+      size_t entry_bytes = hit_bytes;
+      for (const auto& by_slot : buf->chunks)
+        for (const auto& v : by_slot) entry_bytes += v.capacity() * sizeof(PhotonEntry);
+      res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
+      t = std::chrono::steady_clock::now();
+      apply_entries(*buf, done, done + kept, masks.slots(), &res, &hit);
+      res.apply_s += seconds_since(t);
+      t = std::chrono::steady_clock::now();
+      ++res.batches;
+      done += kept;
+      // The limit ended the round: the lists' memory goes back, so that the next round has it.
+      if (done < n_gather)
+        for (auto& by_slot : buf->chunks)
+          for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
+    }
+    if (n_gather == 0) {
+      res.trace_s += seconds_since(t);
+      ++res.batches;
+    }
     t = std::chrono::steady_clock::now();
-    apply_batch(*buf, masks.slots(), &res, &hit);
     if (guide && prm.pixel_weight)
-      for (const std::vector<CellScore>& s : buf->scores) guide->learn(s);
+      // Each photon's score is the sum of its hits', in the order of its path, as if it had been
+      // emitted without guidance (weight removed).
+      for (int c = 0; c < tr.chunks; ++c) {
+        const std::vector<PendingHit>& hits = buf->hits[size_t(c)];
+        const std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
+        buf->scores.clear();
+        size_t j = 0;
+        for (uint32_t p = 0; p < uint32_t(emitted.size()); ++p) {
+          float score = 0;
+          for (; j < hits.size() && hits[j].photon == p; ++j) score += hits[j].score;
+          buf->scores.push_back(
+              {emitted[p].cell, emitted[p].weight > 0 ? score / emitted[p].weight : 0});
+        }
+        guide->learn(buf->scores);
+      }
     res.apply_s += seconds_since(t);
     if (res.cut) break;
-    // A batch the entry limit ended: its lists go back too, so that the next batch has the whole
-    // limit (kept, they would leave it room for one chunk).
-    if (b.kept < count)
-      for (auto& by_slot : buf->chunks)
-        for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
   }
   size_t n_indirect = 0, covered = 0;
   for (size_t g = 0; g < n_bp; ++g)

@@ -1,10 +1,13 @@
 // Stage 3 of a bpm iteration, the light pass (section 3 of the paper): a fixed number of photons,
-// in batches that bound the memory of the recorded entries. Each batch runs in two phases. Phase
-// one: photons travel as photons/light_path.h says; at each diffuse hit the hit object's tree gives
-// the backward photons whose spheres contain the hit, and each accepted pair is appended as
-// (backward photon, contribution) to the lists of its chunk, one list per mask slot. Phase two:
-// each slot applies the entries of its own pixels, chunk by chunk in order, so that no locks are
-// needed and the sums do not depend on the thread count.
+// in batches that bound the memory of what is recorded. Each batch runs in three phases.
+// Trace: photons travel as photons/light_path.h says, in chunks; each chunk records the diffuse
+// hits of its photons, with the bucket (a leaf of the hit object's tree) each hit's query falls in.
+// Gather: the batch's hits, sorted by bucket, are queried in that order, so that a leaf and the
+// backward photons it holds are read from cache by all the hits that fall in it, not fetched
+// from memory hit after hit; each accepted pair is appended as (backward photon, contribution) to
+// the lists of its gather chunk, one list per mask slot. Apply: each slot applies the entries of
+// its own pixels, gather chunk by gather chunk in order, so that no locks are needed and the sums
+// do not depend on the thread count.
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
@@ -47,27 +50,45 @@ struct LightPassParams {
   // A stop request (an interrupt, the time budget), asked before each chunk of photons: once true,
   // the pass ends with the photons traced so far (at least its first chunk). Empty: never.
   std::function<bool()> stop = nullptr;
-  // Bytes the entry lists of a batch may hold (the memory budget left after the film and the
-  // maps); 0: no limit. A batch that reaches it ends at a chunk and the next batch goes on from
-  // there: the image is the same, since entries are applied in photon order whatever the batches.
+  // Bytes the hits and entry lists of a batch may hold (the memory budget left after the film
+  // and the maps); 0: no limit. Batches are then as large as half of it can hold the hits of (so
+  // the image depends on the budget, in its last bits: the order of the sums); the entries of
+  // a batch that fill the rest are applied and freed, and its gather goes on, in the same order.
   size_t entry_bytes_limit = 0;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
 void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm);
 
-// Traces one photon emitted as `e` says. owner[pixel] is the mask slot of the pixel; out has one
-// list per slot. Returns the photon's score for the guide (zero when params.pixel_weight is null).
-float trace_photon(const RenderScene& scene, const BackwardMaps& maps,
-                   const LightPassParams& params, const std::vector<uint16_t>& owner,
-                   const EmissionDraw& e, Rng& rng, std::vector<std::vector<PhotonEntry>>& out,
-                   LightCounters& counters);
+// A diffuse hit of a photon, waiting for its gather.
+struct PendingHit {
+  Vec3 p, ng, wi;  // the hit, its geometric normal, toward where the photon came from
+  Spectrum flux;
+  uint32_t bucket;  // BackwardMaps::bucket_of the hit's query
+  uint32_t photon;  // the photon's index in its chunk
+  int object;
+  int16_t bounces;
+  PhotonClass cls;
+  bool hero_only;
+  float score = 0;  // set by the gather: the hit's part of its photon's score for the guide
+};
 
-// What the light pass keeps between iterations: the entry lists and photon scores of each chunk
-// of a batch and the per-thread counters.
+// A photon's emission cell and weight, for its score (EmissionGuide).
+struct EmittedPhoton {
+  uint32_t cell;
+  float weight;
+};
+
+// What the light pass keeps between iterations (so that their memory is allocated once): per
+// chunk of a batch's photons their hits and emissions, the hits in gather order, per gather chunk
+// the entry lists, the photon scores of a chunk, and the per-thread counters.
 struct LightPassBuffers {
-  std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [chunk][slot]
-  std::vector<std::vector<CellScore>> scores;                 // [chunk]
+  std::vector<std::vector<PendingHit>> hits;        // [chunk]
+  std::vector<std::vector<EmittedPhoton>> emitted;  // [chunk]
+  std::vector<PendingHit*> order;
+  std::vector<uint32_t> bucket_start;                         // of the counting sort
+  std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
+  std::vector<CellScore> scores;
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
 
@@ -84,14 +105,18 @@ struct LightPassResult {
   size_t peak_entry_bytes = 0;
 };
 
-// Photons per batch: the entries of one batch are held in memory until they are applied.
+// Photons per batch: the hits and entries of one batch are held in memory until they are
+// applied. Fewer when the memory budget (params.entry_bytes_limit) cannot hold the hits that many
+// photons may leave (max_depth + 1 each).
 constexpr uint64_t kPhotonsPerBatch = 100000;
+// Hits per gather chunk.
+constexpr int kHitsPerGather = 1024;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in batches of kPhotonsPerBatch (fewer when params.entry_bytes_limit ends one early); stops
-// early, at a chunk, when params.stop says so. With a guide the photons start where it sends them,
-// and with params.pixel_weight as well their scores are added to it (learning does not change its
-// density until its update).
+// index) in batches of kPhotonsPerBatch (fewer under params.entry_bytes_limit); stops early, at
+// a chunk of the trace, when params.stop says so. With a guide the photons start where it sends
+// them, and with params.pixel_weight as well their scores are added to it (learning does not change
+// its density until its update).
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,

@@ -27,13 +27,24 @@ class SphereKdTree {
  public:
   // Queries report sphere i as ids[i] when ids are given (one per sphere), else as i.
   void build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids = nullptr);
+  bool empty() const { return nodes_.empty(); }
   // Calls f(i) for every sphere i with |p - c_i| < r_i.
   template <class F>
   void query(Vec3 p, F&& f) const {
-    if (nodes_.empty()) return;
+    if (!nodes_.empty()) query_leaf(leaf_of(p), p, f);
+  }
+  // A query in two steps, so that queries can be grouped by leaf (their spheres are then read
+  // from cache): the leaf p descends to (a node index, below node_count(); the tree must not be
+  // empty), and the query's tests in that leaf. query_leaf(leaf_of(p), p, f) is query(p, f).
+  uint32_t leaf_of(Vec3 p) const {
     uint32_t n = 0;
     while (nodes_[n].axis != kLeaf) n = p[nodes_[n].axis] < nodes_[n].split ? n + 1 : nodes_[n].a;
-    const uint32_t begin = nodes_[n].a, end = begin + nodes_[n].b;
+    return n;
+  }
+  uint32_t node_count() const { return uint32_t(nodes_.size()); }
+  template <class F>
+  void query_leaf(uint32_t leaf, Vec3 p, F&& f) const {
+    const uint32_t begin = nodes_[leaf].a, end = begin + nodes_[leaf].b;
 #if defined(__SSE2__)
     // Four spheres per step (the arrays are padded, so a step may read past the leaf); the same
     // float operations as the scalar test below, so the same spheres are found, in slot order
@@ -92,6 +103,7 @@ class CentreKdTree {
  public:
   // Queries report sphere i as ids[i] when ids are given (one per sphere), else as i.
   void build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids = nullptr);
+  bool empty() const { return nodes_.empty(); }
   // Calls f(i) for every sphere i with |p - c_i| < r_i (a range search with the largest radius).
   template <class F>
   void query(Vec3 p, F&& f) const {
