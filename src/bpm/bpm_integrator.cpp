@@ -63,6 +63,8 @@ constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 2 * sizeof(
 // What an iteration's maps take once built, with the light pass's per-photon arrays.
 double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
   return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
+                maps.first_bucket.capacity() * sizeof(uint32_t) +
+                size_t(maps.bucket_count() + 1) * sizeof(uint32_t) +
                 maps.photons.size() * (2 * sizeof(Spectrum) + 1) +
                 lp.photon_materials.capacity() * sizeof(Material));
 }
@@ -100,12 +102,15 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
 
   // An eye path leaves at most D + 2 backward photons (two at x_1 when D = 0, one at each other
   // diffuse vertex): the worst iteration must fit the memory budget before the first one starts.
-  // The light pass's entries get what the film and the actual maps leave (smaller batches).
+  // The light pass holds the hits of a group of photons, and its entries get what the film, the
+  // actual maps and those hits leave (applied in more rounds).
   const std::string size = std::to_string(film->width()) + "x" + std::to_string(film->height());
   const std::string advice =
       "lower --resolution or --diffuse-depth (or the radii: --k0, --k1, --radius), or raise "
       "--memory";
-  const double fixed_bytes = double(film->bytes()) + double(n_pixels) * kPixelBytes;
+  const double fixed_bytes =
+      double(film->bytes()) + double(n_pixels) * kPixelBytes +
+      light_pass_hit_bytes(opt.max_depth, tbb::this_task_arena::max_concurrency());
   check_memory("bpm at " + size + " with diffuse depth " + std::to_string(s.diffuse_depth) +
                    " (up to " + std::to_string(s.diffuse_depth + 2) +
                    " backward photons per pixel and iteration)",

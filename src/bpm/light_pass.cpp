@@ -26,7 +26,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // weight, when prm.pixel_weight is set.
 float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                     const std::vector<uint16_t>& owner, const PendingHit& h,
-                    std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
+                    std::vector<std::vector<PhotonEntry>>& out) {
   const int bounces = h.bounces;
   const Vec3 wi = h.wi;
   const Spectrum& flux = h.flux;
@@ -46,7 +46,6 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     const uint32_t bits =
         (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
     out[owner[bp.pixel]].push_back({g | bits, value});
-    ++counters.entries;
     if (prm.pixel_weight)
       score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
                (kPi * bp.radius * bp.radius);
@@ -97,15 +96,18 @@ size_t chunk_bytes(const std::vector<std::vector<PhotonEntry>>& by_slot) {
 }
 
 struct TraceResult {
-  uint64_t kept = 0;     // photons traced, from the batch's first one
+  uint64_t kept = 0;     // photons traced, from the group's first one
   int chunks = 0;        // the chunks that traced them
   bool stopped = false;  // prm.stop ended the trace (and the pass)
 };
 
-// Trace: every chunk traces its photons and records their hits and emissions. The photons kept
-// are all `count`, or a prefix of whole chunks when prm.stop ended the trace. The first chunk
-// always runs, except after a stop request in a later batch.
-TraceResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
+// Trace: chunks of photons are traced in parallel, each recording its photons' hits and
+// emissions (and counters). A group keeps the longest prefix of its chunks that starts before
+// kGroupHits hits, so that its memory is bounded whatever the paths and its size does not depend
+// on the threads (chunks traced past the prefix are traced again in the next group); or fewer
+// whole chunks when prm.stop ended the trace. The first chunk always runs, except after a stop
+// request in a later group.
+TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
                         const LightPassParams& prm, uint64_t seed, int pass_index,
                         uint64_t first_photon, uint64_t count, const EmissionGuide* guide,
                         LightPassBuffers* buf) {
@@ -116,10 +118,12 @@ TraceResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
   if (buf->hits.size() < size_t(n_chunks)) {
     buf->hits.resize(size_t(n_chunks));
     buf->emitted.resize(size_t(n_chunks));
+    buf->chunk_counters.resize(size_t(n_chunks));
   }
   const bool scored = guide && prm.pixel_weight;
-  const int kept = run_chunks_until(n_chunks, stop, [&](int c) {
-    LightCounters& lc = buf->counters.local();
+  auto trace_chunk = [&](int c) {
+    LightCounters lc;
+    lc.observer = buf->counters.local().observer;
     std::vector<PendingHit>& hits = buf->hits[size_t(c)];
     std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
     hits.clear();
@@ -143,8 +147,38 @@ TraceResult trace_batch(const RenderScene& scene, const BackwardMaps& maps,
                        });
       if (scored) emitted.push_back({e.cell, e.weight});
     }
-  });
-  return {std::min(count, uint64_t(kept) * kPhotonsPerChunk), kept, kept < n_chunks};
+    buf->chunk_counters[size_t(c)] = lc;
+  };
+  std::vector<uint8_t> ran(size_t(n_chunks), 0);
+  int kept = 0;
+  uint64_t kept_hits = 0;
+  bool stopped = false;
+  // Rounds: chunks are skipped once the hits traced reach kGroupHits; a skipped chunk that the
+  // prefix turns out to need starts the next round.
+  for (int begin = 0;;) {
+    std::atomic<uint64_t> traced{kept_hits};
+    tbb::parallel_for(tbb::blocked_range<int>(begin, n_chunks, 1),
+                      [&](const tbb::blocked_range<int>& r) {
+                        for (int c = r.begin(); c < r.end(); ++c) {
+                          if (ran[size_t(c)]) continue;
+                          if (c > begin && (stop() || traced.load() >= kGroupHits)) continue;
+                          trace_chunk(c);
+                          ran[size_t(c)] = 1;
+                          traced += buf->hits[size_t(c)].size();
+                        }
+                      });
+    while (kept < n_chunks && ran[size_t(kept)] && kept_hits < kGroupHits)
+      kept_hits += buf->hits[size_t(kept++)].size();
+    if (kept == n_chunks || kept_hits >= kGroupHits) break;
+    if (stop()) {
+      stopped = true;
+      break;
+    }
+    begin = kept;
+  }
+  LightCounters& total = buf->counters.local();
+  for (int c = 0; c < kept; ++c) total.add(buf->chunk_counters[size_t(c)]);
+  return {std::min(count, uint64_t(kept) * kPhotonsPerChunk), kept, stopped};
 }
 
 // The hits of the first `chunks` chunks in bucket order, and within a bucket in chunk and photon
@@ -164,12 +198,12 @@ void sort_hits(const BackwardMaps& maps, int chunks, LightPassBuffers* buf) {
 }
 
 // Gather: gather chunks from `first` on (kHitsPerGather hits of `order` each) add their entries
-// to their own lists, until all have run or the entries, over `fixed_bytes` for the hits, reach
-// the memory limit (the first always runs). Returns how many ran, a prefix; the lists of any past
-// them are emptied (they run again in the next round).
+// to their own lists, until all have run or the entries reach the memory limit (the first always
+// runs). Returns how many ran, a prefix; the lists of any past them are emptied (they run again
+// in the next round).
 int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const PixelMasks& masks,
-                 int first, int n_gather, size_t fixed_bytes, LightPassBuffers* buf) {
-  std::atomic<size_t> bytes{fixed_bytes};
+                 int first, int n_gather, LightPassBuffers* buf) {
+  std::atomic<size_t> bytes{0};
   for (auto& by_slot : buf->chunks) {
     by_slot.resize(size_t(masks.slots()));
     bytes += chunk_bytes(by_slot);
@@ -177,7 +211,6 @@ int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const Pix
   auto full = [&] { return prm.entry_bytes_limit && bytes.load() > prm.entry_bytes_limit; };
   const size_t n_hits = buf->order.size();
   const int kept = run_chunks_until(n_gather - first, full, [&](int i) {
-    LightCounters& lc = buf->counters.local();
     std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(first + i)];
     const size_t bytes_before = chunk_bytes(by_slot);
     for (auto& v : by_slot) v.clear();
@@ -191,7 +224,7 @@ int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const Pix
         __builtin_prefetch(next + sizeof(PendingHit) - 1);
       }
       PendingHit& h = *buf->order[k];
-      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot, lc);
+      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot);
     }
     bytes += chunk_bytes(by_slot) - bytes_before;
   });
@@ -216,19 +249,15 @@ void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots, L
   });
 }
 
-// Photons per batch: kPhotonsPerBatch, or under a memory limit the whole chunks (at least one)
-// whose hits, max_depth + 1 per photon at most, fit in half of it.
-uint64_t batch_photons(const LightPassParams& prm) {
-  if (!prm.entry_bytes_limit) return kPhotonsPerBatch;
-  const double per_photon =
-      double(prm.max_depth + 1) * double(sizeof(PendingHit) + sizeof(PendingHit*)) +
-      double(sizeof(EmittedPhoton));
-  const uint64_t chunks =
-      uint64_t(0.5 * double(prm.entry_bytes_limit) / per_photon) / uint64_t(kPhotonsPerChunk);
-  return std::clamp<uint64_t>(chunks * kPhotonsPerChunk, kPhotonsPerChunk, kPhotonsPerBatch);
-}
-
 }  // namespace
+
+double light_pass_hit_bytes(int max_depth, int threads) {
+  // The kept chunks' hits with their lists' spare capacity, chunks traced past them (one per
+  // thread at most, max_depth + 1 hits per photon at most), and the emissions.
+  return double(kHitBytes) * (2.0 * double(kGroupHits) + double(threads) * kPhotonsPerChunk *
+                                                             double(std::max(max_depth, 0) + 1)) +
+         2.0 * double(kPhotonsPerGroup) * sizeof(EmittedPhoton);
+}
 
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& prm, const BpmSettings& s,
@@ -242,15 +271,14 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
   res.flux_inner.assign(n_bp, Spectrum());
   res.flux_quarter.assign(n_bp, Spectrum());
   std::vector<uint8_t> hit(n_bp, 0);
-  const uint64_t batch = batch_photons(prm);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   for (uint64_t first = 0; first < total;) {
-    const uint64_t count = std::min(batch, total - first);
+    const uint64_t count = std::min(kPhotonsPerGroup, total - first);
     auto t = std::chrono::steady_clock::now();
     const TraceResult tr =
-        trace_batch(scene, maps, prm, seed, pass_index, first, count, guide, buf);
-    if (tr.kept == 0) {  // stopped before the batch began
+        trace_group(scene, maps, prm, seed, pass_index, first, count, guide, buf);
+    if (tr.kept == 0) {  // stopped before the group began
       res.cut = true;
       break;
     }
@@ -258,22 +286,22 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
     res.emitted += tr.kept;
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
-    size_t hit_bytes = buf->order.capacity() * sizeof(PendingHit*);
-    for (int c = 0; c < tr.chunks; ++c)
-      hit_bytes += buf->hits[size_t(c)].capacity() * sizeof(PendingHit) +
-                   buf->emitted[size_t(c)].capacity() * sizeof(EmittedPhoton);
     const int n_gather = int((buf->order.size() + kHitsPerGather - 1) / kHitsPerGather);
     if (buf->chunks.size() < size_t(n_gather)) buf->chunks.resize(size_t(n_gather));
     // Rounds of gather and apply: one, unless the entries reach the memory limit; a round keeps a
     // prefix of the gather chunks and the next goes on from there, so that the entries are
     // applied in the same order whatever the rounds.
-    for (int done = 0; done < n_gather;) {
-      const int kept = gather_round(maps, prm, masks, done, n_gather, hit_bytes, buf);
+    int done = 0;
+    do {
+      const int kept = n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : 0;
       res.trace_s += seconds_since(t);
-      size_t entry_bytes = hit_bytes;
+      size_t entry_bytes = 0, entries = 0;
       for (const auto& by_slot : buf->chunks)
         for (const auto& v : by_slot) entry_bytes += v.capacity() * sizeof(PhotonEntry);
+      for (int g = done; g < done + kept; ++g)
+        for (const auto& v : buf->chunks[size_t(g)]) entries += v.size();
       res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
+      buf->counters.local().entries += entries;
       t = std::chrono::steady_clock::now();
       apply_entries(*buf, done, done + kept, masks.slots(), &res, &hit);
       res.apply_s += seconds_since(t);
@@ -284,12 +312,7 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
       if (done < n_gather)
         for (auto& by_slot : buf->chunks)
           for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
-    }
-    if (n_gather == 0) {
-      res.trace_s += seconds_since(t);
-      ++res.batches;
-    }
-    t = std::chrono::steady_clock::now();
+    } while (done < n_gather);
     if (guide && prm.pixel_weight)
       // Each photon's score is the sum of its hits', in the order of its path, as if it had been
       // emitted without guidance (weight removed).

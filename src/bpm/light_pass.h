@@ -1,13 +1,13 @@
 // Stage 3 of a bpm iteration, the light pass (section 3 of the paper): a fixed number of photons,
-// in batches that bound the memory of what is recorded. Each batch runs in three phases.
+// in groups that bound the memory of what is recorded. Each group runs in three phases.
 // Trace: photons travel as photons/light_path.h says, in chunks; each chunk records the diffuse
-// hits of its photons, with the bucket (a leaf of the hit object's tree) each hit's query falls in.
-// Gather: the batch's hits, sorted by bucket, are queried in that order, so that a leaf and the
-// backward photons it holds are read from cache by all the hits that fall in it, not fetched
-// from memory hit after hit; each accepted pair is appended as (backward photon, contribution) to
-// the lists of its gather chunk, one list per mask slot. Apply: each slot applies the entries of
-// its own pixels, gather chunk by gather chunk in order, so that no locks are needed and the sums
-// do not depend on the thread count.
+// hits of its photons, with the bucket each hit's query falls in (a leaf of the hit object's
+// sphere tree; a whole centre tree). Gather: the group's hits, sorted by bucket, are queried in
+// that order, so that a leaf and the backward photons it holds are read from cache by all the
+// hits that fall in it instead of being fetched from memory hit after hit; each accepted pair is
+// appended as (backward photon, contribution) to the lists of its gather chunk, one list per mask
+// slot. Apply: each slot applies the entries of its own pixels, gather chunk by gather chunk in
+// order, so that no locks are needed and the sums do not depend on the thread count.
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
@@ -48,12 +48,12 @@ struct LightPassParams {
   // its contributions weighted so. Empty: photons are not scored.
   const std::vector<float>* pixel_weight = nullptr;
   // A stop request (an interrupt, the time budget), asked before each chunk of photons: once true,
-  // the pass ends with the photons traced so far (at least its first chunk). Empty: never.
+  // the pass ends with the photons traced so far (at least its first chunk), once their group is
+  // gathered. Empty: never.
   std::function<bool()> stop = nullptr;
-  // Bytes the hits and entry lists of a batch may hold (the memory budget left after the film
-  // and the maps); 0: no limit. Batches are then as large as half of it can hold the hits of (so
-  // the image depends on the budget, in its last bits: the order of the sums); the entries of
-  // a batch that fill the rest are applied and freed, and its gather goes on, in the same order.
+  // Bytes the entry lists of a group may hold (the memory budget left after the film, the maps
+  // and a group's hits); 0: no limit. A group whose entries reach it applies them, frees them and
+  // goes on gathering, in the same order: the image is the same.
   size_t entry_bytes_limit = 0;
 };
 
@@ -89,6 +89,7 @@ struct LightPassBuffers {
   std::vector<uint32_t> bucket_start;                         // of the counting sort
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
   std::vector<CellScore> scores;
+  std::vector<LightCounters> chunk_counters;  // [chunk]: added to counters for the chunks kept
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
 
@@ -98,25 +99,30 @@ struct LightPassResult {
   std::vector<Spectrum> flux_quarter;  // and of its inner quarter (quarter())
   uint64_t emitted = 0;                // photons emitted, N of eq. (2)
   bool cut = false;                    // a stop request ended the pass before all its photons
-  int batches = 0;
+  int batches = 0;  // gather rounds: one per group, more where the memory limit split one
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;
   double trace_s = 0, apply_s = 0;
   size_t peak_entry_bytes = 0;
 };
 
-// Photons per batch: the hits and entries of one batch are held in memory until they are
-// applied. Fewer when the memory budget (params.entry_bytes_limit) cannot hold the hits that many
-// photons may leave (max_depth + 1 each).
-constexpr uint64_t kPhotonsPerBatch = 100000;
+// Photons per group: the hits of a group are sorted together, and its entries are held in memory
+// until they are applied. A group ends earlier, at a chunk, once its hits reach kGroupHits (where
+// photons leave many hits), so that its memory is bounded; where it ends depends on the paths
+// alone, so the order of every sum is fixed by the scene, the seed and the settings.
+constexpr uint64_t kPhotonsPerGroup = 65536;
+constexpr uint64_t kGroupHits = 131072;
+constexpr uint64_t kHitBytes = sizeof(PendingHit) + sizeof(PendingHit*);
+// What the light pass's hits may take, for the memory budget.
+double light_pass_hit_bytes(int max_depth, int threads);
 // Hits per gather chunk.
 constexpr int kHitsPerGather = 1024;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in batches of kPhotonsPerBatch (fewer under params.entry_bytes_limit); stops early, at
-// a chunk of the trace, when params.stop says so. With a guide the photons start where it sends
-// them, and with params.pixel_weight as well their scores are added to it (learning does not change
-// its density until its update).
+// index) in groups of kPhotonsPerGroup at most; stops early, at a chunk of the trace, when
+// params.stop says so (the group's gather still runs). With a guide the photons start where it
+// sends them, and with params.pixel_weight as well their scores are added to it (learning does not
+// change its density until its update).
 LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
                                const LightPassParams& params, const BpmSettings& settings,
                                const PixelMasks& masks, uint64_t seed, int pass_index,
