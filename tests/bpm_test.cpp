@@ -897,6 +897,27 @@ TEST(Bpm, SameImageWithOneAndTwoThreads) {
   }
 }
 
+// Where photons leave many hits (the furnace: about 3 each), a group of the light pass ends by its
+// hits, before kPhotonsPerGroup photons, at the same chunk whatever the threads: the same image
+// and counts for 1, 2 and 3 threads.
+TEST(Bpm, GroupsEndedByTheirHitsDoNotDependOnTheThreads) {
+  LoadedScene ls = sphere_furnace();
+  BpmSettings s = small_batches(0);
+  s.photons_per_iteration = 150000;
+  RenderRun one = render_with(ls, "bpm", 1, 1, 9, s);
+  const nlohmann::json& light = one.stats.details["light"];
+  EXPECT_GT(light["batches"].get<uint64_t>(),
+            (uint64_t(s.photons_per_iteration) + kPhotonsPerGroup - 1) / kPhotonsPerGroup)
+      << "groups should end by their hits: " << light["queries"] << " queries";
+  EXPECT_EQ(light["photons"].get<uint64_t>(), uint64_t(s.photons_per_iteration));
+  for (int threads : {2, 3}) {
+    RenderRun r = render_with(ls, "bpm", 1, threads, 9, s);
+    EXPECT_EQ(r.film.image().rgb, one.film.image().rgb) << threads << " threads";
+    for (const char* count : {"batches", "photons", "light_rays", "queries", "entries"})
+      EXPECT_EQ(r.stats.details["light"][count], light[count]) << count << ", " << threads;
+  }
+}
+
 // The time budget holds inside an iteration: a light pass far longer than the budget ends early,
 // and what it keeps is a prefix of its photons: the image is bit for bit that of an iteration
 // asked for exactly that many photons (with another thread count, too).

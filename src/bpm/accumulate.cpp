@@ -10,18 +10,21 @@ namespace bpm {
 
 void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
-                          const PhotonSettings& settings, Film* film,
+                          const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates) {
   const int w = film->width(), h = film->height();
-  std::vector<Spectrum> photon_L(size_t(w) * size_t(h)), bias(size_t(w) * size_t(h));
+  std::vector<Spectrum>& photon_L = sums->photon_L;
+  std::vector<Spectrum>& bias = sums->bias;
+  photon_L.assign(size_t(w) * size_t(h), Spectrum());
+  bias.assign(size_t(w) * size_t(h), Spectrum());
   for (size_t g = 0; g < maps.photons.size(); ++g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (light.flux[g].is_black()) continue;
     // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
     const float norm = float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
-    const NestedSums sums{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
-    photon_L[bp.pixel] += bp.tau * sums.all * norm;
-    bias[bp.pixel] += bp.tau * radius_bias(sums, norm, settings.bias_model);
+    const NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
+    photon_L[bp.pixel] += bp.tau * nested.all * norm;
+    bias[bp.pixel] += bp.tau * radius_bias(nested, norm, settings.bias_model);
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y)

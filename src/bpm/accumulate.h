@@ -17,9 +17,14 @@ namespace bpm {
 // (radius_bias under bias_model) goes to the film beside its estimate, or with `debias` is taken
 // from it. When `estimates` is given (2 per pixel), each sampled pixel's estimate (the mean over
 // its wavelengths) is added to its first and 1 to its second.
+// `sums` holds the per-pixel sums in between (kept from one iteration to the next, so that their
+// memory is allocated once).
+struct PixelSums {
+  std::vector<Spectrum> photon_L, bias;
+};
 void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
-                          const PhotonSettings& settings, Film* film,
+                          const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates = nullptr);
 
 }  // namespace bpm

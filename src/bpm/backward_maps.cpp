@@ -80,12 +80,23 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
     maps->object_begin[o + 1] = maps->object_begin[o] + uint32_t(n);
   }
   maps->photons.resize(maps->object_begin[object_count]);
-  maps->sphere_trees.clear();
-  maps->centre_trees.clear();
-  if (centre_tree)
+  // The trees of the last iteration are rebuilt in place (keeping their memory); those of objects
+  // without backward photons are emptied.
+  if (centre_tree) {
+    maps->sphere_trees.clear();
     maps->centre_trees.resize(2 * object_count);
-  else
+  } else {
+    maps->centre_trees.clear();
     maps->sphere_trees.resize(2 * object_count);
+  }
+  for (size_t o = 0; o < object_count; ++o)
+    if (!maps->has_photons(int(o)))
+      for (size_t t = 2 * o; t < 2 * o + 2; ++t) {
+        if (centre_tree)
+          maps->centre_trees[t].build({});
+        else
+          maps->sphere_trees[t].build({});
+      }
 
   std::vector<uint32_t> order;
   for (uint32_t o = 0; o < object_count; ++o)
@@ -97,8 +108,10 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
   auto build_one = [&](uint32_t o) {
     BackwardPhoton* dst = maps->photons.data() + maps->object_begin[o];
     const size_t n = gather_in_space(per_thread, o, dst);
+    // Emptied, keeping their memory for the next iteration's eye pass (the memory budget counts
+    // two copies of every backward photon).
     for (ObjectPhotonLists* l : per_thread)
-      if (o < l->size()) std::vector<BackwardPhoton>().swap((*l)[o]);
+      if (o < l->size()) (*l)[o].clear();
     for (int c = 0; c < 2; ++c) {
       const uint8_t accepts = c == 0 ? kAcceptsCaustic : kAcceptsIndirect;
       std::vector<SphereRef> spheres;

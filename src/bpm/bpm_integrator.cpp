@@ -52,12 +52,15 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
     if (count[p]) (*weight)[p] = float(1 / (std::max(0.0, sum[p] / count[p]) + floor));
 }
 
-// Memory (base/memory.h). Per pixel, what the eye pass, the masks and the emission guide keep.
+// Memory (base/memory.h). Per pixel, what the eye pass, the masks, the emission guide and the
+// accumulation's sums keep.
 constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
-                               sizeof(double) + sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
-// Per backward photon: the thread's list and the map's copy, its two fluxes and hit flag, and its
-// references in the two trees (about two per tree where spheres overlap cells).
-constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 2 * sizeof(Spectrum) + 1 +
+                               sizeof(double) + sizeof(uint32_t) + sizeof(float) +
+                               sizeof(uint16_t) + 2 * sizeof(Spectrum);
+// Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
+// inner quarter) and hit flag, and its references in the two trees (about two per tree where
+// spheres overlap cells).
+constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 3 * sizeof(Spectrum) + 1 +
                                         4 * (sizeof(SphereRef) + sizeof(uint32_t));
 
 // What an iteration's maps take once built, with the light pass's per-photon arrays.
@@ -65,7 +68,7 @@ double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
   return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
                 maps.first_bucket.capacity() * sizeof(uint32_t) +
                 size_t(maps.bucket_count() + 1) * sizeof(uint32_t) +
-                maps.photons.size() * (2 * sizeof(Spectrum) + 1) +
+                maps.photons.size() * (3 * sizeof(Spectrum) + 1) +
                 lp.photon_materials.capacity() * sizeof(Material));
 }
 
@@ -88,6 +91,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
   tbb::enumerable_thread_specific<EyeCounters> eye_counters(eye_exemplar);
   BackwardMaps maps;
   LightPassBuffers light;
+  LightPassResult light_result;  // of the last light pass; its arrays are reused
+  PixelSums pixel_sums;
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
   light.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
@@ -151,7 +156,11 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     resolve_photon_materials(maps, &lp);
     if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
     if (opt.memory_budget > 0) {
-      const double used = fixed_bytes + maps_bytes(maps, lp);
+      // The eye pass's lists keep their memory for the next iteration.
+      double list_bytes = 0;
+      for (const ObjectPhotonLists& l : thread_lists)
+        for (const auto& v : l) list_bytes += double(v.capacity() * sizeof(BackwardPhoton));
+      const double used = fixed_bytes + maps_bytes(maps, lp) + list_bytes;
       // Over the budget (the estimate before the first iteration assumed typical trees and no
       // textured materials): an error in the first iteration, which has nothing to keep; later,
       // the render ends with the iterations so far and says why.
@@ -167,8 +176,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     tot.add_maps(maps);
 
     // 3. Light pass: a fixed number of photons, in batches.
-    LightPassResult light_result = run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
-                                                  guide.empty() ? nullptr : &guide);
+    run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
+                   guide.empty() ? nullptr : &guide, &light_result);
     // The film averages iterations with equal weights, so an iteration the budget cut to a share
     // f of its photons adds variance ~ 1/f to a mean of n: with n - 1 whole ones, keeping it
     // helps only when ((n - 1) + 1/f) / n^2 < 1 / (n - 1), about f > 1/2. A later iteration with
@@ -181,7 +190,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
     accumulate_iteration(maps, light_result, eye, wm.wl, ls.film.max_component_value, s, film,
-                         guide.empty() ? nullptr : &estimate_new);
+                         &pixel_sums, guide.empty() ? nullptr : &estimate_new);
     tot.accumulate_s += since(t);
     masks.rebuild(eye.cost_ns);
 

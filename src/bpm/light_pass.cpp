@@ -2,6 +2,8 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -104,7 +106,7 @@ struct TraceResult {
 // Trace: chunks of photons are traced in parallel, each recording its photons' hits and
 // emissions (and counters). A group keeps the longest prefix of its chunks that starts before
 // kGroupHits hits, so that its memory is bounded whatever the paths and its size does not depend
-// on the threads (chunks traced past the prefix are traced again in the next group); or fewer
+// on the threads (a chunk traced past the prefix is traced again in the next group); or fewer
 // whole chunks when prm.stop ended the trace. The first chunk always runs, except after a stop
 // request in a later group.
 TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
@@ -124,8 +126,12 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
   auto trace_chunk = [&](int c) {
     LightCounters lc;
     lc.observer = buf->counters.local().observer;
-    std::vector<PendingHit>& hits = buf->hits[size_t(c)];
-    std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
+    // Filled through lists of this thread's own (their memory taken from the chunk's, and given
+    // back): neighbouring chunks' list headers share cache lines, and other threads fill those.
+    std::vector<PendingHit> hits;
+    std::vector<EmittedPhoton> emitted;
+    hits.swap(buf->hits[size_t(c)]);
+    emitted.swap(buf->emitted[size_t(c)]);
     hits.clear();
     emitted.clear();
     const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
@@ -147,26 +153,33 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
                        });
       if (scored) emitted.push_back({e.cell, e.weight});
     }
+    buf->hits[size_t(c)].swap(hits);
+    buf->emitted[size_t(c)].swap(emitted);
     buf->chunk_counters[size_t(c)] = lc;
   };
+  // Workers take chunks in order and stop taking them once the hits traced reach kGroupHits (or
+  // a stop is requested), so at most one chunk per worker is traced past the prefix kept. Should
+  // the prefix need a chunk no worker took, a further round begins there.
+  const int workers = tbb::this_task_arena::max_concurrency();
   std::vector<uint8_t> ran(size_t(n_chunks), 0);
   int kept = 0;
   uint64_t kept_hits = 0;
   bool stopped = false;
-  // Rounds: chunks are skipped once the hits traced reach kGroupHits; a skipped chunk that the
-  // prefix turns out to need starts the next round.
   for (int begin = 0;;) {
     std::atomic<uint64_t> traced{kept_hits};
-    tbb::parallel_for(tbb::blocked_range<int>(begin, n_chunks, 1),
-                      [&](const tbb::blocked_range<int>& r) {
-                        for (int c = r.begin(); c < r.end(); ++c) {
-                          if (ran[size_t(c)]) continue;
-                          if (c > begin && (stop() || traced.load() >= kGroupHits)) continue;
-                          trace_chunk(c);
-                          ran[size_t(c)] = 1;
-                          traced += buf->hits[size_t(c)].size();
-                        }
-                      });
+    std::atomic<int> next{begin};
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, workers, 1),
+        [&](const tbb::blocked_range<int>&) {
+          for (int c; (c = next.fetch_add(1)) < n_chunks;) {
+            if (ran[size_t(c)]) continue;
+            if (c > begin && (stop() || traced.load() >= kGroupHits)) break;
+            trace_chunk(c);
+            ran[size_t(c)] = 1;
+            traced += buf->hits[size_t(c)].size();
+          }
+        },
+        tbb::simple_partitioner());
     while (kept < n_chunks && ran[size_t(kept)] && kept_hits < kGroupHits)
       kept_hits += buf->hits[size_t(kept++)].size();
     if (kept == n_chunks || kept_hits >= kGroupHits) break;
@@ -176,6 +189,13 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     }
     begin = kept;
   }
+  // A group ended by its hits leaves the lists past those it may use unused: their memory, from a
+  // larger group, goes back.
+  if (kept_hits >= kGroupHits)
+    for (size_t c = size_t(kept) + size_t(workers); c < buf->hits.size(); ++c) {
+      std::vector<PendingHit>().swap(buf->hits[c]);
+      std::vector<EmittedPhoton>().swap(buf->emitted[c]);
+    }
   LightCounters& total = buf->counters.local();
   for (int c = 0; c < kept; ++c) total.add(buf->chunk_counters[size_t(c)]);
   return {std::min(count, uint64_t(kept) * kPhotonsPerChunk), kept, stopped};
@@ -252,25 +272,32 @@ void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots, L
 }  // namespace
 
 double light_pass_hit_bytes(int max_depth, int threads) {
-  // The kept chunks' hits with their lists' spare capacity, chunks traced past them (one per
-  // thread at most, max_depth + 1 hits per photon at most), and the emissions.
-  return double(kHitBytes) * (2.0 * double(kGroupHits) + double(threads) * kPhotonsPerChunk *
+  // The kept chunks' hits with their lists' spare capacity, and a chunk per thread traced past
+  // them or kept from an earlier group (max_depth + 1 hits per photon at most); the emissions.
+  return double(kHitBytes) * (2.0 * double(kGroupHits) + 2.0 * double(threads) * kPhotonsPerChunk *
                                                              double(std::max(max_depth, 0) + 1)) +
          2.0 * double(kPhotonsPerGroup) * sizeof(EmittedPhoton);
 }
 
-LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
-                               const LightPassParams& prm, const BpmSettings& s,
-                               const PixelMasks& masks, uint64_t seed, int pass_index,
-                               LightPassBuffers* buf, EmissionGuide* guide) {
+void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                    const BpmSettings& s, const PixelMasks& masks, uint64_t seed, int pass_index,
+                    LightPassBuffers* buf, EmissionGuide* guide, LightPassResult* out) {
   const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
   BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
-  LightPassResult res;
+  // The arrays keep their memory from the last iteration (fresh pages cost a fault each).
+  LightPassResult& res = *out;
   res.flux.assign(n_bp, Spectrum());
   res.flux_inner.assign(n_bp, Spectrum());
   res.flux_quarter.assign(n_bp, Spectrum());
-  std::vector<uint8_t> hit(n_bp, 0);
+  res.emitted = 0;
+  res.cut = false;
+  res.batches = 0;
+  res.coverage = 0;
+  res.trace_s = res.apply_s = 0;
+  res.peak_entry_bytes = 0;
+  std::vector<uint8_t>& hit = buf->hit;
+  hit.assign(n_bp, 0);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   for (uint64_t first = 0; first < total;) {
@@ -339,7 +366,6 @@ LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& map
       covered += hit[g];
     }
   res.coverage = n_indirect ? double(covered) / double(n_indirect) : 1.0;
-  return res;
 }
 
 }  // namespace bpm

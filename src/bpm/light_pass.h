@@ -90,6 +90,7 @@ struct LightPassBuffers {
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
   std::vector<CellScore> scores;
   std::vector<LightCounters> chunk_counters;  // [chunk]: added to counters for the chunks kept
+  std::vector<uint8_t> hit;                   // per backward photon: reached by an entry
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
 
@@ -123,9 +124,10 @@ constexpr int kHitsPerGather = 1024;
 // params.stop says so (the group's gather still runs). With a guide the photons start where it
 // sends them, and with params.pixel_weight as well their scores are added to it (learning does not
 // change its density until its update).
-LightPassResult run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
-                               const LightPassParams& params, const BpmSettings& settings,
-                               const PixelMasks& masks, uint64_t seed, int pass_index,
-                               LightPassBuffers* buffers, EmissionGuide* guide = nullptr);
+// The result goes to *result (its arrays keep their memory from one iteration to the next).
+void run_light_pass(const RenderScene& scene, const BackwardMaps& maps,
+                    const LightPassParams& params, const BpmSettings& settings,
+                    const PixelMasks& masks, uint64_t seed, int pass_index,
+                    LightPassBuffers* buffers, EmissionGuide* guide, LightPassResult* result);
 
 }  // namespace bpm
