@@ -19,7 +19,7 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
   bias.assign(size_t(w) * size_t(h), Spectrum());
   for (size_t g = 0; g < maps.photons.size(); ++g) {
     const BackwardPhoton& bp = maps.photons[g];
-    if (light.flux[g].is_black()) continue;
+    if (!light.reached[g] || light.flux[g].is_black()) continue;
     // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
     const float norm = float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
     const NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};

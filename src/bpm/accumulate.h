@@ -12,7 +12,8 @@
 
 namespace bpm {
 
-// light.flux[g]: the summed contributions backward photon g received from light.emitted photons;
+// light.flux[g]: the summed contributions backward photon g received from light.emitted photons
+// (where light.reached[g]);
 // with those from the inner discs, each pixel's bias estimate of the pass over its photon part
 // (radius_bias under bias_model) goes to the film beside its estimate, or with `debias` is taken
 // from it. When `estimates` is given (2 per pixel), each sampled pixel's estimate (the mean over

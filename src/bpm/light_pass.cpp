@@ -254,17 +254,21 @@ int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const Pix
 }
 
 // Apply: each slot applies the entries of its own pixels, gather chunk by gather chunk in order.
-void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots, LightPassResult* res,
-                   std::vector<uint8_t>* hit) {
+// A backward photon's sums start from zero at its first entry (the arrays are not cleared).
+void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots,
+                   LightPassResult* res) {
   tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
     for (int slot = r.begin(); slot < r.end(); ++slot)
       for (int g = begin; g < end; ++g)
         for (const PhotonEntry& e : buf.chunks[size_t(g)][size_t(slot)]) {
           const uint32_t b = e.backward_photon();
+          if (!res->reached[b]) {
+            res->reached[b] = 1;
+            res->flux[b] = res->flux_inner[b] = res->flux_quarter[b] = Spectrum();
+          }
           res->flux[b] += e.value;
           if (e.inner()) res->flux_inner[b] += e.value;
           if (e.quarter()) res->flux_quarter[b] += e.value;
-          (*hit)[b] = 1;
         }
   });
 }
@@ -285,19 +289,19 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   const uint64_t total = uint64_t(s.photons_per_iteration);
   const size_t n_bp = maps.photons.size();
   BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
-  // The arrays keep their memory from the last iteration (fresh pages cost a fault each).
+  // The arrays keep their memory from the last iteration (fresh pages cost a fault each), and
+  // only the flags are cleared: the sums of a backward photon are set at its first entry.
   LightPassResult& res = *out;
-  res.flux.assign(n_bp, Spectrum());
-  res.flux_inner.assign(n_bp, Spectrum());
-  res.flux_quarter.assign(n_bp, Spectrum());
+  res.reached.assign(n_bp, 0);
+  res.flux.resize(n_bp);
+  res.flux_inner.resize(n_bp);
+  res.flux_quarter.resize(n_bp);
   res.emitted = 0;
   res.cut = false;
   res.batches = 0;
   res.coverage = 0;
   res.trace_s = res.apply_s = 0;
   res.peak_entry_bytes = 0;
-  std::vector<uint8_t>& hit = buf->hit;
-  hit.assign(n_bp, 0);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   for (uint64_t first = 0; first < total;) {
@@ -330,7 +334,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
       res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
       buf->counters.local().entries += entries;
       t = std::chrono::steady_clock::now();
-      apply_entries(*buf, done, done + kept, masks.slots(), &res, &hit);
+      apply_entries(*buf, done, done + kept, masks.slots(), &res);
       res.apply_s += seconds_since(t);
       t = std::chrono::steady_clock::now();
       ++res.batches;
@@ -363,7 +367,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   for (size_t g = 0; g < n_bp; ++g)
     if (maps.photons[g].accepts & kAcceptsIndirect) {
       ++n_indirect;
-      covered += hit[g];
+      covered += res.reached[g];
     }
   res.coverage = n_indirect ? double(covered) / double(n_indirect) : 1.0;
 }

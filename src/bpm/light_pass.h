@@ -90,11 +90,12 @@ struct LightPassBuffers {
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
   std::vector<CellScore> scores;
   std::vector<LightCounters> chunk_counters;  // [chunk]: added to counters for the chunks kept
-  std::vector<uint8_t> hit;                   // per backward photon: reached by an entry
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
 
 struct LightPassResult {
+  // Per backward photon: 1 where an entry reached it; the sums below hold only there.
+  std::vector<uint8_t> reached;
   std::vector<Spectrum> flux;          // per backward photon: the sum of its entries' values
   std::vector<Spectrum> flux_inner;    // the same over the entries of its inner half (inner())
   std::vector<Spectrum> flux_quarter;  // and of its inner quarter (quarter())
