@@ -136,6 +136,8 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   opt.spp = a.spp > 0 ? a.spp : ls.render.spp;
   opt.time_limit_s = a.time;
   opt.threads = a.threads;
+  // The images at the end (and at --write-every) compress on as many threads as the render runs.
+  set_exr_threads(a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency()));
   opt.seed = a.seed >= 0 ? uint64_t(a.seed) : uint64_t(ls.render.seed);
   opt.max_depth = a.max_depth >= 0 ? a.max_depth : ls.render.max_depth;
   opt.progress = !a.quiet;

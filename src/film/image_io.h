@@ -13,6 +13,9 @@ struct ExtraChannel {
   const std::vector<float>* values;  // width * height
 };
 
+// Threads that compress an OpenEXR file's blocks (OpenEXR's own pool; 0: the calling thread
+// alone, the default). The file's bytes do not depend on them.
+void set_exr_threads(int threads);
 // Linear float OpenEXR with R, G, B and optional extra channels. Throws Error on failure.
 void write_exr(const std::string& path, const Image& img,
                const std::vector<ExtraChannel>& extra = {});
