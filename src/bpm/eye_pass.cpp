@@ -162,13 +162,15 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             skipped = true;
             return;
           }
+          // One clock reading per pixel: a pixel's cost runs from the end of the one before (a
+          // skipped pixel's few instructions go to the next).
+          auto t0 = Clock::now();
           for (uint32_t pixel : masks.pixels(task / slots, task % slots)) {
             px->sampled[pixel] = control.sample_pixel(pass, pixel);
             if (!px->sampled[pixel]) {
               px->cost_ns[pixel] = 0;
               continue;
             }
-            auto t0 = Clock::now();
             CameraSample cs = camera.sample(pass_index, pixel);
             EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec);
             px->radiance[pixel] = r.total;
@@ -177,8 +179,9 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
               px->radiance[pixel] += more_emission_samples(scene, prm, camera, pass_index, pixel,
                                                            cs.filter_weight, r.emission, lists, ec);
             if (!r.emission.is_black()) px->saw_emission[pixel] = 1;
-            px->cost_ns[pixel] =
-                float(std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
+            const auto t1 = Clock::now();
+            px->cost_ns[pixel] = float(std::chrono::duration<double, std::nano>(t1 - t0).count());
+            t0 = t1;
           }
         }
       });
