@@ -897,6 +897,26 @@ TEST(Bpm, SameImageWithOneAndTwoThreads) {
   }
 }
 
+// A scene whose materials have no traced lobe has no caustics: bpm makes no backward photons that
+// accept caustics alone (one per eye path at D = 0 instead of two), and the caustic scene keeps
+// them. may_have_caustics sees any material that is not diffuse (a mix counts as one that may).
+TEST(Bpm, ScenesWithoutTracedLobesMakeNoCausticBackwardPhotons) {
+  EXPECT_FALSE(may_have_caustics(load(cornell()).scene));
+  EXPECT_TRUE(may_have_caustics(load(caustic_scene()).scene));
+  EXPECT_TRUE(
+      may_have_caustics(load(cornell("Material \"conductor\" \"float roughness\" 0.3")).scene));
+  for (bool diffuse_only : {true, false}) {
+    LoadedScene ls = load(diffuse_only ? cornell() : caustic_scene());
+    RenderRun r = render_with(ls, "bpm", 2, 0, 9, small_batches(0));
+    const double per_path =
+        r.stats.details["eye"]["backward_photons_per_pixel_iteration"].get<double>();
+    if (diffuse_only)
+      EXPECT_LE(per_path, 1.0);
+    else
+      EXPECT_GT(per_path, 1.2);
+  }
+}
+
 // Where photons leave many hits (the furnace: about 3 each), a group of the light pass ends by its
 // hits, before kPhotonsPerGroup photons, at the same chunk whatever the threads: the same image
 // and counts for 1, 2 and 3 threads.

@@ -122,6 +122,10 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                fixed_bytes + double(n_pixels) * (s.diffuse_depth + 2) * kBackwardPhotonBytes,
                opt.memory_budget, advice);
 
+  // In a scene where no light path can be a caustic, the backward photons that accept only
+  // caustics (half of them at D = 0) would gather nothing: they are not made.
+  const bool caustics = may_have_caustics(scene);
+
   auto iteration = [&](int pass, const RenderControl& control) {
     const int it = opt.first_iteration + pass;  // the index random streams and radii follow
     const float scale = radius_scale(s, it);
@@ -136,7 +140,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
                      s.k0 * pixel_angle * scale,
                      s.k1 * pixel_angle * scale,
                      s.emission_samples,
-                     s.radius * scale};
+                     s.radius * scale,
+                     caustics};
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);

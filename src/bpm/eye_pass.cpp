@@ -86,12 +86,14 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
           ++counters.backward_photons;
         }
       };
-      if (!last)
+      if (!prm.caustics) {
+        if (last) store(kAcceptsIndirect);
+      } else if (!last) {
         store(kAcceptsCaustic);
-      else if (diffuse > 1 || prm.world_radius > 0 ||
-               prm.radius_per_length0 == prm.radius_per_length1)
+      } else if (diffuse > 1 || prm.world_radius > 0 ||
+                 prm.radius_per_length0 == prm.radius_per_length1) {
         store(kAcceptsCaustic | kAcceptsIndirect);
-      else {
+      } else {
         store(kAcceptsCaustic);
         store(kAcceptsIndirect);
       }
@@ -145,6 +147,18 @@ Spectrum more_emission_samples(const RenderScene& scene, const EyePassParams& pr
 }
 
 }  // namespace
+
+bool may_have_caustics(const RenderScene& scene) {
+  for (const Object& o : scene.objects) {
+    if (o.material < 0 || size_t(o.material) >= scene.materials.size()) return true;
+    const MaterialDesc& m = scene.materials[size_t(o.material)];
+    if (!std::holds_alternative<DiffuseDesc>(m) &&
+        !std::holds_alternative<DiffuseTransmissionDesc>(m) &&
+        !std::holds_alternative<InterfaceMaterial>(m))
+      return true;
+  }
+  return false;
+}
 
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const CameraSampler& camera,
                   const PixelMasks& masks, const RenderControl& control, int pass, int pass_index,

@@ -32,7 +32,15 @@ struct EyePassParams {
   // When positive, every backward photon's radius in world units instead of the per-length radii
   // (BpmSettings::radius, times the iteration's radius scale).
   float world_radius = 0;
+  // False where no light path can be a caustic (no material has a traced lobe,
+  // may_have_caustics): then no backward photon accepts caustic photons.
+  bool caustics = true;
 };
+
+// Whether some material of the scene's objects may have a traced lobe (materials/material.h),
+// through which light could reach a diffuse surface as a caustic: all but diffuse reflection,
+// diffuse transmission and interfaces (a mix counts as one that may).
+bool may_have_caustics(const RenderScene& scene);
 
 struct EyeCounters {
   PathCounters rays;  // camera, bounce and shadow rays
