@@ -161,10 +161,10 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     resolve_photon_materials(maps, &lp);
     if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
     if (opt.memory_budget > 0) {
-      // The eye pass's lists keep their memory for the next iteration.
-      double list_bytes = 0;
-      for (const ObjectPhotonLists& l : thread_lists)
-        for (const auto& v : l) list_bytes += double(v.capacity() * sizeof(BackwardPhoton));
+      // The eye pass's lists keep their memory for the next iteration: a second copy of the
+      // backward photons (counted by their number, not the lists' capacities, which depend on
+      // how the threads shared the pixels: a budget decision must not).
+      const double list_bytes = double(maps.photons.size() * sizeof(BackwardPhoton));
       const double used = fixed_bytes + maps_bytes(maps, lp) + list_bytes;
       // Over the budget (the estimate before the first iteration assumed typical trees and no
       // textured materials): an error in the first iteration, which has nothing to keep; later,
