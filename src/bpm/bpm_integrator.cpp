@@ -180,7 +180,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
     tot.build_s += since(t);
     tot.add_maps(maps);
 
-    // 3. Light pass: a fixed number of photons, in batches.
+    // 3. Light pass: a fixed number of photons, in groups.
     run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
                    guide.empty() ? nullptr : &guide, &light_result);
     // The film averages iterations with equal weights, so an iteration the budget cut to a share

@@ -1,7 +1,7 @@
 // The backward photon mapping integrator (the paper's Fig. 3). Each iteration is an independent
 // estimate of the image in four stages, one file each: the eye pass leaves backward photons
 // (eye_pass), per-object sphere trees are built over them (backward_maps), photons from the lights
-// fill them in batches until they are covered (light_pass), and the iteration's image joins the
+// reach them, a fixed number in groups (light_pass), and the iteration's image joins the
 // film (accumulate). integrator/progressive.h runs the iterations until a budget ends the render.
 #pragma once
 #include "bpm/settings.h"

@@ -29,21 +29,17 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                     const std::vector<uint16_t>& owner, const PendingHit& h,
                     std::vector<std::vector<PhotonEntry>>& out) {
-  const int bounces = h.bounces;
-  const Vec3 wi = h.wi;
-  const Spectrum& flux = h.flux;
-  const bool hero_only = h.hero_only;
   float score = 0;
   auto use = [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
-    if (int(bp.eye_depth) + bounces > prm.max_depth) return;
+    if (int(bp.eye_depth) + h.bounces > prm.max_depth) return;
     if (dot(bp.ng, h.ng) < prm.normal_cos) return;
     // Resolved per backward photon when any material is textured (resolve_photon_materials).
     const Material& m = prm.photon_materials.empty() ? prm.materials->materials[bp.material]
                                                      : prm.photon_materials[g];
-    Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, wi, flux);
+    Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
-    value *= hero_join_factor(bp.hero_only, hero_only);
+    value *= hero_join_factor(bp.hero_only, h.hero_only);
     const float d2 = length_squared(h.p - bp.p), r2 = bp.radius * bp.radius;
     const uint32_t bits =
         (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
@@ -157,38 +153,31 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->emitted[size_t(c)].swap(emitted);
     buf->chunk_counters[size_t(c)] = lc;
   };
-  // Workers take chunks in order and stop taking them once the hits traced reach kGroupHits (or
-  // a stop is requested), so at most one chunk per worker is traced past the prefix kept. Should
-  // the prefix need a chunk no worker took, a further round begins there.
+  // Workers take chunks in order and stop taking them once the hits of the chunks traced reach
+  // kGroupHits, or a stop is requested; at most one chunk per worker is traced past the prefix
+  // kept. The prefix never needs a chunk no worker took: a worker skips chunk c only when the
+  // chunks before it that have finished, all of them kept, already hold kGroupHits hits. So
+  // without a stop request the prefix ends at kGroupHits or at the group's end.
   const int workers = tbb::this_task_arena::max_concurrency();
   std::vector<uint8_t> ran(size_t(n_chunks), 0);
+  std::atomic<uint64_t> traced{0};
+  std::atomic<int> next{0};
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, workers, 1),
+      [&](const tbb::blocked_range<int>&) {
+        for (int c; (c = next.fetch_add(1)) < n_chunks;) {
+          if (c > 0 && (stop() || traced.load() >= kGroupHits)) break;
+          trace_chunk(c);
+          ran[size_t(c)] = 1;
+          traced += buf->hits[size_t(c)].size();
+        }
+      },
+      tbb::simple_partitioner());
   int kept = 0;
   uint64_t kept_hits = 0;
-  bool stopped = false;
-  for (int begin = 0;;) {
-    std::atomic<uint64_t> traced{kept_hits};
-    std::atomic<int> next{begin};
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, workers, 1),
-        [&](const tbb::blocked_range<int>&) {
-          for (int c; (c = next.fetch_add(1)) < n_chunks;) {
-            if (ran[size_t(c)]) continue;
-            if (c > begin && (stop() || traced.load() >= kGroupHits)) break;
-            trace_chunk(c);
-            ran[size_t(c)] = 1;
-            traced += buf->hits[size_t(c)].size();
-          }
-        },
-        tbb::simple_partitioner());
-    while (kept < n_chunks && ran[size_t(kept)] && kept_hits < kGroupHits)
-      kept_hits += buf->hits[size_t(kept++)].size();
-    if (kept == n_chunks || kept_hits >= kGroupHits) break;
-    if (stop()) {
-      stopped = true;
-      break;
-    }
-    begin = kept;
-  }
+  while (kept < n_chunks && ran[size_t(kept)] && kept_hits < kGroupHits)
+    kept_hits += buf->hits[size_t(kept++)].size();
+  const bool stopped = kept < n_chunks && kept_hits < kGroupHits;
   // A group ended by its hits leaves the lists past those it may use unused: their memory, from a
   // larger group, goes back.
   if (kept_hits >= kGroupHits)
@@ -219,10 +208,14 @@ void sort_hits(const BackwardMaps& maps, int chunks, LightPassBuffers* buf) {
 
 // Gather: gather chunks from `first` on (kHitsPerGather hits of `order` each) add their entries
 // to their own lists, until all have run or the entries reach the memory limit (the first always
-// runs). Returns how many ran, a prefix; the lists of any past them are emptied (they run again
-// in the next round).
-int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const PixelMasks& masks,
-                 int first, int n_gather, LightPassBuffers* buf) {
+// runs). Returns how many ran, a prefix (the lists of any past them are emptied: they run again in
+// the next round), and the bytes all the lists hold.
+struct GatherRound {
+  int kept;
+  size_t bytes;
+};
+GatherRound gather_round(const BackwardMaps& maps, const LightPassParams& prm,
+                         const PixelMasks& masks, int first, int n_gather, LightPassBuffers* buf) {
   std::atomic<size_t> bytes{0};
   for (auto& by_slot : buf->chunks) {
     by_slot.resize(size_t(masks.slots()));
@@ -250,7 +243,7 @@ int gather_round(const BackwardMaps& maps, const LightPassParams& prm, const Pix
   });
   for (int g = first + kept; g < n_gather; ++g)
     for (auto& v : buf->chunks[size_t(g)]) v.clear();
-  return kept;
+  return {kept, bytes.load()};
 }
 
 // Apply: each slot applies the entries of its own pixels, gather chunk by gather chunk in order.
@@ -324,14 +317,14 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     // applied in the same order whatever the rounds.
     int done = 0;
     do {
-      const int kept = n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : 0;
+      const GatherRound round =
+          n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : GatherRound{0, 0};
+      const int kept = round.kept;
       res.trace_s += seconds_since(t);
-      size_t entry_bytes = 0, entries = 0;
-      for (const auto& by_slot : buf->chunks)
-        for (const auto& v : by_slot) entry_bytes += v.capacity() * sizeof(PhotonEntry);
+      size_t entries = 0;
       for (int g = done; g < done + kept; ++g)
         for (const auto& v : buf->chunks[size_t(g)]) entries += v.size();
-      res.peak_entry_bytes = std::max(res.peak_entry_bytes, entry_bytes);
+      res.peak_entry_bytes = std::max(res.peak_entry_bytes, round.bytes);
       buf->counters.local().entries += entries;
       t = std::chrono::steady_clock::now();
       apply_entries(*buf, done, done + kept, masks.slots(), &res);

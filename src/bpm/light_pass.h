@@ -80,7 +80,7 @@ struct EmittedPhoton {
 };
 
 // What the light pass keeps between iterations (so that their memory is allocated once): per
-// chunk of a batch's photons their hits and emissions, the hits in gather order, per gather chunk
+// chunk of a group's photons their hits and emissions, the hits in gather order, per gather chunk
 // the entry lists, the photon scores of a chunk, and the per-thread counters.
 struct LightPassBuffers {
   std::vector<std::vector<PendingHit>> hits;        // [chunk]

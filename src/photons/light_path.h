@@ -25,7 +25,7 @@ namespace bpm {
 constexpr int kPhotonsPerChunk = 1024;
 
 // Runs body(c) for the chunks c in [0, n) in parallel, where a stop request can cut the loop
-// short: a chunk does not start once stop() is true (chunk 0 always runs: a pass or batch keeps
+// short: a chunk does not start once stop() is true (chunk 0 always runs: a pass or round keeps
 // at least one), and the result is the number of leading chunks that ran. The caller keeps only
 // those: the photons kept are then a prefix of the photon sequence, the same whichever thread ran
 // which chunk, and the work of any later chunk that ran is the caller's to discard.

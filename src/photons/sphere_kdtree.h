@@ -27,7 +27,6 @@ class SphereKdTree {
  public:
   // Queries report sphere i as ids[i] when ids are given (one per sphere), else as i.
   void build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids = nullptr);
-  bool empty() const { return nodes_.empty(); }
   // Calls f(i) for every sphere i with |p - c_i| < r_i.
   template <class F>
   void query(Vec3 p, F&& f) const {
