@@ -28,6 +28,7 @@ PixelMasks::PixelMasks(int width, int height, int slots)
 
 void PixelMasks::rebuild(const std::vector<float>& cost) {
   BPM_CHECK(cost.size() == owner_.size());
+  if (slots_ == 1) return;  // one slot owns every pixel, in image order, whatever the costs
   // Blocks own disjoint pixels and lists: they are rebuilt in parallel, each as it would be alone.
   tbb::parallel_for(tbb::blocked_range<int>(0, block_count(), 1),
                     [&](const tbb::blocked_range<int>& r) {
@@ -36,37 +37,26 @@ void PixelMasks::rebuild(const std::vector<float>& cost) {
 }
 
 void PixelMasks::assign_block(int b, const std::vector<float>* cost) {
-  int x0 = (b % bx_) * block_, y0 = (b / bx_) * block_;
-  int x1 = std::min(x0 + block_, width_), y1 = std::min(y0 + block_, height_);
-  std::vector<uint32_t> pix;
+  const int x0 = (b % bx_) * block_, y0 = (b / bx_) * block_;
+  const int x1 = std::min(x0 + block_, width_), y1 = std::min(y0 + block_, height_);
+  std::vector<uint32_t>* lists = &lists_[size_t(b) * slots_];
+  for (int s = 0; s < slots_; ++s) lists[s].clear();
+  // Before any measurement: a diagonal interleave, so that each slot's pixels spread over the
+  // whole block. After: each pixel, in image order, goes to the slot with the least cost so far
+  // (list scheduling), so that no slot's cost exceeds the mean by more than one pixel's, and each
+  // slot walks its pixels in image order (coherent rays).
+  std::vector<double> load(cost ? size_t(slots_) : 0, 0.0);
   for (int y = y0; y < y1; ++y)
-    for (int x = x0; x < x1; ++x) pix.push_back(uint32_t(y) * width_ + x);
-  for (int s = 0; s < slots_; ++s) lists_[size_t(b) * slots_ + s].clear();
-  if (!cost) {
-    // Before any measurement: a diagonal interleave, so that each slot's pixels spread over the
-    // whole block.
-    for (uint32_t p : pix) {
-      int x = int(p % width_), y = int(p / width_);
+    for (int x = x0; x < x1; ++x) {
+      const uint32_t p = uint32_t(y) * uint32_t(width_) + uint32_t(x);
       int s = (x + 3 * y) % slots_;
+      if (cost) {
+        s = int(std::min_element(load.begin(), load.end()) - load.begin());
+        load[size_t(s)] += std::max(0.0f, (*cost)[p]);
+      }
       owner_[p] = uint16_t(s);
-      lists_[size_t(b) * slots_ + s].push_back(p);
+      lists[s].push_back(p);
     }
-    return;
-  }
-  std::stable_sort(pix.begin(), pix.end(),
-                   [&](uint32_t a, uint32_t c) { return (*cost)[a] > (*cost)[c]; });
-  std::vector<double> load(slots_, 0.0);
-  for (uint32_t p : pix) {
-    int s = int(std::min_element(load.begin(), load.end()) - load.begin());
-    load[s] += std::max(0.0f, (*cost)[p]);
-    owner_[p] = uint16_t(s);
-    lists_[size_t(b) * slots_ + s].push_back(p);
-  }
-  // Each slot walks its pixels in image order (coherent rays).
-  for (int s = 0; s < slots_; ++s) {
-    auto& l = lists_[size_t(b) * slots_ + s];
-    std::sort(l.begin(), l.end());
-  }
 }
 
 }  // namespace bpm

@@ -25,8 +25,8 @@ class PixelMasks {
   const std::vector<uint32_t>& pixels(int block, int slot) const {
     return lists_[size_t(block) * slots_ + slot];
   }
-  // Reassigns the pixels of every block to balance the summed cost per slot (longest processing
-  // time first).
+  // Reassigns the pixels of every block to balance the summed cost per slot: no slot of a block
+  // gets more than the block's mean cost per slot plus one pixel's.
   void rebuild(const std::vector<float>& cost_per_pixel);
 
  private:
