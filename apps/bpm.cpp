@@ -478,7 +478,8 @@ int main(int argc, char** argv) {
       ->group(g);
   render
       ->add_option("--photons", ra.photons,
-                   "Photons per iteration (default 100000; file: integer photonsperiteration)")
+                   "Photons per iteration (default 100000 per 256x256 pixels, at least 100000; "
+                   "fpm: no more than --memory holds; file: integer photonsperiteration)")
       ->check(CLI::Range(1, 1 << 30))
       ->group(g);
   render

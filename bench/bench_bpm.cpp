@@ -272,6 +272,7 @@ int main(int argc, char** argv) {
   ls.film.height = h;
   int hw = int(std::thread::hardware_concurrency());
   BpmSettings bs = bpm_settings_from_file(ls.render.integrator_directive);
+  bs.photons_per_iteration = photons_for(bs, size_t(w) * size_t(h));
   std::printf(
       "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per "
       "iteration\n",

@@ -3,7 +3,7 @@
 // pixels (fireflies), and the ratio of each channel's image mean to the reference's. Prints
 // figures; never fails.
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
-//              [--references-only]
+//              [--integrators path,bpm,fpm] [--references-only]
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
 // (references by bpm), lamp-room and the Cornell box (../shared's at 256x256 when present, else
 // ours; references by path). scenes/tools/make_equal_time_scenes.py writes the last three of ours.
@@ -204,7 +204,7 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   double seconds = 60, reference_s = 600;
-  std::string only, res;
+  std::string only, res, ours = "path,bpm,fpm";
   bool references_only = false;
   std::string pbrt = default_pbrt_path();
   for (int i = 1; i < argc; ++i) {
@@ -219,6 +219,8 @@ int main(int argc, char** argv) {
       pbrt = next();
     else if (!std::strcmp(argv[i], "--res"))
       res = next();
+    else if (!std::strcmp(argv[i], "--integrators"))
+      ours = next();
     else if (!std::strcmp(argv[i], "--references-only"))
       references_only = true;
     else {
@@ -226,7 +228,8 @@ int main(int argc, char** argv) {
       if (!help) std::fprintf(stderr, "equal_time: unknown argument '%s'\n", argv[i]);
       std::fprintf(help ? stdout : stderr,
                    "usage: equal_time [--time S] [--scenes a,b] [--pbrt PATH] "
-                   "[--reference-time S] [--res WxH] [--references-only]\n"
+                   "[--reference-time S] [--res WxH] [--integrators path,bpm,fpm] "
+                   "[--references-only]\n"
                    "  references are kept in ./equal_time_references/; --references-only makes "
                    "the missing ones and stops\n");
       return help ? 0 : 2;
@@ -248,6 +251,8 @@ int main(int argc, char** argv) {
     Image ref = reference_for(e, ls, reference_s);
     if (references_only) continue;
     for (const char* integrator : {"path", "bpm", "fpm"}) {
+      if (("," + ours + ",").find(std::string(",") + integrator + ",") == std::string::npos)
+        continue;
       RenderStats st;
       Image img = render_ours(ls, integrator, seconds, 1, &st);
       std::string samples =

@@ -688,6 +688,63 @@ TEST(BpmSettings, SppmLineGivesDepth0ItsRadiusAndItsPhotons) {
   }
 }
 
+// By default the photons per iteration follow the pixel count (100000 per 256x256 pixels, at
+// least 100000); a count set is kept. Both photon methods emit the count resolved, and their
+// records say it.
+TEST(PhotonSettings, PhotonsPerIterationFollowThePixelCount) {
+  PhotonSettings d;
+  EXPECT_EQ(photons_for(d, 256 * 256), 100000);
+  EXPECT_EQ(photons_for(d, 64 * 64), 100000);
+  EXPECT_EQ(photons_for(d, 1024 * 1024), 1600000);
+  EXPECT_EQ(photons_for(d, 400 * 300), 183105);
+  d.photons_per_iteration = 5000;
+  EXPECT_EQ(photons_for(d, 1024 * 1024), 5000);
+
+  LoadedScene ls = load(cornell());
+  ls.film.width = 400;
+  ls.film.height = 300;
+  for (const char* integrator : {"bpm", "fpm"}) {
+    RenderRun r = render_with(ls, integrator, 1);
+    EXPECT_EQ(r.stats.details["settings"]["photons_per_iteration"].get<int>(), 183105)
+        << integrator;
+    EXPECT_EQ(r.stats.details["light"]["photons_kept"].get<uint64_t>(), 183105u) << integrator;
+  }
+}
+
+// fpm holds an iteration's photons at once: under a memory budget that 100000 photons fit and the
+// automatic count would not, it emits fewer (never fewer than 100000) instead of failing.
+TEST(PhotonSettings, FpmAutomaticPhotonsFitTheMemoryBudget) {
+  LoadedScene ls = load(cornell());
+  ls.film.width = 400;
+  ls.film.height = 300;
+  auto options = [&](int photons, double budget) {
+    FpmSettings f;
+    f.photons_per_iteration = photons;
+    RenderOptions opt = test_options(ls, "fpm", 1, 1, {}, f);
+    opt.fpm.photons_per_iteration = photons;
+    opt.memory_budget = uint64_t(budget);
+    return opt;
+  };
+  // The smallest budget, in steps of 1.25x, that passes fpm's check for 100000 photons (a budget
+  // too small fails before anything is rendered).
+  double budget = 16e6;
+  for (;; budget *= 1.25) {
+    Film film(ls.film.width, ls.film.height);
+    try {
+      render(ls, options(100000, budget), &film);
+      break;
+    } catch (const Error&) {
+      ASSERT_LT(budget, 64e9) << "no budget fits 100000 photons";
+    }
+  }
+  Film film(ls.film.width, ls.film.height);
+  EXPECT_THROW(render(ls, options(183105, budget), &film), Error) << "183105 photons set by hand";
+  RenderStats st = render(ls, options(0, budget), &film);
+  const uint64_t kept = st.details["light"]["photons_kept"].get<uint64_t>();
+  EXPECT_GE(kept, 100000u);
+  EXPECT_LT(kept, 183105u);
+}
+
 // A world-space radius gives every backward photon that radius (times the iteration's scale), and
 // one backward photon at the first vertex with D = 0, accepting both classes.
 TEST(Bpm, WorldRadiusGivesEveryBackwardPhotonThatRadius) {

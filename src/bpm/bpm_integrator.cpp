@@ -74,11 +74,13 @@ double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
 
 }  // namespace
 
-RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt, const BpmSettings& s,
-                       Film* film) {
+RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
+                       const BpmSettings& settings, Film* film) {
+  const size_t n_pixels = size_t(film->width()) * size_t(film->height());
+  BpmSettings s = settings;
+  s.photons_per_iteration = photons_for(settings, n_pixels);
   check(s);
   const RenderScene& scene = ls.scene;
-  const size_t n_pixels = size_t(film->width()) * size_t(film->height());
   const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
   const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
 

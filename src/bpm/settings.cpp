@@ -13,7 +13,7 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("radius", b.radius >= 0 && std::isfinite(b.radius), "must not be negative", in.loc);
   if (in.name == "sppm") {
     // pbrt-v4's sppm: its radius is a world-space initial radius; its photons per iteration
-    // default to the pixel count (-1), ours to a fixed count.
+    // default to the pixel count (-1), ours to about 1.5 per pixel (photons_for).
     b.diffuse_depth = 0;
     const int photons = ps.get_int("photonsperiteration", -1);
     if (photons > 0) b.photons_per_iteration = photons;

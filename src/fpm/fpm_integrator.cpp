@@ -62,15 +62,16 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
 
 }  // namespace
 
-RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, const FpmSettings& s,
-                       Film* film) {
+RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
+                       const FpmSettings& settings, Film* film) {
+  FpmSettings s = settings;
+  s.photons_per_iteration = photons_for(settings, size_t(film->width()) * size_t(film->height()));
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: radius factors k0 and k1 must be positive");
   if (s.photons_per_iteration <= 0) throw Error("fpm: photons per iteration must be positive");
   if (s.knn < 0) throw Error("fpm: knn must not be negative");
   const RenderScene& scene = ls.scene;
   const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
   const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
-  const uint64_t n_photons = uint64_t(s.photons_per_iteration);
   const int min_eye_vertices = s.final_gather ? 2 : 1;
   // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
   // for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
@@ -78,6 +79,14 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt, cons
   const double stored_per_photon = std::max(0, opt.max_depth - min_eye_vertices + 1) + 1;
   const double photon_bytes =
       2 * sizeof(ForwardPhoton) + 2 * (sizeof(SphereRef) + sizeof(uint32_t));
+  // The map holds a whole iteration's photons: the automatic count takes no more than the budget
+  // holds at worst (but never fewer than 100000, which fail as a count set would).
+  if (settings.photons_per_iteration == 0 && opt.memory_budget > 0) {
+    const double fit =
+        (double(opt.memory_budget) - double(film->bytes())) / (stored_per_photon * photon_bytes);
+    s.photons_per_iteration = int(std::clamp(fit, 100000.0, double(s.photons_per_iteration)));
+  }
+  const uint64_t n_photons = uint64_t(s.photons_per_iteration);
   check_memory("fpm with " + std::to_string(n_photons) + " photons per iteration and maxdepth " +
                    std::to_string(opt.max_depth) + " (up to " +
                    std::to_string(int(stored_per_photon)) + " stored per photon)",

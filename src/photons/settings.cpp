@@ -1,5 +1,6 @@
 #include "photons/settings.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -11,6 +12,12 @@ float radius_scale(const PhotonSettings& s, int iteration) {
   double r2 = 1;
   for (int i = 1; i <= iteration; ++i) r2 *= (i + double(s.alpha)) / (i + 1);
   return float(std::sqrt(r2));
+}
+
+int photons_for(const PhotonSettings& s, size_t pixels) {
+  if (s.photons_per_iteration != 0) return s.photons_per_iteration;
+  constexpr double kPerPixel = 100000.0 / (256 * 256);
+  return int(std::clamp(std::round(double(pixels) * kPerPixel), 100000.0, double(1 << 30)));
 }
 
 void read_photon_settings(const SceneEntity& in, PhotonSettings* s) {
@@ -25,8 +32,10 @@ void read_photon_settings(const SceneEntity& in, PhotonSettings* s) {
   s->radius_policy = policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
   s->alpha = ps.get_float("alpha", s->alpha);
   ps.require("alpha", s->alpha > 0 && s->alpha < 1, "must be in (0, 1)", in.loc);
-  s->photons_per_iteration = ps.get_int("photonsperiteration", s->photons_per_iteration);
-  ps.require("photonsperiteration", s->photons_per_iteration > 0, "must be positive", in.loc);
+  if (ps.find_any("photonsperiteration")) {
+    s->photons_per_iteration = ps.get_int("photonsperiteration", 0);
+    ps.require("photonsperiteration", s->photons_per_iteration > 0, "must be positive", in.loc);
+  }
 }
 
 }  // namespace bpm

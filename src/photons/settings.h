@@ -28,8 +28,9 @@ struct PhotonSettings {
   RadiusPolicy radius_policy = RadiusPolicy::kProgressive;
   // Knaus & Zwicker 2011: r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1).
   float alpha = 2.0f / 3.0f;
-  // Photons emitted per iteration: a fixed count, never one that depends on what they hit.
-  int photons_per_iteration = 100000;
+  // Photons emitted per iteration: a fixed count, never one that depends on what they hit. 0 (the
+  // default): by the image's size, photons_for().
+  int photons_per_iteration = 0;
   // Photons count only where the normals of the photon's surface and of the gathering point agree
   // to within this cosine.
   float normal_cos = 0.5f;
@@ -42,6 +43,12 @@ struct PhotonSettings {
 inline const char* to_string(RadiusPolicy p) {
   return p == RadiusPolicy::kFixed ? "fixed" : "progressive";
 }
+
+// Photons per iteration for an image of `pixels` pixels: the count set, or by default 100000 per
+// 256x256 pixels and at least 100000. A backward photon's radius is a few pixel footprints, so
+// this keeps the photons one finds per iteration, and with them the balance of eye and light
+// work, the same at every resolution (README, "Photons per iteration").
+int photons_for(const PhotonSettings& s, size_t pixels);
 
 // Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.
 float radius_scale(const PhotonSettings& s, int iteration);

@@ -41,9 +41,20 @@ nlohmann::json render_identity(const std::vector<std::string>& scene_files, cons
   }
   char fingerprint[17];
   std::snprintf(fingerprint, sizeof fingerprint, "%016llx", (unsigned long long)h);
+  // The photon methods' settings with the photons per iteration resolved for this resolution (so
+  // that the automatic count and the same count set by hand are one setting).
+  const size_t pixels = size_t(ls.film.width) * size_t(ls.film.height);
   nlohmann::json settings;
-  if (opt.integrator == "bpm") settings = settings_json(opt.bpm);
-  if (opt.integrator == "fpm") settings = settings_json(opt.fpm);
+  if (opt.integrator == "bpm") {
+    BpmSettings s = opt.bpm;
+    s.photons_per_iteration = photons_for(s, pixels);
+    settings = settings_json(s);
+  }
+  if (opt.integrator == "fpm") {
+    FpmSettings s = opt.fpm;
+    s.photons_per_iteration = photons_for(s, pixels);
+    settings = settings_json(s);
+  }
   return {{"scene", scene_files.empty() ? "" : scene_files.front()},
           {"scene_fingerprint", fingerprint},
           {"scene_stats",
