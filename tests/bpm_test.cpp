@@ -975,16 +975,18 @@ TEST(Bpm, ScenesWithoutTracedLobesMakeNoCausticBackwardPhotons) {
 }
 
 // Where photons leave many hits (the furnace: about 3 each), a group of the light pass ends by its
-// hits, before kPhotonsPerGroup photons, at the same chunk whatever the threads: the same image
-// and counts for 1, 2 and 3 threads.
+// hits, before a group's photons (at least 65536), at the same chunk whatever the threads: the same
+// image and counts for 1, 2 and 3 threads.
 TEST(Bpm, GroupsEndedByTheirHitsDoNotDependOnTheThreads) {
   LoadedScene ls = sphere_furnace();
   BpmSettings s = small_batches(0);
   s.photons_per_iteration = 150000;
   RenderRun one = render_with(ls, "bpm", 1, 1, 9, s);
   const nlohmann::json& light = one.stats.details["light"];
+  const uint64_t group =
+      group_size(one.stats.details["eye"]["backward_photons"].get<size_t>()).photons;
   EXPECT_GT(light["batches"].get<uint64_t>(),
-            (uint64_t(s.photons_per_iteration) + kPhotonsPerGroup - 1) / kPhotonsPerGroup)
+            (uint64_t(s.photons_per_iteration) + group - 1) / group)
       << "groups should end by their hits: " << light["queries"] << " queries";
   EXPECT_EQ(light["photons"].get<uint64_t>(), uint64_t(s.photons_per_iteration));
   for (int threads : {2, 3}) {
@@ -1111,9 +1113,9 @@ TEST(Bpm, MemoryBudgetSplitsBatchesWithoutChangingTheImage) {
   const int iterations = 2;
   RenderRun unlimited = render_with(ls, "bpm", iterations, 2, 9, s);
   const nlohmann::json& light = unlimited.stats.details["light"];
+  const uint64_t group = group_size(0).photons;  // the smallest group: few backward photons here
   ASSERT_EQ(light["batches"].get<uint64_t>(),
-            uint64_t(iterations) *
-                ((uint64_t(s.photons_per_iteration) + kPhotonsPerGroup - 1) / kPhotonsPerGroup));
+            uint64_t(iterations) * ((uint64_t(s.photons_per_iteration) + group - 1) / group));
   const size_t unlimited_entries =
       unlimited.stats.details["maps"]["peak_entry_bytes"].get<size_t>();
 

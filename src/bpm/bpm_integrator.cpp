@@ -117,7 +117,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
       "--memory";
   const double fixed_bytes =
       double(film->bytes()) + double(n_pixels) * kPixelBytes +
-      light_pass_hit_bytes(opt.max_depth, tbb::this_task_arena::max_concurrency());
+      light_pass_hit_bytes(opt.max_depth, tbb::this_task_arena::max_concurrency(),
+                           n_pixels * size_t(s.diffuse_depth + 2));
   check_memory("bpm at " + size + " with diffuse depth " + std::to_string(s.diffuse_depth) +
                    " (up to " + std::to_string(s.diffuse_depth + 2) +
                    " backward photons per pixel and iteration)",

@@ -101,14 +101,14 @@ struct TraceResult {
 
 // Trace: chunks of photons are traced in parallel, each recording its photons' hits and
 // emissions (and counters). A group keeps the longest prefix of its chunks that starts before
-// kGroupHits hits, so that its memory is bounded whatever the paths and its size does not depend
+// group_hits hits, so that its memory is bounded whatever the paths and its size does not depend
 // on the threads (a chunk traced past the prefix is traced again in the next group); or fewer
 // whole chunks when prm.stop ended the trace. The first chunk always runs, except after a stop
 // request in a later group.
 TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
                         const LightPassParams& prm, uint64_t seed, int pass_index,
-                        uint64_t first_photon, uint64_t count, const EmissionGuide* guide,
-                        LightPassBuffers* buf) {
+                        uint64_t first_photon, uint64_t count, uint64_t group_hits,
+                        const EmissionGuide* guide, LightPassBuffers* buf) {
   const int n_chunks = int((count + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   auto stop = [&] { return prm.stop && prm.stop(); };
   // A pass keeps at least its first chunk: N of eq. (2) is never zero.
@@ -154,10 +154,10 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->chunk_counters[size_t(c)] = lc;
   };
   // Workers take chunks in order and stop taking them once the hits of the chunks traced reach
-  // kGroupHits, or a stop is requested; at most one chunk per worker is traced past the prefix
+  // group_hits, or a stop is requested; at most one chunk per worker is traced past the prefix
   // kept. The prefix never needs a chunk no worker took: a worker skips chunk c only when the
-  // chunks before it that have finished, all of them kept, already hold kGroupHits hits. So
-  // without a stop request the prefix ends at kGroupHits or at the group's end.
+  // chunks before it that have finished, all of them kept, already hold group_hits hits. So
+  // without a stop request the prefix ends at group_hits or at the group's end.
   const int workers = tbb::this_task_arena::max_concurrency();
   std::vector<uint8_t> ran(size_t(n_chunks), 0);
   std::atomic<uint64_t> traced{0};
@@ -166,7 +166,7 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
       tbb::blocked_range<int>(0, workers, 1),
       [&](const tbb::blocked_range<int>&) {
         for (int c; (c = next.fetch_add(1)) < n_chunks;) {
-          if (c > 0 && (stop() || traced.load() >= kGroupHits)) break;
+          if (c > 0 && (stop() || traced.load() >= group_hits)) break;
           trace_chunk(c);
           ran[size_t(c)] = 1;
           traced += buf->hits[size_t(c)].size();
@@ -175,12 +175,12 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
       tbb::simple_partitioner());
   int kept = 0;
   uint64_t kept_hits = 0;
-  while (kept < n_chunks && ran[size_t(kept)] && kept_hits < kGroupHits)
+  while (kept < n_chunks && ran[size_t(kept)] && kept_hits < group_hits)
     kept_hits += buf->hits[size_t(kept++)].size();
-  const bool stopped = kept < n_chunks && kept_hits < kGroupHits;
+  const bool stopped = kept < n_chunks && kept_hits < group_hits;
   // A group ended by its hits leaves the lists past those it may use unused: their memory, from a
   // larger group, goes back.
-  if (kept_hits >= kGroupHits)
+  if (kept_hits >= group_hits)
     for (size_t c = size_t(kept) + size_t(workers); c < buf->hits.size(); ++c) {
       std::vector<PendingHit>().swap(buf->hits[c]);
       std::vector<EmittedPhoton>().swap(buf->emitted[c]);
@@ -268,12 +268,20 @@ void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots,
 
 }  // namespace
 
-double light_pass_hit_bytes(int max_depth, int threads) {
+GroupSize group_size(size_t backward_photons) {
+  const uint64_t hits =
+      std::clamp<uint64_t>(backward_photons, uint64_t(1) << 17, uint64_t(1) << 20) &
+      ~uint64_t(2 * kPhotonsPerChunk - 1);
+  return {hits / 2, hits};
+}
+
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons) {
   // The kept chunks' hits with their lists' spare capacity, and a chunk per thread traced past
   // them or kept from an earlier group (max_depth + 1 hits per photon at most); the emissions.
-  return double(kHitBytes) * (2.0 * double(kGroupHits) + 2.0 * double(threads) * kPhotonsPerChunk *
-                                                             double(std::max(max_depth, 0) + 1)) +
-         2.0 * double(kPhotonsPerGroup) * sizeof(EmittedPhoton);
+  const GroupSize g = group_size(backward_photons);
+  return double(kHitBytes) * (2.0 * double(g.hits) + 2.0 * double(threads) * kPhotonsPerChunk *
+                                                         double(std::max(max_depth, 0) + 1)) +
+         2.0 * double(g.photons) * sizeof(EmittedPhoton);
 }
 
 void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
@@ -297,11 +305,12 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   res.peak_entry_bytes = 0;
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
+  const GroupSize group = group_size(n_bp);
   for (uint64_t first = 0; first < total;) {
-    const uint64_t count = std::min(kPhotonsPerGroup, total - first);
+    const uint64_t count = std::min(group.photons, total - first);
     auto t = std::chrono::steady_clock::now();
     const TraceResult tr =
-        trace_group(scene, maps, prm, seed, pass_index, first, count, guide, buf);
+        trace_group(scene, maps, prm, seed, pass_index, first, count, group.hits, guide, buf);
     if (tr.kept == 0) {  // stopped before the group began
       res.cut = true;
       break;

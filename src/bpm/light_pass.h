@@ -109,20 +109,25 @@ struct LightPassResult {
 };
 
 // Photons per group: the hits of a group are sorted together, and its entries are held in memory
-// until they are applied. A group ends earlier, at a chunk, once its hits reach kGroupHits (where
+// until they are applied. A group ends earlier, at a chunk, once its hits reach `hits` (where
 // photons leave many hits), so that its memory is bounded; where it ends depends on the paths
 // alone, so the order of every sum is fixed by the scene, the seed and the settings.
-constexpr uint64_t kPhotonsPerGroup = 65536;
-constexpr uint64_t kGroupHits = 131072;
+// A group has about as many hits as the iteration has backward photons, so that a leaf of the
+// trees is reached by about as many hits of a group, and read from cache by all but the first, at
+// any resolution; within [131072, 1048576] hits, and half as many photons.
+struct GroupSize {
+  uint64_t photons, hits;
+};
+GroupSize group_size(size_t backward_photons);
 constexpr uint64_t kHitBytes = sizeof(PendingHit) + sizeof(PendingHit*);
-// What the light pass's hits may take, for the memory budget.
-double light_pass_hit_bytes(int max_depth, int threads);
+// What the light pass's hits may take with at most `backward_photons`, for the memory budget.
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons);
 // Hits per gather chunk.
 constexpr int kHitsPerGather = 1024;
 
 // Shoots settings.photons_per_iteration photons (streams keyed by seed, pass_index and photon
-// index) in groups of kPhotonsPerGroup at most; stops early, at a chunk of the trace, when
-// params.stop says so (the group's gather still runs). With a guide the photons start where it
+// index) in groups of group_size(backward photons) at most; stops early, at a chunk of the trace,
+// when params.stop says so (the group's gather still runs). With a guide the photons start where it
 // sends them, and with params.pixel_weight as well their scores are added to it (learning does not
 // change its density until its update).
 // The result goes to *result (its arrays keep their memory from one iteration to the next).
