@@ -39,24 +39,45 @@ size_t gather_in_space(const std::vector<ObjectPhotonLists*>& per_thread, uint32
   auto cell = [](float x, float lo, float size) {
     return size > 0 ? uint32_t(std::clamp((x - lo) / size * 1024.0f, 0.0f, 1023.0f)) : 0u;
   };
-  struct Item {
-    uint32_t code;
-    uint64_t key;
-    const BackwardPhoton* photon;
-  };
-  std::vector<Item> items;
+  // Each photon as its code (high half) and its place in src (low half), sorted by code with
+  // three passes of a radix sort (10 bits each), then each run of one code by key().
+  std::vector<const BackwardPhoton*> src;
+  std::vector<uint64_t> items, sorted(n);
+  src.reserve(n);
   items.reserve(n);
   for (const ObjectPhotonLists* l : per_thread)
     if (o < l->size())
-      for (const BackwardPhoton& bp : (*l)[o])
-        items.push_back({spread_bits(cell(bp.p.x, b.lo.x, extent.x)) |
-                             spread_bits(cell(bp.p.y, b.lo.y, extent.y)) << 1 |
-                             spread_bits(cell(bp.p.z, b.lo.z, extent.z)) << 2,
-                         bp.key(), &bp});
-  std::sort(items.begin(), items.end(), [](const Item& a, const Item& c) {
-    return a.code != c.code ? a.code < c.code : a.key < c.key;
-  });
-  for (size_t k = 0; k < n; ++k) dst[k] = *items[k].photon;
+      for (const BackwardPhoton& bp : (*l)[o]) {
+        const uint32_t code = spread_bits(cell(bp.p.x, b.lo.x, extent.x)) |
+                              spread_bits(cell(bp.p.y, b.lo.y, extent.y)) << 1 |
+                              spread_bits(cell(bp.p.z, b.lo.z, extent.z)) << 2;
+        items.push_back(uint64_t(code) << 32 | src.size());
+        src.push_back(&bp);
+      }
+  for (int shift = 32; shift < 62; shift += 10) {
+    uint32_t start[1025] = {};
+    for (uint64_t v : items) ++start[((v >> shift) & 1023) + 1];
+    for (int d = 1; d <= 1024; ++d) start[d] += start[d - 1];
+    for (uint64_t v : items) sorted[start[(v >> shift) & 1023]++] = v;
+    items.swap(sorted);
+  }
+  auto photon = [&](uint64_t v) { return src[uint32_t(v)]; };
+  for (size_t i = 0, j; i < n; i = j) {
+    for (j = i + 1; j < n && items[j] >> 32 == items[i] >> 32;) ++j;
+    if (j - i > 1)
+      std::sort(items.begin() + long(i), items.begin() + long(j),
+                [&](uint64_t a, uint64_t c) { return photon(a)->key() < photon(c)->key(); });
+  }
+  // The records are read out of order: fetched a few ahead.
+  constexpr size_t kAhead = 8;
+  for (size_t k = 0; k < n; ++k) {
+    if (k + kAhead < n) {
+      const char* next = reinterpret_cast<const char*>(photon(items[k + kAhead]));
+      __builtin_prefetch(next);
+      __builtin_prefetch(next + sizeof(BackwardPhoton) - 1);
+    }
+    dst[k] = *photon(items[k]);
+  }
   return n;
 }
 
@@ -112,15 +133,24 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
     // two copies of every backward photon).
     for (ObjectPhotonLists* l : per_thread)
       if (o < l->size()) (*l)[o].clear();
+    // Per class (caustic, indirect), the spheres that accept it, in one pass over the records.
+    std::vector<SphereRef> spheres_of[2];
+    std::vector<uint32_t> ids_of[2];
     for (int c = 0; c < 2; ++c) {
-      const uint8_t accepts = c == 0 ? kAcceptsCaustic : kAcceptsIndirect;
-      std::vector<SphereRef> spheres;
-      std::vector<uint32_t> ids;
-      for (size_t k = 0; k < n; ++k)
-        if (dst[k].accepts & accepts) {
-          spheres.push_back({dst[k].p, dst[k].radius});
-          ids.push_back(maps->object_begin[o] + uint32_t(k));
+      spheres_of[c].reserve(n);
+      ids_of[c].reserve(n);
+    }
+    for (size_t k = 0; k < n; ++k) {
+      const BackwardPhoton& bp = dst[k];
+      for (int c = 0; c < 2; ++c)
+        if (bp.accepts & (c == 0 ? kAcceptsCaustic : kAcceptsIndirect)) {
+          spheres_of[c].push_back({bp.p, bp.radius});
+          ids_of[c].push_back(maps->object_begin[o] + uint32_t(k));
         }
+    }
+    for (int c = 0; c < 2; ++c) {
+      const std::vector<SphereRef>& spheres = spheres_of[c];
+      const std::vector<uint32_t>& ids = ids_of[c];
       if (centre_tree)
         maps->centre_trees[2 * o + c].build(spheres, &ids);
       else

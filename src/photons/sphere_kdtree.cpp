@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <optional>
+#include <tuple>
+#include <utility>
 
 namespace bpm {
 namespace {
@@ -18,6 +20,9 @@ namespace {
 constexpr float kTraversalCost = 64;
 constexpr size_t kMinLeaf = 8;
 constexpr int kMaxDepth = 48;
+// Cells with more spheres than this take their median from an even sample of this many.
+constexpr size_t kSampledMedianMin = 512;
+constexpr size_t kMedianSample = 64;
 // Cells with at least this many spheres build their two halves as separate tasks (a scene whose
 // photons lie mostly on one object would otherwise build its tree on one thread).
 constexpr size_t kParallelMin = 16384;
@@ -39,8 +44,7 @@ void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vecto
   Bounds3 cell;
   for (uint32_t i = 0; i < order.size(); ++i) {
     order[i] = i;
-    cell.expand(spheres[i].c - Vec3(spheres[i].r, spheres[i].r, spheres[i].r));
-    cell.expand(spheres[i].c + Vec3(spheres[i].r, spheres[i].r, spheres[i].r));
+    cell.expand(extent(spheres[i]));
   }
   nodes_.reserve(2 * spheres.size() / kMinLeaf + 1);
   build_node(order, cell, 0, spheres);
@@ -51,6 +55,13 @@ void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vecto
     for (uint32_t& item : items_) item = (*ids)[item];
 }
 
+Bounds3 SphereKdTree::extent(const SphereRef& s) {
+  const Vec3 r(s.r, s.r, s.r);
+  return {s.c - r, s.c + r};
+}
+
+// `cell` is the node's region of space clipped to the bounds of its spheres (no query outside
+// their union finds anything).
 void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth,
                               const std::vector<SphereRef>& spheres) {
   uint32_t self = uint32_t(nodes_.size());
@@ -59,73 +70,92 @@ void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int dept
     nodes_[self] = {0, kLeaf, uint32_t(items_.size()), uint32_t(ids.size())};
     for (uint32_t i : ids) add_slot(i, spheres[i]);
   };
-  size_t n = ids.size();
+  const size_t n = ids.size();
   if (n <= kMinLeaf || depth >= kMaxDepth) return make_leaf();
-  // Tighten the cell to the spheres in it: no query outside their union finds anything.
-  Bounds3 tight;
-  for (uint32_t i : ids) {
-    Vec3 r(spheres[i].r, spheres[i].r, spheres[i].r);
-    tight.expand(spheres[i].c - r);
-    tight.expand(spheres[i].c + r);
-  }
-  cell.lo = vmax(cell.lo, tight.lo);
-  cell.hi = vmin(cell.hi, tight.hi);
-  // The plane: the median centre on the longest axis (balanced trees for clustered photons). Where
-  // many centres share that coordinate (photons on a wall perpendicular to the axis) a plane
-  // through them puts every such sphere on both sides and splits nothing; then the middle of the
-  // axis, then the other axes. The first plane that separates some spheres is kept if it pays.
-  struct Split {
-    int axis;
-    float at;
-    size_t nl, nr;
-    float cost;
+  // The plane: the median centre on the longest axis (balanced trees for clustered photons), over
+  // every sphere in a small cell and over an even sample of them in a large one. Where many
+  // centres share that coordinate (photons on a wall perpendicular to the axis) a plane through
+  // them puts every such sphere on both sides and splits nothing; then the middle of the axis,
+  // then the other axes. The first plane that separates some spheres is kept if it pays.
+  // A small cell counts each candidate's sides before splitting; a large one splits at once
+  // (it nearly always pays) and counts the sides it made.
+  const bool large = n > kSampledMedianMin;
+  std::vector<uint32_t> left, right;
+  Bounds3 lbounds, rbounds;
+  auto split = [&](int axis, float at) {
+    left.clear();
+    right.clear();
+    lbounds = rbounds = Bounds3();
+    for (uint32_t i : ids) {
+      const SphereRef& s = spheres[i];
+      const Bounds3 e = extent(s);
+      if (s.c[axis] - s.r < at) {
+        left.push_back(i);
+        lbounds.expand(e);
+      }
+      if (s.c[axis] + s.r >= at) {
+        right.push_back(i);
+        rbounds.expand(e);
+      }
+    }
   };
-  auto evaluate = [&](int axis, float at) {
+  auto count = [&](int axis, float at) {
     size_t nl = 0, nr = 0;
     for (uint32_t i : ids) {
       const SphereRef& s = spheres[i];
       nl += s.c[axis] - s.r < at;
       nr += s.c[axis] + s.r >= at;
     }
-    float lo = cell.lo[axis], hi = cell.hi[axis];
-    float pl = (at - lo) / (hi - lo);
-    return Split{axis, at, nl, nr, kTraversalCost + pl * float(nl) + (1 - pl) * float(nr)};
+    return std::pair{nl, nr};
+  };
+  struct Split {
+    int axis;
+    float at;
+    float cost;
   };
   const int first_axis = longest_axis(cell);
   std::optional<Split> best;
-  std::vector<float> cs(n);
+  std::vector<float> cs;
   for (int k = 0; k < 3 && !best; ++k) {
     const int axis = (first_axis + k) % 3;
     const float lo = cell.lo[axis], hi = cell.hi[axis];
     if (!(hi > lo)) continue;
-    for (size_t j = 0; j < n; ++j) cs[j] = spheres[ids[j]].c[axis];
-    std::nth_element(cs.begin(), cs.begin() + n / 2, cs.end());
-    for (float at : {cs[n / 2], 0.5f * (lo + hi)}) {
+    cs.clear();
+    const size_t step = large ? n / kMedianSample : 1;
+    for (size_t j = 0; j < n; j += step) cs.push_back(spheres[ids[j]].c[axis]);
+    std::nth_element(cs.begin(), cs.begin() + cs.size() / 2, cs.end());
+    for (float at : {cs[cs.size() / 2], 0.5f * (lo + hi)}) {
       if (!(at > lo && at < hi)) continue;
-      Split c = evaluate(axis, at);
-      if (c.nl < n && c.nr < n) {
-        best = c;
+      size_t nl, nr;
+      if (large) {
+        split(axis, at);
+        nl = left.size();
+        nr = right.size();
+      } else {
+        std::tie(nl, nr) = count(axis, at);
+      }
+      if (nl < n && nr < n) {
+        const float pl = (at - lo) / (hi - lo);
+        best = Split{axis, at, kTraversalCost + pl * float(nl) + (1 - pl) * float(nr)};
         break;
       }
     }
   }
   if (!best || best->cost >= float(n)) return make_leaf();
   const int axis = best->axis;
-  const float split = best->at;
-  const size_t nl = best->nl, nr = best->nr;
-
-  std::vector<uint32_t> left, right;
-  left.reserve(nl);
-  right.reserve(nr);
-  for (uint32_t i : ids) {
-    const SphereRef& s = spheres[i];
-    if (s.c[axis] - s.r < split) left.push_back(i);
-    if (s.c[axis] + s.r >= split) right.push_back(i);
-  }
+  const float at = best->at;
+  if (!large) split(axis, at);
   std::vector<uint32_t>().swap(ids);
+  auto clip = [](Bounds3 c, const Bounds3& b) {
+    c.lo = vmax(c.lo, b.lo);
+    c.hi = vmin(c.hi, b.hi);
+    return c;
+  };
   Bounds3 lcell = cell, rcell = cell;
-  lcell.hi[axis] = split;
-  rcell.lo[axis] = split;
+  lcell.hi[axis] = at;
+  rcell.lo[axis] = at;
+  lcell = clip(lcell, lbounds);
+  rcell = clip(rcell, rbounds);
   uint32_t right_index;
   if (n >= kParallelMin) {
     // Both halves as subtrees of their own, appended in the order the serial build lays them out:
@@ -142,7 +172,7 @@ void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int dept
     right_index = uint32_t(nodes_.size());
     build_node(right, rcell, depth + 1, spheres);
   }
-  nodes_[self] = {split, uint32_t(axis), right_index, 0};
+  nodes_[self] = {at, uint32_t(axis), right_index, 0};
 }
 
 void SphereKdTree::append(const SphereKdTree& sub) {

@@ -86,6 +86,7 @@ class SphereKdTree {
   };
   void build_node(std::vector<uint32_t>& ids, Bounds3 cell, int depth,
                   const std::vector<SphereRef>& spheres);
+  static Bounds3 extent(const SphereRef& s);  // the sphere's bounding box
   // Appends a subtree built on its own (its node and item indices shifted).
   void append(const SphereKdTree& sub);
   std::vector<Node> nodes_;
