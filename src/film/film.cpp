@@ -1,10 +1,44 @@
 #include "film/film.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
 namespace bpm {
 namespace {
+
+// Calls f(i) for every pixel i, in parallel.
+template <class F>
+void for_pixels(size_t n, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i < r.end(); ++i) f(i);
+                    });
+}
+
+// The sums over pixels of f(i) (a pair), block by block in parallel and then over the blocks in
+// order: the same bits for any thread count.
+template <class F>
+std::pair<double, double> sum_over_pixels(size_t n, F&& f) {
+  constexpr size_t kBlock = 4096;
+  const size_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::pair<double, double>> partial(blocks, {0.0, 0.0});
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    for (size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
+      const auto [x, y] = f(i);
+      partial[b].first += x;
+      partial[b].second += y;
+    }
+  });
+  std::pair<double, double> total{0.0, 0.0};
+  for (const auto& [x, y] : partial) {
+    total.first += x;
+    total.second += y;
+  }
+  return total;
+}
 
 // eq. (5): RMS^2 = (1/N) (mean(L^2) - mean(L)^2), with Bessel's correction: the standard error of
 // the mean of N pass estimates whose sum and sum of squares are given.
@@ -31,43 +65,44 @@ Image Film::image(float scale) const {
   img.width = width_;
   img.height = height_;
   img.rgb.resize(pixels_.size() * 3);
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  for_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
     for (int c = 0; c < 3; ++c)
       img.rgb[3 * i + c] = p.sum_w != 0 ? float(scale * p.sum_wl[c] / p.sum_w) : 0.0f;
-  }
+  });
   return img;
 }
 
 std::vector<float> Film::rms_rgb() const {
   std::vector<float> out(pixels_.size() * 3, 0.0f);
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  for_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
     for (int c = 0; c < 3; ++c) out[3 * i + c] = standard_error(p.sum_e[c], p.sum_e2[c], p.passes);
-  }
+  });
   return out;
 }
 
 std::vector<float> Film::rms() const {
   std::vector<float> out(pixels_.size(), 0.0f);
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  for_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
     out[i] = standard_error(p.sum_y, p.sum_y2, p.passes);
-  }
+  });
   return out;
 }
 
 double Film::delta_rgb(const std::vector<float>& r) const {
-  double num = 0, den = 0;
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  const auto [num, den] = sum_over_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
-    if (p.passes == 0) continue;
-    for (int c = 0; c < 3; ++c) {
-      double mean = p.sum_e[c] / p.passes;
-      num += double(r[3 * i + c]) * r[3 * i + c];
-      den += mean * mean;
-    }
-  }
+    double n = 0, d = 0;
+    if (p.passes > 0)
+      for (int c = 0; c < 3; ++c) {
+        double mean = p.sum_e[c] / p.passes;
+        n += double(r[3 * i + c]) * r[3 * i + c];
+        d += mean * mean;
+      }
+    return std::pair{n, d};
+  });
   return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
 }
 
@@ -101,32 +136,34 @@ std::vector<float> Film::bias_standard_error_rgb() const {
 
 std::vector<float> Film::total_rms_rgb() const {
   std::vector<float> out = rms_rgb();
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  for_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
-    if (p.bias_passes == 0) continue;
+    if (p.bias_passes == 0) return;
     for (int c = 0; c < 3; ++c) {
       double b = p.sum_b[c] / p.bias_passes;
       double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
       double rms = out[3 * i + c];
       out[3 * i + c] = float(std::sqrt(rms * rms + std::fmax(0.0, b * b - se * se)));
     }
-  }
+  });
   return out;
 }
 
 double Film::relative_error_bias() const {
-  double num = 0, den = 0;
-  for (const Pixel& p : pixels_) {
-    if (p.passes == 0) continue;
-    for (int c = 0; c < 3; ++c) {
-      double mean = p.sum_e[c] / p.passes;
-      den += mean * mean;
-      if (p.bias_passes == 0) continue;
-      double b = p.sum_b[c] / p.bias_passes;
-      double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
-      num += b * b - se * se;
-    }
-  }
+  const auto [num, den] = sum_over_pixels(pixels_.size(), [&](size_t i) {
+    const Pixel& p = pixels_[i];
+    double n = 0, d = 0;
+    if (p.passes > 0)
+      for (int c = 0; c < 3; ++c) {
+        double mean = p.sum_e[c] / p.passes;
+        d += mean * mean;
+        if (p.bias_passes == 0) continue;
+        double b = p.sum_b[c] / p.bias_passes;
+        double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
+        n += b * b - se * se;
+      }
+    return std::pair{n, d};
+  });
   return den > 0 && num > 0 ? std::sqrt(num / den) : 0;
 }
 
@@ -167,12 +204,12 @@ float m_images_error(const int* count, int m, Value&& value) {
 std::vector<float> Film::rms_m_images_rgb() const {
   std::vector<float> out(pixels_.size() * 3, 0.0f);
   if (m_ == 0) return out;
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  for_pixels(pixels_.size(), [&](size_t i) {
     const int* count = &m_count_[i * size_t(m_)];
     for (int c = 0; c < 3; ++c)
       out[3 * i + c] =
           m_images_error(count, m_, [&](int k) { return m_sum_[3 * (i * m_ + k) + c] / count[k]; });
-  }
+  });
   return out;
 }
 
@@ -206,7 +243,7 @@ uint64_t Film::dropped_samples() const {
 
 std::vector<int> Film::lit_pass_counts() const {
   std::vector<int> out(pixels_.size());
-  for (size_t i = 0; i < pixels_.size(); ++i) out[i] = pixels_[i].lit_passes;
+  for_pixels(pixels_.size(), [&](size_t i) { out[i] = pixels_[i].lit_passes; });
   return out;
 }
 

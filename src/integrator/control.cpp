@@ -1,5 +1,7 @@
 #include "integrator/control.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -73,8 +75,7 @@ void RenderControl::update_probabilities() {
   // brightness), with a small share of the image's mean added to the denominator so that black
   // pixels (rms 0 / mean 0) are not declared infinitely noisy.
   std::vector<double> value(n), error(n);
-  double image_mean = 0;
-  for (size_t i = 0; i < n; ++i) {
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
     double v2 = 0, e2 = 0;
     for (int c = 0; c < 3; ++c) {
       v2 += double(img.rgb[3 * i + c]) * img.rgb[3 * i + c];
@@ -82,10 +83,13 @@ void RenderControl::update_probabilities() {
     }
     value[i] = std::sqrt(v2);
     error[i] = std::sqrt(e2);
-    image_mean += value[i] / double(n);
-  }
+  });
+  double image_mean = 0;
+  for (size_t i = 0; i < n; ++i) image_mean += value[i] / double(n);
   std::vector<float> rel(n);
-  for (size_t i = 0; i < n; ++i) rel[i] = float(error[i] / (value[i] + 0.01 * image_mean + 1e-12));
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    rel[i] = float(error[i] / (value[i] + 0.01 * image_mean + 1e-12));
+  });
   // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
   std::vector<float> sorted = rel;
   size_t k = std::min(n - 1, size_t(0.9 * double(n)));
@@ -96,9 +100,10 @@ void RenderControl::update_probabilities() {
   // would leave it black far longer (unbiased, but heavily skewed), so it is sampled every pass.
   const std::vector<int> lit = film_.lit_pass_counts();
   probability_.resize(n);
-  for (size_t i = 0; i < n; ++i)
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
     probability_[i] =
         ref > 0 && lit[i] > 0 ? std::clamp(rel[i] / ref, opt_.adaptive_floor, 1.0f) : 1.0f;
+  });
 }
 
 void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra) {
