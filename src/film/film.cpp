@@ -91,19 +91,31 @@ std::vector<float> Film::rms() const {
   return out;
 }
 
-double Film::delta_rgb(const std::vector<float>& r) const {
-  const auto [num, den] = sum_over_pixels(pixels_.size(), [&](size_t i) {
-    const Pixel& p = pixels_[i];
+namespace {
+
+// sqrt(sum of term(i, c) / sum of mean_ic^2) over the channels c of the pixels i that have passes
+// (eq. 4 with term = RMS_ic^2); 0 where either sum is not positive.
+template <class Pixels, class Term>
+double relative_to_means(const Pixels& pixels, Term&& term) {
+  const auto [num, den] = sum_over_pixels(pixels.size(), [&](size_t i) {
+    const auto& p = pixels[i];
     double n = 0, d = 0;
     if (p.passes > 0)
       for (int c = 0; c < 3; ++c) {
-        double mean = p.sum_e[c] / p.passes;
-        n += double(r[3 * i + c]) * r[3 * i + c];
+        const double mean = p.sum_e[c] / p.passes;
         d += mean * mean;
+        n += term(i, c);
       }
     return std::pair{n, d};
   });
-  return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
+  return den > 0 && num > 0 ? std::sqrt(num / den) : 0;
+}
+
+}  // namespace
+
+double Film::delta_rgb(const std::vector<float>& r) const {
+  return relative_to_means(pixels_,
+                           [&](size_t i, int c) { return double(r[3 * i + c]) * r[3 * i + c]; });
 }
 
 double Film::relative_error() const { return delta_rgb(rms_rgb()); }
@@ -150,21 +162,13 @@ std::vector<float> Film::total_rms_rgb() const {
 }
 
 double Film::relative_error_bias() const {
-  const auto [num, den] = sum_over_pixels(pixels_.size(), [&](size_t i) {
+  return relative_to_means(pixels_, [&](size_t i, int c) {
     const Pixel& p = pixels_[i];
-    double n = 0, d = 0;
-    if (p.passes > 0)
-      for (int c = 0; c < 3; ++c) {
-        double mean = p.sum_e[c] / p.passes;
-        d += mean * mean;
-        if (p.bias_passes == 0) continue;
-        double b = p.sum_b[c] / p.bias_passes;
-        double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
-        n += b * b - se * se;
-      }
-    return std::pair{n, d};
+    if (p.bias_passes == 0) return 0.0;
+    const double b = p.sum_b[c] / p.bias_passes;
+    const double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
+    return b * b - se * se;
   });
-  return den > 0 && num > 0 ? std::sqrt(num / den) : 0;
 }
 
 double Film::relative_error_total() const {
