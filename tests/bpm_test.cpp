@@ -1101,6 +1101,27 @@ TEST(Bpm, BiasEstimateMatchesTheAnalyticCurvature) {
   EXPECT_LT(4 * patch_sigma(sum_drms), std::fabs(true_bias)) << "too noisy to tell it is gone";
 }
 
+// At a resolution whose backward photons outnumber the smallest group's hits, the groups grow with
+// them (group_size) and the photons per iteration with the pixels (photons_for): still the same
+// image and counts for 1 and 3 threads.
+TEST(Bpm, LargerGroupsAtHigherResolutionDoNotDependOnTheThreads) {
+  LoadedScene ls = load(caustic_scene());
+  ls.film.width = 320;
+  ls.film.height = 300;  // 96000 pixels, two backward photons each where the floor is seen
+  RenderRun one = render_with(ls, "bpm", 1, 1, 4);
+  const nlohmann::json& d = one.stats.details;
+  const uint64_t backward = d["eye"]["backward_photons"].get<uint64_t>();
+  const GroupSize group = group_size(backward);
+  ASSERT_GT(group.photons, group_size(0).photons) << backward << " backward photons";
+  const uint64_t photons = d["light"]["photons_kept"].get<uint64_t>();
+  EXPECT_EQ(photons, uint64_t(photons_for(PhotonSettings(), 96000)));
+  EXPECT_GE(d["light"]["batches"].get<uint64_t>(), (photons + group.photons - 1) / group.photons);
+  RenderRun three = render_with(ls, "bpm", 1, 3, 4);
+  EXPECT_EQ(three.film.image().rgb, one.film.image().rgb);
+  EXPECT_EQ(three.stats.details["light"]["entries"], d["light"]["entries"]);
+  EXPECT_EQ(three.stats.details["light"]["batches"], d["light"]["batches"]);
+}
+
 // A memory budget: too small for the film and one iteration's backward photons, the render stops
 // before it starts with an error that names the budget; just large enough, the light pass applies
 // the entries of its groups of photons in more rounds, and the image is exactly the unlimited one
