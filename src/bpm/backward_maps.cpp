@@ -140,21 +140,20 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
       spheres_of[c].reserve(n);
       ids_of[c].reserve(n);
     }
+    constexpr uint8_t kAcceptsOf[2] = {kAcceptsCaustic, kAcceptsIndirect};
     for (size_t k = 0; k < n; ++k) {
       const BackwardPhoton& bp = dst[k];
       for (int c = 0; c < 2; ++c)
-        if (bp.accepts & (c == 0 ? kAcceptsCaustic : kAcceptsIndirect)) {
+        if (bp.accepts & kAcceptsOf[c]) {
           spheres_of[c].push_back({bp.p, bp.radius});
           ids_of[c].push_back(maps->object_begin[o] + uint32_t(k));
         }
     }
     for (int c = 0; c < 2; ++c) {
-      const std::vector<SphereRef>& spheres = spheres_of[c];
-      const std::vector<uint32_t>& ids = ids_of[c];
       if (centre_tree)
-        maps->centre_trees[2 * o + c].build(spheres, &ids);
+        maps->centre_trees[2 * o + c].build(spheres_of[c], &ids_of[c]);
       else
-        maps->sphere_trees[2 * o + c].build(spheres, &ids);
+        maps->sphere_trees[2 * o + c].build(spheres_of[c], &ids_of[c]);
     }
   };
   // The queue: each worker takes the largest object not yet taken.

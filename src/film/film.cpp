@@ -18,28 +18,6 @@ void for_pixels(size_t n, F&& f) {
                     });
 }
 
-// The sums over pixels of f(i) (a pair), block by block in parallel and then over the blocks in
-// order: the same bits for any thread count.
-template <class F>
-std::pair<double, double> sum_over_pixels(size_t n, F&& f) {
-  constexpr size_t kBlock = 4096;
-  const size_t blocks = (n + kBlock - 1) / kBlock;
-  std::vector<std::pair<double, double>> partial(blocks, {0.0, 0.0});
-  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-    for (size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
-      const auto [x, y] = f(i);
-      partial[b].first += x;
-      partial[b].second += y;
-    }
-  });
-  std::pair<double, double> total{0.0, 0.0};
-  for (const auto& [x, y] : partial) {
-    total.first += x;
-    total.second += y;
-  }
-  return total;
-}
-
 // eq. (5): RMS^2 = (1/N) (mean(L^2) - mean(L)^2), with Bessel's correction: the standard error of
 // the mean of N pass estimates whose sum and sum of squares are given.
 float standard_error(double sum, double sum2, int passes) {
@@ -94,21 +72,30 @@ std::vector<float> Film::rms() const {
 namespace {
 
 // sqrt(sum of term(i, c) / sum of mean_ic^2) over the channels c of the pixels i that have passes
-// (eq. 4 with term = RMS_ic^2); 0 where either sum is not positive.
+// (eq. 4 with term = RMS_ic^2); 0 where either sum is not positive. Summed by fixed blocks of
+// pixels in parallel, then over the blocks in order: the same bits for any thread count.
 template <class Pixels, class Term>
 double relative_to_means(const Pixels& pixels, Term&& term) {
-  const auto [num, den] = sum_over_pixels(pixels.size(), [&](size_t i) {
-    const auto& p = pixels[i];
-    double n = 0, d = 0;
-    if (p.passes > 0)
+  constexpr size_t kBlock = 4096;
+  const size_t n = pixels.size(), blocks = (n + kBlock - 1) / kBlock;
+  std::vector<double> num(blocks, 0.0), den(blocks, 0.0);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    for (size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) {
+      const auto& p = pixels[i];
+      if (p.passes == 0) continue;
       for (int c = 0; c < 3; ++c) {
         const double mean = p.sum_e[c] / p.passes;
-        d += mean * mean;
-        n += term(i, c);
+        den[b] += mean * mean;
+        num[b] += term(i, c);
       }
-    return std::pair{n, d};
+    }
   });
-  return den > 0 && num > 0 ? std::sqrt(num / den) : 0;
+  double total_num = 0, total_den = 0;
+  for (size_t b = 0; b < blocks; ++b) {
+    total_num += num[b];
+    total_den += den[b];
+  }
+  return total_den > 0 && total_num > 0 ? std::sqrt(total_num / total_den) : 0;
 }
 
 }  // namespace
