@@ -3,6 +3,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
+#include "base/error.h"
 #include "integrator/progressive.h"
 #include "photons/density.h"
 
@@ -13,29 +16,62 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates) {
   const int w = film->width(), h = film->height();
-  std::vector<Spectrum>& photon_L = sums->photon_L;
-  std::vector<Spectrum>& bias = sums->bias;
-  photon_L.assign(size_t(w) * size_t(h), Spectrum());
-  bias.assign(size_t(w) * size_t(h), Spectrum());
-  for (size_t g = 0; g < maps.photons.size(); ++g) {
-    const BackwardPhoton& bp = maps.photons[g];
-    if (!light.reached[g] || light.flux[g].is_black()) continue;
-    // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
-    const float norm = float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
-    const NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
-    photon_L[bp.pixel] += bp.tau * nested.all * norm;
-    bias[bp.pixel] += bp.tau * radius_bias(nested, norm, settings.bias_model);
-  }
+  // Each backward photon that received light: its share of its pixel's estimate and bias, and its
+  // place among its pixel's, in parallel over the photons in the maps' order; each pixel then adds
+  // its shares in that order.
+  const size_t places = size_t(sums->places);
+  BPM_CHECK(places >= 1 && places <= 8);
+  std::vector<uint32_t>& at = sums->photons;
+  at.resize(size_t(w) * size_t(h) * places);
+  sums->shares.resize(maps.photons.size());
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, at.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+        std::fill(at.begin() + long(r.begin()), at.begin() + long(r.end()), PixelSums::kNone);
+      });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, maps.photons.size(), 1 << 12),
+      [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t g = r.begin(); g < r.end(); ++g) {
+          if (!light.reached[g] || light.flux[g].is_black()) continue;
+          const BackwardPhoton& bp = maps.photons[g];
+          // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
+          const float norm =
+              float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
+          const NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
+          sums->shares[g] = {bp.tau * nested.all * norm,
+                             bp.tau * radius_bias(nested, norm, settings.bias_model)};
+          const size_t place = size_t(backward_photon_place(bp));
+          BPM_CHECK(place < places);
+          uint32_t& slot = at[size_t(bp.pixel) * places + place];
+          BPM_CHECK(slot == PixelSums::kNone);
+          slot = uint32_t(g);
+        }
+      });
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y)
       for (int x = 0; x < w; ++x) {
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
-        Spectrum L = eye.radiance[p] + photon_L[p];
+        // In the maps' order (an insertion sort of a few).
+        uint32_t found[8];
+        size_t n = 0;
+        for (size_t k = 0; k < places; ++k) {
+          const uint32_t g = at[p * places + k];
+          if (g == PixelSums::kNone) continue;
+          size_t i = n++;
+          for (; i > 0 && found[i - 1] > g; --i) found[i] = found[i - 1];
+          found[i] = g;
+        }
+        Spectrum photon_L, bias;
+        for (size_t k = 0; k < n; ++k) {
+          photon_L += sums->shares[found[k]].L;
+          bias += sums->shares[found[k]].bias;
+        }
+        Spectrum L = eye.radiance[p] + photon_L;
         if (settings.debias)
-          L -= bias[p];
-        else if (bias[p].is_finite() && eye.filter_weight[p] != 0 && recordable(L))
-          film->add_bias(x, y, spectrum_to_rgb(bias[p], wl));
+          L -= bias;
+        else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))
+          film->add_bias(x, y, spectrum_to_rgb(bias, wl));
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
         if (estimates && L.is_finite()) {
           (*estimates)[2 * size_t(p)] += L.average();

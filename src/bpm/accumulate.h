@@ -18,11 +18,25 @@ namespace bpm {
 // (radius_bias under bias_model) goes to the film beside its estimate, or with `debias` is taken
 // from it. When `estimates` is given (2 per pixel), each sampled pixel's estimate (the mean over
 // its wavelengths) is added to its first and 1 to its second.
-// `sums` holds the per-pixel sums in between (kept from one iteration to the next, so that their
-// memory is allocated once).
+// `sums` holds, per pixel, its backward photons that received light (kept from one iteration to
+// the next, so that its memory is allocated once): `places` of them per pixel at most (one per
+// backward_photon_place), the diffuse depth plus 2.
 struct PixelSums {
-  std::vector<Spectrum> photon_L, bias;
+  static constexpr uint32_t kNone = ~0u;
+  int places = 0;
+  std::vector<uint32_t> photons;  // pixel * places + backward_photon_place(bp): g, or kNone
+  struct Share {
+    Spectrum L, bias;
+  };
+  std::vector<Share> shares;  // per backward photon g that received light: its part of the pixel's
 };
+
+// Where a backward photon sits among its pixel's: one per diffuse vertex, and the second of the
+// two a vertex stores when it splits the radii (the indirect one). Unique within a pixel.
+inline int backward_photon_place(const BackwardPhoton& bp) {
+  return bp.diffuse_index + (bp.accepts == kAcceptsIndirect ? 1 : 0);
+}
+
 void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,

@@ -52,16 +52,15 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
     if (count[p]) (*weight)[p] = float(1 / (std::max(0.0, sum[p] / count[p]) + floor));
 }
 
-// Memory (base/memory.h). Per pixel, what the eye pass, the masks, the emission guide and the
-// accumulation's sums keep.
+// Memory (base/memory.h). Per pixel, what the eye pass, the masks and the emission guide keep.
 constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
-                               sizeof(double) + sizeof(uint32_t) + sizeof(float) +
-                               sizeof(uint16_t) + 2 * sizeof(Spectrum);
+                               sizeof(double) + sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
 // Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
-// inner quarter) and hit flag, and its references in the two trees (about two per tree where
-// spheres overlap cells).
+// inner quarter) and hit flag, its references in the two trees (about two per tree where spheres
+// overlap cells), and its place among its pixel's for the accumulation (PixelSums).
 constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 3 * sizeof(Spectrum) + 1 +
-                                        4 * (sizeof(SphereRef) + sizeof(uint32_t));
+                                        4 * (sizeof(SphereRef) + sizeof(uint32_t)) +
+                                        sizeof(uint32_t);
 
 // What an iteration's maps take once built, with the light pass's per-photon arrays.
 double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
@@ -95,6 +94,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   LightPassBuffers light;
   LightPassResult light_result;  // of the last light pass; its arrays are reused
   PixelSums pixel_sums;
+  pixel_sums.places = s.diffuse_depth + 2;
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
   light.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);

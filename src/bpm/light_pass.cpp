@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
@@ -346,31 +347,45 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
         for (auto& by_slot : buf->chunks)
           for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
     } while (done < n_gather);
-    if (guide && prm.pixel_weight)
+    if (guide && prm.pixel_weight) {
       // Each photon's score is the sum of its hits', in the order of its path, as if it had been
-      // emitted without guidance (weight removed).
-      for (int c = 0; c < tr.chunks; ++c) {
+      // emitted without guidance (weight removed); the guide learns them in photon order.
+      if (buf->scores.size() < size_t(tr.chunks)) buf->scores.resize(size_t(tr.chunks));
+      tbb::parallel_for(0, tr.chunks, [&](int c) {
         const std::vector<PendingHit>& hits = buf->hits[size_t(c)];
         const std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
-        buf->scores.clear();
+        std::vector<CellScore>& scores = buf->scores[size_t(c)];
+        scores.clear();
         size_t j = 0;
         for (uint32_t p = 0; p < uint32_t(emitted.size()); ++p) {
           float score = 0;
           for (; j < hits.size() && hits[j].photon == p; ++j) score += hits[j].score;
-          buf->scores.push_back(
+          scores.push_back(
               {emitted[p].cell, emitted[p].weight > 0 ? score / emitted[p].weight : 0});
         }
-        guide->learn(buf->scores);
-      }
+      });
+      for (int c = 0; c < tr.chunks; ++c) guide->learn(buf->scores[size_t(c)]);
+    }
     res.apply_s += seconds_since(t);
     if (res.cut) break;
   }
-  size_t n_indirect = 0, covered = 0;
-  for (size_t g = 0; g < n_bp; ++g)
-    if (maps.photons[g].accepts & kAcceptsIndirect) {
-      ++n_indirect;
-      covered += res.reached[g];
-    }
+  struct Coverage {
+    size_t indirect = 0, covered = 0;
+  };
+  const Coverage cov = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, n_bp, 1 << 14), Coverage{},
+      [&](const tbb::blocked_range<size_t>& r, Coverage c) {
+        for (size_t g = r.begin(); g < r.end(); ++g)
+          if (maps.photons[g].accepts & kAcceptsIndirect) {
+            ++c.indirect;
+            c.covered += res.reached[g];
+          }
+        return c;
+      },
+      [](Coverage a, const Coverage& b) {
+        return Coverage{a.indirect + b.indirect, a.covered + b.covered};
+      });
+  const size_t n_indirect = cov.indirect, covered = cov.covered;
   res.coverage = n_indirect ? double(covered) / double(n_indirect) : 1.0;
 }
 

@@ -81,14 +81,14 @@ struct EmittedPhoton {
 
 // What the light pass keeps between iterations (so that their memory is allocated once): per
 // chunk of a group's photons their hits and emissions, the hits in gather order, per gather chunk
-// the entry lists, the photon scores of a chunk, and the per-thread counters.
+// the entry lists, per chunk its photons' scores, and the per-thread counters.
 struct LightPassBuffers {
   std::vector<std::vector<PendingHit>> hits;        // [chunk]
   std::vector<std::vector<EmittedPhoton>> emitted;  // [chunk]
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
-  std::vector<CellScore> scores;
+  std::vector<std::vector<CellScore>> scores;                 // per chunk
   std::vector<LightCounters> chunk_counters;  // [chunk]: added to counters for the chunks kept
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
