@@ -40,11 +40,13 @@ size_t gather_in_space(const std::vector<ObjectPhotonLists*>& per_thread, uint32
     return size > 0 ? uint32_t(std::clamp((x - lo) / size * 1024.0f, 0.0f, 1023.0f)) : 0u;
   };
   // Each photon as its code (high half) and its place in src (low half), sorted by code with
-  // three passes of a radix sort (10 bits each), then each run of one code by key().
+  // three passes of a radix sort (10 bits each), then each run of one code by key() (kept beside
+  // the codes: the records lie far apart).
   std::vector<const BackwardPhoton*> src;
-  std::vector<uint64_t> items, sorted(n);
+  std::vector<uint64_t> items, sorted(n), keys;
   src.reserve(n);
   items.reserve(n);
+  keys.reserve(n);
   for (const ObjectPhotonLists* l : per_thread)
     if (o < l->size())
       for (const BackwardPhoton& bp : (*l)[o]) {
@@ -53,6 +55,7 @@ size_t gather_in_space(const std::vector<ObjectPhotonLists*>& per_thread, uint32
                               spread_bits(cell(bp.p.z, b.lo.z, extent.z)) << 2;
         items.push_back(uint64_t(code) << 32 | src.size());
         src.push_back(&bp);
+        keys.push_back(bp.key());
       }
   for (int shift = 32; shift < 62; shift += 10) {
     uint32_t start[1025] = {};
@@ -66,7 +69,7 @@ size_t gather_in_space(const std::vector<ObjectPhotonLists*>& per_thread, uint32
     for (j = i + 1; j < n && items[j] >> 32 == items[i] >> 32;) ++j;
     if (j - i > 1)
       std::sort(items.begin() + long(i), items.begin() + long(j),
-                [&](uint64_t a, uint64_t c) { return photon(a)->key() < photon(c)->key(); });
+                [&](uint64_t a, uint64_t c) { return keys[uint32_t(a)] < keys[uint32_t(c)]; });
   }
   // The records are read out of order: fetched a few ahead.
   constexpr size_t kAhead = 8;
