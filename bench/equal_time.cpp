@@ -5,8 +5,9 @@
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
 //              [--integrators path,bpm,fpm] [--references-only]
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
-// (references by bpm), lamp-room and the Cornell box (../shared's at 256x256 when present, else
-// ours; references by path). scenes/tools/make_equal_time_scenes.py writes the last three of ours.
+// (references by bpm), lamp-room, room2 and the Cornell box (../shared's at 256x256 when present,
+// else ours; references by path). scenes/tools/make_equal_time_scenes.py writes spot-facets,
+// water-box and lamp-room.
 //
 // Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
 // loaded). pbrt-v4 (its path, bdpt and sppm), when ../shared/tools/pbrt-v4/pbrt or --pbrt is there,
@@ -60,6 +61,7 @@ std::vector<SceneEntry> default_scenes() {
       {"spot-facets", ours + "spot-facets.pbrt", "bpm"},
       {"water-box", ours + "water-box.pbrt", "bpm"},
       {"lamp-room", ours + "lamp-room.pbrt", "path"},
+      {"room2", ours + "room2.pbrt", "path"},
   };
   if (fs::exists(shared_cornell))
     s.push_back({"cornell-box", shared_cornell.lexically_normal().string(), "path", "256x256"});
