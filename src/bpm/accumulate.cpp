@@ -21,7 +21,7 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
   // its shares in that order.
   const size_t places = size_t(sums->places);
   BPM_CHECK(places >= 1 && places <= 8);
-  std::vector<uint32_t>& at = sums->photons;
+  std::vector<uint32_t>& at = sums->by_place;
   at.resize(size_t(w) * size_t(h) * places);
   sums->shares.resize(maps.photons.size());
   tbb::parallel_for(

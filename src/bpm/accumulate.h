@@ -24,11 +24,12 @@ namespace bpm {
 struct PixelSums {
   static constexpr uint32_t kNone = ~0u;
   int places = 0;
-  std::vector<uint32_t> photons;  // pixel * places + backward_photon_place(bp): g, or kNone
+  std::vector<uint32_t> by_place;  // [pixel * places + backward_photon_place(bp)]: g, or kNone
+  // Per backward photon g that received light, its parts of its pixel's estimate and bias.
   struct Share {
     Spectrum L, bias;
   };
-  std::vector<Share> shares;  // per backward photon g that received light: its part of the pixel's
+  std::vector<Share> shares;
 };
 
 // Where a backward photon sits among its pixel's: one per diffuse vertex, and the second of the
