@@ -11,19 +11,19 @@
 
 namespace bpm {
 
-void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
+void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates) {
   const int w = film->width(), h = film->height();
-  // Each backward photon that received light: its share of its pixel's estimate and bias, and its
-  // place among its pixel's, in parallel over the photons in the maps' order; each pixel then adds
-  // its shares in that order.
+  LightPassResult& light = *light_sums;
+  // Each backward photon that received light: its shares of its pixel's estimate and bias (in place
+  // of its sums, whose cache lines are at hand), and its place among its pixel's, in parallel over
+  // the photons in the maps' order; each pixel then adds its shares in that order.
   const size_t places = size_t(sums->places);
   BPM_CHECK(places >= 1 && places <= 8);
   std::vector<uint32_t>& at = sums->by_place;
   at.resize(size_t(w) * size_t(h) * places);
-  sums->shares.resize(maps.photons.size());
   tbb::parallel_for(
       tbb::blocked_range<size_t>(0, at.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
         std::fill(at.begin() + long(r.begin()), at.begin() + long(r.end()), PixelSums::kNone);
@@ -38,8 +38,10 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
           const float norm =
               float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
           const NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
-          sums->shares[g] = {bp.tau * nested.all * norm,
-                             bp.tau * radius_bias(nested, norm, settings.bias_model)};
+          const Spectrum share = bp.tau * nested.all * norm,
+                         bias = bp.tau * radius_bias(nested, norm, settings.bias_model);
+          light.flux[g] = share;
+          light.flux_inner[g] = bias;
           const size_t place = size_t(backward_photon_place(bp));
           BPM_CHECK(place < places);
           uint32_t& slot = at[size_t(bp.pixel) * places + place];
@@ -64,8 +66,8 @@ void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light
         }
         Spectrum photon_L, bias;
         for (size_t k = 0; k < n; ++k) {
-          photon_L += sums->shares[found[k]].L;
-          bias += sums->shares[found[k]].bias;
+          photon_L += light.flux[found[k]];
+          bias += light.flux_inner[found[k]];
         }
         Spectrum L = eye.radiance[p] + photon_L;
         if (settings.debias)

@@ -12,12 +12,16 @@
 
 namespace bpm {
 
-// light.flux[g]: the summed contributions backward photon g received from light.emitted photons
-// (where light.reached[g]);
-// with those from the inner discs, each pixel's bias estimate of the pass over its photon part
-// (radius_bias under bias_model) goes to the film beside its estimate, or with `debias` is taken
-// from it. When `estimates` is given (2 per pixel), each sampled pixel's estimate (the mean over
-// its wavelengths) is added to its first and 1 to its second.
+// light_sums->flux[g]: the summed contributions backward photon g received from the pass's
+// `emitted` photons (where reached[g]); with those from the inner discs, each pixel's bias estimate
+// of the pass over its photon part (radius_bias under bias_model) goes to the film beside its
+// estimate, or with `debias` is taken from it. When `estimates` is given (2 per pixel), each
+// sampled pixel's estimate (the mean over its wavelengths) is added to its first and 1 to its
+// second.
+//
+// The light pass's sums are used up: afterwards flux[g] and flux_inner[g] hold backward photon g's
+// parts of its pixel's estimate and bias (its shares), where it received light.
+//
 // `sums` holds, per pixel, its backward photons that received light (kept from one iteration to
 // the next, so that its memory is allocated once): `places` of them per pixel at most (one per
 // backward_photon_place), the diffuse depth plus 2.
@@ -25,11 +29,6 @@ struct PixelSums {
   static constexpr uint32_t kNone = ~0u;
   int places = 0;
   std::vector<uint32_t> by_place;  // [pixel * places + backward_photon_place(bp)]: g, or kNone
-  // Per backward photon g that received light, its parts of its pixel's estimate and bias.
-  struct Share {
-    Spectrum L, bias;
-  };
-  std::vector<Share> shares;
 };
 
 // Where a backward photon sits among its pixel's: one per diffuse vertex, and the second of the
@@ -38,7 +37,7 @@ inline int backward_photon_place(const BackwardPhoton& bp) {
   return bp.diffuse_index + (bp.accepts == kAcceptsIndirect ? 1 : 0);
 }
 
-void accumulate_iteration(const BackwardMaps& maps, const LightPassResult& light,
+void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                           const EyePixels& eye, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates = nullptr);

@@ -57,18 +57,17 @@ constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof
                                sizeof(double) + sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
 // Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
 // inner quarter) and hit flag, its references in the two trees (about two per tree where spheres
-// overlap cells), and its share of its pixel and place among its pixel's for the accumulation.
+// overlap cells), and its place among its pixel's for the accumulation.
 constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 3 * sizeof(Spectrum) + 1 +
                                         4 * (sizeof(SphereRef) + sizeof(uint32_t)) +
-                                        sizeof(PixelSums::Share) + sizeof(uint32_t);
+                                        sizeof(uint32_t);
 
-// What an iteration's maps take once built, with the light pass's per-photon arrays and the
-// accumulation's shares.
+// What an iteration's maps take once built, with the light pass's per-photon arrays.
 double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
   return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
                 maps.first_bucket.capacity() * sizeof(uint32_t) +
                 size_t(maps.bucket_count() + 1) * sizeof(uint32_t) +
-                maps.photons.size() * (3 * sizeof(Spectrum) + 1 + sizeof(PixelSums::Share)) +
+                maps.photons.size() * (3 * sizeof(Spectrum) + 1) +
                 lp.photon_materials.capacity() * sizeof(Material));
 }
 
@@ -198,7 +197,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
-    accumulate_iteration(maps, light_result, eye, wm.wl, ls.film.max_component_value, s, film,
+    accumulate_iteration(maps, &light_result, eye, wm.wl, ls.film.max_component_value, s, film,
                          &pixel_sums, guide.empty() ? nullptr : &estimate_new);
     tot.accumulate_s += since(t);
     masks.rebuild(eye.cost_ns);
