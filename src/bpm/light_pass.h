@@ -88,7 +88,7 @@ struct LightPassBuffers {
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
-  std::vector<std::vector<CellScore>> scores;                 // per chunk
+  std::vector<std::vector<CellScore>> scores;                 // [chunk]
   std::vector<LightCounters> chunk_counters;  // [chunk]: added to counters for the chunks kept
   tbb::enumerable_thread_specific<LightCounters> counters;
 };
