@@ -485,6 +485,25 @@ TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
   expect_bpm_converges(ls, render_with(ls, "path", 2048).film, 3);
 }
 
+// Without the disc probes, every backward photon near a wall or an edge of the box divides the
+// photons it finds by its whole disc, of which a part lies past the wall: the image is darker
+// than path's by a share that grows with the radius (here k1 = 3 pixels of 32). With them its
+// mean agrees with path's, except for the small excess of 1 / share over a share's inverse.
+TEST(Bpm, DiscProbesRemoveTheDeficitAtWallsAndEdges) {
+  LoadedScene ls = load(cornell());
+  const Film ref = render_with(ls, "path", 4096).film;
+  const BlockStats path = block_stats(ref, ls.film.width)[0];
+  BpmSettings s = small_batches(0);
+  const BlockStats probed = image_mean(render_seeds(ls, 8, 24, s));
+  s.disc_probes = false;
+  const BlockStats whole = image_mean(render_seeds(ls, 8, 24, s));
+  const double sigma = std::sqrt(probed.var + path.var);
+  std::printf("image mean / path's: %.4f with the probes, %.4f without (sigma %.4f)\n",
+              probed.mean / path.mean, whole.mean / path.mean, sigma / path.mean);
+  EXPECT_NEAR(probed.mean, path.mean, 4.5 * sigma + 0.003 * path.mean);
+  EXPECT_LT(whole.mean, path.mean - 4.5 * std::sqrt(whole.var + path.var));
+}
+
 TEST(Bpm, GlassSphereCausticConvergesToPath) {
   LoadedScene ls = load(caustic_scene());
   expect_bpm_converges(ls, render_with(ls, "path", 4096).film, 5);

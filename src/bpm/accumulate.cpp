@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "base/error.h"
+#include "bpm/disc_probes.h"
 #include "integrator/progressive.h"
 #include "photons/density.h"
 
@@ -37,7 +38,13 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
           // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
           const float norm =
               float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
-          const NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
+          // Over the part of each nested disc where photons can land (bpm/disc_probes.h).
+          NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
+          if (bp.disc_cut) {
+            nested.all /= disc_share(bp.disc_found, bp.disc_cut, 0);
+            nested.half /= disc_share(bp.disc_found, bp.disc_cut, 1);
+            nested.quarter /= disc_share(bp.disc_found, bp.disc_cut, 2);
+          }
           const Spectrum share = bp.tau * nested.all * norm,
                          bias = bp.tau * radius_bias(nested, norm, settings.bias_model);
           light.flux[g] = share;

@@ -21,10 +21,12 @@ struct BackwardPhoton {
   Spectrum tau;  // throughput from the camera (the paper's transmittance)
   uint32_t pixel;
   uint32_t material;
-  uint16_t eye_depth;     // scattering events on the eye path, this vertex included
-  uint8_t accepts;        // AcceptMask bits
-  uint8_t diffuse_index;  // j - 1 for the j-th diffuse vertex (0..3)
-  bool hero_only;         // the eye path keeps its hero wavelength alone (PathState)
+  uint16_t eye_depth;      // scattering events on the eye path, this vertex included
+  uint8_t accepts;         // AcceptMask bits
+  uint8_t diffuse_index;   // j - 1 for the j-th diffuse vertex (0..3)
+  bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
+  uint8_t disc_cut = 0;    // the disc probes that found no surface (bpm/disc_probes.h)
+  uint8_t disc_found = 0;  // and those that found some
 
   // Sort key that fixes the order of backward photons whatever thread stored them.
   uint64_t key() const { return (uint64_t(pixel) << 4) | (uint64_t(diffuse_index) << 2) | accepts; }

@@ -144,9 +144,17 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                      s.k1 * pixel_angle * scale,
                      s.emission_samples,
                      s.radius * scale,
-                     caustics};
+                     caustics,
+                     s.normal_cos,
+                     s.disc_probes};
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
+    // Where the next eye pass probes its first vertices' discs: near edges, within the radii of
+    // this iteration (the next one's are smaller) in pixels, plus half a pixel for the sample's
+    // place in it.
+    if (s.disc_probes && s.radius <= 0 && complete)
+      mark_near_edges(eye.first, ls.film.width, ls.film.height, int(std::ceil(s.k0 * scale + 0.5f)),
+                      int(std::ceil(s.k1 * scale + 0.5f)), &eye.near_edge);
     tot.eye_s += since(t);
     // An eye pass cut short (an interrupt, or the time budget after the first iteration) leaves
     // pixels without their estimate: the iteration is dropped.

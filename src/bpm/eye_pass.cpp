@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "bpm/disc_probes.h"
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
 
@@ -43,7 +44,7 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
 
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray,
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
-                           bool emission_only) {
+                           bool emission_only, uint8_t near_edge, FirstVertex* first) {
   PathState s{ray};
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
@@ -72,6 +73,10 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
     if (is_diffuse) {
       ++diffuse;
       bool last = diffuse == prm.diffuse_depth + 1;
+      // Seen straight from the camera: the screen around the pixel says whether its discs may be
+      // cut (disc_probes.h).
+      const bool seen_directly = diffuse == 1 && depth == 1;
+      if (seen_directly && first) *first = FirstVertex{v.sp.p, v.sp.ng, v.object()};
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
@@ -82,6 +87,14 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       auto store = [&](uint8_t accepts) {
         BackwardPhoton bp = backward_photon_at(v, s, prm, pixel, depth, diffuse, accepts);
         if (bp.radius > 0 && !s.beta.is_black()) {
+          const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
+          if (prm.disc_probes && (!seen_directly || (near_edge & near_bit)) &&
+              may_cut_discs(scene.objects[size_t(v.object())].shape)) {
+            const DiscProbes probes = probe_disc(scene, v.sp, v.wo, v.object(), bp.radius,
+                                                 prm.normal_cos, rng, counters.rays);
+            bp.disc_found = probes.found;
+            bp.disc_cut = probes.cut;
+          }
           out[size_t(v.object())].push_back(bp);
           ++counters.backward_photons;
         }
@@ -186,7 +199,9 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
               continue;
             }
             CameraSample cs = camera.sample(pass_index, pixel);
-            EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec);
+            px->first[pixel] = FirstVertex{};
+            EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, false,
+                                           px->near_edge[pixel], &px->first[pixel]);
             px->radiance[pixel] = r.total;
             px->filter_weight[pixel] = cs.filter_weight;
             if (prm.emission_samples > 1 && px->sees_emission[pixel] && cs.filter_weight != 0)

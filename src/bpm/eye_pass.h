@@ -12,6 +12,7 @@
 
 #include "base/rng.h"
 #include "bpm/backward_photon.h"
+#include "bpm/disc_probes.h"
 #include "bpm/masks.h"
 #include "integrator/counters.h"
 #include "integrator/progressive.h"
@@ -35,6 +36,10 @@ struct EyePassParams {
   // False where no light path can be a caustic (no material has a traced lobe,
   // may_have_caustics): then no backward photon accepts caustic photons.
   bool caustics = true;
+  // Photons count only where the normals agree to within this cosine (PhotonSettings).
+  float normal_cos = 0.5f;
+  // Measure the share of each backward photon's disc where photons can land (disc_probes.h).
+  bool disc_probes = true;
 };
 
 // Whether some material of the scene's objects may have a traced lobe (materials/material.h),
@@ -43,7 +48,7 @@ struct EyePassParams {
 bool may_have_caustics(const RenderScene& scene);
 
 struct EyeCounters {
-  PathCounters rays;  // camera, bounce and shadow rays
+  PathCounters rays;  // camera, bounce, shadow and probe rays
   uint64_t backward_photons = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);
@@ -62,10 +67,13 @@ struct EyeRadiance {
 
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
 // appends the path's backward photons to out[object]. With emission_only the path ends at its
-// first diffuse vertex and stores nothing: only `emission` is computed.
+// first diffuse vertex and stores nothing: only `emission` is computed. near_edge: the pixel's
+// mark_near_edges bits, which decide whether a first vertex seen directly probes its discs; the
+// path's first vertex is left in *first when the camera sees it directly.
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
-                           bool emission_only = false);
+                           bool emission_only = false, uint8_t near_edge = 3,
+                           FirstVertex* first = nullptr);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
@@ -77,13 +85,19 @@ struct EyePixels {
   // its first diffuse vertex: such pixels take EyePassParams::emission_samples camera samples for
   // it. saw_emission marks those of this round, merged at its end.
   std::vector<uint8_t> sees_emission, saw_emission;
+  // The first vertices of the pixels' last samples, and where they say a disc may be cut
+  // (mark_near_edges; every pixel until an eye pass has run).
+  std::vector<FirstVertex> first;
+  std::vector<uint8_t> near_edge;
   explicit EyePixels(size_t n)
       : radiance(n),
         filter_weight(n),
         cost_ns(n),
         sampled(n, 0),
         sees_emission(n, 0),
-        saw_emission(n, 0) {}
+        saw_emission(n, 0),
+        first(n),
+        near_edge(n, 3) {}
 };
 
 // Per-thread state the eye pass fills.

@@ -41,6 +41,7 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
   return {{"camera_rays", t.eye.rays.camera_rays},
           {"bounce_rays", t.eye.rays.bounce_rays},
           {"shadow_rays", t.eye.rays.shadow_rays},
+          {"probe_rays", t.eye.rays.probe_rays},
           {"backward_photons", t.eye.backward_photons},
           // The paper's Table 1 counts per ray traced from the camera with all its continuations
           // (an eye path); per segment counts every camera and bounce ray.

@@ -16,17 +16,18 @@ class RayObserver {
   virtual void shadow(const Ray& ray) = 0;
 };
 
-// Camera-side rays: camera rays, their continuations (bounces and crossings of interfaces) and
-// shadow rays.
+// Camera-side rays: camera rays, their continuations (bounces and crossings of interfaces),
+// shadow rays, and bpm's disc probes (closest-hit rays; bpm/disc_probes.h).
 struct PathCounters {
-  uint64_t camera_rays = 0, bounce_rays = 0, shadow_rays = 0;
+  uint64_t camera_rays = 0, bounce_rays = 0, shadow_rays = 0, probe_rays = 0;
   RayObserver* observer = nullptr;
   void add(const PathCounters& o) {
     camera_rays += o.camera_rays;
     bounce_rays += o.bounce_rays;
     shadow_rays += o.shadow_rays;
+    probe_rays += o.probe_rays;
   }
-  uint64_t total() const { return camera_rays + bounce_rays + shadow_rays; }
+  uint64_t total() const { return camera_rays + bounce_rays + shadow_rays + probe_rays; }
 };
 
 }  // namespace bpm

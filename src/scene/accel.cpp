@@ -181,6 +181,44 @@ class Accel {
     return true;
   }
 
+  void intersect_coherent(const Ray* rays, int n, Hit* hits, bool* found) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(32) RTCRayHit8 rh;
+    alignas(32) int valid[8];
+    for (int i = 0; i < 8; ++i) {
+      const bool on = i < n;
+      valid[i] = on ? -1 : 0;
+      const Ray& ray = rays[on ? i : 0];
+      rh.ray.org_x[i] = ray.o.x;
+      rh.ray.org_y[i] = ray.o.y;
+      rh.ray.org_z[i] = ray.o.z;
+      rh.ray.dir_x[i] = ray.d.x;
+      rh.ray.dir_y[i] = ray.d.y;
+      rh.ray.dir_z[i] = ray.d.z;
+      rh.ray.tnear[i] = 0;
+      rh.ray.tfar[i] = ray.t_max;
+      rh.ray.time[i] = 0;
+      rh.ray.mask[i] = ~0u;
+      rh.ray.id[i] = unsigned(i);
+      rh.ray.flags[i] = 0;
+      rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, scene_, &ctx, &rh);
+    for (int i = 0; i < n; ++i) {
+      found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+      if (!found[i]) continue;
+      hits[i].object = int(rh.hit.geomID[i]);
+      hits[i].primitive = int(rh.hit.primID[i]);
+      hits[i].barycentric = {rh.hit.u[i], rh.hit.v[i]};
+      hits[i].t = rh.ray.tfar[i];
+    }
+  }
+  static constexpr int kBundle = RenderScene::kBundle;
+
   bool occluded(const Ray& ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -236,6 +274,10 @@ void RenderScene::commit() {
 }
 
 bool RenderScene::intersect(const Ray& ray, Hit* hit) const { return accel_->intersect(ray, hit); }
+void RenderScene::intersect_bundle(const Ray* rays, int n, Hit* hits, bool* found) const {
+  BPM_CHECK(n >= 0 && n <= kBundle);
+  accel_->intersect_coherent(rays, n, hits, found);
+}
 bool RenderScene::occluded_ray(const Ray& ray) const { return accel_->occluded(ray); }
 bool RenderScene::occluded(Vec3 a, Vec3 b) const {
   Vec3 d = b - a;

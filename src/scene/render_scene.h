@@ -59,6 +59,10 @@ class RenderScene {
   void commit();
 
   bool intersect(const Ray& ray, Hit* hit) const;
+  // Up to kBundle rays that start close together and go alike (Embree's coherent traversal);
+  // found[i] says whether ray i hit, and hits[i] where.
+  static constexpr int kBundle = 8;
+  void intersect_bundle(const Ray* rays, int n, Hit* hits, bool* found) const;
   // True when something blocks the open segment between a and b.
   bool occluded(Vec3 a, Vec3 b) const;
   bool occluded_ray(const Ray& ray) const;

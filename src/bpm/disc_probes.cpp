@@ -1,0 +1,210 @@
+#include "bpm/disc_probes.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace bpm {
+
+namespace {
+
+// Whether light may pass through the object's surface (refraction, diffuse transmission, an
+// interface; a mix if either of its materials may).
+bool lets_light_through(const RenderScene& scene, int object, int material = -2, int depth = 0) {
+  if (material == -2) material = scene.objects[size_t(object)].material;
+  if (material < 0 || size_t(material) >= scene.materials.size()) return true;
+  const MaterialDesc& m = scene.materials[size_t(material)];
+  if (const auto* mix = std::get_if<MixDesc>(&m))
+    return depth > 8 || lets_light_through(scene, object, mix->materials[0], depth + 1) ||
+           lets_light_through(scene, object, mix->materials[1], depth + 1);
+  return std::holds_alternative<DielectricMaterial>(m) ||
+         std::holds_alternative<ThinDielectricMaterial>(m) ||
+         std::holds_alternative<DiffuseTransmissionDesc>(m) ||
+         std::holds_alternative<InterfaceMaterial>(m);
+}
+
+// Whether the segment from a to b meets another object that light does not cross, or `object`
+// where its normal disagrees with ng (a crease of one mesh).
+bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng,
+                   float normal_cos, PathCounters& rays) {
+  const Vec3 d = b - a;
+  const float len = length(d);
+  if (len == 0) return false;
+  Ray ray{a, d / len, len};
+  for (int crossing = 0; crossing < 8; ++crossing) {
+    Hit h;
+    ++rays.probe_rays;
+    if (rays.observer) rays.observer->closest_hit(ray);
+    if (!scene.intersect(ray, &h)) return false;
+    const SurfacePoint at = scene.surface(ray, h);
+    const bool passes = h.object == object ? std::fabs(dot(at.ng, ng)) >= normal_cos
+                                           : lets_light_through(scene, h.object);
+    if (!passes) return true;
+    ray = Ray{offset_origin(at.p, at.ng, ray.d, at.error), ray.d, ray.t_max - h.t};
+  }
+  return false;
+}
+
+}  // namespace
+
+DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
+                      float radius, float normal_cos, Rng& rng, PathCounters& rays) {
+  static_assert(kDiscProbes == RenderScene::kBundle);
+  const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
+  const Frame frame = Frame::from_z(n);
+  // Unit directions a common rotation apart, in a bit-reversed order of angles so that each
+  // nested set of probes (0-1, 0-3, all) spreads around the point.
+  constexpr float kC = 0.70710678f;
+  constexpr float kCos[kDiscProbes] = {1, -1, 0, 0, kC, -kC, -kC, kC};
+  constexpr float kSin[kDiscProbes] = {0, 0, 1, -1, kC, -kC, kC, -kC};
+  constexpr float kTan60 = 1.7320508f;
+  const float rotation = 2 * kPi * rng.uniform();
+  const Vec3 u = frame.s * std::cos(rotation) + frame.t * std::sin(rotation), v = cross(n, u);
+  const float lift = std::fmax(sp.error, 1e-30f) * 4;  // keeps the origin off the surface
+  // The origins must be in the open: under something lower than they would be (an overhang
+  // near where a sphere touches the floor, a shelf over the point), the probes start halfway up
+  // to it, at a lower angle.
+  float slope = kTan60;
+  {
+    const Ray up{sp.p + n * lift, n, radius * kTan60};
+    Hit h;
+    ++rays.probe_rays;
+    if (rays.observer) rays.observer->closest_hit(up);
+    if (scene.intersect(up, &h)) slope = 0.5f * h.t / radius;
+  }
+  const float skim = std::fmax(lift, 1e-4f * radius);  // the height of blocked_along's rays
+  Ray probes[kDiscProbes];
+  float to_target[kDiscProbes];
+  for (int i = 0; i < kDiscProbes; ++i) {
+    const float rho = radius * std::sqrt((float(i) + rng.uniform()) / kDiscProbes);
+    const Vec3 target = sp.p + (u * kCos[i] + v * kSin[i]) * rho;
+    const Vec3 origin = sp.p + n * (rho * slope + lift);
+    const Vec3 to = target - origin;
+    to_target[i] = length(to);
+    // On past the target, to a surface that curves away below the tangent plane.
+    probes[i] = Ray{origin, to / to_target[i], 3 * to_target[i] + lift};
+  }
+  Hit hits[kDiscProbes];
+  bool found[kDiscProbes];
+  scene.intersect_bundle(probes, kDiscProbes, hits, found);
+  rays.probe_rays += kDiscProbes;
+  if (rays.observer)
+    for (const Ray& r : probes) rays.observer->closest_hit(r);
+  const auto* mesh = std::get_if<TriangleMesh>(&scene.objects[size_t(object)].shape);
+  DiscProbes out;
+  for (int i = 0; i < kDiscProbes; ++i) {
+    Hit& h = hits[i];
+    Ray& ray = probes[i];
+    float travelled = 0;
+    // Photons cross glass and interfaces: so does a probe (the rare case, one ray at a time).
+    for (int crossing = 0; found[i] && h.object != object && crossing < 4; ++crossing) {
+      if (!lets_light_through(scene, h.object)) break;
+      const SurfacePoint at = scene.surface(ray, h);
+      travelled += h.t;
+      ray = Ray{offset_origin(at.p, at.ng, ray.d, at.error), ray.d, ray.t_max - h.t};
+      ++rays.probe_rays;
+      if (rays.observer) rays.observer->closest_hit(ray);
+      found[i] = scene.intersect(ray, &h);
+    }
+    const uint8_t bit = uint8_t(1u << i);
+    // Nothing (past an edge), or another object after the target: no surface here.
+    if (!found[i] || (h.object != object && travelled + h.t >= to_target[i])) {
+      out.cut |= bit;
+      continue;
+    }
+    // Another object before the target. Below the tangent plane, where only a surface that
+    // curves away (or ends) lets a probe go: the probe says nothing. Above it, a wall standing on
+    // the surface, or an overhang with surface under it (where a sphere rests on a floor), which
+    // photons reach: a ray along the surface, just above it, tells them apart.
+    if (h.object != object) {
+      if (dot(ray.o + ray.d * h.t - sp.p, n) < 0) continue;
+      const Vec3 target = ray.o + ray.d * (to_target[i] - travelled);
+      if (blocked_along(scene, sp.p + n * skim, target + n * skim, object, sp.ng, normal_cos, rays))
+        out.cut |= bit;
+      else
+        out.found |= bit;
+      continue;
+    }
+    // Either side: a probe from the front reaches no back face of the object without crossing a
+    // front one first.
+    const Vec3 ng = mesh && !mesh->face_normals.empty() ? mesh->face_normals[size_t(h.primitive)]
+                                                        : scene.surface(ray, h).ng;
+    if (std::fabs(dot(ng, sp.ng)) < normal_cos) {
+      out.cut |= bit;  // a crease: photons there do not count
+    } else if (length_squared(ray.o + ray.d * h.t - sp.p) <= radius * radius) {
+      out.found |= bit;
+    } else if (travelled + h.t < to_target[i]) {
+      out.cut |= bit;  // the surface rises out of the sphere before the target
+    }
+    // Else the surface curves away below the target and meets the probe outside the sphere: the
+    // probe says nothing of the disc (on a sphere, the part of the surface inside the gathering
+    // sphere has area pi r^2 exactly, a whole disc's).
+  }
+  return out;
+}
+
+namespace {
+
+// Whether two neighbouring pixels' first vertices may lie on one smooth piece of one surface:
+// normals within 25 degrees, and b off a's tangent plane by at most a fifth of their distance (a
+// sphere seen edge-on passes; a step between parallel faces does not).
+bool continuous(const FirstVertex& a, const FirstVertex& b) {
+  if (a.object < 0 || a.object != b.object || dot(a.ng, b.ng) < 0.9f) return false;
+  const Vec3 d = b.p - a.p;
+  return std::fabs(dot(d, a.ng)) <= 0.2f * length(d);
+}
+
+// out[i] = 1 where some in[j] with |j - i| <= r along a line of n values (stride apart) is set,
+// or the window leaves the line.
+void spread_line(const uint8_t* in, uint8_t* out, int n, size_t stride, int r) {
+  int count = 0;  // set values in the window [i - r, i + r] inside the line
+  for (int j = 0; j < std::min(n, r); ++j) count += in[size_t(j) * stride];
+  for (int i = 0; i < n; ++i) {
+    if (i + r < n) count += in[size_t(i + r) * stride];
+    if (i - r - 1 >= 0) count -= in[size_t(i - r - 1) * stride];
+    out[size_t(i) * stride] = (count > 0 || i - r < 0 || i + r >= n) ? 1 : 0;
+  }
+}
+
+// Spreads the marks over a square of side 2r + 1 (rows, then columns).
+std::vector<uint8_t> spread(const std::vector<uint8_t>& edge, int w, int h, int r) {
+  std::vector<uint8_t> rows(edge.size()), out(edge.size());
+  tbb::parallel_for(0, h, [&](int y) {
+    spread_line(&edge[size_t(y) * size_t(w)], &rows[size_t(y) * size_t(w)], w, 1, r);
+  });
+  tbb::parallel_for(0, w, [&](int x) {
+    spread_line(&rows[size_t(x)], &out[size_t(x)], h, size_t(w), r);
+  });
+  return out;
+}
+
+}  // namespace
+
+void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height,
+                     int radius_px0, int radius_px1, std::vector<uint8_t>* near) {
+  const size_t w = size_t(width), h = size_t(height);
+  // Whether each pixel breaks with its right neighbour, and with the one below.
+  std::vector<uint8_t> right(first.size(), 1), down(first.size(), 1);
+  auto breaks = [&](size_t p, size_t q) {
+    return !continuous(first[p], first[q]) || !continuous(first[q], first[p]);
+  };
+  tbb::parallel_for(size_t(0), h, [&](size_t y) {
+    for (size_t x = 0, p = y * w; x < w; ++x, ++p) {
+      if (x + 1 < w) right[p] = breaks(p, p + 1);
+      if (y + 1 < h) down[p] = breaks(p, p + w);
+    }
+  });
+  std::vector<uint8_t> edge(first.size());
+  tbb::parallel_for(size_t(0), h, [&](size_t y) {
+    for (size_t x = 0, p = y * w; x < w; ++x, ++p)
+      edge[p] = first[p].object < 0 || (x + 1 < w && right[p]) || (x > 0 && right[p - 1]) ||
+                (y + 1 < h && down[p]) || (y > 0 && down[p - w]);
+  });
+  const std::vector<uint8_t> near1 = spread(edge, width, height, radius_px1),
+                             near0 = spread(edge, width, height, radius_px0);
+  near->resize(first.size());
+  for (size_t p = 0; p < first.size(); ++p) (*near)[p] = uint8_t(near1[p] | (near0[p] << 1));
+}
+
+}  // namespace bpm

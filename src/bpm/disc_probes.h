@@ -1,0 +1,73 @@
+// The share of a backward photon's disc where photons can land. Eq. (2) divides the photons
+// gathered by pi r^2, the whole disc; but where a wall stands inside the disc, or the surface ends
+// at an edge, photons land on part of it only, and the estimate falls short: dark seams along
+// every corner and edge, and in a bright closed room about 1% of all its light (indirect light
+// gathered near corners is carried everywhere). Probe rays measure the share, and the estimate is
+// divided by it instead. The share tends to 1 as the radius shrinks, wherever the point is not on
+// an edge, so the estimator stays consistent.
+//
+// Probing every backward photon would cost as much as the rest of the eye pass; most discs are
+// whole. A disc can be cut only by geometry near its point, which the camera sees around the
+// pixel: the first vertices of the last eye pass say where objects, creases and depth steps are,
+// and only pixels within a disc's radius of one probe their first vertex. Later vertices (seen
+// through specular ones, or at D > 0) are always probed.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "base/rng.h"
+#include "integrator/counters.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+// Probes per backward photon. They lie uniformly over the disc, stratified by area so that
+// probes 0-1 fall within r/2 and 0-3 within r/sqrt 2 (the nested discs of the bias estimate,
+// density.h). Bit i of `found` says that probe i found surface where photons count, of `cut`
+// that it found none (a wall, an edge, a crease); a probe in neither says nothing (below).
+constexpr int kDiscProbes = 8;
+struct DiscProbes {
+  uint8_t found = 0, cut = 0;
+};
+
+// Probes the disc of `radius` about sp.p in its tangent plane, on the side wo points to. A probe
+// is a ray from above the point, 60 degrees off the plane, aimed at a point of the disc: it finds
+// surface when it hits `object` inside the sphere of `radius` with a normal that agrees with sp's
+// to within normal_cos, as a photon must to be gathered. A wall in between stops it; past an edge
+// it misses the surface. Where the surface curves away below the plane, the probe meets it
+// outside the sphere and says nothing. The probes count in rays.probe_rays.
+DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
+                      float radius, float normal_cos, Rng& rng, PathCounters& rays);
+
+// Whether the probes apply to the shape: not to spheres and cylinders, whose surface inside a
+// gathering sphere is whole (on a sphere its area is pi r^2 exactly, Archimedes' hat-box theorem)
+// unless another object cuts into it, and whose curvature would send the probes past it.
+inline bool may_cut_discs(const Shape& shape) {
+  return std::holds_alternative<TriangleMesh>(shape) || std::holds_alternative<Disk>(shape);
+}
+
+// The share of the disc (nested = 0), of the one of radius r / sqrt 2 (1) or of r / 2 (2) where
+// photons can land: the probes that found surface among those that found surface or a cut, at
+// least half a probe's worth; 1 when no probe found a cut.
+inline float disc_share(uint8_t found, uint8_t cut, int nested) {
+  constexpr uint8_t kBits[3] = {0xff, 0x0f, 0x03};
+  const int in = __builtin_popcount(unsigned(found & kBits[nested])),
+            out = __builtin_popcount(unsigned(cut & kBits[nested]));
+  return out == 0 ? 1.0f : std::fmax(float(in), 0.5f) / float(in + out);
+}
+
+// A pixel's first eye vertex when the camera sees it directly (object -1: none this far).
+struct FirstVertex {
+  Vec3 p, ng;
+  int object = -1;
+};
+
+// Per pixel, bit 0: some cut of the large disc (k1) is possible, bit 1: of the small one (k0).
+// Neighbouring first vertices that differ (another object or none, a crease, a step off the
+// plane) mark an edge; the marks spread over radius_px1 and radius_px0 pixels (the discs' radii
+// on screen, rounded up) and over the image's border, beyond which nothing is known.
+void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height,
+                     int radius_px0, int radius_px1, std::vector<uint8_t>* near);
+
+}  // namespace bpm
