@@ -52,9 +52,11 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
     if (count[p]) (*weight)[p] = float(1 / (std::max(0.0, sum[p] / count[p]) + floor));
 }
 
-// Memory (base/memory.h). Per pixel, what the eye pass, the masks and the emission guide keep.
+// Memory (base/memory.h). Per pixel, what the eye pass (with the first vertex and the near-edge
+// marks of the disc probes), the masks and the emission guide keep.
 constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
-                               sizeof(double) + sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
+                               sizeof(FirstVertex) + sizeof(uint8_t) + sizeof(double) +
+                               sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
 // Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
 // inner quarter) and hit flag, its references in the two trees (about two per tree where spheres
 // overlap cells), and its place among its pixel's for the accumulation.

@@ -26,8 +26,8 @@ bool lets_light_through(const RenderScene& scene, int object, int material = -2,
 
 // Whether the segment from a to b meets another object that light does not cross, or `object`
 // where its normal disagrees with ng (a crease of one mesh).
-bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng,
-                   float normal_cos, PathCounters& rays) {
+bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng, float normal_cos,
+                   PathCounters& rays) {
   const Vec3 d = b - a;
   const float len = length(d);
   if (len == 0) return false;
@@ -173,16 +173,15 @@ std::vector<uint8_t> spread(const std::vector<uint8_t>& edge, int w, int h, int 
   tbb::parallel_for(0, h, [&](int y) {
     spread_line(&edge[size_t(y) * size_t(w)], &rows[size_t(y) * size_t(w)], w, 1, r);
   });
-  tbb::parallel_for(0, w, [&](int x) {
-    spread_line(&rows[size_t(x)], &out[size_t(x)], h, size_t(w), r);
-  });
+  tbb::parallel_for(
+      0, w, [&](int x) { spread_line(&rows[size_t(x)], &out[size_t(x)], h, size_t(w), r); });
   return out;
 }
 
 }  // namespace
 
-void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height,
-                     int radius_px0, int radius_px1, std::vector<uint8_t>* near) {
+void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height, int radius_px0,
+                     int radius_px1, std::vector<uint8_t>* near) {
   const size_t w = size_t(width), h = size_t(height);
   // Whether each pixel breaks with its right neighbour, and with the one below.
   std::vector<uint8_t> right(first.size(), 1), down(first.size(), 1);

@@ -67,7 +67,7 @@ struct FirstVertex {
 // Neighbouring first vertices that differ (another object or none, a crease, a step off the
 // plane) mark an edge; the marks spread over radius_px1 and radius_px0 pixels (the discs' radii
 // on screen, rounded up) and over the image's border, beyond which nothing is known.
-void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height,
-                     int radius_px0, int radius_px1, std::vector<uint8_t>* near);
+void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height, int radius_px0,
+                     int radius_px1, std::vector<uint8_t>* near);
 
 }  // namespace bpm

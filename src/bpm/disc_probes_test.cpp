@@ -27,7 +27,8 @@ std::string floor_at(float y) {
 
 // A wall in the plane x = 0, from the floor up to y = 2.
 const char* kWall =
-    "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 -10  0 0 10  0 2 10 "
+    "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 -10  0 0 10  0 2 "
+    "10 "
     " 0 2 -10]\n";
 
 // The share of a disc of radius 1 about p on an upward surface of `object`, over n draws of the
@@ -131,13 +132,13 @@ TEST(DiscProbes, MarksPixelsNearEdgesAndTheBorder) {
   std::vector<uint8_t> near;
   mark_near_edges(first, w, h, 1, 2, &near);
   auto at = [&](int x, int y) { return near[size_t(y * w + x)]; };
-  EXPECT_EQ(at(3, 3), 0);    // two from the border, four from the seam
-  EXPECT_EQ(at(5, 3), 1);    // the seam's columns are 7 and 8: two away, within r1 only
-  EXPECT_EQ(at(6, 3), 3);    // one away: within both
-  EXPECT_EQ(at(12, 2), 0);   // far from the seam, the step (rows 5 and 6) and the border
-  EXPECT_EQ(at(12, 3), 1);   // two rows above the step
-  EXPECT_EQ(at(12, 8), 1);   // two rows below it
-  EXPECT_EQ(at(12, 9), 0);   // three below it, two from the border
+  EXPECT_EQ(at(3, 3), 0);      // two from the border, four from the seam
+  EXPECT_EQ(at(5, 3), 1);      // the seam's columns are 7 and 8: two away, within r1 only
+  EXPECT_EQ(at(6, 3), 3);      // one away: within both
+  EXPECT_EQ(at(12, 2), 0);     // far from the seam, the step (rows 5 and 6) and the border
+  EXPECT_EQ(at(12, 3), 1);     // two rows above the step
+  EXPECT_EQ(at(12, 8), 1);     // two rows below it
+  EXPECT_EQ(at(12, 9), 0);     // three below it, two from the border
   EXPECT_EQ(at(0, 3) & 2, 2);  // the border
   EXPECT_EQ(at(1, 3), 1);
   // A pixel without a first vertex is an edge, and so are its neighbours (a break marks both
