@@ -84,31 +84,35 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
                                         choice.part);
       // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
       // vertex is also the last: two backward photons, one per radius.
-      auto store = [&](uint8_t accepts) {
+      // Each backward photon's disc is probed where it may be cut (disc_probes.h); `whole`: a
+      // larger disc about the same point was probed and found whole, and so is this one.
+      auto store = [&](uint8_t accepts, bool whole) {
         BackwardPhoton bp = backward_photon_at(v, s, prm, pixel, depth, diffuse, accepts);
-        if (bp.radius > 0 && !s.beta.is_black()) {
-          const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
-          if (prm.disc_probes && (!seen_directly || (near_edge & near_bit)) &&
-              may_cut_discs(scene.objects[size_t(v.object())].shape)) {
-            const DiscProbes probes = probe_disc(scene, v.sp, v.wo, v.object(), bp.radius,
-                                                 prm.normal_cos, rng, counters.rays);
-            bp.disc_found = probes.found;
-            bp.disc_cut = probes.cut;
-          }
-          out[size_t(v.object())].push_back(bp);
-          ++counters.backward_photons;
+        if (bp.radius <= 0 || s.beta.is_black()) return false;
+        const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
+        bool probed_whole = false;
+        if (prm.disc_probes && !whole && (!seen_directly || (near_edge & near_bit)) &&
+            may_cut_discs(scene.objects[size_t(v.object())].shape)) {
+          const DiscProbes probes = probe_disc(scene, v.sp, v.wo, v.object(), bp.radius,
+                                               prm.normal_cos, rng, counters.rays);
+          bp.disc_found = probes.found;
+          bp.disc_cut = probes.cut;
+          probed_whole = probes.cut == 0;
         }
+        out[size_t(v.object())].push_back(bp);
+        ++counters.backward_photons;
+        return probed_whole;
       };
       if (!prm.caustics) {
-        if (last) store(kAcceptsIndirect);
+        if (last) store(kAcceptsIndirect, false);
       } else if (!last) {
-        store(kAcceptsCaustic);
+        store(kAcceptsCaustic, false);
       } else if (diffuse > 1 || prm.world_radius > 0 ||
                  prm.radius_per_length0 == prm.radius_per_length1) {
-        store(kAcceptsCaustic | kAcceptsIndirect);
+        store(kAcceptsCaustic | kAcceptsIndirect, false);
       } else {
-        store(kAcceptsCaustic);
-        store(kAcceptsIndirect);
+        const bool whole = store(kAcceptsIndirect, false);  // r1 > r0: the larger disc first
+        store(kAcceptsCaustic, whole && prm.radius_per_length0 < prm.radius_per_length1);
       }
       if (last) break;
     }
