@@ -458,8 +458,7 @@ int main(int argc, char** argv) {
   const char* g = "Backward photon mapping (--integrator bpm)";
   render
       ->add_option("--diffuse-depth", ra.diffuse_depth,
-                   "Diffuse vertices before the last backward photon (0..3; default 0; 1 serves "
-                   "bright closed rooms better)")
+                   "Diffuse vertices before the last backward photon (0..3; default 0)")
       ->check(CLI::Range(0, 3))
       ->group(g);
   render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")
