@@ -52,11 +52,11 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
     if (count[p]) (*weight)[p] = float(1 / (std::max(0.0, sum[p] / count[p]) + floor));
 }
 
-// Memory (base/memory.h). Per pixel, what the eye pass (with the first vertex and the near-edge
-// marks of the disc probes), the masks and the emission guide keep.
+// Memory (base/memory.h). Per pixel, what the eye pass (with the edges and near-edge marks of the
+// disc probes), the masks and the emission guide keep.
 constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
-                               sizeof(FirstVertex) + sizeof(uint8_t) + sizeof(double) +
-                               sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
+                               2 * sizeof(uint8_t) + sizeof(double) + sizeof(uint32_t) +
+                               sizeof(float) + sizeof(uint16_t);
 // Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
 // inner quarter) and hit flag, its references in the two trees (about two per tree where spheres
 // overlap cells), and its place among its pixel's for the accumulation.
@@ -131,6 +131,15 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   // caustics (half of them at D = 0) would gather nothing: they are not made.
   const bool caustics = may_have_caustics(scene);
 
+  // Disc probes at first vertices near edges only (bpm/disc_probes.h); with a radius in world
+  // units the radii on screen are unknown, and every disc is probed.
+  const std::vector<uint8_t> edges =
+      s.disc_probes && s.radius <= 0
+          ? find_edges(scene, camera.camera(), ls.film.width, ls.film.height)
+          : std::vector<uint8_t>();
+  const float reach = std::fmax(0.5f, std::fmax(ls.filter.radius.x, ls.filter.radius.y));
+  int near_radii[2] = {-1, -1};
+
   auto iteration = [&](int pass, const RenderControl& control) {
     const int it = opt.first_iteration + pass;  // the index random streams and radii follow
     const float scale = radius_scale(s, it);
@@ -149,14 +158,19 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                      caustics,
                      s.normal_cos,
                      s.disc_probes};
+    // Where the first vertices' discs are probed: near edges, within this iteration's radii in
+    // pixels, plus the reach of the pixel filter (where in or around the pixel the sample falls).
+    if (!edges.empty()) {
+      const int r0 = int(std::ceil(s.k0 * scale + reach)),
+                r1 = int(std::ceil(s.k1 * scale + reach));
+      if (r0 != near_radii[0] || r1 != near_radii[1]) {
+        mark_near_edges(edges, ls.film.width, ls.film.height, r0, r1, &eye.near_edge);
+        near_radii[0] = r0;
+        near_radii[1] = r1;
+      }
+    }
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
-    // Where the next eye pass probes its first vertices' discs: near edges, within the radii of
-    // this iteration (the next one's are smaller) in pixels, plus half a pixel for the sample's
-    // place in it.
-    if (s.disc_probes && s.radius <= 0 && complete)
-      mark_near_edges(eye.first, ls.film.width, ls.film.height, int(std::ceil(s.k0 * scale + 0.5f)),
-                      int(std::ceil(s.k1 * scale + 0.5f)), &eye.near_edge);
     tot.eye_s += since(t);
     // An eye pass cut short (an interrupt, or the time budget after the first iteration) leaves
     // pixels without their estimate: the iteration is dropped.

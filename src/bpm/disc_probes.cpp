@@ -146,9 +146,29 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
 
 namespace {
 
-// Whether two neighbouring pixels' first vertices may lie on one smooth piece of one surface:
-// normals within 25 degrees, and b off a's tangent plane by at most a fifth of their distance (a
-// sphere seen edge-on passes; a step between parallel faces does not).
+// The surface seen through a pixel's centre (object -1: none).
+struct FirstVertex {
+  Vec3 p, ng;
+  int object = -1;
+};
+
+FirstVertex first_surface(const RenderScene& scene, Ray ray) {
+  for (int crossing = 0; crossing < 16; ++crossing) {
+    Hit h;
+    if (!scene.intersect(ray, &h)) return {};
+    const SurfacePoint sp = scene.surface(ray, h);
+    const int m = scene.objects[size_t(h.object)].material;
+    const bool interface = m >= 0 && size_t(m) < scene.materials.size() &&
+                           std::holds_alternative<InterfaceMaterial>(scene.materials[size_t(m)]);
+    if (!interface) return {sp.p, sp.ng, h.object};
+    ray = spawn_ray(sp, ray.d);
+  }
+  return {};
+}
+
+// Whether two neighbouring pixels' surfaces may be one smooth piece of one surface: normals
+// within 25 degrees, and b off a's tangent plane by at most a fifth of their distance (a sphere
+// seen edge-on passes; a step between parallel faces does not).
 bool continuous(const FirstVertex& a, const FirstVertex& b) {
   if (a.object < 0 || a.object != b.object || dot(a.ng, b.ng) < 0.9f) return false;
   const Vec3 d = b.p - a.p;
@@ -180,9 +200,15 @@ std::vector<uint8_t> spread(const std::vector<uint8_t>& edge, int w, int h, int 
 
 }  // namespace
 
-void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height, int radius_px0,
-                     int radius_px1, std::vector<uint8_t>* near) {
+std::vector<uint8_t> find_edges(const RenderScene& scene, const PerspectiveCamera& camera,
+                                int width, int height) {
   const size_t w = size_t(width), h = size_t(height);
+  std::vector<FirstVertex> first(w * h);
+  tbb::parallel_for(size_t(0), h, [&](size_t y) {
+    for (size_t x = 0; x < w; ++x)
+      first[y * w + x] = first_surface(
+          scene, camera.generate_ray({float(x) + 0.5f, float(y) + 0.5f}, {0.5f, 0.5f}));
+  });
   // Whether each pixel breaks with its right neighbour, and with the one below.
   std::vector<uint8_t> right(first.size(), 1), down(first.size(), 1);
   auto breaks = [&](size_t p, size_t q) {
@@ -200,10 +226,15 @@ void mark_near_edges(const std::vector<FirstVertex>& first, int width, int heigh
       edge[p] = first[p].object < 0 || (x + 1 < w && right[p]) || (x > 0 && right[p - 1]) ||
                 (y + 1 < h && down[p]) || (y > 0 && down[p - w]);
   });
-  const std::vector<uint8_t> near1 = spread(edge, width, height, radius_px1),
-                             near0 = spread(edge, width, height, radius_px0);
-  near->resize(first.size());
-  for (size_t p = 0; p < first.size(); ++p) (*near)[p] = uint8_t(near1[p] | (near0[p] << 1));
+  return edge;
+}
+
+void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, int radius_px0,
+                     int radius_px1, std::vector<uint8_t>* near) {
+  const std::vector<uint8_t> near1 = spread(edges, width, height, radius_px1),
+                             near0 = spread(edges, width, height, radius_px0);
+  near->resize(edges.size());
+  for (size_t p = 0; p < edges.size(); ++p) (*near)[p] = uint8_t(near1[p] | (near0[p] << 1));
 }
 
 }  // namespace bpm

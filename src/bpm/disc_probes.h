@@ -8,15 +8,18 @@
 //
 // Probing every backward photon would cost as much as the rest of the eye pass; most discs are
 // whole. A disc can be cut only by geometry near its point, which the camera sees around the
-// pixel: the first vertices of the last eye pass say where objects, creases and depth steps are,
-// and only pixels within a disc's radius of one probe their first vertex. Later vertices (seen
-// through specular ones, or at D > 0) are always probed.
+// pixel: one ray through each pixel's centre, before the first iteration, finds where objects,
+// creases and depth steps are, and only pixels within a disc's radius of one probe their first
+// vertex. Later vertices (seen through specular ones, or at D > 0) are always probed. What is
+// probed depends only on the scene, the camera and the iteration, never on another iteration, so
+// an iteration is the same computation in any process and after a resume.
 #pragma once
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "base/rng.h"
+#include "camera/camera.h"
 #include "integrator/counters.h"
 #include "scene/render_scene.h"
 
@@ -57,17 +60,16 @@ inline float disc_share(uint8_t found, uint8_t cut, int nested) {
   return out == 0 ? 1.0f : std::fmax(float(in), 0.5f) / float(in + out);
 }
 
-// A pixel's first eye vertex when the camera sees it directly (object -1: none this far).
-struct FirstVertex {
-  Vec3 p, ng;
-  int object = -1;
-};
+// Per pixel, whether the surface seen through its centre meets another there or nearby: a change
+// of object between neighbours, a crease, a step off the plane, or no surface (the sky, an
+// interface-only path), from one camera ray per pixel.
+std::vector<uint8_t> find_edges(const RenderScene& scene, const PerspectiveCamera& camera,
+                                int width, int height);
 
-// Per pixel, bit 0: some cut of the large disc (k1) is possible, bit 1: of the small one (k0).
-// Neighbouring first vertices that differ (another object or none, a crease, a step off the
-// plane) mark an edge; the marks spread over radius_px1 and radius_px0 pixels (the discs' radii
-// on screen, rounded up) and over the image's border, beyond which nothing is known.
-void mark_near_edges(const std::vector<FirstVertex>& first, int width, int height, int radius_px0,
+// Per pixel, bit 0: some cut of the large disc is possible, bit 1: of the small one; that is, an
+// edge pixel (find_edges) or the image's border lies within radius_px1 or radius_px0 pixels (the
+// discs' radii on screen, rounded up, with the filter's reach).
+void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, int radius_px0,
                      int radius_px1, std::vector<uint8_t>* near);
 
 }  // namespace bpm

@@ -117,37 +117,48 @@ TEST(DiscProbes, SpheresAndCylindersAreNotProbed) {
   EXPECT_TRUE(may_cut_discs(TriangleMesh{}));
 }
 
-// First vertices of a 16 x 12 image on a plane: two objects meeting between columns 7 and 8, and
-// a step between rows 5 and 6 of the right one. The marks spread over the radii and the border.
-TEST(DiscProbes, MarksPixelsNearEdgesAndTheBorder) {
+// Looking straight down at two floors that meet at x = 0 (two objects), with a raised block on
+// the right one: the seam and the block's outline are edges, the open floor is not; the marks
+// spread over the radii and the image's border.
+TEST(DiscProbes, FindsEdgesAndMarksPixelsNearThem) {
   const int w = 16, h = 12;
-  std::vector<FirstVertex> first(size_t(w * h));
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      FirstVertex& f = first[size_t(y * w + x)];
-      f.p = Vec3(0.1f * float(x), x >= 8 && y >= 6 ? 0.5f : 0.0f, 0.1f * float(y));
-      f.ng = Vec3(0, 1, 0);
-      f.object = x < 8 ? 0 : 1;
-    }
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "LookAt 0 10 0  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 20\nFilm \"rgb\" "
+      "\"integer xresolution\" 16 \"integer yresolution\" 12\nWorldBegin\n"
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-5 0 -5  -5 0 5  0 0 "
+      "5  0 0 -5]\n"
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [0 0 -5  0 0 5  5 0 5 "
+      " 5 0 -5]\n"
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.2 0.5 -0.3  -1.2 "
+      "0.5 0.3  -0.8 0.5 0.3  -0.8 0.5 -0.3]\n"));
+  const PerspectiveCamera camera(ls.camera, w, h);
+  const std::vector<uint8_t> edges = find_edges(ls.scene, camera, w, h);
+  ASSERT_EQ(edges.size(), size_t(w * h));
+  auto edge = [&](int x, int y) { return edges[size_t(y * w + x)]; };
+  // Which columns hold the seam (the camera may mirror x).
+  int seam = -1;
+  for (int x = 0; x + 1 < w; ++x)
+    if (edge(x, 0) && edge(x + 1, 0) && edge(x, h - 1) && edge(x + 1, h - 1)) seam = x;
+  ASSERT_TRUE(seam == 7) << "seam at column " << seam;
+  int marked = 0;
+  for (uint8_t e : edges) marked += e;
+  // The seam's two columns and the block's outline (about 3 x 5 pixels, at x -1.2..-0.8).
+  EXPECT_GE(marked, 2 * h + 8);
+  EXPECT_LE(marked, 2 * h + 24);
+  // An open stretch of floor on the block's far side: no edge.
+  const int open_x = camera.generate_ray({0.5f, 6.5f}, {0.5f, 0.5f}).d.x < 0 ? 13 : 2;
+  EXPECT_EQ(edge(open_x, 6), 0);
+
   std::vector<uint8_t> near;
-  mark_near_edges(first, w, h, 1, 2, &near);
+  mark_near_edges(edges, w, h, 1, 2, &near);
   auto at = [&](int x, int y) { return near[size_t(y * w + x)]; };
-  EXPECT_EQ(at(3, 3), 0);      // two from the border, four from the seam
-  EXPECT_EQ(at(5, 3), 1);      // the seam's columns are 7 and 8: two away, within r1 only
-  EXPECT_EQ(at(6, 3), 3);      // one away: within both
-  EXPECT_EQ(at(12, 2), 0);     // far from the seam, the step (rows 5 and 6) and the border
-  EXPECT_EQ(at(12, 3), 1);     // two rows above the step
-  EXPECT_EQ(at(12, 8), 1);     // two rows below it
-  EXPECT_EQ(at(12, 9), 0);     // three below it, two from the border
-  EXPECT_EQ(at(0, 3) & 2, 2);  // the border
-  EXPECT_EQ(at(1, 3), 1);
-  // A pixel without a first vertex is an edge, and so are its neighbours (a break marks both
-  // sides): (3, 2) is one row from (3, 1).
-  first[size_t(3 * w + 3)].object = -1;
-  mark_near_edges(first, w, h, 1, 2, &near);
-  EXPECT_EQ(at(3, 3), 3);
-  EXPECT_EQ(at(3, 1), 3);
-  EXPECT_EQ(at(0 + 3, 7), 0);  // four rows below it, three from the border
+  EXPECT_EQ(at(open_x, 6), 0);        // far from the seam, the block and the border
+  EXPECT_EQ(at(open_x, 2), 0);        // the large disc's window (two rows) reaches the border
+  EXPECT_EQ(at(open_x, 1), 1);        // only from here
+  EXPECT_EQ(at(open_x, 0), 3);        // the border row
+  EXPECT_EQ(at(seam - 2, 6) & 1, 1);  // two columns from the seam (on either side of it)
+  EXPECT_EQ(at(seam + 3, 6) & 1, 1);
+  EXPECT_EQ(at(seam - 1, 6), 3);  // one from it
 }
 
 }  // namespace

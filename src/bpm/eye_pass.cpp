@@ -44,7 +44,7 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
 
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray,
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
-                           bool emission_only, uint8_t near_edge, FirstVertex* first) {
+                           bool emission_only, uint8_t near_edge) {
   PathState s{ray};
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
@@ -76,7 +76,6 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       // Seen straight from the camera: the screen around the pixel says whether its discs may be
       // cut (disc_probes.h).
       const bool seen_directly = diffuse == 1 && depth == 1;
-      if (seen_directly && first) *first = FirstVertex{v.sp.p, v.sp.ng, v.object()};
       // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
       // last vertex, where the path ends.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
@@ -203,9 +202,8 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
               continue;
             }
             CameraSample cs = camera.sample(pass_index, pixel);
-            px->first[pixel] = FirstVertex{};
             EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, false,
-                                           px->near_edge[pixel], &px->first[pixel]);
+                                           px->near_edge[pixel]);
             px->radiance[pixel] = r.total;
             px->filter_weight[pixel] = cs.filter_weight;
             if (prm.emission_samples > 1 && px->sees_emission[pixel] && cs.filter_weight != 0)

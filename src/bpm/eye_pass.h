@@ -68,12 +68,10 @@ struct EyeRadiance {
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
 // appends the path's backward photons to out[object]. With emission_only the path ends at its
 // first diffuse vertex and stores nothing: only `emission` is computed. near_edge: the pixel's
-// mark_near_edges bits, which decide whether a first vertex seen directly probes its discs; the
-// path's first vertex is left in *first when the camera sees it directly.
+// mark_near_edges bits, which decide whether a first vertex seen directly probes its discs.
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
-                           bool emission_only = false, uint8_t near_edge = 3,
-                           FirstVertex* first = nullptr);
+                           bool emission_only = false, uint8_t near_edge = 3);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
@@ -85,9 +83,7 @@ struct EyePixels {
   // its first diffuse vertex: such pixels take EyePassParams::emission_samples camera samples for
   // it. saw_emission marks those of this round, merged at its end.
   std::vector<uint8_t> sees_emission, saw_emission;
-  // The first vertices of the pixels' last samples, and where they say a disc may be cut
-  // (mark_near_edges; every pixel until an eye pass has run).
-  std::vector<FirstVertex> first;
+  // Where a disc of the pixel's first vertex may be cut (mark_near_edges; everywhere unless set).
   std::vector<uint8_t> near_edge;
   explicit EyePixels(size_t n)
       : radiance(n),
@@ -96,7 +92,6 @@ struct EyePixels {
         sampled(n, 0),
         sees_emission(n, 0),
         saw_emission(n, 0),
-        first(n),
         near_edge(n, 3) {}
 };
 
