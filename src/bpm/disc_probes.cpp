@@ -1,6 +1,5 @@
 #include "bpm/disc_probes.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <cmath>
