@@ -8,6 +8,12 @@ namespace bpm {
 
 namespace {
 
+// Counts a probe ray, and shows it to the benchmarks' observer.
+void count(PathCounters& rays, const Ray& ray) {
+  ++rays.probe_rays;
+  if (rays.observer) rays.observer->closest_hit(ray);
+}
+
 // Whether light may pass through the object's surface (refraction, diffuse transmission, an
 // interface; a mix if either of its materials may).
 bool lets_light_through(const RenderScene& scene, int object, int material = -2, int depth = 0) {
@@ -33,8 +39,7 @@ bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng
   Ray ray{a, d / len, len};
   for (int crossing = 0; crossing < 8; ++crossing) {
     Hit h;
-    ++rays.probe_rays;
-    if (rays.observer) rays.observer->closest_hit(ray);
+    count(rays, ray);
     if (!scene.intersect(ray, &h)) return false;
     const SurfacePoint at = scene.surface(ray, h);
     const bool passes = h.object == object ? std::fabs(dot(at.ng, ng)) >= normal_cos
@@ -68,8 +73,7 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
   {
     const Ray up{sp.p + n * lift, n, radius * kTan60};
     Hit h;
-    ++rays.probe_rays;
-    if (rays.observer) rays.observer->closest_hit(up);
+    count(rays, up);
     if (scene.intersect(up, &h)) slope = 0.5f * h.t / radius;
   }
   const float skim = std::fmax(lift, 1e-4f * radius);  // the height of blocked_along's rays
@@ -87,9 +91,7 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
   Hit hits[kDiscProbes];
   bool found[kDiscProbes];
   scene.intersect_bundle(probes, kDiscProbes, hits, found);
-  rays.probe_rays += kDiscProbes;
-  if (rays.observer)
-    for (const Ray& r : probes) rays.observer->closest_hit(r);
+  for (const Ray& r : probes) count(rays, r);
   const auto* mesh = std::get_if<TriangleMesh>(&scene.objects[size_t(object)].shape);
   DiscProbes out;
   for (int i = 0; i < kDiscProbes; ++i) {
@@ -102,8 +104,7 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
       const SurfacePoint at = scene.surface(ray, h);
       travelled += h.t;
       ray = Ray{offset_origin(at.p, at.ng, ray.d, at.error), ray.d, ray.t_max - h.t};
-      ++rays.probe_rays;
-      if (rays.observer) rays.observer->closest_hit(ray);
+      count(rays, ray);
       found[i] = scene.intersect(ray, &h);
     }
     const uint8_t bit = uint8_t(1u << i);

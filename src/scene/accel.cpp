@@ -182,6 +182,7 @@ class Accel {
   }
 
   void intersect_coherent(const Ray* rays, int n, Hit* hits, bool* found) const {
+    static_assert(RenderScene::kBundle == 8, "an RTCRayHit8 packet");
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -217,7 +218,6 @@ class Accel {
       hits[i].t = rh.ray.tfar[i];
     }
   }
-  static constexpr int kBundle = RenderScene::kBundle;
 
   bool occluded(const Ray& ray) const {
     RTCIntersectContext ctx;
