@@ -152,7 +152,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
   if (a.no_guide) opt.bpm.guide_emission = false;
-  if (a.no_disc_probes) opt.bpm.disc_probes = false;
+  if (a.no_disc_probes) opt.bpm.disc_probes = opt.fpm.disc_probes = false;
   if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;
   if (a.radius >= 0) opt.bpm.radius = a.radius;
   for (PhotonSettings* p :
@@ -492,8 +492,8 @@ int main(int argc, char** argv) {
       ->group(g);
   render
       ->add_flag("--no-disc-probes", ra.no_disc_probes,
-                 "bpm: divide the photons a backward photon gathers by its whole disc, even where "
-                 "a wall or an edge leaves photons part of it (file: bool discprobes false)")
+                 "bpm and fpm: divide the photons an estimate gathers by its whole disc, even "
+                 "where a wall or an edge leaves photons part of it (file: bool discprobes false)")
       ->group(g);
   render
       ->add_flag("--debias", ra.debias,

@@ -163,11 +163,12 @@ Iterations render_iterations(const LoadedScene& ls, const std::string& integrato
 
 // One whole render of `iterations` per seed (so that anything learnt across iterations, such as
 // guided emission, is at work); the spread over seeds gives the standard errors.
-Iterations render_seeds(const LoadedScene& ls, int seeds, int iterations, const BpmSettings& bpm) {
+Iterations render_seeds(const LoadedScene& ls, int seeds, int iterations, const BpmSettings& bpm,
+                        const std::string& integrator = "bpm") {
   Iterations out;
   for (int k = 0; k < seeds; ++k) {
     Film film(ls.film.width, ls.film.height);
-    out.last = render(ls, test_options(ls, "bpm", iterations, 100 + uint64_t(k), bpm), &film);
+    out.last = render(ls, test_options(ls, integrator, iterations, 100 + uint64_t(k), bpm), &film);
     out.images.push_back(film.image());
   }
   return out;
@@ -485,23 +486,36 @@ TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
   expect_bpm_converges(ls, render_with(ls, "path", 2048).film, 3);
 }
 
-// Without the disc probes, every backward photon near a wall or an edge of the box divides the
-// photons it finds by its whole disc, of which a part lies past the wall: the image is darker
-// than path's by a share that grows with the radius (here k1 = 3 pixels of 32). With them its
-// mean agrees with path's, except for the small excess of 1 / share over a share's inverse.
+// Without the disc probes, every estimate near a wall or an edge of the box divides the photons
+// it finds by its whole disc, of which a part lies past the wall: the image is darker than path's
+// by a share that grows with the radius (here k1 = 3 pixels of 32). With them its mean agrees with
+// path's, except for the small excess of 1 / share over a share's inverse. So in bpm (a map per
+// object) and in fpm (one map for all objects).
 TEST(Bpm, DiscProbesRemoveTheDeficitAtWallsAndEdges) {
   LoadedScene ls = load(cornell());
   const Film ref = render_with(ls, "path", 4096).film;
   const BlockStats path = block_stats(ref, ls.film.width)[0];
-  BpmSettings s = small_batches(0);
-  const BlockStats probed = image_mean(render_seeds(ls, 8, 24, s));
-  s.disc_probes = false;
-  const BlockStats whole = image_mean(render_seeds(ls, 8, 24, s));
-  const double sigma = std::sqrt(probed.var + path.var);
-  std::printf("image mean / path's: %.4f with the probes, %.4f without (sigma %.4f)\n",
-              probed.mean / path.mean, whole.mean / path.mean, sigma / path.mean);
-  EXPECT_NEAR(probed.mean, path.mean, 4.5 * sigma + 0.003 * path.mean);
-  EXPECT_LT(whole.mean, path.mean - 4.5 * std::sqrt(whole.var + path.var));
+  for (const std::string integrator : {"bpm", "fpm"}) {
+    BpmSettings s = small_batches(0);
+    const Iterations with = render_seeds(ls, 8, 24, s, integrator);
+    s.disc_probes = false;
+    const Iterations without = render_seeds(ls, 8, 24, s, integrator);
+    // Per seed the two renders share their photons, so their difference is far less noisy than
+    // either: the probes' gain, measured in pairs.
+    Iterations gain = with;
+    for (size_t k = 0; k < gain.images.size(); ++k)
+      for (size_t i = 0; i < gain.images[k].rgb.size(); ++i)
+        gain.images[k].rgb[i] -= without.images[k].rgb[i];
+    const BlockStats probed = image_mean(with), whole = image_mean(without), g = image_mean(gain);
+    const double sigma = std::sqrt(probed.var + path.var);
+    std::printf(
+        "%s image mean / path's: %.4f with the probes (sigma %.4f), %.4f without; gain "
+        "%.4f (sigma %.4f)\n",
+        integrator.c_str(), probed.mean / path.mean, sigma / path.mean, whole.mean / path.mean,
+        g.mean / path.mean, std::sqrt(g.var) / path.mean);
+    EXPECT_NEAR(probed.mean, path.mean, 4.5 * sigma + 0.003 * path.mean) << integrator;
+    EXPECT_GT(g.mean, 4.5 * std::sqrt(g.var)) << integrator;
+  }
 }
 
 TEST(Bpm, GlassSphereCausticConvergesToPath) {

@@ -6,9 +6,9 @@
 #include <algorithm>
 
 #include "base/error.h"
-#include "bpm/disc_probes.h"
 #include "integrator/progressive.h"
 #include "photons/density.h"
+#include "photons/disc_probes.h"
 
 namespace bpm {
 
@@ -38,7 +38,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
           // eq. (2): L = tau * sum f dPhi / (pi r^2), with dPhi = flux / N emitted.
           const float norm =
               float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
-          // Over the part of each nested disc where photons can land (bpm/disc_probes.h).
+          // Over the part of each nested disc where photons can land (photons/disc_probes.h).
           NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
           if (bp.disc_cut) {
             nested.all /= disc_share(bp.disc_found, bp.disc_cut, 0);

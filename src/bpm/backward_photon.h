@@ -25,7 +25,7 @@ struct BackwardPhoton {
   uint8_t accepts;         // AcceptMask bits
   uint8_t diffuse_index;   // j - 1 for the j-th diffuse vertex (0..3)
   bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
-  uint8_t disc_cut = 0;    // the disc probes that found no surface (bpm/disc_probes.h)
+  uint8_t disc_cut = 0;    // the disc probes that found no surface (photons/disc_probes.h)
   uint8_t disc_found = 0;  // and those that found some
 
   // Sort key that fixes the order of backward photons whatever thread stored them.

@@ -131,14 +131,11 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   // caustics (half of them at D = 0) would gather nothing: they are not made.
   const bool caustics = may_have_caustics(scene);
 
-  // Disc probes at first vertices near edges only (bpm/disc_probes.h); with a radius in world
+  // Disc probes at first vertices near edges only (photons/disc_probes.h); with a radius in world
   // units the radii on screen are unknown, and every disc is probed.
-  const std::vector<uint8_t> edges =
-      s.disc_probes && s.radius <= 0
-          ? find_edges(scene, camera.camera(), ls.film.width, ls.film.height)
-          : std::vector<uint8_t>();
-  const float reach = std::fmax(0.5f, std::fmax(ls.filter.radius.x, ls.filter.radius.y));
-  int near_radii[2] = {-1, -1};
+  NearEdges near_edges(s.disc_probes && s.radius <= 0, scene, camera.camera(), ls.film.width,
+                       ls.film.height,
+                       std::fmax(0.5f, std::fmax(ls.filter.radius.x, ls.filter.radius.y)));
 
   auto iteration = [&](int pass, const RenderControl& control) {
     const int it = opt.first_iteration + pass;  // the index random streams and radii follow
@@ -158,17 +155,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                      caustics,
                      s.normal_cos,
                      s.disc_probes};
-    // Where the first vertices' discs are probed: near edges, within this iteration's radii in
-    // pixels, plus the reach of the pixel filter (where in or around the pixel the sample falls).
-    if (!edges.empty()) {
-      const int r0 = int(std::ceil(s.k0 * scale + reach)),
-                r1 = int(std::ceil(s.k1 * scale + reach));
-      if (r0 != near_radii[0] || r1 != near_radii[1]) {
-        mark_near_edges(edges, ls.film.width, ls.film.height, r0, r1, &eye.near_edge);
-        near_radii[0] = r0;
-        near_radii[1] = r1;
-      }
-    }
+    // Where the first vertices' discs are probed: near edges, within this iteration's radii.
+    near_edges.mark(s.k0 * scale, s.k1 * scale, &eye.near_edge);
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);

@@ -8,9 +8,9 @@
 #include <chrono>
 #include <cmath>
 
-#include "bpm/disc_probes.h"
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
+#include "photons/disc_probes.h"
 
 namespace bpm {
 namespace {
@@ -92,8 +92,9 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
         bool probed_whole = false;
         if (prm.disc_probes && !whole && (!seen_directly || (near_edge & near_bit)) &&
             may_cut_discs(scene.objects[size_t(v.object())].shape)) {
-          const DiscProbes probes = probe_disc(scene, v.sp, v.wo, v.object(), bp.radius,
-                                               prm.normal_cos, rng, counters.rays);
+          const DiscProbes probes =
+              probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
+                         prm.normal_cos, rng, counters.rays);
           bp.disc_found = probes.found;
           bp.disc_cut = probes.cut;
           probed_whole = probes.cut == 0;

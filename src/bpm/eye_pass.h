@@ -12,10 +12,10 @@
 
 #include "base/rng.h"
 #include "bpm/backward_photon.h"
-#include "bpm/disc_probes.h"
 #include "bpm/masks.h"
 #include "integrator/counters.h"
 #include "integrator/progressive.h"
+#include "photons/disc_probes.h"
 #include "scene/render_scene.h"
 
 namespace bpm {

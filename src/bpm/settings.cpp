@@ -28,7 +28,6 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"",
              in.loc);
   b.guide_emission = ps.get_bool("guideemission", b.guide_emission);
-  b.disc_probes = ps.get_bool("discprobes", b.disc_probes);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);

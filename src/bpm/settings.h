@@ -18,9 +18,6 @@ struct BpmSettings : PhotonSettings {
   bool centre_tree = false;
   // Guide photon emission toward what the camera sees (photons/emission_guide.h).
   bool guide_emission = true;
-  // Divide each backward photon's estimate by the share of its disc where photons can land,
-  // measured by probe rays near edges (bpm/disc_probes.h), instead of by the whole disc.
-  bool disc_probes = true;
   // Camera samples per iteration for emission seen before the first diffuse vertex, in pixels
   // that show any (EyePassParams::emission_samples): emitter edges and lights seen through glass
   // converge with these, not with the iterations.

@@ -6,6 +6,7 @@
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
 #include "photons/density.h"
+#include "photons/disc_probes.h"
 
 namespace bpm {
 namespace {
@@ -13,13 +14,15 @@ namespace {
 // Radiance reflected at v toward wo from the map's photons of the accepted classes, eq. (2):
 // sum f dPhi / (pi r^2 N), and the estimate of its bias (radius_bias). With knn > 0
 // the radius is the distance to the knn-th nearest photon within `radius` (Jensen's estimate),
-// else `radius`.
+// else `radius`. probe(r) measures the share of the disc of radius r where photons can land
+// (photons/disc_probes.h), which the sums are divided by.
 struct Estimate {
   Spectrum L, bias;
 };
-template <class Accept>
+template <class Accept, class Probe>
 Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only, float radius,
-                  int eye_depth, const FpmEyeParams& prm, Accept&& accept, FpmEyeCounters& c) {
+                  int eye_depth, const FpmEyeParams& prm, Accept&& accept, Probe&& probe,
+                  FpmEyeCounters& c) {
   ++c.lookups;
   const SurfacePoint& sp = v.sp;
   auto usable = [&](const ForwardPhoton& ph) {
@@ -46,6 +49,12 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
                  hero_join_factor(eye_hero_only, ph.hero_only),
              length_squared(ph.p - sp.p), r * r);
   });
+  const DiscProbes d = probe(r);
+  if (d.cut) {
+    sums.all /= disc_share(d.found, d.cut, 0);
+    sums.half /= disc_share(d.found, d.cut, 1);
+    sums.quarter /= disc_share(d.found, d.cut, 2);
+  }
   const float norm = float(1.0 / (kPi * double(r) * r * prm.emitted));
   return {sums.all * norm, radius_bias(sums, norm, prm.fpm->bias_model)};
 }
@@ -57,7 +66,8 @@ bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
 }  // namespace
 
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                                const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c) {
+                                const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c,
+                                uint8_t near_edge) {
   PathState s{ray};
   Spectrum L, bias;
   int depth = 0;
@@ -75,8 +85,23 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
     const EyeVertexChoice choice = choose_eye_vertex(v, rng, s);
     const bool is_diffuse = choice.gather;
-    auto gather = [&](const PhotonMap& map, float radius, auto accept) {
-      const Estimate e = estimate(map, v, s.hero_only, radius, depth, prm, accept, c);
+    // The discs about v are probed where they may be cut: at a vertex seen straight from the
+    // camera, where the screen around the pixel shows an edge (near_bit of near_edge). A disc no
+    // larger than one found whole is whole too.
+    const bool seen_directly = depth == 1;
+    float whole_radius = 0;
+    auto gather = [&](const PhotonMap& map, float radius, uint8_t near_bit, auto accept) {
+      auto probe = [&](float r) {
+        if (!prm.fpm->disc_probes || r <= whole_radius ||
+            (seen_directly && !(near_edge & near_bit)) ||
+            !may_cut_discs(scene.objects[size_t(v.object())].shape))
+          return DiscProbes{};
+        const DiscProbes d = probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyOpaque,
+                                        r, prm.fpm->normal_cos, rng, c.rays);
+        if (!d.cut) whole_radius = r;
+        return d;
+      };
+      const Estimate e = estimate(map, v, s.hero_only, radius, depth, prm, accept, probe, c);
       L += s.beta * e.L;
       bias += s.beta * e.bias;
     };
@@ -84,7 +109,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
       float r1 = s.length * prm.radius_per_length1;
       if (gathering) {
         // x2: everything the global map holds, direct photons included.
-        gather(maps.global, r1, any_class);
+        gather(maps.global, r1, 1, any_class);
         break;
       }
       // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
@@ -92,11 +117,14 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
       L +=
           s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
                                        v.wo_local, false, *prm.materials, rng, c.rays, choice.part);
-      gather(maps.caustic, s.length * prm.radius_per_length0, caustic_class);
+      // Without final gathering the larger disc first (r1 > r0 by default): where it is whole,
+      // the caustic map's is too.
       if (!prm.fpm->final_gather) {
-        gather(maps.global, r1, indirect_class);
+        gather(maps.global, r1, 1, indirect_class);
+        gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
         break;
       }
+      gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
       gathering = true;
       emitter = EmitterWeight::none();
     }

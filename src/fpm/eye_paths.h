@@ -30,12 +30,14 @@ struct FpmEyeCounters {
 };
 
 // Radiance arriving along -ray.d at the camera, and the estimate of its bias: the photon
-// estimates' 2 (L(r) - L(r / sqrt 2)), as bpm's (film.h, add_bias).
+// estimates' 2 (L(r) - L(r / sqrt 2)), as bpm's (film.h, add_bias). near_edge: the pixel's
+// mark_near_edges bits (photons/disc_probes.h), which decide whether the discs about a vertex
+// seen directly are probed.
 struct FpmEyeRadiance {
   Spectrum L, bias;
 };
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
                                 const FpmEyeParams& params, Ray ray, Rng& rng,
-                                FpmEyeCounters& counters);
+                                FpmEyeCounters& counters, uint8_t near_edge = 3);
 
 }  // namespace bpm

@@ -11,6 +11,7 @@
 #include "fpm/eye_paths.h"
 #include "fpm/photon_maps.h"
 #include "integrator/progressive.h"
+#include "photons/disc_probes.h"
 
 namespace bpm {
 namespace {
@@ -53,6 +54,7 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
        {{"camera_rays", t.eye.rays.camera_rays},
         {"bounce_rays", t.eye.rays.bounce_rays},
         {"shadow_rays", t.eye.rays.shadow_rays},
+        {"probe_rays", t.eye.rays.probe_rays},
         {"lookups", t.eye.lookups},
         {"photons_used", t.eye.photons_used},
         {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s)}}},
@@ -92,6 +94,10 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                    std::to_string(int(stored_per_photon)) + " stored per photon)",
                double(film->bytes()) + double(n_photons) * stored_per_photon * photon_bytes,
                opt.memory_budget, "lower --photons or --maxdepth, or raise --memory");
+  // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
+  NearEdges near_edges(s.disc_probes, scene, camera.camera(), film->width(), film->height(),
+                       std::fmax(0.5f, std::fmax(ls.filter.radius.x, ls.filter.radius.y)));
+  std::vector<uint8_t> near_edge(size_t(film->width()) * size_t(film->height()), 3);
   ForwardMaps maps;
   tbb::enumerable_thread_specific<LightCounters> light_counters;
   tbb::enumerable_thread_specific<FpmEyeCounters> eye_counters;
@@ -128,6 +134,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
     // 3. Eye pass.
     t = Clock::now();
     float scale = radius_scale(s, it);
+    near_edges.mark(s.k0 * scale, s.k1 * scale, &near_edge);
     FpmEyeParams ep{&wm,
                     &s,
                     opt.max_depth,
@@ -137,7 +144,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(it, pixel);
       const FpmEyeRadiance r =
-          fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local());
+          fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local(), near_edge[pixel]);
       if (s.debias) {
         record_pass(film, pixel, r.L - r.bias, wm.wl, cs.filter_weight, ls.film.max_component_value,
                     true);

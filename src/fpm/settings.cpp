@@ -21,6 +21,7 @@ nlohmann::json settings_json(const FpmSettings& s) {
           {"final_gather", s.final_gather},
           {"knn", s.knn},
           {"normal_cos", s.normal_cos},
+          {"disc_probes", s.disc_probes},
           {"debias", s.debias},
           {"bias_model", to_string(s.bias_model)}};
 }

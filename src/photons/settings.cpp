@@ -32,6 +32,7 @@ void read_photon_settings(const SceneEntity& in, PhotonSettings* s) {
   s->radius_policy = policy == "fixed" ? RadiusPolicy::kFixed : RadiusPolicy::kProgressive;
   s->alpha = ps.get_float("alpha", s->alpha);
   ps.require("alpha", s->alpha > 0 && s->alpha < 1, "must be in (0, 1)", in.loc);
+  s->disc_probes = ps.get_bool("discprobes", s->disc_probes);
   if (ps.find_any("photonsperiteration")) {
     s->photons_per_iteration = ps.get_int("photonsperiteration", 0);
     ps.require("photonsperiteration", s->photons_per_iteration > 0, "must be positive", in.loc);

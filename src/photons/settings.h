@@ -34,6 +34,9 @@ struct PhotonSettings {
   // Photons count only where the normals of the photon's surface and of the gathering point agree
   // to within this cosine.
   float normal_cos = 0.5f;
+  // Divide each estimate by the share of its disc where photons can land, measured by probe rays
+  // near edges (photons/disc_probes.h), instead of by the whole disc.
+  bool disc_probes = true;
   // Record the photon estimates less their bias estimate (2 L(r / sqrt 2) - L(r) under kSquare;
   // film.h, add_bias): noisier, and without a bias estimate of its own.
   bool debias = false;
@@ -53,8 +56,8 @@ int photons_for(const PhotonSettings& s, size_t pixels);
 // Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.
 float radius_scale(const PhotonSettings& s, int iteration);
 
-// Reads k0, k1, radiuspolicy, alpha and photonsperiteration (pbrt-v4 sppm's name) from an
-// Integrator line; a bad value is an error at its place in the file.
+// Reads k0, k1, radiuspolicy, alpha, discprobes and photonsperiteration (pbrt-v4 sppm's name) from
+// an Integrator line; a bad value is an error at its place in the file.
 void read_photon_settings(const SceneEntity& integrator, PhotonSettings* s);
 
 }  // namespace bpm

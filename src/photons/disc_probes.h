@@ -34,14 +34,20 @@ struct DiscProbes {
   uint8_t found = 0, cut = 0;
 };
 
+// Where the photons an estimate gathers may lie: on the gathering point's own object (bpm keeps a
+// map per object), or on any object that stops light (fpm's maps hold them all).
+enum class PhotonSurfaces { kOwnObject, kAnyOpaque };
+
 // Probes the disc of `radius` about sp.p in its tangent plane, on the side wo points to. A probe
 // is a ray from above the point, 60 degrees off the plane, aimed at a point of the disc: it finds
-// surface when it hits `object` inside the sphere of `radius` with a normal that agrees with sp's
-// to within normal_cos, as a photon must to be gathered. A wall in between stops it; past an edge
+// surface when it hits `object` (or, under kAnyOpaque, any object that stops light) inside the
+// sphere of `radius` with a normal that agrees with sp's to within normal_cos, as a photon must to
+// be gathered. A wall in between stops it; past an edge
 // it misses the surface. Where the surface curves away below the plane, the probe meets it
 // outside the sphere and says nothing. The probes count in rays.probe_rays.
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
-                      float radius, float normal_cos, Rng& rng, PathCounters& rays);
+                      PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
+                      PathCounters& rays);
 
 // Whether the probes apply to the shape: not to spheres and cylinders, whose surface inside a
 // gathering sphere is whole (on a sphere its area is pi r^2 exactly, Archimedes' hat-box theorem)
@@ -71,5 +77,25 @@ std::vector<uint8_t> find_edges(const RenderScene& scene, const PerspectiveCamer
 // discs' radii on screen, rounded up, with the filter's reach).
 void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, int radius_px0,
                      int radius_px1, std::vector<uint8_t>* near);
+
+// The pixels near edges for each iteration's discs: the edges found once, before the first
+// iteration, spread over the discs' radii on screen with the pixel filter's reach (where in or
+// around the pixel its sample falls), anew whenever their rounded sizes change.
+class NearEdges {
+ public:
+  // Not enabled (no probes, or radii in world units, whose sizes on screen are unknown): no
+  // marks are made, and every disc may be cut.
+  NearEdges(bool enabled, const RenderScene& scene, const PerspectiveCamera& camera, int width,
+            int height, float filter_reach);
+  // The marks (mark_near_edges) for discs of radius_px0 and radius_px1 pixels into *near; left
+  // as they are when not enabled (the caller fills it with 3) or when the rounded sizes have not
+  // changed since the last call.
+  void mark(float radius_px0, float radius_px1, std::vector<uint8_t>* near);
+
+ private:
+  std::vector<uint8_t> edges_;
+  int width_, height_, radii_[2] = {-1, -1};
+  float reach_;
+};
 
 }  // namespace bpm

@@ -1,4 +1,4 @@
-#include "bpm/disc_probes.h"
+#include "photons/disc_probes.h"
 
 #include <tbb/parallel_for.h>
 
@@ -53,7 +53,8 @@ bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng
 }  // namespace
 
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
-                      float radius, float normal_cos, Rng& rng, PathCounters& rays) {
+                      PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
+                      PathCounters& rays) {
   static_assert(kDiscProbes == RenderScene::kBundle);
   const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
   const Frame frame = Frame::from_z(n);
@@ -108,6 +109,17 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
       found[i] = scene.intersect(ray, &h);
     }
     const uint8_t bit = uint8_t(1u << i);
+    // Another object whose photons count as well (one map for all), in the disc, with a normal
+    // that agrees as the gather compares them (signs included).
+    if (found[i] && h.object != object && where == PhotonSurfaces::kAnyOpaque &&
+        !lets_light_through(scene, h.object)) {
+      const Vec3 at = ray.o + ray.d * h.t;
+      if (length_squared(at - sp.p) <= radius * radius &&
+          dot(scene.surface(ray, h).ng, sp.ng) >= normal_cos) {
+        out.found |= bit;
+        continue;
+      }
+    }
     // Nothing (past an edge), or another object after the target: no surface here.
     if (!found[i] || (h.object != object && travelled + h.t >= to_target[i])) {
       out.cut |= bit;
@@ -118,7 +130,14 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
     // the surface, or an overhang with surface under it (where a sphere rests on a floor), which
     // photons reach: a ray along the surface, just above it, tells them apart.
     if (h.object != object) {
-      if (dot(ray.o + ray.d * h.t - sp.p, n) < 0) continue;
+      const float height = dot(ray.o + ray.d * h.t - sp.p, n);
+      // In the disc's plane: a neighbouring surface (floor tiles, say), whose photons are not
+      // gathered here (a map of their own, or a normal that disagrees).
+      if (std::fabs(height) <= skim) {
+        out.cut |= bit;
+        continue;
+      }
+      if (height < 0) continue;
       const Vec3 target = ray.o + ray.d * (to_target[i] - travelled);
       if (blocked_along(scene, sp.p + n * skim, target + n * skim, object, sp.ng, normal_cos, rays))
         out.cut |= bit;
@@ -235,6 +254,21 @@ void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, i
                              near0 = spread(edges, width, height, radius_px0);
   near->resize(edges.size());
   for (size_t p = 0; p < edges.size(); ++p) (*near)[p] = uint8_t(near1[p] | (near0[p] << 1));
+}
+
+NearEdges::NearEdges(bool enabled, const RenderScene& scene, const PerspectiveCamera& camera,
+                     int width, int height, float filter_reach)
+    : width_(width), height_(height), reach_(filter_reach) {
+  if (enabled) edges_ = find_edges(scene, camera, width, height);
+}
+
+void NearEdges::mark(float radius_px0, float radius_px1, std::vector<uint8_t>* near) {
+  if (edges_.empty()) return;
+  const int r0 = int(std::ceil(radius_px0 + reach_)), r1 = int(std::ceil(radius_px1 + reach_));
+  if (r0 == radii_[0] && r1 == radii_[1] && near->size() == edges_.size()) return;
+  mark_near_edges(edges_, width_, height_, r0, r1, near);
+  radii_[0] = r0;
+  radii_[1] = r1;
 }
 
 }  // namespace bpm
