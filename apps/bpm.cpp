@@ -305,7 +305,9 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
   Film film(ls.film.width, ls.film.height, a.m_images);
   // A checkpoint is kept when outputs are written as the render goes, or when it resumes one
   // (so that it can be resumed again); it is written every --write-every and at the end.
-  const nlohmann::json identity = render_identity(parsed.files, ls, opt, film.m_images());
+  // (Only then: its fingerprint reads every scene and data file again.)
+  const nlohmann::json identity =
+      keep_checkpoint ? render_identity(parsed.files, ls, opt, film.m_images()) : nlohmann::json();
   Checkpoint resumed;
   if (!a.resume.empty()) {
     resumed = read_checkpoint(a.resume);

@@ -491,7 +491,7 @@ TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
 // by a share that grows with the radius (here k1 = 3 pixels of 32). With them its mean agrees with
 // path's, except for the small excess of 1 / share over a share's inverse. So in bpm (a map per
 // object) and in fpm (one map for all objects).
-TEST(Bpm, DiscProbesRemoveTheDeficitAtWallsAndEdges) {
+TEST(DiscProbes, RemoveTheDeficitAtWallsAndEdgesInBpmAndFpm) {
   LoadedScene ls = load(cornell());
   const Film ref = render_with(ls, "path", 4096).film;
   const BlockStats path = block_stats(ref, ls.film.width)[0];
@@ -500,8 +500,9 @@ TEST(Bpm, DiscProbesRemoveTheDeficitAtWallsAndEdges) {
     const Iterations with = render_seeds(ls, 8, 24, s, integrator);
     s.disc_probes = false;
     const Iterations without = render_seeds(ls, 8, 24, s, integrator);
-    // Per seed the two renders share their photons, so their difference is far less noisy than
-    // either: the probes' gain, measured in pairs.
+    // Per seed the two renders share most of their randomness (fpm all its photons; bpm its
+    // first iteration's, its guide then learns from other scores), so their difference is far
+    // less noisy than either: the probes' gain, measured in pairs.
     Iterations gain = with;
     for (size_t k = 0; k < gain.images.size(); ++k)
       for (size_t i = 0; i < gain.images[k].rgb.size(); ++i)

@@ -489,6 +489,44 @@ TEST_F(Cli, ResumeRefusesAnotherRendersCheckpoint) {
             0);
 }
 
+// The data a scene reads from other files (a PLY mesh, a spectrum file) is part of the render's
+// identity as much as the scene file: a checkpoint is refused when one changed since.
+TEST_F(Cli, ResumeRefusesACheckpointWhoseDataFilesChanged) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+      "float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n-1 -1 0\n1 "
+      "-1 0\n0 1 0\n3 0 1 2\n";
+  const std::string spd = "400 0.5\n700 0.5\n";
+  write("m.ply", ply);
+  write("grey.spd", spd);
+  std::string scene = write("s.pbrt", R"(
+LookAt 0 0 -3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 12
+WorldBegin
+LightSource "point" "rgb I" [5 5 5] "point3 from" [0 2 -2]
+Material "diffuse" "spectrum reflectance" "grey.spd"
+Shape "plymesh" "string filename" "m.ply"
+)");
+  const std::string out = (dir_ / "a.exr").string(), b = (dir_ / "b.exr").string();
+  ASSERT_EQ(run("render " + scene + " -q --spp 2 --write-every 100 -o " + out).exit_code, 0);
+  const std::string resume =
+      "render " + scene + " -q --spp 4 --resume " + (dir_ / "a.checkpoint").string() + " -o " + b;
+  const std::vector<std::pair<std::string, std::string>> changes = {
+      {"m.ply", ply + "\n"}, {"grey.spd", "400 0.6\n700 0.5\n"}};
+  for (const auto& [file, changed] : changes) {
+    write(file, changed);
+    CliRun r = run(resume);
+    EXPECT_EQ(r.exit_code, 1) << file;
+    EXPECT_NE(r.err.find("contents of its files"), std::string::npos) << file << ": " << r.err;
+    EXPECT_FALSE(fs::exists(b)) << file;
+  }
+  write("m.ply", ply);
+  write("grey.spd", spd);
+  CliRun r = run(resume);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 TEST_F(Cli, AccuracyFlagStopsAtTheRequestedDelta) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r = run("render " + scene + " -q --accuracy 0.05 -o " + (dir_ / "out.exr").string());

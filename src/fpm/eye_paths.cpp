@@ -15,7 +15,8 @@ namespace {
 // sum f dPhi / (pi r^2 N), and the estimate of its bias (radius_bias). With knn > 0
 // the radius is the distance to the knn-th nearest photon within `radius` (Jensen's estimate),
 // else `radius`. probe(r) measures the share of the disc of radius r where photons can land
-// (photons/disc_probes.h), which the sums are divided by.
+// (photons/disc_probes.h), which the sums are divided by (the photon maps do not depend on the
+// threads, so neither do the probes made).
 struct Estimate {
   Spectrum L, bias;
 };
@@ -49,7 +50,8 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
                  hero_join_factor(eye_hero_only, ph.hero_only),
              length_squared(ph.p - sp.p), r * r);
   });
-  const DiscProbes d = probe(r);
+  // Nothing to divide where nothing was gathered: no probes.
+  const DiscProbes d = sums.all.is_black() ? DiscProbes{} : probe(r);
   if (d.cut) {
     sums.all /= disc_share(d.found, d.cut, 0);
     sums.half /= disc_share(d.found, d.cut, 1);
@@ -96,7 +98,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
             (seen_directly && !(near_edge & near_bit)) ||
             !may_cut_discs(scene.objects[size_t(v.object())].shape))
           return DiscProbes{};
-        const DiscProbes d = probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyOpaque,
+        const DiscProbes d = probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject,
                                         r, prm.fpm->normal_cos, rng, c.rays);
         if (!d.cut) whole_radius = r;
         return d;

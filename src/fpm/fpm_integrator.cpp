@@ -77,7 +77,9 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
   const int min_eye_vertices = s.final_gather ? 2 : 1;
   // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
   // for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
-  // joined map and in the tree. The worst iteration must fit the budget before the first one.
+  // joined map and in the tree. The worst iteration must fit the budget before the first one. Per
+  // pixel, beside the film: the disc probes' edges and near-edge marks.
+  const double fixed_bytes = double(film->bytes()) + 2.0 * film->width() * film->height();
   const double stored_per_photon = std::max(0, opt.max_depth - min_eye_vertices + 1) + 1;
   const double photon_bytes =
       2 * sizeof(ForwardPhoton) + 2 * (sizeof(SphereRef) + sizeof(uint32_t));
@@ -85,14 +87,14 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
   // holds at worst (but never fewer than 100000, which fail as a count set would).
   if (settings.photons_per_iteration == 0 && opt.memory_budget > 0) {
     const double fit =
-        (double(opt.memory_budget) - double(film->bytes())) / (stored_per_photon * photon_bytes);
+        (double(opt.memory_budget) - fixed_bytes) / (stored_per_photon * photon_bytes);
     s.photons_per_iteration = int(std::clamp(fit, 100000.0, double(s.photons_per_iteration)));
   }
   const uint64_t n_photons = uint64_t(s.photons_per_iteration);
   check_memory("fpm with " + std::to_string(n_photons) + " photons per iteration and maxdepth " +
                    std::to_string(opt.max_depth) + " (up to " +
                    std::to_string(int(stored_per_photon)) + " stored per photon)",
-               double(film->bytes()) + double(n_photons) * stored_per_photon * photon_bytes,
+               fixed_bytes + double(n_photons) * stored_per_photon * photon_bytes,
                opt.memory_budget, "lower --photons or --maxdepth, or raise --memory");
   // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
   NearEdges near_edges(s.disc_probes, scene, camera.camera(), film->width(), film->height(),

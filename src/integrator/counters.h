@@ -17,7 +17,7 @@ class RayObserver {
 };
 
 // Camera-side rays: camera rays, their continuations (bounces and crossings of interfaces),
-// shadow rays, and bpm's disc probes (closest-hit rays; photons/disc_probes.h).
+// shadow rays, and the photon methods' disc probes (closest-hit rays; photons/disc_probes.h).
 struct PathCounters {
   uint64_t camera_rays = 0, bounce_rays = 0, shadow_rays = 0, probe_rays = 0;
   RayObserver* observer = nullptr;

@@ -29,6 +29,22 @@ bool lets_light_through(const RenderScene& scene, int object, int material = -2,
          std::holds_alternative<InterfaceMaterial>(m);
 }
 
+// Whether photons are stored on the object (fpm's maps): some lobe of its material is gathered.
+// Not on glass, interfaces or a smooth conductor; a textured roughness may be rough anywhere.
+bool holds_photons(const RenderScene& scene, int object, int material = -2, int depth = 0) {
+  if (material == -2) material = scene.objects[size_t(object)].material;
+  if (material < 0 || size_t(material) >= scene.materials.size()) return true;
+  const MaterialDesc& m = scene.materials[size_t(material)];
+  if (const auto* mix = std::get_if<MixDesc>(&m))
+    return depth > 8 || holds_photons(scene, object, mix->materials[0], depth + 1) ||
+           holds_photons(scene, object, mix->materials[1], depth + 1);
+  if (const auto* c = std::get_if<ConductorDesc>(&m))
+    return c->roughness_tex.any() || !c->roughness.traced();
+  return !std::holds_alternative<DielectricMaterial>(m) &&
+         !std::holds_alternative<ThinDielectricMaterial>(m) &&
+         !std::holds_alternative<InterfaceMaterial>(m);
+}
+
 // Whether the segment from a to b meets another object that light does not cross, or `object`
 // where its normal disagrees with ng (a crease of one mesh).
 bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng, float normal_cos,
@@ -94,6 +110,10 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
   scene.intersect_bundle(probes, kDiscProbes, hits, found);
   for (const Ray& r : probes) count(rays, r);
   const auto* mesh = std::get_if<TriangleMesh>(&scene.objects[size_t(object)].shape);
+  // Another object whose photons count here too (kAnyObject: one map holds them all).
+  auto counts = [&](int o) {
+    return o != object && where == PhotonSurfaces::kAnyObject && holds_photons(scene, o);
+  };
   DiscProbes out;
   for (int i = 0; i < kDiscProbes; ++i) {
     Hit& h = hits[i];
@@ -101,7 +121,7 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
     float travelled = 0;
     // Photons cross glass and interfaces: so does a probe (the rare case, one ray at a time).
     for (int crossing = 0; found[i] && h.object != object && crossing < 4; ++crossing) {
-      if (!lets_light_through(scene, h.object)) break;
+      if (!lets_light_through(scene, h.object) || counts(h.object)) break;
       const SurfacePoint at = scene.surface(ray, h);
       travelled += h.t;
       ray = Ray{offset_origin(at.p, at.ng, ray.d, at.error), ray.d, ray.t_max - h.t};
@@ -109,10 +129,10 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
       found[i] = scene.intersect(ray, &h);
     }
     const uint8_t bit = uint8_t(1u << i);
-    // Another object whose photons count as well (one map for all), in the disc, with a normal
-    // that agrees as the gather compares them (signs included).
-    if (found[i] && h.object != object && where == PhotonSurfaces::kAnyOpaque &&
-        !lets_light_through(scene, h.object)) {
+    // Another object whose photons count as well, inside the sphere (a lower surface too: the
+    // gather takes its photons), with a normal that agrees as the gather compares them (signs
+    // included). Elsewhere it is any other object.
+    if (found[i] && counts(h.object)) {
       const Vec3 at = ray.o + ray.d * h.t;
       if (length_squared(at - sp.p) <= radius * radius &&
           dot(scene.surface(ray, h).ng, sp.ng) >= normal_cos) {

@@ -1,18 +1,18 @@
-// The share of a backward photon's disc where photons can land. Eq. (2) divides the photons
-// gathered by pi r^2, the whole disc; but where a wall stands inside the disc, or the surface ends
-// at an edge, photons land on part of it only, and the estimate falls short: dark seams along
-// every corner and edge, and in a bright closed room about 1% of all its light (indirect light
-// gathered near corners is carried everywhere). Probe rays measure the share, and the estimate is
-// divided by it instead. The share tends to 1 as the radius shrinks, wherever the point is not on
-// an edge, so the estimator stays consistent.
+// The share of a photon estimate's disc where photons can land (bpm's backward photons, fpm's
+// gathers). Eq. (2) divides the photons gathered by pi r^2, the whole disc; but where a wall stands
+// inside the disc, or the surface ends at an edge, photons land on part of it only, and the
+// estimate falls short: dark seams along every corner and edge, and in a bright closed room about
+// 1% of all its light (indirect light gathered near corners is carried everywhere). Probe rays
+// measure the share, and the estimate is divided by it instead. The share tends to 1 as the radius
+// shrinks, wherever the point is not on an edge, so the estimator stays consistent.
 //
-// Probing every backward photon would cost as much as the rest of the eye pass; most discs are
-// whole. A disc can be cut only by geometry near its point, which the camera sees around the
-// pixel: one ray through each pixel's centre, before the first iteration, finds where objects,
-// creases and depth steps are, and only pixels within a disc's radius of one probe their first
-// vertex. Later vertices (seen through specular ones, or at D > 0) are always probed. What is
-// probed depends only on the scene, the camera and the iteration, never on another iteration, so
-// an iteration is the same computation in any process and after a resume.
+// Probing every disc would cost as much as the rest of the eye pass; most discs are whole. A disc
+// can be cut only by geometry near its point, which the camera sees around the pixel: one ray
+// through each pixel's centre, before the first iteration, finds where objects, creases and depth
+// steps are, and only pixels within a disc's radius of one probe their first vertex. Later
+// vertices (seen through specular ones, bpm's at D > 0, fpm's final gathers) are always probed.
+// What is probed depends only on the scene, the camera and the iteration, never on another
+// iteration, so an iteration is the same computation in any process and after a resume.
 #pragma once
 #include <cmath>
 #include <cstdint>
@@ -25,7 +25,7 @@
 
 namespace bpm {
 
-// Probes per backward photon. They lie uniformly over the disc, stratified by area so that
+// Probes per disc. They lie uniformly over the disc, stratified by area so that
 // probes 0-1 fall within r/2 and 0-3 within r/sqrt 2 (the nested discs of the bias estimate,
 // density.h). Bit i of `found` says that probe i found surface where photons count, of `cut`
 // that it found none (a wall, an edge, a crease); a probe in neither says nothing (below).
@@ -35,16 +35,18 @@ struct DiscProbes {
 };
 
 // Where the photons an estimate gathers may lie: on the gathering point's own object (bpm keeps a
-// map per object), or on any object that stops light (fpm's maps hold them all).
-enum class PhotonSurfaces { kOwnObject, kAnyOpaque };
+// map per object), or on any object that holds photons (fpm's maps hold them all: any with a
+// gathered lobe, so not glass, interfaces or a smooth conductor).
+enum class PhotonSurfaces { kOwnObject, kAnyObject };
 
 // Probes the disc of `radius` about sp.p in its tangent plane, on the side wo points to. A probe
 // is a ray from above the point, 60 degrees off the plane, aimed at a point of the disc: it finds
-// surface when it hits `object` (or, under kAnyOpaque, any object that stops light) inside the
-// sphere of `radius` with a normal that agrees with sp's to within normal_cos, as a photon must to
-// be gathered. A wall in between stops it; past an edge
-// it misses the surface. Where the surface curves away below the plane, the probe meets it
-// outside the sphere and says nothing. The probes count in rays.probe_rays.
+// surface when it hits `object` inside the sphere of `radius` with a normal that agrees with sp's
+// to within normal_cos, as a photon must to be gathered (under kAnyObject, also any other object
+// that holds photons, its normal compared with its sign as fpm's gather does). A wall in between
+// stops it; past an edge it misses the surface; another object's surface in the disc's plane (floor
+// tiles) is a cut unless it counts. Where the surface curves away below the plane, the probe
+// meets it outside the sphere and says nothing. The probes count in rays.probe_rays.
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays);

@@ -1,7 +1,8 @@
 // The disc probes measure the share of a gathering disc where photons can land: all of it on an
 // open floor, the part left of a wall or of a table top's edge (the disc less a circular segment),
-// all of it under an overhang or behind glass; and the screen test marks the pixels near where
-// the camera sees an edge.
+// all of it under an overhang or behind glass; where one map holds every object's photons (fpm),
+// other objects count too; and the screen test marks the pixels near where the camera sees an
+// edge.
 #include "photons/disc_probes.h"
 
 #include <gtest/gtest.h>
@@ -38,7 +39,7 @@ struct Shares {
 };
 Shares shares(const LoadedScene& ls, int object, Vec3 p, int n = 2000,
               PhotonSurfaces where = PhotonSurfaces::kOwnObject) {
-  // The surface as the scene gives it (its normal's sign included, which kAnyOpaque compares).
+  // The surface as the scene gives it (its normal's sign included, which kAnyObject compares).
   const Ray down{p + Vec3(0, 1e-3f, 0), Vec3(0, -1, 0), 1e-2f};
   Hit hit;
   EXPECT_TRUE(ls.scene.intersect(down, &hit));
@@ -107,7 +108,7 @@ TEST(DiscProbes, EdgeOfASurfaceCutsOffACircularSegment) {
 // bpm's per-object maps hold photons of one side only (the disc less a segment); walls, a table
 // top's edge and the floor under a resting sphere count as they do for bpm.
 TEST(DiscProbes, AnySurfaceThatStopsLightCountsWhereOneMapHoldsAll) {
-  const PhotonSurfaces any = PhotonSurfaces::kAnyOpaque;
+  const PhotonSurfaces any = PhotonSurfaces::kAnyObject;
   LoadedScene seam = flatten_scene(parse_scene_string(
       std::string(kHeader) +
       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-10 0 -10  -10 0 "

@@ -35,10 +35,11 @@ std::string field_name(const std::string& key) {
 nlohmann::json render_identity(const std::vector<std::string>& scene_files, const LoadedScene& ls,
                                const RenderOptions& opt, int m_images) {
   uint64_t h = fnv1a64(nullptr, 0);
-  for (const std::string& f : scene_files) {
-    const std::string bytes = read_file_bytes(f);
-    h = fnv1a64(bytes.data(), bytes.size(), h);
-  }
+  for (const auto* files : {&scene_files, &ls.data_files})
+    for (const std::string& f : *files) {
+      const std::string bytes = read_file_bytes(f);
+      h = fnv1a64(bytes.data(), bytes.size(), h);
+    }
   char fingerprint[17];
   std::snprintf(fingerprint, sizeof fingerprint, "%016llx", (unsigned long long)h);
   // The photon methods' settings with the photons per iteration resolved for this resolution (so

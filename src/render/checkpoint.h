@@ -29,7 +29,8 @@ struct Checkpoint {
 };
 
 // The identity of a render of `ls` with `opt` (scene_files: ParsedScene::files, whose contents are
-// fingerprinted; m_images: the film's).
+// fingerprinted with those of ls.data_files, the meshes, images and spectra the scene read;
+// m_images: the film's).
 nlohmann::json render_identity(const std::vector<std::string>& scene_files, const LoadedScene& ls,
                                const RenderOptions& opt, int m_images);
 

@@ -2,6 +2,7 @@
 #include "scene/flatten.h"
 
 #include "scene/flatten_internal.h"
+#include "scene/spectra.h"
 
 namespace bpm {
 namespace flatten_internal {
@@ -22,7 +23,20 @@ LoadedScene Flattener::run() {
   for (const LightEntity& l : parsed_.lights) add_light(l, &out.scene);
   out.scene.commit();
   // Distant and infinite lights needed the scene bounds; nothing more to do after commit.
+  out.data_files = data_files_;
   return out;
+}
+
+void Flattener::read_data_file(const std::string& path) {
+  if (data_file_set_.insert(path).second) data_files_.push_back(path);
+}
+
+std::optional<SpectrumCurve> Flattener::spectrum_curve(const ParamSet& ps, const std::string& name,
+                                                       SpectrumKind kind) {
+  std::vector<std::string> files;
+  auto s = get_spectrum(ps, name, kind, parsed_.base_directory, &files);
+  for (const std::string& f : files) read_data_file(f);
+  return s;
 }
 
 }  // namespace flatten_internal

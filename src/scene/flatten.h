@@ -41,6 +41,9 @@ struct LoadedScene {
   FilmSettings film;
   FilterSettings filter;
   FileRenderSettings render;
+  // The files other than scene files that the scene's contents come from: PLY meshes, images and
+  // spectra, in the order first read (ParsedScene::files has the scene files).
+  std::vector<std::string> data_files;
 };
 
 LoadedScene flatten_scene(const ParsedScene& parsed);

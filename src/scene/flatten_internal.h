@@ -38,6 +38,13 @@ class Flattener {
   std::map<std::string, int> named_material_ids_;
   std::map<std::string, int> medium_ids_;
   std::set<std::string> building_materials_;
+  // The data files read so far (LoadedScene::data_files), and the same as a set.
+  std::vector<std::string> data_files_;
+  std::set<std::string> data_file_set_;
+  void read_data_file(const std::string& path);
+  // get_spectrum with the scene's directory, noting a spectrum file it reads.
+  std::optional<SpectrumCurve> spectrum_curve(const ParamSet& ps, const std::string& name,
+                                              SpectrumKind kind);
   // The render scene being filled (set by read_camera, the first step).
   RenderScene* scene_ = nullptr;
   RenderScene& scene() { return *scene_; }

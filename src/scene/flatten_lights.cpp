@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 
 // A light's spectrum; D65 at unit luminance when absent (pbrt-v4's colour-space illuminant).
 SpectrumCurve Flattener::light_spectrum(const ParamSet& ps, const std::string& name) {
-  return get_spectrum(ps, name, SpectrumKind::kIlluminant, parsed_.base_directory)
+  return spectrum_curve(ps, name, SpectrumKind::kIlluminant)
       .value_or(SpectrumCurve::from_rgb(Rgb(1.0f), SpectrumKind::kIlluminant));
 }
 
@@ -29,6 +29,7 @@ std::shared_ptr<const TexImage> Flattener::light_image(const ParamSet& ps,
     throw Error(f ? f->loc : FileLoc{}, light + " light needs \"string filename\"");
   fs::path path =
       fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+  read_data_file(path.string());
   std::shared_ptr<const TexImage> image;
   try {
     image = load_texture_image(path.string(), TexEncoding{});

@@ -23,14 +23,14 @@ std::optional<SpectrumParam> Flattener::spectrum_param(const ParamSet& ps, const
       return SpectrumParam(SpectrumCurve(v));
     }
     if (t.name == "constant") {
-      auto v = get_spectrum(t.params, "value", kind, parsed_.base_directory);
+      auto v = spectrum_curve(t.params, "value", kind);
       return SpectrumParam(v ? *v : SpectrumCurve(1.0f));
     }
     SpectrumParam sp;
     sp.texture = texture_node(t, false, kind);
     return sp;
   }
-  if (auto c = get_spectrum(ps, name, kind, parsed_.base_directory)) return SpectrumParam(*c);
+  if (auto c = spectrum_curve(ps, name, kind)) return SpectrumParam(*c);
   return std::nullopt;
 }
 // A float material parameter that must not vary over the surface (a constant texture is fine).
@@ -254,13 +254,13 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   if (!(scale >= 0) || !std::isfinite(scale))
     throw Error(m.loc, "medium scale must be a non-negative number");
   // pbrt-v4's defaults scatter: sigma_s must be stated, and zero.
-  auto sigma_s = get_spectrum(ps, "sigma_s", SpectrumKind::kUnbounded, parsed_.base_directory);
+  auto sigma_s = spectrum_curve(ps, "sigma_s", SpectrumKind::kUnbounded);
   if (!sigma_s || sigma_s->max_value() * scale > 0) throw unsupported("it scatters (sigma_s > 0)");
-  auto Le = get_spectrum(ps, "Le", SpectrumKind::kIlluminant, parsed_.base_directory);
+  auto Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
   float le_scale = ps.get_float("Lescale", 1);
   if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
   ps.get_float("g", 0);
-  auto sigma_a = get_spectrum(ps, "sigma_a", SpectrumKind::kUnbounded, parsed_.base_directory)
+  auto sigma_a = spectrum_curve(ps, "sigma_a", SpectrumKind::kUnbounded)
                      .value_or(SpectrumCurve::from_rgb(Rgb(0.0011f, 0.0024f, 0.014f),
                                                        SpectrumKind::kUnbounded));
   if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");

@@ -142,6 +142,7 @@ TriangleMesh Flattener::plymesh_shape(const ShapeEntity& s, bool flip) {
   if (auto* d = ps.find_any("displacement")) throw Error(d->loc, "displacement is not supported");
   ps.get_float("edgelength", 1);
   fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(s.directory) / file;
+  read_data_file(path.string());
   PlyMesh ply = read_ply(path.string(), ps.find_any("filename")->loc);
   return mesh_from(s.world_from_object, flip, ply.positions, ply.normals, ply.uvs, ply.indices);
 }

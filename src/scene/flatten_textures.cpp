@@ -40,7 +40,7 @@ int Flattener::spectrum_node(const ParamSet& ps, const std::string& name, Spectr
   if (p && p->type == "texture") return texture_node(texture_entity(*p), false, kind);
   if (p && p->type == "float")
     return scene().textures.add(ConstantTexture{SpectrumCurve(ps.get_float(name, def)), 0});
-  auto v = get_spectrum(ps, name, kind, parsed_.base_directory);
+  auto v = spectrum_curve(ps, name, kind);
   return scene().textures.add(ConstantTexture{v.value_or(SpectrumCurve(def)), 0});
 }
 int Flattener::float_node(const ParamSet& ps, const std::string& name, float def) {
@@ -90,8 +90,7 @@ int Flattener::build_texture(const TextureEntity& t, bool as_float, SpectrumKind
     if (as_float)
       c.value = ps.get_float("value", 1);
     else
-      c.spectrum =
-          get_spectrum(ps, "value", kind, parsed_.base_directory).value_or(SpectrumCurve(1.0f));
+      c.spectrum = spectrum_curve(ps, "value", kind).value_or(SpectrumCurve(1.0f));
     node = c;
   } else if (t.name == "imagemap") {
     node = image_texture(t, kind);
@@ -135,6 +134,7 @@ ImageTexture Flattener::image_texture(const TextureEntity& t, SpectrumKind kind)
     throw Error(t.loc, "imagemap texture \"" + t.texture_name + "\" has no \"string filename\"");
   fs::path path =
       fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+  read_data_file(path.string());
   TexEncoding enc;
   std::string encoding = ps.get_string("encoding", "sRGB");
   if (encoding == "sRGB") {

@@ -74,7 +74,8 @@ std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKin
 }
 
 std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string& name,
-                                          SpectrumKind kind, const std::string& directory) {
+                                          SpectrumKind kind, const std::string& directory,
+                                          std::vector<std::string>* files_read) {
   const Param* p = ps.find_any(name);
   if (!p) return std::nullopt;
   p->used = true;
@@ -109,6 +110,7 @@ std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string&
         throw Error(
             p->loc,
             "\"" + str + "\" is neither a known named spectrum nor a readable spectrum file");
+      if (files_read) files_read->push_back(path.string());
       std::vector<double> pairs;
       std::string line;
       while (std::getline(in, line)) {

@@ -13,9 +13,11 @@
 namespace bpm {
 
 // nullopt when the parameter is absent. Throws Error (with the parameter's location) for a bad
-// value: negative, reflectance above 1, unknown named spectrum, unreadable file.
+// value: negative, reflectance above 1, unknown named spectrum, unreadable file. A spectrum file
+// read is appended to *files_read when given.
 std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string& name,
-                                          SpectrumKind kind, const std::string& directory);
+                                          SpectrumKind kind, const std::string& directory,
+                                          std::vector<std::string>* files_read = nullptr);
 
 // A named pbrt-v4 spectrum as it is stored (not normalised); nullopt when the name is unknown.
 std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKind kind);
