@@ -14,35 +14,39 @@ void count(PathCounters& rays, const Ray& ray) {
   if (rays.observer) rays.observer->closest_hit(ray);
 }
 
-// Whether light may pass through the object's surface (refraction, diffuse transmission, an
-// interface; a mix if either of its materials may).
-bool lets_light_through(const RenderScene& scene, int object, int material = -2, int depth = 0) {
-  if (material == -2) material = scene.objects[size_t(object)].material;
+// Whether `is` holds for the material, or for either material of a mix (or there is no material
+// to tell: then it may).
+template <class Is>
+bool some_material(const RenderScene& scene, int material, Is&& is, int depth = 0) {
   if (material < 0 || size_t(material) >= scene.materials.size()) return true;
   const MaterialDesc& m = scene.materials[size_t(material)];
   if (const auto* mix = std::get_if<MixDesc>(&m))
-    return depth > 8 || lets_light_through(scene, object, mix->materials[0], depth + 1) ||
-           lets_light_through(scene, object, mix->materials[1], depth + 1);
-  return std::holds_alternative<DielectricMaterial>(m) ||
-         std::holds_alternative<ThinDielectricMaterial>(m) ||
-         std::holds_alternative<DiffuseTransmissionDesc>(m) ||
-         std::holds_alternative<InterfaceMaterial>(m);
+    return depth > 8 || some_material(scene, mix->materials[0], is, depth + 1) ||
+           some_material(scene, mix->materials[1], is, depth + 1);
+  return is(m);
+}
+
+// Whether light may pass through the object's surface (refraction, diffuse transmission, an
+// interface).
+bool lets_light_through(const RenderScene& scene, int object) {
+  return some_material(scene, scene.objects[size_t(object)].material, [](const MaterialDesc& m) {
+    return std::holds_alternative<DielectricMaterial>(m) ||
+           std::holds_alternative<ThinDielectricMaterial>(m) ||
+           std::holds_alternative<DiffuseTransmissionDesc>(m) ||
+           std::holds_alternative<InterfaceMaterial>(m);
+  });
 }
 
 // Whether photons are stored on the object (fpm's maps): some lobe of its material is gathered.
 // Not on glass, interfaces or a smooth conductor; a textured roughness may be rough anywhere.
-bool holds_photons(const RenderScene& scene, int object, int material = -2, int depth = 0) {
-  if (material == -2) material = scene.objects[size_t(object)].material;
-  if (material < 0 || size_t(material) >= scene.materials.size()) return true;
-  const MaterialDesc& m = scene.materials[size_t(material)];
-  if (const auto* mix = std::get_if<MixDesc>(&m))
-    return depth > 8 || holds_photons(scene, object, mix->materials[0], depth + 1) ||
-           holds_photons(scene, object, mix->materials[1], depth + 1);
-  if (const auto* c = std::get_if<ConductorDesc>(&m))
-    return c->roughness_tex.any() || !c->roughness.traced();
-  return !std::holds_alternative<DielectricMaterial>(m) &&
-         !std::holds_alternative<ThinDielectricMaterial>(m) &&
-         !std::holds_alternative<InterfaceMaterial>(m);
+bool holds_photons(const RenderScene& scene, int object) {
+  return some_material(scene, scene.objects[size_t(object)].material, [](const MaterialDesc& m) {
+    if (const auto* c = std::get_if<ConductorDesc>(&m))
+      return c->roughness_tex.any() || !c->roughness.traced();
+    return !std::holds_alternative<DielectricMaterial>(m) &&
+           !std::holds_alternative<ThinDielectricMaterial>(m) &&
+           !std::holds_alternative<InterfaceMaterial>(m);
+  });
 }
 
 // Whether the segment from a to b meets another object that light does not cross, or `object`
