@@ -40,11 +40,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
               float(1.0 / (kPi * double(bp.radius) * bp.radius * double(light.emitted)));
           // Over the part of each nested disc where photons can land (photons/disc_probes.h).
           NestedSums nested{light.flux[g], light.flux_inner[g], light.flux_quarter[g]};
-          if (bp.disc_cut) {
-            nested.all /= disc_share(bp.disc_found, bp.disc_cut, 0);
-            nested.half /= disc_share(bp.disc_found, bp.disc_cut, 1);
-            nested.quarter /= disc_share(bp.disc_found, bp.disc_cut, 2);
-          }
+          divide_by_disc_shares(&nested, bp.disc_found, bp.disc_cut);
           const Spectrum share = bp.tau * nested.all * norm,
                          bias = bp.tau * radius_bias(nested, norm, settings.bias_model);
           light.flux[g] = share;

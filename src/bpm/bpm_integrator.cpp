@@ -134,8 +134,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   // Disc probes at first vertices near edges only (photons/disc_probes.h); with a radius in world
   // units the radii on screen are unknown, and every disc is probed.
   NearEdges near_edges(s.disc_probes && s.radius <= 0, scene, camera.camera(), ls.film.width,
-                       ls.film.height,
-                       std::fmax(0.5f, std::fmax(ls.filter.radius.x, ls.filter.radius.y)));
+                       ls.film.height, ls.filter.radius);
 
   auto iteration = [&](int pass, const RenderControl& control) {
     const int it = opt.first_iteration + pass;  // the index random streams and radii follow
@@ -154,9 +153,10 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                      s.radius * scale,
                      caustics,
                      s.normal_cos,
-                     s.disc_probes};
+                     s.disc_probes,
+                     &near_edges};
     // Where the first vertices' discs are probed: near edges, within this iteration's radii.
-    near_edges.mark(s.k0 * scale, s.k1 * scale, &eye.near_edge);
+    near_edges.mark(s.k0 * scale, s.k1 * scale);
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
                                  {thread_lists, eye_counters});
     tot.eye_s += since(t);

@@ -204,7 +204,7 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             }
             CameraSample cs = camera.sample(pass_index, pixel);
             EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, false,
-                                           px->near_edge[pixel]);
+                                           prm.near_edges ? prm.near_edges->at(pixel) : 3);
             px->radiance[pixel] = r.total;
             px->filter_weight[pixel] = cs.filter_weight;
             if (prm.emission_samples > 1 && px->sees_emission[pixel] && cs.filter_weight != 0)

@@ -38,8 +38,10 @@ struct EyePassParams {
   bool caustics = true;
   // Photons count only where the normals agree to within this cosine (PhotonSettings).
   float normal_cos = 0.5f;
-  // Measure the share of each backward photon's disc where photons can land (disc_probes.h).
+  // Measure the share of each backward photon's disc where photons can land (disc_probes.h),
+  // at first vertices seen directly only where near_edges marks the pixel (all when null).
   bool disc_probes = true;
+  const NearEdges* near_edges = nullptr;
 };
 
 // Whether some material of the scene's objects may have a traced lobe (materials/material.h),
@@ -83,16 +85,13 @@ struct EyePixels {
   // its first diffuse vertex: such pixels take EyePassParams::emission_samples camera samples for
   // it. saw_emission marks those of this round, merged at its end.
   std::vector<uint8_t> sees_emission, saw_emission;
-  // Where a disc of the pixel's first vertex may be cut (mark_near_edges; everywhere unless set).
-  std::vector<uint8_t> near_edge;
   explicit EyePixels(size_t n)
       : radiance(n),
         filter_weight(n),
         cost_ns(n),
         sampled(n, 0),
         sees_emission(n, 0),
-        saw_emission(n, 0),
-        near_edge(n, 3) {}
+        saw_emission(n, 0) {}
 };
 
 // Per-thread state the eye pass fills.

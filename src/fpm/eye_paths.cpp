@@ -52,11 +52,7 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
   });
   // Nothing to divide where nothing was gathered: no probes.
   const DiscProbes d = sums.all.is_black() ? DiscProbes{} : probe(r);
-  if (d.cut) {
-    sums.all /= disc_share(d.found, d.cut, 0);
-    sums.half /= disc_share(d.found, d.cut, 1);
-    sums.quarter /= disc_share(d.found, d.cut, 2);
-  }
+  divide_by_disc_shares(&sums, d.found, d.cut);
   const float norm = float(1.0 / (kPi * double(r) * r * prm.emitted));
   return {sums.all * norm, radius_bias(sums, norm, prm.fpm->bias_model)};
 }

@@ -98,8 +98,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                opt.memory_budget, "lower --photons or --maxdepth, or raise --memory");
   // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
   NearEdges near_edges(s.disc_probes, scene, camera.camera(), film->width(), film->height(),
-                       std::fmax(0.5f, std::fmax(ls.filter.radius.x, ls.filter.radius.y)));
-  std::vector<uint8_t> near_edge(size_t(film->width()) * size_t(film->height()), 3);
+                       ls.filter.radius);
   ForwardMaps maps;
   tbb::enumerable_thread_specific<LightCounters> light_counters;
   tbb::enumerable_thread_specific<FpmEyeCounters> eye_counters;
@@ -136,7 +135,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
     // 3. Eye pass.
     t = Clock::now();
     float scale = radius_scale(s, it);
-    near_edges.mark(s.k0 * scale, s.k1 * scale, &near_edge);
+    near_edges.mark(s.k0 * scale, s.k1 * scale);
     FpmEyeParams ep{&wm,
                     &s,
                     opt.max_depth,
@@ -145,8 +144,8 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                     double(emitted)};
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(it, pixel);
-      const FpmEyeRadiance r =
-          fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng, eye_counters.local(), near_edge[pixel]);
+      const FpmEyeRadiance r = fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng,
+                                                eye_counters.local(), near_edges.at(pixel));
       if (s.debias) {
         record_pass(film, pixel, r.L - r.bias, wm.wl, cs.filter_weight, ls.film.max_component_value,
                     true);

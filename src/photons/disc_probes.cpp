@@ -281,16 +281,18 @@ void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, i
 }
 
 NearEdges::NearEdges(bool enabled, const RenderScene& scene, const PerspectiveCamera& camera,
-                     int width, int height, float filter_reach)
-    : width_(width), height_(height), reach_(filter_reach) {
+                     int width, int height, Vec2 filter_radius)
+    : width_(width),
+      height_(height),
+      reach_(std::fmax(0.5f, std::fmax(filter_radius.x, filter_radius.y))) {
   if (enabled) edges_ = find_edges(scene, camera, width, height);
 }
 
-void NearEdges::mark(float radius_px0, float radius_px1, std::vector<uint8_t>* near) {
+void NearEdges::mark(float radius_px0, float radius_px1) {
   if (edges_.empty()) return;
   const int r0 = int(std::ceil(radius_px0 + reach_)), r1 = int(std::ceil(radius_px1 + reach_));
-  if (r0 == radii_[0] && r1 == radii_[1] && near->size() == edges_.size()) return;
-  mark_near_edges(edges_, width_, height_, r0, r1, near);
+  if (r0 == radii_[0] && r1 == radii_[1]) return;
+  mark_near_edges(edges_, width_, height_, r0, r1, &near_);
   radii_[0] = r0;
   radii_[1] = r1;
 }

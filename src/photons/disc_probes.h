@@ -21,6 +21,7 @@
 #include "base/rng.h"
 #include "camera/camera.h"
 #include "integrator/counters.h"
+#include "photons/density.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -86,18 +87,27 @@ void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, i
 class NearEdges {
  public:
   // Not enabled (no probes, or radii in world units, whose sizes on screen are unknown): no
-  // marks are made, and every disc may be cut.
+  // marks are made, and every disc may be cut. filter_radius: the pixel filter's, in pixels.
   NearEdges(bool enabled, const RenderScene& scene, const PerspectiveCamera& camera, int width,
-            int height, float filter_reach);
-  // The marks (mark_near_edges) for discs of radius_px0 and radius_px1 pixels into *near; left
-  // as they are when not enabled (the caller fills it with 3) or when the rounded sizes have not
-  // changed since the last call.
-  void mark(float radius_px0, float radius_px1, std::vector<uint8_t>* near);
+            int height, Vec2 filter_radius);
+  // Marks the pixels for discs of radius_px0 and radius_px1 pixels (the iteration's k0 and k1
+  // times its radius scale); nothing to do when the rounded sizes have not changed.
+  void mark(float radius_px0, float radius_px1);
+  // The pixel's mark_near_edges bits: 3 (both discs may be cut) when not enabled.
+  uint8_t at(size_t pixel) const { return near_.empty() ? uint8_t(3) : near_[pixel]; }
 
  private:
-  std::vector<uint8_t> edges_;
+  std::vector<uint8_t> edges_, near_;
   int width_, height_, radii_[2] = {-1, -1};
   float reach_;
 };
+
+// Divides the nested sums by the shares of their discs where photons can land (disc_share).
+inline void divide_by_disc_shares(NestedSums* sums, uint8_t found, uint8_t cut) {
+  if (!cut) return;
+  sums->all /= disc_share(found, cut, 0);
+  sums->half /= disc_share(found, cut, 1);
+  sums->quarter /= disc_share(found, cut, 2);
+}
 
 }  // namespace bpm
