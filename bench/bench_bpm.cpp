@@ -240,6 +240,27 @@ void equal_time(const LoadedScene& ls, const std::string& scene_path,
   }
 }
 
+int run_benchmarks(const std::string& scene_path, const std::string& only, const std::string& pbrt,
+                   int w, int h, int iterations, double reference_s,
+                   const std::vector<double>& times) {
+  LoadedScene ls = flatten_scene(parse_scene_file(scene_path));
+  ls.film.width = w;
+  ls.film.height = h;
+  int hw = int(std::thread::hardware_concurrency());
+  BpmSettings bs = bpm_settings_from_file(ls.render.integrator_directive);
+  bs.photons_per_iteration = photons_for(bs, size_t(w) * size_t(h));
+  std::printf(
+      "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per "
+      "iteration\n",
+      scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1,
+      bs.photons_per_iteration);
+  if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
+  if (only.empty() || only == "rays") rays(ls, scene_path, iterations, bs, hw, pbrt);
+  if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);
+  if (only == "reference") equal_time(ls, scene_path, {}, reference_s, bs);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -264,23 +285,21 @@ int main(int argc, char** argv) {
       times.clear();
       std::stringstream ss(next());
       for (std::string t; std::getline(ss, t, ',');) times.push_back(std::atof(t.c_str()));
-    } else
+    } else if (argv[i][0] == '-') {
+      const bool help = !std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h");
+      if (!help) std::fprintf(stderr, "bench_bpm: unknown argument '%s'\n", argv[i]);
+      std::fprintf(help ? stdout : stderr,
+                   "usage: bench_bpm [scene.pbrt] [--res WxH] [--iterations N] [--times 30,60] "
+                   "[--reference-time S] [--only trees|rays|equal-time|reference] [--pbrt PATH]\n");
+      return help ? 0 : 2;
+    } else {
       scene_path = argv[i];
+    }
   }
-  LoadedScene ls = flatten_scene(parse_scene_file(scene_path));
-  ls.film.width = w;
-  ls.film.height = h;
-  int hw = int(std::thread::hardware_concurrency());
-  BpmSettings bs = bpm_settings_from_file(ls.render.integrator_directive);
-  bs.photons_per_iteration = photons_for(bs, size_t(w) * size_t(h));
-  std::printf(
-      "scene %s, %dx%d, maxdepth %d, %d hardware threads, D=%d k0=%g k1=%g, %d photons per "
-      "iteration\n",
-      scene_path.c_str(), w, h, ls.render.max_depth, hw, bs.diffuse_depth, bs.k0, bs.k1,
-      bs.photons_per_iteration);
-  if (only.empty() || only == "trees") trees(ls, iterations, hw, bs);
-  if (only.empty() || only == "rays") rays(ls, scene_path, iterations, bs, hw, pbrt);
-  if (only.empty() || only == "equal-time") equal_time(ls, scene_path, times, reference_s, bs);
-  if (only == "reference") equal_time(ls, scene_path, {}, reference_s, bs);
-  return 0;
+  try {
+    return run_benchmarks(scene_path, only, pbrt, w, h, iterations, reference_s, times);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_bpm: %s\n", e.what());
+    return 1;
+  }
 }
