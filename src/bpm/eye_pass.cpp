@@ -76,11 +76,13 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       // Seen straight from the camera: the screen around the pixel says whether its discs may be
       // cut (disc_probes.h).
       const bool seen_directly = diffuse == 1 && depth == 1;
-      // Direct light: shared by MIS with the BSDF sample that continues the path, or alone at the
-      // last vertex, where the path ends.
+      // Direct light: shared by MIS with the BSDF sample that continues the path; at the last
+      // vertex, where the path ends, with one that only looks for the light (unless every light
+      // is a point or a direction, which no BSDF sample finds).
+      const bool bsdf_finds_light = !last || prm.light_by_bsdf;
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, !last, *prm.materials, rng, counters.rays,
-                                        choice.part);
+                                        v.wo_local, bsdf_finds_light, *prm.materials, rng,
+                                        counters.rays, choice.part);
       // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
       // vertex is also the last: two backward photons, one per radius.
       // Each backward photon's disc is probed where it may be cut (disc_probes.h); `whole`: a
@@ -114,7 +116,11 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
         const bool whole = store(kAcceptsIndirect, false);  // r1 > r0: the larger disc first
         store(kAcceptsCaustic, whole && prm.radius_per_length0 < prm.radius_per_length1);
       }
-      if (last) break;
+      if (last) {
+        if (prm.light_by_bsdf)
+          L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, counters.rays);
+        break;
+      }
     }
     // A glossy specular vertex seen through specular ones only (a highlight): direct light by
     // next-event estimation, shared by MIS with the BSDF sample that goes on. After a diffuse

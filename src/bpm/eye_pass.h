@@ -42,6 +42,10 @@ struct EyePassParams {
   // at first vertices seen directly only where near_edges marks the pixel (all when null).
   bool disc_probes = true;
   const NearEdges* near_edges = nullptr;
+  // Direct light at the last diffuse vertex by next-event estimation and a BSDF sample, combined
+  // by MIS (direct_light_by_bsdf); false: next-event estimation alone (every light a point or a
+  // direction, has_non_delta_light).
+  bool light_by_bsdf = true;
 };
 
 // Whether some material of the scene's objects may have a traced lobe (materials/material.h),

@@ -69,8 +69,9 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
   PathState s{ray};
   Spectrum L, bias;
   int depth = 0;
-  // Between x1 and x2 on a final-gather ray emission is not counted: next-event estimation at x1
-  // has counted direct light there.
+  // Emission found by the ray that leaves x1 is direct light at x1, shared by MIS with next-event
+  // estimation there; past that ray's first surface (a final gather through specular vertices) it
+  // is not counted: the photons at x2 carry it.
   EmitterWeight emitter = EmitterWeight::full();
   bool gathering = false;
   ++c.rays.camera_rays;
@@ -110,21 +111,22 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
         gather(maps.global, r1, 1, any_class);
         break;
       }
-      // x1: direct light by next-event estimation (BSDF samples that find an emitter are never
-      // counted), caustics from the caustic map.
-      L +=
-          s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                       v.wo_local, false, *prm.materials, rng, c.rays, choice.part);
+      // x1: direct light by next-event estimation, shared by MIS with the BSDF sample that leaves
+      // x1 (unless every light is a point or a direction); caustics from the caustic map.
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                        v.wo_local, prm.light_by_bsdf, *prm.materials, rng, c.rays,
+                                        choice.part);
       // Without final gathering the larger disc first (r1 > r0 by default): where it is whole,
-      // the caustic map's is too.
+      // the caustic map's is too. The path ends here: its BSDF sample only looks for the light.
       if (!prm.fpm->final_gather) {
         gather(maps.global, r1, 1, indirect_class);
         gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+        if (prm.light_by_bsdf)
+          L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, c.rays);
         break;
       }
       gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
       gathering = true;
-      emitter = EmitterWeight::none();
     }
     // A glossy specular vertex seen through specular ones only (a highlight): direct light by
     // next-event estimation, shared by MIS with the BSDF sample that goes on.
@@ -142,6 +144,10 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
     if (!gathering)
       emitter = direct_here && !bs->is_specular() ? EmitterWeight::mis(bs->mis_pdf, v.sp.p)
                                                   : EmitterWeight::full();
+    else if (is_diffuse && prm.light_by_bsdf && !bs->is_specular())  // leaving x1
+      emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+    else
+      emitter = EmitterWeight::none();
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++c.rays.bounce_rays;
   }

@@ -17,6 +17,10 @@ struct FpmEyeParams {
   int max_depth;
   float radius_per_length0, radius_per_length1;  // per unit of eye path length
   double emitted;                                // photons emitted, N of eq. (2)
+  // Direct light at x1 by next-event estimation and a BSDF sample, combined by MIS (the final
+  // gather's ray, or one that only looks for the light: direct_light_by_bsdf); false: next-event
+  // estimation alone (every light a point or a direction, has_non_delta_light).
+  bool light_by_bsdf = true;
 };
 
 struct FpmEyeCounters {

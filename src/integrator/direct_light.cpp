@@ -1,5 +1,6 @@
 #include "integrator/direct_light.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "base/sampling.h"
@@ -76,6 +77,28 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
       L += beta * Le * power_heuristic(w.pdf_bsdf, p_light);
     }
   }
+}
+
+bool has_non_delta_light(const RenderScene& scene) {
+  return std::any_of(scene.lights.begin(), scene.lights.end(),
+                     [](const Light& l) { return !light_is_delta(l); });
+}
+
+Spectrum direct_light_by_bsdf(const RenderScene& scene, const WavelengthMaterials& materials,
+                              const PathVertex& v, PathState s, BsdfPart part, Rng& rng,
+                              PathCounters& counters) {
+  const float uc = rng.uniform();
+  const Vec2 u{rng.uniform(), rng.uniform()};
+  const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, part);
+  if (!bs || bs->is_specular()) return {};
+  s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+  if (s.beta.is_black()) return {};
+  leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+  ++counters.bounce_rays;
+  Spectrum L;
+  PathVertex next;
+  next_eye_vertex(scene, materials, s, next, counters, EmitterWeight::mis(bs->mis_pdf, v.sp.p), L);
+  return L;
 }
 
 }  // namespace bpm

@@ -57,4 +57,18 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
   return end;
 }
 
+// Whether some light has an area or lies at infinity: one that a BSDF sample can find, and whose
+// next-event estimates alone have unbounded variance beside it (a lamp against a wall: the light's
+// density over directions falls to nothing where its contribution does not).
+bool has_non_delta_light(const RenderScene& scene);
+
+// The direct light that a BSDF sample at the last vertex of a photon method's camera path finds:
+// one segment along a direction drawn from the `part` lobes, the emitter it reaches (through
+// interfaces only) weighted by the power heuristic against next-event estimation at v. The
+// path's other strategy for that light, next-event estimation with use_mis, is the caller's.
+// A sample of a specular lobe finds nothing: next-event estimation cannot reach its light.
+Spectrum direct_light_by_bsdf(const RenderScene& scene, const WavelengthMaterials& materials,
+                              const PathVertex& v, PathState s, BsdfPart part, Rng& rng,
+                              PathCounters& counters);
+
 }  // namespace bpm
