@@ -94,6 +94,8 @@ Spectrum direct_light_by_bsdf(const RenderScene& scene, const WavelengthMaterial
   s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
   if (s.beta.is_black()) return {};
   leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+  // Most such rays meet no emitter at all; the query against the emitters alone says so cheaply.
+  if (!scene.may_reach_emitter(s.ray)) return {};
   ++counters.bounce_rays;
   Spectrum L;
   PathVertex next;

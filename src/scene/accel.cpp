@@ -112,6 +112,8 @@ class Accel {
     scene_ = rtcNewScene(device_);
     rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    emitters_ = rtcNewScene(device_);
+    rtcSetSceneFlags(emitters_, RTC_SCENE_FLAG_ROBUST);
     user_shapes_.reserve(objects.size());
     for (size_t id = 0; id < objects.size(); ++id) {
       const Object& obj = objects[id];
@@ -141,14 +143,17 @@ class Accel {
       rtcCommitGeometry(g);
       unsigned gid = rtcAttachGeometry(scene_, g);
       BPM_CHECK(gid == id);
+      if (obj.first_light >= 0) rtcAttachGeometryByID(emitters_, g, unsigned(id));
       rtcReleaseGeometry(g);
     }
     rtcCommitScene(scene_);
+    rtcCommitScene(emitters_);
     RTCError err = rtcGetDeviceError(device_);
     if (err != RTC_ERROR_NONE)
       throw Error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
   }
   ~Accel() {
+    rtcReleaseScene(emitters_);
     rtcReleaseScene(scene_);
     rtcReleaseDevice(device_);
   }
@@ -219,7 +224,8 @@ class Accel {
     }
   }
 
-  bool occluded(const Ray& ray) const {
+  // Whether anything (the emitting surfaces alone, with `emitters`) lies along the ray.
+  bool occluded(const Ray& ray, bool emitters = false) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
@@ -235,7 +241,7 @@ class Accel {
     r.mask = ~0u;
     r.id = 0;
     r.flags = 0;
-    rtcOccluded1(scene_, &ctx, &r);
+    rtcOccluded1(emitters ? emitters_ : scene_, &ctx, &r);
     return r.tfar < 0;
   }
 
@@ -244,6 +250,7 @@ class Accel {
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  RTCScene emitters_ = nullptr;  // the geometries of the objects that emit, under their own IDs
   TextureSet textures_;
   std::vector<UserShape> user_shapes_;
   size_t triangles_ = 0;
@@ -279,6 +286,9 @@ void RenderScene::intersect_bundle(const Ray* rays, int n, Hit* hits, bool* foun
   accel_->intersect_coherent(rays, n, hits, found);
 }
 bool RenderScene::occluded_ray(const Ray& ray) const { return accel_->occluded(ray); }
+bool RenderScene::may_reach_emitter(const Ray& ray) const {
+  return !infinite_lights.empty() || accel_->occluded(ray, true);
+}
 bool RenderScene::occluded(Vec3 a, Vec3 b) const {
   Vec3 d = b - a;
   float len = length(d);

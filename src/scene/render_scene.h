@@ -66,6 +66,10 @@ class RenderScene {
   // True when something blocks the open segment between a and b.
   bool occluded(Vec3 a, Vec3 b) const;
   bool occluded_ray(const Ray& ray) const;
+  // False when the ray can find no emission: no environment light, and no emitting surface along
+  // it (a query against the emitters alone, much cheaper than `intersect`). True does not say
+  // that the emitter met is the nearest surface.
+  bool may_reach_emitter(const Ray& ray) const;
   SurfacePoint surface(const Ray& ray, const Hit& hit) const {
     return surface_point(objects[hit.object].shape, hit.primitive, hit.barycentric,
                          ray.o + ray.d * hit.t);
