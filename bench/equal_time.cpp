@@ -5,9 +5,9 @@
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
 //              [--integrators path,bpm,fpm] [--references-only]
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
-// (references by bpm), lamp-room, room2 and the Cornell box (../shared's at 256x256 when present,
-// else ours; references by path). scenes/tools/make_equal_time_scenes.py writes spot-facets,
-// water-box and lamp-room.
+// (references by bpm), lamp-room, room2, the Cornell box (../shared's at 256x256 when present,
+// else ours) and, when ../shared has it, the staircase2 stand-in at 256x256 (references by path).
+// scenes/tools/make_equal_time_scenes.py writes spot-facets, water-box and lamp-room.
 //
 // Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
 // loaded). pbrt-v4 (its path, bdpt and sppm), when ../shared/tools/pbrt-v4/pbrt or --pbrt is there,
@@ -67,6 +67,12 @@ std::vector<SceneEntry> default_scenes() {
     s.push_back({"cornell-box", shared_cornell.lexically_normal().string(), "path", "256x256"});
   else
     s.push_back({"cornell-box", ours + "cornell-box.pbrt", "path"});
+  // A real interior: a hall lit by 21 small lamps set in holders against walls and ceiling, tiles
+  // under a near-mirror coat, glass, rough metal (the stand-in replaces a missing wood texture).
+  const fs::path staircase =
+      shared_cornell.parent_path().parent_path() / "staircase2" / "scene-v4-standin.pbrt";
+  if (fs::exists(staircase))
+    s.push_back({"staircase2", staircase.lexically_normal().string(), "path", "256x256"});
   return s;
 }
 

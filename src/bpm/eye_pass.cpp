@@ -51,9 +51,10 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
   std::optional<Spectrum> emission;
   int diffuse = 0;  // diffuse vertices so far (j of DESIGN.md)
   int depth = 0;    // scattering events so far, as the path integrator counts them
-  // Emitters are counted here when seen through specular vertices only, and when a diffuse
-  // vertex's BSDF sample finds them through interfaces only: that is direct light at the vertex,
-  // shared with next-event estimation by MIS.
+  // Emitters are counted here when seen through specular vertices only, and when the BSDF sample
+  // of a diffuse vertex before the last finds them through interfaces only: that is direct light
+  // at the vertex, shared with next-event estimation by MIS (at the last vertex,
+  // direct_light_by_bsdf does the same).
   EmitterWeight emitter = EmitterWeight::full();
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
@@ -77,12 +78,11 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
       // cut (disc_probes.h).
       const bool seen_directly = diffuse == 1 && depth == 1;
       // Direct light: shared by MIS with the BSDF sample that continues the path; at the last
-      // vertex, where the path ends, with one that only looks for the light (unless every light
-      // is a point or a direction, which no BSDF sample finds).
-      const bool bsdf_finds_light = !last || prm.light_by_bsdf;
+      // vertex, where the path ends, with one that only looks for the light (none where every
+      // light is a point or a direction: those next-event estimation counts in full).
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, bsdf_finds_light, *prm.materials, rng,
-                                        counters.rays, choice.part);
+                                        v.wo_local, true, *prm.materials, rng, counters.rays,
+                                        choice.part);
       // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
       // vertex is also the last: two backward photons, one per radius.
       // Each backward photon's disc is probed where it may be cut (disc_probes.h); `whole`: a

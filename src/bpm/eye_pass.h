@@ -42,9 +42,9 @@ struct EyePassParams {
   // at first vertices seen directly only where near_edges marks the pixel (all when null).
   bool disc_probes = true;
   const NearEdges* near_edges = nullptr;
-  // Direct light at the last diffuse vertex by next-event estimation and a BSDF sample, combined
-  // by MIS (direct_light_by_bsdf); false: next-event estimation alone (every light a point or a
-  // direction, has_non_delta_light).
+  // Whether a BSDF sample at the last diffuse vertex looks for the light, shared by MIS with
+  // next-event estimation (direct_light_by_bsdf); false where every light is a point or a
+  // direction, which no BSDF sample finds (has_non_delta_light).
   bool light_by_bsdf = true;
 };
 

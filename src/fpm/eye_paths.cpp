@@ -71,7 +71,8 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
   int depth = 0;
   // Emission found by the ray that leaves x1 is direct light at x1, shared by MIS with next-event
   // estimation there; past that ray's first surface (a final gather through specular vertices) it
-  // is not counted: the photons at x2 carry it.
+  // is not counted: light that reaches x1 through specular vertices is a caustic, x1's caustic
+  // map's.
   EmitterWeight emitter = EmitterWeight::full();
   bool gathering = false;
   ++c.rays.camera_rays;
@@ -112,10 +113,10 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
         break;
       }
       // x1: direct light by next-event estimation, shared by MIS with the BSDF sample that leaves
-      // x1 (unless every light is a point or a direction); caustics from the caustic map.
+      // x1 (points and directions, which no BSDF sample finds, in full); caustics from the
+      // caustic map.
       L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, prm.light_by_bsdf, *prm.materials, rng, c.rays,
-                                        choice.part);
+                                        v.wo_local, true, *prm.materials, rng, c.rays, choice.part);
       // Without final gathering the larger disc first (r1 > r0 by default): where it is whole,
       // the caustic map's is too. The path ends here: its BSDF sample only looks for the light.
       if (!prm.fpm->final_gather) {
@@ -144,7 +145,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
     if (!gathering)
       emitter = direct_here && !bs->is_specular() ? EmitterWeight::mis(bs->mis_pdf, v.sp.p)
                                                   : EmitterWeight::full();
-    else if (is_diffuse && prm.light_by_bsdf && !bs->is_specular())  // leaving x1
+    else if (is_diffuse && !bs->is_specular())  // the final gather's ray leaving x1
       emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
     else
       emitter = EmitterWeight::none();

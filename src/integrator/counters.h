@@ -16,8 +16,11 @@ class RayObserver {
   virtual void shadow(const Ray& ray) = 0;
 };
 
-// Camera-side rays: camera rays, their continuations (bounces and crossings of interfaces),
-// shadow rays, and the photon methods' disc probes (closest-hit rays; photons/disc_probes.h).
+// Camera-side rays: camera rays, their continuations (bounces and crossings of interfaces; also
+// the photon methods' rays from the last vertex that look for a light, direct_light_by_bsdf, when
+// the query against the emitters alone did not rule them out), shadow rays, and the photon
+// methods' disc probes (closest-hit rays; photons/disc_probes.h). The emitter queries themselves
+// are not counted.
 struct PathCounters {
   uint64_t camera_rays = 0, bounce_rays = 0, shadow_rays = 0, probe_rays = 0;
   RayObserver* observer = nullptr;

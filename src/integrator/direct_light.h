@@ -43,17 +43,23 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
                               const Spectrum& beta, const EmitterWeight& w, Spectrum& L);
 
 // The next vertex of a camera path (next_vertex), adding to L the emission found on the way:
-// surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says.
+// surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says;
+// except that emission found past an interface counts in full: next-event estimation's shadow ray
+// along the same line stops at the interface, so BSDF sampling is the only strategy for it.
 inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
                                PathState& s, PathVertex& v, PathCounters& counters,
                                const EmitterWeight& emitter, Spectrum& L) {
   const Wavelengths& wl = materials.wl;
+  auto weight = [&] {
+    return emitter.kind == EmitterWeight::kMis && s.interfaces > 0 ? EmitterWeight::full()
+                                                                   : emitter;
+  };
   StepEnd end =
       next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
                   [&](const Hit& hit, const SurfacePoint& sp) {
-                    L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
+                    L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, weight());
                   });
-  if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
+  if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, weight(), L);
   return end;
 }
 
@@ -66,7 +72,8 @@ bool has_non_delta_light(const RenderScene& scene);
 // one segment along a direction drawn from the `part` lobes, the emitter it reaches (through
 // interfaces only) weighted by the power heuristic against next-event estimation at v. The
 // path's other strategy for that light, next-event estimation with use_mis, is the caller's.
-// A sample of a specular lobe finds nothing: next-event estimation cannot reach its light.
+// The gathered lobes of a vertex where a path ends are never delta, so the sample is never
+// specular (a specular one would find nothing here).
 Spectrum direct_light_by_bsdf(const RenderScene& scene, const WavelengthMaterials& materials,
                               const PathVertex& v, PathState s, BsdfPart part, Rng& rng,
                               PathCounters& counters);

@@ -20,6 +20,7 @@ struct PathState {
   int medium = -1;         // the medium the ray travels in (-1: vacuum)
   float length = 0;        // world distance travelled, interfaces included
   bool hero_only = false;  // only the first wavelength goes on (hero_wavelength_only)
+  int interfaces = 0;      // interface surfaces crossed since the last vertex (next_vertex)
 };
 
 // A surface where the path scatters.
@@ -42,15 +43,16 @@ struct PathVertex {
 enum class StepEnd { kVertex, kEscaped, kAbsorbed };
 
 // Follows s.ray to the next scattering surface and fills v. on_surface(hit, sp) is called at every
-// surface reached, interfaces included, with s.beta already attenuated up to it (emission is
-// counted there). kEscaped: the ray left the scene (s.ray is the escaping ray, s.beta attenuated
-// by the medium it leaves in); kAbsorbed: nothing is left of the throughput. Each crossing of an
-// interface counts one ray in continuation_rays.
+// surface reached, interfaces included, with s.beta already attenuated up to it and s.interfaces
+// the interfaces crossed before it (emission is counted there). kEscaped: the ray left the scene
+// (s.ray is the escaping ray, s.beta attenuated by the medium it leaves in); kAbsorbed: nothing is
+// left of the throughput. Each crossing of an interface counts one ray in continuation_rays.
 template <class OnSurface>
 StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materials, PathState& s,
                     PathVertex& v, uint64_t& continuation_rays, RayObserver* observer,
                     OnSurface&& on_surface) {
   const Wavelengths& wl = materials.wl;
+  s.interfaces = 0;
   for (int guard = 0; guard < 10000; ++guard) {
     if (observer) observer->closest_hit(s.ray);
     v.hit = Hit();
@@ -69,6 +71,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       // A boundary that does not scatter: the same ray goes on past it.
       s.medium = medium_toward(scene, v.hit.object, v.sp.ng, s.ray.d, s.medium);
       s.ray = spawn_ray(v.sp, s.ray.d);
+      ++s.interfaces;
       ++continuation_rays;
       continue;
     }

@@ -1,5 +1,6 @@
 // Embree 3 acceleration structure: one geometry per object (triangle meshes natively, spheres,
-// disks and cylinders as user geometry with analytic intersection).
+// disks and cylinders as user geometry with analytic intersection); the geometries of the objects
+// that emit are also attached, under the same ids, to a scene of their own (may_reach_emitter).
 #include <cmath>
 #include <limits>
 
@@ -224,8 +225,14 @@ class Accel {
     }
   }
 
-  // Whether anything (the emitting surfaces alone, with `emitters`) lies along the ray.
-  bool occluded(const Ray& ray, bool emitters = false) const {
+  // Whether anything lies along the ray (occluded), or any emitting surface (meets_emitter).
+  bool occluded(const Ray& ray) const { return any_hit(scene_, ray); }
+  bool meets_emitter(const Ray& ray) const { return any_hit(emitters_, ray); }
+
+  size_t triangles() const { return triangles_; }
+
+ private:
+  static bool any_hit(RTCScene scene, const Ray& ray) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
@@ -241,13 +248,10 @@ class Accel {
     r.mask = ~0u;
     r.id = 0;
     r.flags = 0;
-    rtcOccluded1(emitters ? emitters_ : scene_, &ctx, &r);
+    rtcOccluded1(scene, &ctx, &r);
     return r.tfar < 0;
   }
 
-  size_t triangles() const { return triangles_; }
-
- private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   RTCScene emitters_ = nullptr;  // the geometries of the objects that emit, under their own IDs
@@ -287,7 +291,7 @@ void RenderScene::intersect_bundle(const Ray* rays, int n, Hit* hits, bool* foun
 }
 bool RenderScene::occluded_ray(const Ray& ray) const { return accel_->occluded(ray); }
 bool RenderScene::may_reach_emitter(const Ray& ray) const {
-  return !infinite_lights.empty() || accel_->occluded(ray, true);
+  return !infinite_lights.empty() || accel_->meets_emitter(ray);
 }
 bool RenderScene::occluded(Vec3 a, Vec3 b) const {
   Vec3 d = b - a;

@@ -94,5 +94,47 @@ TEST(WavelengthMaterials, SamplingWithTheLightSpectraChangesNoSample) {
   EXPECT_GT(back_facing, 50);  // the one-sided light was seen from behind
 }
 
+// may_reach_emitter asks the emitters' own Embree scene: it must say false only where no emitting
+// surface lies anywhere along the ray (a light-finding BSDF sample is then skipped), whatever
+// stands in front or behind. Random rays through a sphere light (user geometry), a quad light, a
+// wall and an interface sphere; each one walked surface by surface through the whole scene.
+TEST(RenderScene, MayReachEmitterIsFalseOnlyWhereNoEmitterLiesAlongTheRay) {
+  const LoadedScene ls = flatten_scene(parse_scene_string(
+      "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nFilm \"rgb\" \"integer "
+      "xresolution\" 8 \"integer yresolution\" 8\nWorldBegin\n"
+      "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\nTranslate 0.5 0 0\n"
+      "Shape \"sphere\" \"float radius\" 0.3\nAttributeEnd\n"
+      "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1 1 -0.5  -0.2 1 "
+      "-0.5  -0.2 1 0.5  -1 1 0.5]\nAttributeEnd\n"
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1 -1 0  1 -1 0  1 "
+      "1 0  -1 1 0]\n"
+      "AttributeBegin\nMaterial \"interface\"\nTranslate -0.5 0 0\nShape \"sphere\" \"float "
+      "radius\" 0.4\nAttributeEnd\n"));
+  const RenderScene& scene = ls.scene;
+  Rng rng(7);
+  int said_no = 0, said_yes = 0, found = 0;
+  for (int i = 0; i < 20000; ++i) {
+    auto u = [&] { return 4 * rng.uniform() - 2; };
+    const Vec3 o{u(), u(), u()}, d = normalize(Vec3{u(), u(), u()});
+    const bool may = scene.may_reach_emitter(Ray{o, d});
+    (may ? said_yes : said_no)++;
+    // Every surface along the line, in order, whatever it is.
+    bool emitter = false;
+    Ray r{o, d};
+    Hit h;
+    for (int k = 0; k < 16 && scene.intersect(r, &h); ++k) {
+      emitter |= scene.objects[size_t(h.object)].first_light >= 0;
+      r.o = r.o + r.d * (h.t + 1e-4f);
+    }
+    found += emitter;
+    if (emitter) {
+      EXPECT_TRUE(may) << "ray " << i;
+    }
+  }
+  EXPECT_GT(said_no, 1000);
+  EXPECT_GT(found, 300);
+}
+
 }  // namespace
 }  // namespace bpm
