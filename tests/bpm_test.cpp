@@ -643,16 +643,21 @@ TEST(Bpm, AbsorbingGlassCausticConvergesToPath) {
   EXPECT_GT(its.last.details["light"]["entries"].get<uint64_t>(), 0u);
 }
 
+// A square lamp of half-side `half` facing down at `height` over a large floor, radiance L; the
+// lamp's own surface reflects nothing, or it would light the floor indirectly.
+std::string lamp_over_floor(float half, float height, float L) {
+  const std::string l = std::to_string(L);
+  return "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
+         "\"diffuse\" \"rgb L\" [" +
+         l + " " + l + " " + l + "]\n" + quad(-half, -half, half, half, height, true) +
+         "AttributeEnd\nMaterial \"diffuse\" \"rgb reflectance\" [0.6 0.5 0.4]\n" +
+         quad(-2, -2, 2, 2, 0, false);
+}
+
 // Light that reaches every visible point only directly: the photons add nothing (no entry is
 // made) and the image is the path tracer's, so nothing is counted twice.
 TEST(Bpm, DirectLightOnlyGivesThePathImageAndNoPhotonEntries) {
-  std::string s = header(32, 5, "0 1.5 -1.5  0 0 0  0 1 0");
-  s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
-       "\"diffuse\" \"rgb L\" [8 8 8]\n" +
-       quad(-0.3f, -0.3f, 0.3f, 0.3f, 1.2f, true) + "AttributeEnd\n";
-  s += "Material \"diffuse\" \"rgb reflectance\" [0.6 0.5 0.4]\n" + quad(-2, -2, 2, 2, 0, false);
-  // The light's own surface reflects nothing, or it would light the floor indirectly.
-  LoadedScene ls = load(s);
+  LoadedScene ls = load(header(32, 5, "0 1.5 -1.5  0 0 0  0 1 0") + lamp_over_floor(0.3f, 1.2f, 8));
   RenderRun ref = render_with(ls, "path", 256);
   for (int d : {0, 1}) {
     Iterations its = render_iterations(ls, "bpm", 64, 2, small_batches(d));
@@ -672,12 +677,8 @@ TEST(Bpm, DirectLightOnlyGivesThePathImageAndNoPhotonEntries) {
 // the spread of such sums (measured 0.88-0.94 of it); twice path's bounds it far from the 6 times
 // of next-event estimation alone.
 TEST(Bpm, DirectLightBesideALampHasThePathTracersNoise) {
-  std::string s = header(32, 1, "0 1.5 -1.2  0 0 0  0 1 0");
-  s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
-       "\"diffuse\" \"rgb L\" [4 4 4]\n" +
-       quad(-0.2f, -0.2f, 0.2f, 0.2f, 0.03f, true) + "AttributeEnd\n";
-  s += "Material \"diffuse\" \"rgb reflectance\" [0.6 0.5 0.4]\n" + quad(-2, -2, 2, 2, 0, false);
-  LoadedScene ls = load(s);
+  LoadedScene ls =
+      load(header(32, 1, "0 1.5 -1.2  0 0 0  0 1 0") + lamp_over_floor(0.2f, 0.03f, 4));
   const Image ref = render_with(ls, "path", 4096).film.image();
   constexpr int kSeeds = 8, kSamples = 16;
   double path = 0;
@@ -709,14 +710,10 @@ TEST(Bpm, DirectLightBesideALampHasThePathTracersNoise) {
 // Every integrator: the image mean with the sphere against the one without, within 4.5 sigma.
 TEST(Integrators, InterfaceAroundALampChangesNothing) {
   auto scene = [](bool sphere) {
-    std::string s = header(24, 3, "0 1.8 -1.8  0 0.2 0  0 1 0");
-    s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
-         "\"diffuse\" \"rgb L\" [6 6 6]\n" +
-         quad(-0.15f, -0.15f, 0.15f, 0.15f, 0.5f, true) + "AttributeEnd\n";
+    std::string s = header(24, 3, "0 1.8 -1.8  0 0.2 0  0 1 0") + lamp_over_floor(0.15f, 0.5f, 6);
     if (sphere)
       s += "AttributeBegin\nMaterial \"interface\"\nTranslate 0 0.5 0\nShape \"sphere\" "
            "\"float radius\" 0.4\nAttributeEnd\n";
-    s += "Material \"diffuse\" \"rgb reflectance\" [0.6 0.5 0.4]\n" + quad(-2, -2, 2, 2, 0, false);
     return load(s);
   };
   const LoadedScene without = scene(false), with = scene(true);
