@@ -14,7 +14,6 @@
 #include "bpm/light_pass.h"
 #include "bpm/masks.h"
 #include "bpm/statistics.h"
-#include "integrator/direct_light.h"
 #include "integrator/progressive.h"
 #include "photons/emission_guide.h"
 
@@ -131,7 +130,6 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   // In a scene where no light path can be a caustic, the backward photons that accept only
   // caustics (half of them at D = 0) would gather nothing: they are not made.
   const bool caustics = may_have_caustics(scene);
-  const bool light_by_bsdf = has_non_delta_light(scene);
 
   // Disc probes at first vertices near edges only (photons/disc_probes.h); with a radius in world
   // units the radii on screen are unknown, and every disc is probed.
@@ -156,8 +154,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                      caustics,
                      s.normal_cos,
                      s.disc_probes,
-                     &near_edges,
-                     light_by_bsdf};
+                     &near_edges};
     // Where the first vertices' discs are probed: near edges, within this iteration's radii.
     near_edges.mark(s.k0 * scale, s.k1 * scale);
     bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,

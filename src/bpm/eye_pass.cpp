@@ -117,8 +117,7 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
         store(kAcceptsCaustic, whole && prm.radius_per_length0 < prm.radius_per_length1);
       }
       if (last) {
-        if (prm.light_by_bsdf)
-          L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, counters.rays);
+        L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, counters.rays);
         break;
       }
     }

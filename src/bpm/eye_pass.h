@@ -42,10 +42,6 @@ struct EyePassParams {
   // at first vertices seen directly only where near_edges marks the pixel (all when null).
   bool disc_probes = true;
   const NearEdges* near_edges = nullptr;
-  // Whether a BSDF sample at the last diffuse vertex looks for the light, shared by MIS with
-  // next-event estimation (direct_light_by_bsdf); false where every light is a point or a
-  // direction, which no BSDF sample finds (has_non_delta_light).
-  bool light_by_bsdf = true;
 };
 
 // Whether some material of the scene's objects may have a traced lobe (materials/material.h),

@@ -122,8 +122,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
       if (!prm.fpm->final_gather) {
         gather(maps.global, r1, 1, indirect_class);
         gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
-        if (prm.light_by_bsdf)
-          L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, c.rays);
+        L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, c.rays);
         break;
       }
       gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);

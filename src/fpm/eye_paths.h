@@ -17,11 +17,6 @@ struct FpmEyeParams {
   int max_depth;
   float radius_per_length0, radius_per_length1;  // per unit of eye path length
   double emitted;                                // photons emitted, N of eq. (2)
-  // Without final gathering, whether a BSDF sample at x1 looks for the light, shared by MIS with
-  // next-event estimation (direct_light_by_bsdf); false where every light is a point or a
-  // direction, which no BSDF sample finds (has_non_delta_light). The final gather's ray does so
-  // anyway.
-  bool light_by_bsdf = true;
 };
 
 struct FpmEyeCounters {

@@ -10,7 +10,6 @@
 #include "base/memory.h"
 #include "fpm/eye_paths.h"
 #include "fpm/photon_maps.h"
-#include "integrator/direct_light.h"
 #include "integrator/progressive.h"
 #include "photons/disc_probes.h"
 
@@ -97,7 +96,6 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                    std::to_string(int(stored_per_photon)) + " stored per photon)",
                fixed_bytes + double(n_photons) * stored_per_photon * photon_bytes,
                opt.memory_budget, "lower --photons or --maxdepth, or raise --memory");
-  const bool light_by_bsdf = has_non_delta_light(scene);
   // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
   NearEdges near_edges(s.disc_probes, scene, camera.camera(), film->width(), film->height(),
                        ls.filter.radius);
@@ -143,8 +141,7 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                     opt.max_depth,
                     s.k0 * pixel_angle * scale,
                     s.k1 * pixel_angle * scale,
-                    double(emitted),
-                    light_by_bsdf};
+                    double(emitted)};
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(it, pixel);
       const FpmEyeRadiance r = fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng,

@@ -1,6 +1,5 @@
 #include "integrator/direct_light.h"
 
-#include <algorithm>
 #include <cmath>
 
 #include "base/sampling.h"
@@ -79,14 +78,10 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
   }
 }
 
-bool has_non_delta_light(const RenderScene& scene) {
-  return std::any_of(scene.lights.begin(), scene.lights.end(),
-                     [](const Light& l) { return !light_is_delta(l); });
-}
-
 Spectrum direct_light_by_bsdf(const RenderScene& scene, const WavelengthMaterials& materials,
                               const PathVertex& v, PathState s, BsdfPart part, Rng& rng,
                               PathCounters& counters) {
+  if (!scene.bsdf_finds_lights) return {};  // points and directions: next-event estimation's
   const float uc = rng.uniform();
   const Vec2 u{rng.uniform(), rng.uniform()};
   const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, part);

@@ -63,17 +63,15 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
   return end;
 }
 
-// Whether some light has an area or lies at infinity: one that a BSDF sample can find, and whose
-// next-event estimates alone have unbounded variance beside it (a lamp against a wall: the light's
-// density over directions falls to nothing where its contribution does not).
-bool has_non_delta_light(const RenderScene& scene);
-
-// The direct light that a BSDF sample at the last vertex of a photon method's camera path finds:
+// The direct light that a BSDF sample at the last vertex of a photon method's camera path finds
+// (next-event estimation alone has unbounded variance beside an area light: a lamp against a wall,
+// where the light's density over directions falls to nothing and its contribution does not):
 // one segment along a direction drawn from the `part` lobes, the emitter it reaches (through
 // interfaces only) weighted by the power heuristic against next-event estimation at v. The
 // path's other strategy for that light, next-event estimation with use_mis, is the caller's.
 // The gathered lobes of a vertex where a path ends are never delta, so the sample is never
-// specular (a specular one would find nothing here).
+// specular (a specular one would find nothing here). Nothing, and no random number drawn, where
+// every light is a point or a direction (RenderScene::bsdf_finds_lights).
 Spectrum direct_light_by_bsdf(const RenderScene& scene, const WavelengthMaterials& materials,
                               const PathVertex& v, PathState s, BsdfPart part, Rng& rng,
                               PathCounters& counters);

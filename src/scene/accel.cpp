@@ -276,9 +276,11 @@ void RenderScene::commit() {
   bounds_info.radius = std::fmax(1e-3f, 0.5f * length(bounds.diagonal()));
   std::vector<float> weights;
   infinite_lights.clear();
+  bsdf_finds_lights = false;
   for (size_t i = 0; i < lights.size(); ++i) {
     weights.push_back(std::fmax(0.0f, light_power(lights[i], bounds_info).average()));
     if (light_is_environment(lights[i])) infinite_lights.push_back(int(i));
+    bsdf_finds_lights |= !light_is_delta(lights[i]);
   }
   light_distribution = Distribution1D(weights);
   accel_ = std::make_unique<Accel>(objects, textures);

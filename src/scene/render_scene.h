@@ -50,7 +50,10 @@ class RenderScene {
   TextureSet textures;  // the nodes textured materials read
   std::vector<AbsorbingMedium> media;
   std::vector<Light> lights;
-  std::vector<int> infinite_lights;   // lights a ray that escapes the scene sees
+  std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
+  // Some light has an area or lies at infinity: one that a BSDF sample can find (not only points
+  // and directions, which next-event estimation alone reaches).
+  bool bsdf_finds_lights = false;
   Distribution1D light_distribution;  // in proportion to power
   Bounds3 bounds;
   SceneBoundsInfo bounds_info;
