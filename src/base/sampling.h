@@ -125,6 +125,9 @@ class AliasTable {
     return int(k);
   }
   float pmf(int i) const { return bins_[size_t(i)].pmf; }
+  // A bin's parts, for a caller that keeps its own copy of the table with more in each bin.
+  float keep(int i) const { return bins_[size_t(i)].keep; }
+  uint32_t alias(int i) const { return bins_[size_t(i)].alias; }
 
  private:
   struct Bin {

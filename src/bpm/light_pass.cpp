@@ -133,8 +133,13 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     emitted.clear();
     const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
     const uint64_t last = std::min(first + kPhotonsPerChunk, count);
+    auto photon_rng = [&](uint64_t k) {
+      return Rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), first_photon + k, 1));
+    };
     for (uint64_t k = first; k < last; ++k) {
-      Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), first_photon + k, 1));
+      Rng rng = photon_rng(k);
+      // The next photon's part of the guide's table arrives while this one is traced.
+      if (guide && k + 1 < last) guide->prefetch(photon_rng(k + 1));
       const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
       const uint32_t photon = uint32_t(k - first);
       // A backward photon adds at least one eye vertex; direct photons are never used

@@ -43,7 +43,7 @@ EmissionGuide::EmissionGuide(const RenderScene& scene) {
     float p = scene.light_distribution.pmf(int(li)) / float(count);
     std::fill_n(unguided_.begin() + lc.first, count, p);
   }
-  guided_ = AliasTable(unguided_);
+  set_density(unguided_);
   score_sum_.assign(cells_, 0.0);
   photons_.assign(cells_, 0.0);
   new_score_.assign(cells_, 0.0);
@@ -52,9 +52,12 @@ EmissionGuide::EmissionGuide(const RenderScene& scene) {
 
 EmissionDraw EmissionGuide::sample(Rng& rng) const {
   EmissionDraw d;
-  float pmf = 0;
   const uint32_t bits = rng.next_u32();
-  const uint32_t cell = uint32_t(guided_.sample(bits, rng.uniform(), &pmf));
+  const uint32_t own = bin_of(bits);
+  const Bin& b = bins_[own];
+  const int k = rng.uniform() < b.keep ? 0 : 1;  // as AliasTable::sample
+  const uint32_t cell = k == 0 ? own : b.alias;
+  const float pmf = b.pmf[k];
   // The light owning the cell: the last whose first cell is not after it.
   auto it = std::upper_bound(lights_.begin(), lights_.end(), cell,
                              [](uint32_t c, const LightCells& l) { return c < l.first; });
@@ -72,7 +75,7 @@ EmissionDraw EmissionGuide::sample(Rng& rng) const {
   d.u_pos = in_cell(pos_cell, lc.pos_res, lc.pos_bits);
   d.u_dir = in_cell(dir_cell, lc.dir_res, lc.dir_bits);
   d.cell = cell;
-  const float unguided = unguided_[cell];
+  const float unguided = b.unguided[k];
   d.light_pmf = unguided * float(lc.pos_res * lc.pos_res) * float(dir_cells);
   d.weight = pmf > 0 ? unguided / pmf : 0;
   return d;
@@ -129,7 +132,17 @@ void EmissionGuide::rebuild() {
     mixed[c] = float(g);
     moved_ += 0.5 * std::fabs(g - double(unguided_[c]));
   }
-  guided_ = AliasTable(mixed);
+  set_density(mixed);
+}
+
+void EmissionGuide::set_density(const std::vector<float>& guided) {
+  const AliasTable table(guided);
+  bins_.resize(cells_);
+  for (size_t c = 0; c < cells_; ++c) {
+    const int i = int(c);
+    const uint32_t a = table.alias(i);
+    bins_[c] = {table.keep(i), a, {table.pmf(i), table.pmf(int(a))}, {unguided_[c], unguided_[a]}};
+  }
 }
 
 void EmissionGuide::save(ByteWriter& w) const {

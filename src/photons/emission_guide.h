@@ -42,6 +42,11 @@ class EmissionGuide {
   size_t cells() const { return cells_; }
   // Draws the emission of one photon (six numbers from rng: two choose the cell).
   EmissionDraw sample(Rng& rng) const;
+  // Starts fetching the part of the table that sample(rng) will read (rng itself is not advanced):
+  // the table is read at random, once per photon, and may not fit in the cache.
+  void prefetch(Rng rng) const {
+    if (!bins_.empty()) __builtin_prefetch(&bins_[size_t(bin_of(rng.next_u32()))]);
+  }
   // Adds the scores of photons, in a fixed order (the sums must not depend on the thread count),
   // to what was learnt since the last merge; sampling does not change until then.
   void learn(const std::vector<CellScore>& scores);
@@ -72,7 +77,17 @@ class EmissionGuide {
   };
   std::vector<LightCells> lights_;
   std::vector<float> unguided_;  // probability of each cell without guidance
-  AliasTable guided_;            // drawn once per photon: two look-ups, not a binary search
+  // The guided density's alias table, with everything a draw reads in its bin, the alias's part
+  // included: one cache line per photon (the table holds up to a million cells).
+  struct alignas(32) Bin {
+    float keep;         // probability of keeping the bin's own cell
+    uint32_t alias;     // the cell drawn otherwise
+    float pmf[2];       // guided probability of the own cell [0] and of the alias [1]
+    float unguided[2];  // their unguided probabilities
+  };
+  std::vector<Bin> bins_;
+  uint32_t bin_of(uint32_t bits) const { return uint32_t((uint64_t(bits) * bins_.size()) >> 32); }
+  void set_density(const std::vector<float>& guided);
   void rebuild();
   std::vector<double> score_sum_, photons_;      // merged
   std::vector<double> new_score_, new_photons_;  // learnt since the last merge
