@@ -517,8 +517,9 @@ int main(int argc, char** argv) {
       ->group(g);
   render
       ->add_option("--emission-samples", ra.emission_samples,
-                   "Camera samples per iteration for light seen directly or through specular "
-                   "surfaces, in pixels that show any (default 8; file: integer emissionsamples)")
+                   "Most camera samples per iteration for light seen directly or through specular "
+                   "surfaces, in pixels that show any; each pixel takes what its measured "
+                   "variance pays for (default 8; file: integer emissionsamples)")
       ->check(CLI::Range(1, 1024))
       ->group(g);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")

@@ -727,12 +727,15 @@ TEST(Integrators, InterfaceAroundALampChangesNothing) {
   }
 }
 
-// Emission seen before the first diffuse vertex takes EyePassParams::emission_samples camera
-// samples in pixels that have shown some: a light whose edges cross pixels, partly behind a
-// glass sphere. The averaged image stays that of path (blocks within 4.5 sigma), and its pixels'
-// error falls as the extra samples promise. A pixel's first sighting is never averaged (nothing
-// marks it yet), so over 16 iterations its variance falls at best to (1 + 15 / 8) / 16 of that of
-// one sample each: an RMS ratio of 0.42; 0.6 leaves room for pixels that see the light rarely.
+// Emission seen before the first diffuse vertex takes up to EyePassParams::emission_samples
+// camera samples in pixels that have shown some: a light whose edges cross pixels, partly behind a
+// glass sphere, and nothing that reflects light, so that all of a pixel's variance is its
+// emission's and the pixels take the most. The averaged image stays that of path (blocks within
+// 4.5 sigma), and its pixels' error falls as the extra samples promise. A pixel that first shows
+// emission in iteration 1 takes one sample until its statistics are known (iterations 2 and 3,
+// the next two rounds) and the cost of an extra sample has been measured (iteration 4), so over
+// 16 iterations its variance falls at best to (3 + 13 / 8) / 16 of that of one sample each: an
+// RMS ratio of 0.54; 0.75 leaves room for pixels that see the light rarely.
 TEST(Bpm, EmissionSamplesAverageEmitterEdgesWithoutBias) {
   std::string s = header(16, 8, "0 0 -3  0 0 0  0 1 0");
   s += "AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource "
@@ -762,8 +765,37 @@ TEST(Bpm, EmissionSamplesAverageEmitterEdgesWithoutBias) {
   expect_blocks_agree(b, ref.film, 4, 0.0, "8 emission samples");
   expect_blocks_agree(a, ref.film, 4, 0.0, "1 emission sample");
   const double e1 = rms_error(a), e8 = rms_error(b);
-  EXPECT_LT(e8, 0.6 * e1) << "pixel RMS error with 1 sample " << e1 << ", with 8 " << e8;
+  EXPECT_LT(e8, 0.75 * e1) << "pixel RMS error with 1 sample " << e1 << ", with 8 " << e8;
   std::printf("pixel RMS error: 1 sample %.4f, 8 samples %.4f\n", e1, e8);
+}
+
+// A pixel's emission samples minimise its variance times its cost: sqrt(cost ratio * V_emission /
+// V_rest), within [1, max]; 1 while its statistics are not known yet or where no emission was
+// seen, max while the cost ratio is not known.
+TEST(Bpm, EmissionSampleCountBalancesVarianceAndCost) {
+  auto stats = [](std::vector<double> emission, std::vector<double> rest) {
+    EmissionStats<float> s;
+    for (double e : emission) s.add_emission(e);
+    for (double r : rest) s.add_rest(r);
+    return s;
+  };
+  // Emission 0 or 2 (sample variance 4/3 over four), rest 1 or 3 (variance 4/3 over four).
+  const EmissionStats<float> even = stats({0, 2, 0, 2}, {1, 3, 1, 3});
+  EXPECT_EQ(emission_sample_count(even, 9.0, 8), 3);   // sqrt(9 * 1)
+  EXPECT_EQ(emission_sample_count(even, 16.0, 8), 4);  // sqrt(16)
+  EXPECT_EQ(emission_sample_count(even, 0.5, 8), 1);   // sqrt(0.5) rounds to 1
+  EXPECT_EQ(emission_sample_count(even, 400.0, 8), 8);
+  EXPECT_EQ(emission_sample_count(even, 9.0, 1), 1);
+  // Emission 25 times as variable as the rest: five times the samples.
+  const EmissionStats<float> bright = stats({0, 10, 0, 10}, {1, 3, 1, 3});
+  EXPECT_EQ(emission_sample_count(bright, 1.0, 8), 5);
+  // Nothing seen; not enough known; no cost ratio yet; a rest without variance.
+  EXPECT_EQ(emission_sample_count(stats({0, 0, 0}, {1, 3, 1}), 9.0, 8), 1);
+  EXPECT_EQ(emission_sample_count(stats({2}, {1, 3}), 9.0, 8), 1);
+  EXPECT_EQ(emission_sample_count(stats({0, 2}, {1}), 9.0, 8), 1);
+  EXPECT_EQ(emission_sample_count(even, 0.0, 8), 8);
+  EXPECT_EQ(emission_sample_count(stats({0, 2, 0, 2}, {1, 1, 1}), 9.0, 8), 8);
+  EXPECT_EQ(emission_sample_count(stats({2, 2, 2}, {1, 1, 1}), 9.0, 8), 1);
 }
 
 // pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon

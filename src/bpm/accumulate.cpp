@@ -13,11 +13,12 @@
 namespace bpm {
 
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
-                          const EyePixels& eye, const Wavelengths& wl, float max_component_value,
+                          EyePixels* eye_pixels, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates) {
   const int w = film->width(), h = film->height();
   LightPassResult& light = *light_sums;
+  EyePixels& eye = *eye_pixels;
   // Each backward photon that received light: its shares of its pixel's estimate and bias (in place
   // of its sums, whose cache lines are at hand), and its place among its pixel's, in parallel over
   // the photons in the maps' order; each pixel then adds its shares in that order.
@@ -78,6 +79,8 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))
           film->add_bias(x, y, spectrum_to_rgb(bias, wl));
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
+        if (eye.sees_emission[p] && L.is_finite())
+          eye.round_stats[p].add_rest(L.average() - eye.emission_part[p]);
         if (estimates && L.is_finite()) {
           (*estimates)[2 * size_t(p)] += L.average();
           (*estimates)[2 * size_t(p) + 1] += 1;

@@ -17,7 +17,8 @@ namespace bpm {
 // of the pass over its photon part (radius_bias under bias_model) goes to the film beside its
 // estimate, or with `debias` is taken from it. When `estimates` is given (2 per pixel), each
 // sampled pixel's estimate (the mean over its wavelengths) is added to its first and 1 to its
-// second.
+// second. The rest of the estimate of each sampled pixel that sees emission, less its emission
+// part, goes to its round statistics (EyePixels::round_stats).
 //
 // The light pass's sums are used up: afterwards flux[g] and flux_inner[g] hold backward photon g's
 // parts of its pixel's estimate and bias (its shares), where it received light.
@@ -37,8 +38,8 @@ inline int backward_photon_place(const BackwardPhoton& bp) {
   return bp.diffuse_index + (bp.accepts == kAcceptsIndirect ? 1 : 0);
 }
 
-void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
-                          const EyePixels& eye, const Wavelengths& wl, float max_component_value,
+void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums, EyePixels* eye,
+                          const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates = nullptr);
 

@@ -53,10 +53,26 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 }
 
 // Memory (base/memory.h). Per pixel, what the eye pass (with the edges and near-edge marks of the
-// disc probes), the masks and the emission guide keep.
-constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 2 * sizeof(uint8_t) +
-                               2 * sizeof(uint8_t) + sizeof(double) + sizeof(uint32_t) +
-                               sizeof(float) + sizeof(uint16_t);
+// disc probes, and the emission statistics with their copy at the end of a round), the masks and
+// the emission guide keep.
+constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) +
+                               sizeof(uint16_t) + sizeof(float) + sizeof(EmissionStats<float>) +
+                               2 * sizeof(EmissionStats<double>) + sizeof(double) +
+                               sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
+
+// What the extra emission samples cost against whole iterations (emission_sample_count), in rays:
+// all the rays the iterations cast and the pixels they sampled, the extra emission samples and
+// their rays.
+struct EmissionCost {
+  std::array<double, 4> v{};  // rays, pixels, samples, sample rays
+  // What an iteration costs per pixel over what one extra sample costs, less one; 0 while no
+  // extra sample has been taken.
+  double ratio() const {
+    const auto [rays, pixels, samples, sample_rays] = v;
+    if (!(pixels > 0) || !(samples > 0) || !(sample_rays > 0)) return 0;
+    return std::max(0.0, (rays / pixels) / (sample_rays / samples) - 1);
+  }
+};
 // Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
 // inner quarter) and hit flag, its references in the two trees (about two per tree where spheres
 // overlap cells), and its place among its pixel's for the accumulation.
@@ -209,7 +225,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
 
     // 4. Accumulation of the iteration into the film; masks balanced for the next one.
     t = Clock::now();
-    accumulate_iteration(maps, &light_result, eye, wm.wl, ls.film.max_component_value, s, film,
+    accumulate_iteration(maps, &light_result, &eye, wm.wl, ls.film.max_component_value, s, film,
                          &pixel_sums, guide.empty() ? nullptr : &estimate_new);
     tot.accumulate_s += since(t);
     masks.rebuild(eye.cost_ns);
@@ -224,30 +240,65 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
     r.progress = progress;
     return r;
   };
-  // Carried from one iteration to the next, and merged at the end of each round: which pixels see
-  // emission, what the guide learnt and the pixels' running means (the pixel weights follow from
-  // them).
+  // Carried from one iteration to the next, and merged at the end of each round: the pixels'
+  // emission statistics and what their extra samples cost (their sample counts follow from them),
+  // what the guide learnt and the pixels' running means (the pixel weights follow from them).
+  EmissionCost cost_sum, cost_new, counted;  // counted: the counters' totals at the last round
+  auto set_emission_samples = [&] {
+    const double ratio = cost_sum.ratio();
+    for (size_t p = 0; p < n_pixels; ++p)
+      eye.emission_samples[p] =
+          eye.sees_emission[p]
+              ? uint16_t(emission_sample_count(eye.emission_stats[p], ratio, s.emission_samples))
+              : 1;
+  };
   IntegratorState state;
   state.learnt = [&](std::vector<double>* out) {
     for (uint8_t& saw : eye.saw_emission) {
       out->push_back(saw);
       saw = 0;
     }
+    for (EmissionStats<double>& st : eye.round_stats) {
+      out->insert(out->end(), st.v.begin(), st.v.end());
+      st = {};
+    }
+    EmissionCost now;
+    for (const EyeCounters& c : eye_counters) {
+      now.v[0] += double(c.rays.total());
+      now.v[1] += double(c.pixels);
+      now.v[2] += double(c.emission_samples);
+      now.v[3] += double(c.emission_rays);
+    }
+    for (const LightCounters& c : light.counters) now.v[0] += double(c.light_rays);
+    for (size_t k = 0; k < now.v.size(); ++k)
+      out->push_back(cost_new.v[k] + now.v[k] - counted.v[k]);
+    counted = now;
+    cost_new = {};
     if (guide.empty()) return;
     guide.take_learnt(out);
     out->insert(out->end(), estimate_new.begin(), estimate_new.end());
     std::fill(estimate_new.begin(), estimate_new.end(), 0.0);
   };
+  constexpr size_t kStats = EmissionStats<double>::kValues;
+  const size_t pixel_values = (1 + kStats) * n_pixels + EmissionCost().v.size();
   state.merge = [&](const std::vector<double>& sums) {
-    for (size_t p = 0; p < n_pixels; ++p)
+    // Rounded to float before they join, as the guide's sums below.
+    const double* stats = sums.data() + n_pixels;
+    for (size_t p = 0; p < n_pixels; ++p) {
+      std::array<float, kStats>& st = eye.emission_stats[p].v;
+      for (size_t k = 0; k < kStats; ++k) st[k] += float(stats[kStats * p + k]);
       if (sums[p] > 0) eye.sees_emission[p] = 1;
+    }
+    const double* c = stats + kStats * n_pixels;
+    for (size_t k = 0; k < cost_sum.v.size(); ++k) cost_sum.v[k] += double(float(c[k]));
+    set_emission_samples();
     if (guide.empty()) return;
     // A round's sums are rounded to float precision before they join: processes add their
     // shares in another order than one process adds passes, and a difference in the last bits
     // of a sum would move a boundary of the guided density, so that the same seed would draw
     // other photons.
-    std::vector<double> learnt(sums.size() - n_pixels);
-    for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[n_pixels + i]));
+    std::vector<double> learnt(sums.size() - pixel_values);
+    for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[pixel_values + i]));
     guide.merge(learnt.data());
     tot.guide_moved = guide.moved();
     const double* e = learnt.data() + 2 * guide.cells();
@@ -258,15 +309,25 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
     update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
   };
   state.keep_learnt = [&](const std::vector<double>& sums) {
-    for (size_t p = 0; p < n_pixels; ++p) eye.saw_emission[p] = sums[p] > 0;
+    const double* stats = sums.data() + n_pixels;
+    for (size_t p = 0; p < n_pixels; ++p) {
+      eye.saw_emission[p] = sums[p] > 0;
+      std::copy_n(stats + kStats * p, kStats, eye.round_stats[p].v.begin());
+    }
+    const double* c = stats + kStats * n_pixels;
+    std::copy_n(c, cost_new.v.size(), cost_new.v.begin());
     if (guide.empty()) return;
-    guide.keep_learnt(sums.data() + n_pixels);
-    const double* e = sums.data() + n_pixels + 2 * guide.cells();
+    guide.keep_learnt(sums.data() + pixel_values);
+    const double* e = sums.data() + pixel_values + 2 * guide.cells();
     estimate_new.assign(e, e + 2 * n_pixels);
   };
   state.save = [&](ByteWriter& w) {
     w.put_vector(eye.sees_emission);
     w.put_vector(eye.saw_emission);
+    w.put_vector(eye.emission_stats);
+    w.put_vector(eye.round_stats);
+    w.put(cost_sum.v);
+    w.put(cost_new.v);
     w.put(uint8_t(!guide.empty()));
     if (guide.empty()) return;
     guide.save(w);
@@ -277,8 +338,16 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   state.load = [&](ByteReader& r) {
     eye.sees_emission = r.get_vector<uint8_t>();
     eye.saw_emission = r.get_vector<uint8_t>();
-    if (eye.sees_emission.size() != n_pixels || eye.saw_emission.size() != n_pixels)
+    eye.emission_stats = r.get_vector<EmissionStats<float>>();
+    eye.round_stats = r.get_vector<EmissionStats<double>>();
+    if (eye.sees_emission.size() != n_pixels || eye.saw_emission.size() != n_pixels ||
+        eye.emission_stats.size() != n_pixels || eye.round_stats.size() != n_pixels)
       throw Error(r.what() + " is truncated or corrupt (pixels that see emission)");
+    cost_sum.v = r.get<std::array<double, 4>>();
+    cost_new.v = r.get<std::array<double, 4>>();
+    // The counters start again from zero.
+    counted = {};
+    set_emission_samples();
     if (r.get<uint8_t>() != uint8_t(!guide.empty()))
       throw Error(r.what() + " differs in guided emission (--no-guide)");
     if (guide.empty()) return;

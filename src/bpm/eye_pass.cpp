@@ -151,24 +151,45 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
 
 namespace {
 
-// Replaces the first sample's emission by the mean over prm.emission_samples camera samples of the
-// pixel (the first and emission_samples - 1 more); returns what to add to the first sample's
-// radiance. Each sample counts by its filter weight relative to the first one's, so the film's
-// weighted sums stay those of unbiased estimates. The extra samples have their own streams.
-Spectrum more_emission_samples(const RenderScene& scene, const EyePassParams& prm,
-                               const CameraSampler& camera, int pass_index, uint32_t pixel,
-                               float first_weight, const Spectrum& first_emission,
-                               ObjectPhotonLists& lists, EyeCounters& ec) {
+// The mean of the first sample's emission and count - 1 more camera samples' of the pixel, each
+// counted by its filter weight relative to the first one's, so that the film's weighted sums stay
+// those of unbiased estimates (the extra samples have their own streams). Each sample's value
+// goes to *stats, when given.
+Spectrum mean_emission(const RenderScene& scene, const EyePassParams& prm,
+                       const CameraSampler& camera, int pass_index, uint32_t pixel, int count,
+                       float first_weight, const Spectrum& first_emission, ObjectPhotonLists& lists,
+                       EyeCounters& ec, EmissionStats<double>* stats) {
+  if (stats) stats->add_emission(first_emission.average());
+  if (count <= 1 || first_weight == 0) return first_emission;
   Spectrum sum = first_emission;
-  for (int k = 1; k < prm.emission_samples; ++k) {
+  const uint64_t rays_before = ec.rays.total();
+  for (int k = 1; k < count; ++k) {
     CameraSample cs = camera.sample(pass_index, pixel, uint32_t(k));
     EyeRadiance e = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, true);
-    sum += e.emission * (cs.filter_weight / first_weight);
+    const Spectrum v = e.emission * (cs.filter_weight / first_weight);
+    if (stats) stats->add_emission(v.average());
+    sum += v;
   }
-  return sum / float(prm.emission_samples) - first_emission;
+  ec.emission_samples += uint64_t(count - 1);
+  ec.emission_rays += ec.rays.total() - rays_before;
+  return sum / float(count);
 }
 
 }  // namespace
+
+int emission_sample_count(const EmissionStats<float>& s, double cost_ratio, int max_samples) {
+  if (max_samples <= 1) return 1;
+  if (s.emission_n() < 2 || s.rest_n() < 2) return 1;
+  if (!(cost_ratio > 0)) return max_samples;
+  auto variance = [&](int at) {
+    const double n = s.v[size_t(at)], sum = s.v[size_t(at) + 1], sum2 = s.v[size_t(at) + 2];
+    return std::max(0.0, (sum2 - sum * sum / n) / (n - 1));
+  };
+  const double v_emission = variance(0), v_rest = variance(3);
+  if (!(v_rest > 0)) return v_emission > 0 ? max_samples : 1;
+  const double e = std::sqrt(cost_ratio * v_emission / v_rest);
+  return int(std::clamp(std::round(e), 1.0, double(max_samples)));
+}
 
 bool may_have_caustics(const RenderScene& scene) {
   for (const Object& o : scene.objects) {
@@ -207,14 +228,18 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
               px->cost_ns[pixel] = 0;
               continue;
             }
+            ++ec.pixels;
             CameraSample cs = camera.sample(pass_index, pixel);
             EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, false,
                                            prm.near_edges ? prm.near_edges->at(pixel) : 3);
-            px->radiance[pixel] = r.total;
             px->filter_weight[pixel] = cs.filter_weight;
-            if (prm.emission_samples > 1 && px->sees_emission[pixel] && cs.filter_weight != 0)
-              px->radiance[pixel] += more_emission_samples(scene, prm, camera, pass_index, pixel,
-                                                           cs.filter_weight, r.emission, lists, ec);
+            const Spectrum emission =
+                mean_emission(scene, prm, camera, pass_index, pixel,
+                              std::min<int>(prm.emission_samples, px->emission_samples[pixel]),
+                              cs.filter_weight, r.emission, lists, ec,
+                              px->sees_emission[pixel] ? &px->round_stats[pixel] : nullptr);
+            px->radiance[pixel] = r.total + (emission - r.emission);
+            px->emission_part[pixel] = emission.average();
             if (!r.emission.is_black()) px->saw_emission[pixel] = 1;
             const auto t1 = Clock::now();
             px->cost_ns[pixel] = float(std::chrono::duration<double, std::nano>(t1 - t0).count());

@@ -8,6 +8,7 @@
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
+#include <array>
 #include <vector>
 
 #include "base/rng.h"
@@ -26,9 +27,9 @@ struct EyePassParams {
   int max_depth = 5;
   // Radius per unit of eye path length: k * sqrt(pixel solid angle) * radius_scale(iteration).
   float radius_per_length0 = 0, radius_per_length1 = 0;
-  // Camera samples per iteration for emission seen before the first diffuse vertex, in pixels
-  // where some sample has seen any (emitter edges, lights behind glass): cheap paths that end at
-  // that vertex, averaged with the full path's share (1: the full path alone).
+  // At most this many camera samples per iteration for emission seen before the first diffuse
+  // vertex (emitter edges, lights behind glass): cheap paths that end at that vertex, averaged
+  // with the full path's share. Each pixel takes EyePixels::emission_samples of them.
   int emission_samples = 1;
   // When positive, every backward photon's radius in world units instead of the per-length radii
   // (BpmSettings::radius, times the iteration's radius scale).
@@ -52,9 +53,15 @@ bool may_have_caustics(const RenderScene& scene);
 struct EyeCounters {
   PathCounters rays;  // camera, bounce, shadow and probe rays
   uint64_t backward_photons = 0;
+  uint64_t pixels = 0;  // pixels sampled (over the iterations)
+  // The extra camera samples for emission, and the rays they cast (counted in `rays` too).
+  uint64_t emission_samples = 0, emission_rays = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);
     backward_photons += o.backward_photons;
+    pixels += o.pixels;
+    emission_samples += o.emission_samples;
+    emission_rays += o.emission_rays;
   }
 };
 
@@ -75,6 +82,34 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only = false, uint8_t near_edge = 3);
 
+// A pixel's samples of emission seen before the first diffuse vertex (per camera sample), and of
+// the rest of its estimate (per iteration): counts, sums and sums of squares of their means over
+// the wavelengths, in that order.
+template <class T>
+struct EmissionStats {
+  static constexpr int kValues = 6;
+  std::array<T, kValues> v{};
+  void add_emission(double x) { add(0, x); }
+  void add_rest(double x) { add(3, x); }
+  T emission_n() const { return v[0]; }
+  T rest_n() const { return v[3]; }
+
+ private:
+  void add(int at, double x) {
+    v[size_t(at)] += 1;
+    v[size_t(at) + 1] += T(x);
+    v[size_t(at) + 2] += T(x * x);
+  }
+};
+
+// Camera samples per iteration for the emission of a pixel that has seen some, from its
+// statistics over the iterations so far: the count E that makes the pixel's variance V_rest +
+// V_emission / E times its cost per iteration, 1 + (E - 1) / cost_ratio in units of an iteration,
+// least: E = sqrt(cost_ratio V_emission / V_rest) rounded, where cost_ratio is what an iteration
+// costs per pixel over what one more emission sample costs, less one. Within [1, max_samples]: 1
+// until both parts have two samples, then max_samples until the cost ratio is known (not 0).
+int emission_sample_count(const EmissionStats<float>& s, double cost_ratio, int max_samples);
+
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
   std::vector<Spectrum> radiance;    // the eye pass's own part of the pixel's estimate
@@ -82,16 +117,28 @@ struct EyePixels {
   std::vector<float> cost_ns;        // time spent on the pixel, to rebuild the masks
   std::vector<uint8_t> sampled;      // whether this iteration samples the pixel
   // Whether a sample of the pixel in an earlier round (integrator/control.h) saw emission before
-  // its first diffuse vertex: such pixels take EyePassParams::emission_samples camera samples for
-  // it. saw_emission marks those of this round, merged at its end.
+  // its first diffuse vertex; saw_emission marks those of this round, merged at its end.
   std::vector<uint8_t> sees_emission, saw_emission;
+  // Camera samples per iteration for the pixel's emission (emission_sample_count, set at the end
+  // of each round), and the part of this iteration's estimate that is their mean (over the
+  // wavelengths).
+  std::vector<uint16_t> emission_samples;
+  std::vector<float> emission_part;
+  // The emission statistics of the pixels that see emission: of every round so far, and of this
+  // round (summed over processes at its end).
+  std::vector<EmissionStats<float>> emission_stats;
+  std::vector<EmissionStats<double>> round_stats;
   explicit EyePixels(size_t n)
       : radiance(n),
         filter_weight(n),
         cost_ns(n),
         sampled(n, 0),
         sees_emission(n, 0),
-        saw_emission(n, 0) {}
+        saw_emission(n, 0),
+        emission_samples(n, 1),
+        emission_part(n, 0.0f),
+        emission_stats(n),
+        round_stats(n) {}
 };
 
 // Per-thread state the eye pass fills.

@@ -42,6 +42,10 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
           {"bounce_rays", t.eye.rays.bounce_rays},
           {"shadow_rays", t.eye.rays.shadow_rays},
           {"probe_rays", t.eye.rays.probe_rays},
+          // The extra camera samples of emission (EyePixels::emission_samples) and their rays
+          // (counted among the camera, bounce and shadow rays).
+          {"emission_samples", t.eye.emission_samples},
+          {"emission_sample_rays", t.eye.emission_rays},
           {"backward_photons", t.eye.backward_photons},
           // The paper's Table 1 counts per ray traced from the camera with all its continuations
           // (an eye path); per segment counts every camera and bounce ray.

@@ -12,7 +12,7 @@ namespace bpm {
 namespace {
 
 constexpr char kMagic[8] = {'B', 'P', 'M', 'C', 'K', 'P', 'T', '\n'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: bpm keeps emission statistics per pixel
 
 std::string read_file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
