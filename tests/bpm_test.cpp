@@ -771,29 +771,30 @@ TEST(Bpm, EmissionSamplesAverageEmitterEdgesWithoutBias) {
 
 // A pixel's emission samples minimise its variance times its cost: sqrt(cost ratio * V_emission /
 // V_rest), within [1, max]; 1 while its statistics are not known yet or where no emission was
-// seen, max while the cost ratio is not known.
+// seen, max while the cost ratio is not known (negative).
 TEST(Bpm, EmissionSampleCountBalancesVarianceAndCost) {
   auto stats = [](std::vector<double> emission, std::vector<double> rest) {
-    EmissionStats<float> s;
+    EmissionStats<double> s;
     for (double e : emission) s.add_emission(e);
     for (double r : rest) s.add_rest(r);
     return s;
   };
   // Emission 0 or 2 (sample variance 4/3 over four), rest 1 or 3 (variance 4/3 over four).
-  const EmissionStats<float> even = stats({0, 2, 0, 2}, {1, 3, 1, 3});
+  const EmissionStats<double> even = stats({0, 2, 0, 2}, {1, 3, 1, 3});
   EXPECT_EQ(emission_sample_count(even, 9.0, 8), 3);   // sqrt(9 * 1)
   EXPECT_EQ(emission_sample_count(even, 16.0, 8), 4);  // sqrt(16)
   EXPECT_EQ(emission_sample_count(even, 0.5, 8), 1);   // sqrt(0.5) rounds to 1
   EXPECT_EQ(emission_sample_count(even, 400.0, 8), 8);
   EXPECT_EQ(emission_sample_count(even, 9.0, 1), 1);
   // Emission 25 times as variable as the rest: five times the samples.
-  const EmissionStats<float> bright = stats({0, 10, 0, 10}, {1, 3, 1, 3});
+  const EmissionStats<double> bright = stats({0, 10, 0, 10}, {1, 3, 1, 3});
   EXPECT_EQ(emission_sample_count(bright, 1.0, 8), 5);
   // Nothing seen; not enough known; no cost ratio yet; a rest without variance.
   EXPECT_EQ(emission_sample_count(stats({0, 0, 0}, {1, 3, 1}), 9.0, 8), 1);
   EXPECT_EQ(emission_sample_count(stats({2}, {1, 3}), 9.0, 8), 1);
   EXPECT_EQ(emission_sample_count(stats({0, 2}, {1}), 9.0, 8), 1);
-  EXPECT_EQ(emission_sample_count(even, 0.0, 8), 8);
+  EXPECT_EQ(emission_sample_count(even, -1.0, 8), 8);
+  EXPECT_EQ(emission_sample_count(even, 0.0, 8), 1);  // an extra sample costs a whole iteration
   EXPECT_EQ(emission_sample_count(stats({0, 2, 0, 2}, {1, 1, 1}), 9.0, 8), 8);
   EXPECT_EQ(emission_sample_count(stats({2, 2, 2}, {1, 1, 1}), 9.0, 8), 1);
 }

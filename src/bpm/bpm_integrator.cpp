@@ -25,7 +25,8 @@ void check(const BpmSettings& s) {
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("bpm: radius factors k0 and k1 must be positive");
   if (!(s.alpha > 0 && s.alpha < 1)) throw Error("bpm: alpha must be in (0, 1)");
   if (s.photons_per_iteration <= 0) throw Error("bpm: photons per iteration must be positive");
-  if (s.emission_samples < 1) throw Error("bpm: emission samples must be at least 1");
+  if (s.emission_samples < 1 || s.emission_samples > 1024)
+    throw Error("bpm: emission samples must be in 1..1024");
   if (!(s.radius >= 0) || !std::isfinite(s.radius)) throw Error("bpm: radius must not be negative");
 }
 
@@ -56,21 +57,21 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 // disc probes, and the emission statistics with their copy at the end of a round), the masks and
 // the emission guide keep.
 constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) +
-                               sizeof(uint16_t) + sizeof(float) + sizeof(EmissionStats<float>) +
-                               2 * sizeof(EmissionStats<double>) + sizeof(double) +
+                               sizeof(uint16_t) + sizeof(float) +
+                               3 * sizeof(EmissionStats<double>) + sizeof(double) +
                                sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
 
 // What the extra emission samples cost against whole iterations (emission_sample_count), in rays:
 // all the rays the iterations cast and the pixels they sampled, the extra emission samples and
 // their rays.
 struct EmissionCost {
-  std::array<double, 4> v{};  // rays, pixels, samples, sample rays
-  // What an iteration costs per pixel over what one extra sample costs, less one; 0 while no
-  // extra sample has been taken.
+  std::array<double, 4> v{};  // rays (the extra samples' included), pixels, samples, sample rays
+  // What an iteration costs per pixel without extra samples over what one extra sample costs,
+  // less one (at least 0); -1 while no extra sample has been taken (unknown).
   double ratio() const {
     const auto [rays, pixels, samples, sample_rays] = v;
-    if (!(pixels > 0) || !(samples > 0) || !(sample_rays > 0)) return 0;
-    return std::max(0.0, (rays / pixels) / (sample_rays / samples) - 1);
+    if (!(pixels > 0) || !(samples > 0) || !(sample_rays > 0)) return -1;
+    return std::max(0.0, ((rays - sample_rays) / pixels) / (sample_rays / samples) - 1);
   }
 };
 // Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
@@ -244,6 +245,20 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   // emission statistics and what their extra samples cost (their sample counts follow from them),
   // what the guide learnt and the pixels' running means (the pixel weights follow from them).
   EmissionCost cost_sum, cost_new, counted;  // counted: the counters' totals at the last round
+  // The round's costs so far: cost_new (kept from a checkpoint or another process's share) and
+  // what the counters added since the last round.
+  auto round_cost = [&] {
+    EmissionCost now, round = cost_new;
+    for (const EyeCounters& c : eye_counters) {
+      now.v[0] += double(c.rays.total());
+      now.v[1] += double(c.pixels);
+      now.v[2] += double(c.emission_samples);
+      now.v[3] += double(c.emission_rays);
+    }
+    for (const LightCounters& c : light.counters) now.v[0] += double(c.light_rays);
+    for (size_t k = 0; k < now.v.size(); ++k) round.v[k] += now.v[k] - counted.v[k];
+    return std::pair{round, now};
+  };
   auto set_emission_samples = [&] {
     const double ratio = cost_sum.ratio();
     for (size_t p = 0; p < n_pixels; ++p)
@@ -262,16 +277,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
       out->insert(out->end(), st.v.begin(), st.v.end());
       st = {};
     }
-    EmissionCost now;
-    for (const EyeCounters& c : eye_counters) {
-      now.v[0] += double(c.rays.total());
-      now.v[1] += double(c.pixels);
-      now.v[2] += double(c.emission_samples);
-      now.v[3] += double(c.emission_rays);
-    }
-    for (const LightCounters& c : light.counters) now.v[0] += double(c.light_rays);
-    for (size_t k = 0; k < now.v.size(); ++k)
-      out->push_back(cost_new.v[k] + now.v[k] - counted.v[k]);
+    const auto [round, now] = round_cost();
+    out->insert(out->end(), round.v.begin(), round.v.end());
     counted = now;
     cost_new = {};
     if (guide.empty()) return;
@@ -285,8 +292,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
     // Rounded to float before they join, as the guide's sums below.
     const double* stats = sums.data() + n_pixels;
     for (size_t p = 0; p < n_pixels; ++p) {
-      std::array<float, kStats>& st = eye.emission_stats[p].v;
-      for (size_t k = 0; k < kStats; ++k) st[k] += float(stats[kStats * p + k]);
+      std::array<double, kStats>& st = eye.emission_stats[p].v;
+      for (size_t k = 0; k < kStats; ++k) st[k] += double(float(stats[kStats * p + k]));
       if (sums[p] > 0) eye.sees_emission[p] = 1;
     }
     const double* c = stats + kStats * n_pixels;
@@ -327,7 +334,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
     w.put_vector(eye.emission_stats);
     w.put_vector(eye.round_stats);
     w.put(cost_sum.v);
-    w.put(cost_new.v);
+    w.put(round_cost().first.v);  // the counters start from zero when the render goes on
     w.put(uint8_t(!guide.empty()));
     if (guide.empty()) return;
     guide.save(w);
@@ -338,7 +345,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
   state.load = [&](ByteReader& r) {
     eye.sees_emission = r.get_vector<uint8_t>();
     eye.saw_emission = r.get_vector<uint8_t>();
-    eye.emission_stats = r.get_vector<EmissionStats<float>>();
+    eye.emission_stats = r.get_vector<EmissionStats<double>>();
     eye.round_stats = r.get_vector<EmissionStats<double>>();
     if (eye.sees_emission.size() != n_pixels || eye.saw_emission.size() != n_pixels ||
         eye.emission_stats.size() != n_pixels || eye.round_stats.size() != n_pixels)

@@ -177,10 +177,10 @@ Spectrum mean_emission(const RenderScene& scene, const EyePassParams& prm,
 
 }  // namespace
 
-int emission_sample_count(const EmissionStats<float>& s, double cost_ratio, int max_samples) {
+int emission_sample_count(const EmissionStats<double>& s, double cost_ratio, int max_samples) {
   if (max_samples <= 1) return 1;
   if (s.emission_n() < 2 || s.rest_n() < 2) return 1;
-  if (!(cost_ratio > 0)) return max_samples;
+  if (cost_ratio < 0) return max_samples;
   auto variance = [&](int at) {
     const double n = s.v[size_t(at)], sum = s.v[size_t(at) + 1], sum2 = s.v[size_t(at) + 2];
     return std::max(0.0, (sum2 - sum * sum / n) / (n - 1));
@@ -188,6 +188,7 @@ int emission_sample_count(const EmissionStats<float>& s, double cost_ratio, int 
   const double v_emission = variance(0), v_rest = variance(3);
   if (!(v_rest > 0)) return v_emission > 0 ? max_samples : 1;
   const double e = std::sqrt(cost_ratio * v_emission / v_rest);
+  if (!std::isfinite(e)) return max_samples;
   return int(std::clamp(std::round(e), 1.0, double(max_samples)));
 }
 

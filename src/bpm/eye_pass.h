@@ -9,6 +9,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "base/rng.h"
@@ -89,6 +90,7 @@ template <class T>
 struct EmissionStats {
   static constexpr int kValues = 6;
   std::array<T, kValues> v{};
+  // Non-finite values (numerical accidents) are left out.
   void add_emission(double x) { add(0, x); }
   void add_rest(double x) { add(3, x); }
   T emission_n() const { return v[0]; }
@@ -96,6 +98,7 @@ struct EmissionStats {
 
  private:
   void add(int at, double x) {
+    if (!std::isfinite(x)) return;
     v[size_t(at)] += 1;
     v[size_t(at) + 1] += T(x);
     v[size_t(at) + 2] += T(x * x);
@@ -103,12 +106,12 @@ struct EmissionStats {
 };
 
 // Camera samples per iteration for the emission of a pixel that has seen some, from its
-// statistics over the iterations so far: the count E that makes the pixel's variance V_rest +
-// V_emission / E times its cost per iteration, 1 + (E - 1) / cost_ratio in units of an iteration,
-// least: E = sqrt(cost_ratio V_emission / V_rest) rounded, where cost_ratio is what an iteration
-// costs per pixel over what one more emission sample costs, less one. Within [1, max_samples]: 1
-// until both parts have two samples, then max_samples until the cost ratio is known (not 0).
-int emission_sample_count(const EmissionStats<float>& s, double cost_ratio, int max_samples);
+// statistics over the iterations so far: with C the cost of an iteration per pixel without extra
+// samples and c that of one extra sample, the count E that makes the pixel's variance V_rest +
+// V_emission / E times its cost C + (E - 1) c least: E = sqrt(cost_ratio V_emission / V_rest)
+// rounded, where cost_ratio = C / c - 1. Within [1, max_samples]: 1 until both parts have two
+// samples, then max_samples while the cost ratio is unknown (negative).
+int emission_sample_count(const EmissionStats<double>& s, double cost_ratio, int max_samples);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
@@ -126,7 +129,7 @@ struct EyePixels {
   std::vector<float> emission_part;
   // The emission statistics of the pixels that see emission: of every round so far, and of this
   // round (summed over processes at its end).
-  std::vector<EmissionStats<float>> emission_stats;
+  std::vector<EmissionStats<double>> emission_stats;
   std::vector<EmissionStats<double>> round_stats;
   explicit EyePixels(size_t n)
       : radiance(n),
