@@ -136,10 +136,15 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     auto photon_rng = [&](uint64_t k) {
       return Rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), first_photon + k, 1));
     };
+    // Each photon's stream is made one photon ahead, so that its part of the guide's table
+    // arrives while the photon before it is traced.
+    Rng next = photon_rng(first);
     for (uint64_t k = first; k < last; ++k) {
-      Rng rng = photon_rng(k);
-      // The next photon's part of the guide's table arrives while this one is traced.
-      if (guide && k + 1 < last) guide->prefetch(photon_rng(k + 1));
+      Rng rng = next;
+      if (k + 1 < last) {
+        next = photon_rng(k + 1);
+        if (guide) guide->prefetch(next);
+      }
       const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
       const uint32_t photon = uint32_t(k - first);
       // A backward photon adds at least one eye vertex; direct photons are never used
