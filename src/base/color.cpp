@@ -123,10 +123,9 @@ float sigmoid(float x) { return 0.5f + x / (2 * std::sqrt(1 + x * x)); }
 // and within about 5e-4 of the 1 nm sum.
 void sigmoid_rgb(const std::array<double, 3>& c, double rgb[3], double jac[3][3], bool coarse) {
   const Tables& t = tables();
-  for (int i = 0; i < 3; ++i) {
-    rgb[i] = 0;
-    for (int k = 0; k < 3; ++k) jac[i][k] = 0;
-  }
+  // Summed in locals: the out-parameters could alias the tables, which would keep every sum in
+  // memory.
+  double sum[3] = {0, 0, 0}, d[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   const int n = coarse ? Tables::kNodes : kTableSize, step = coarse ? Tables::kNodeStep : 1;
   for (int j = 0; j < n; ++j) {
     double u = normalised_lambda(kLambdaMin + float(j * step));
@@ -134,12 +133,19 @@ void sigmoid_rgb(const std::array<double, 3>& c, double rgb[3], double jac[3][3]
     double q = 1 / std::sqrt(1 + x * x);
     double s = 0.5 + 0.5 * x * q;
     double ds = 0.5 * q * q * q;
-    double basis[3] = {u * u, u, 1};
+    double uu = u * u;
     for (int ch = 0; ch < 3; ++ch) {
       double w = coarse ? t.node_weight_d65[j][ch] : double(t.rgb_weight_d65[j][ch]);
-      rgb[ch] += w * s;
-      for (int k = 0; k < 3; ++k) jac[ch][k] += w * ds * basis[k];
+      sum[ch] += w * s;
+      double wds = w * ds;
+      d[ch][0] += wds * uu;
+      d[ch][1] += wds * u;
+      d[ch][2] += wds;
     }
+  }
+  for (int ch = 0; ch < 3; ++ch) {
+    rgb[ch] = sum[ch];
+    for (int k = 0; k < 3; ++k) jac[ch][k] = d[ch][k];
   }
 }
 
@@ -218,28 +224,39 @@ float sigmoid_spectrum(const std::array<float, 3>& c, float lambda) {
 
 namespace {
 
-// Gauss-Newton with backtracking from c toward the sigmoid whose colour is target; returns the
+// Sigmoid coefficients with the colour of their spectrum and its Jacobian, so that a solve that
+// starts where the last one ended needs no new evaluation.
+struct SigmoidFit {
+  explicit SigmoidFit(bool coarse) : coarse(coarse) {}
+  void set(const std::array<double, 3>& coefficients) {
+    c = coefficients;
+    sigmoid_rgb(c, rgb, jac, coarse);
+  }
+
+  bool coarse;
+  std::array<double, 3> c{};
+  double rgb[3] = {0, 0, 0}, jac[3][3] = {};
+};
+
+// Gauss-Newton with backtracking from fit toward the sigmoid whose colour is target; returns the
 // largest remaining channel error.
-double gauss_newton(std::array<double, 3>& c, const double target[3], int max_iterations,
-                    bool coarse) {
-  double rgb_now[3], jac[3][3];
-  sigmoid_rgb(c, rgb_now, jac, coarse);
-  double residual = max_abs_residual(rgb_now, target);
+double gauss_newton(SigmoidFit& fit, const double target[3], int max_iterations) {
+  double residual = max_abs_residual(fit.rgb, target);
   for (int iter = 0; iter < max_iterations && residual >= 1e-6; ++iter) {
-    double r[3] = {target[0] - rgb_now[0], target[1] - rgb_now[1], target[2] - rgb_now[2]}, d[3];
+    double r[3] = {target[0] - fit.rgb[0], target[1] - fit.rgb[1], target[2] - fit.rgb[2]}, d[3];
+    double jac[3][3];
+    std::copy(&fit.jac[0][0], &fit.jac[0][0] + 9, &jac[0][0]);
     if (!solve3(jac, r, d)) break;
     double scale = 1;
     bool improved = false;
     for (int tries = 0; tries < 12 && !improved; ++tries, scale *= 0.5) {
-      std::array<double, 3> trial = {c[0] + scale * d[0], c[1] + scale * d[1], c[2] + scale * d[2]};
-      double trial_rgb[3], trial_jac[3][3];
-      sigmoid_rgb(trial, trial_rgb, trial_jac, coarse);
-      double trial_residual = max_abs_residual(trial_rgb, target);
+      SigmoidFit trial(fit.coarse);
+      const std::array<double, 3>& c = fit.c;
+      trial.set({c[0] + scale * d[0], c[1] + scale * d[1], c[2] + scale * d[2]});
+      double trial_residual = max_abs_residual(trial.rgb, target);
       if (trial_residual < residual) {
-        c = trial;
+        fit = trial;
         residual = trial_residual;
-        std::copy(trial_rgb, trial_rgb + 3, rgb_now);
-        std::copy(&trial_jac[0][0], &trial_jac[0][0] + 9, &jac[0][0]);
         improved = true;
       }
     }
@@ -250,15 +267,15 @@ double gauss_newton(std::array<double, 3>& c, const double target[3], int max_it
 
 // From the grey of the same mean, moving the target toward rgb in steps so that each solve starts
 // close to its answer (saturated colours need large coefficients).
-double fit_from_grey(const double target_end[3], std::array<double, 3>& c, bool coarse) {
+double fit_from_grey(const double target_end[3], SigmoidFit& fit) {
   double grey = std::clamp((target_end[0] + target_end[1] + target_end[2]) / 3.0, 0.02, 0.98);
-  c = {0, 0, (2 * grey - 1) / (2 * std::sqrt(grey * (1 - grey)))};
+  fit.set({0, 0, (2 * grey - 1) / (2 * std::sqrt(grey * (1 - grey)))});
   constexpr int kSteps = 8;
   double residual = 0;
   for (int step = 1; step <= kSteps; ++step) {
     double f = double(step) / kSteps, target[3];
     for (int i = 0; i < 3; ++i) target[i] = grey + (target_end[i] - grey) * f;
-    residual = gauss_newton(c, target, 40, coarse);
+    residual = gauss_newton(fit, target, 40);
   }
   return residual;
 }
@@ -277,22 +294,22 @@ class SigmoidTable {
     tbb::parallel_for(0, 3 * kXY, [&](int task) {
       int l = task / kXY, yi = task % kXY;
       const int z_mid = kZ / 2;
-      std::array<double, 3> c{};
+      SigmoidFit fit(true);
       for (int xi = 0; xi < kXY; ++xi) {
         double target[3];
         node_rgb(l, z_mid, xi, yi, target);
-        if (xi == 0 || gauss_newton(c, target, 40, true) > 1e-4) fit_from_grey(target, c, true);
-        std::array<double, 3> start = c;
-        at(l, z_mid, yi, xi) = to_float(c);
+        if (xi == 0 || gauss_newton(fit, target, 40) > 1e-4) fit_from_grey(target, fit);
+        const SigmoidFit start = fit;
+        at(l, z_mid, yi, xi) = to_float(fit.c);
         for (int dir : {1, -1}) {
-          c = start;
+          fit = start;
           for (int zi = z_mid + dir; zi >= 0 && zi < kZ; zi += dir) {
             node_rgb(l, zi, xi, yi, target);
-            gauss_newton(c, target, 40, true);
-            at(l, zi, yi, xi) = to_float(c);
+            gauss_newton(fit, target, 40);
+            at(l, zi, yi, xi) = to_float(fit.c);
           }
         }
-        c = start;
+        fit = start;
       }
     });
   }
@@ -347,9 +364,9 @@ class SigmoidTable {
 
 float fit_sigmoid(Rgb rgb, std::array<float, 3>* coeff) {
   double target[3] = {rgb[0], rgb[1], rgb[2]};
-  std::array<double, 3> c{};
-  double residual = fit_from_grey(target, c, false);
-  *coeff = {float(c[0]), float(c[1]), float(c[2])};
+  SigmoidFit fit(false);
+  double residual = fit_from_grey(target, fit);
+  *coeff = {float(fit.c[0]), float(fit.c[1]), float(fit.c[2])};
   return float(residual);
 }
 
