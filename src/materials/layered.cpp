@@ -1,5 +1,7 @@
 #include "materials/layered.h"
 
+#include <tbb/parallel_for.h>
+
 #include <bit>
 #include <cmath>
 
@@ -26,6 +28,19 @@ uint64_t key_of(Vec3 a, Vec3 b) {
                     bits(b.y) | bits(b.z) << 32);
 }
 
+constexpr int kGrid = 64;  // points per side of the grids of the coat's 2D integrals
+
+float node_cos(int j) {
+  float x = float(j) / (CoatWalkTable::kNodes - 1);
+  return x * x;
+}
+
+float lookup(const std::array<float, CoatWalkTable::kNodes>& t, float cos_theta) {
+  float x = std::sqrt(std::clamp(cos_theta, 0.0f, 1.0f)) * (CoatWalkTable::kNodes - 1);
+  int j = std::min(int(x), CoatWalkTable::kNodes - 2);
+  return t[j] + (t[j + 1] - t[j]) * (x - float(j));
+}
+
 // A sample that can be used: it exists, carries value and has a density.
 bool usable(const std::optional<BsdfSample>& s) {
   return s && !s->f.is_black() && s->pdf_solid_angle > 0 && s->wi.z != 0;
@@ -50,6 +65,8 @@ struct Layer {
   Base base;
   float thickness;
   int max_depth, samples;
+  // The walks' expectation, for a Lambertian base under the coat it was made for; else null.
+  const CoatWalkTable* walk_table = nullptr;
   // Which lobes to see (BsdfPart): the coating's own reflection (`coat`), the walks under it
   // (`walks`), or both. A material whose coating is not traced, or whose base is traced as well,
   // does not split: it is seen whole.
@@ -81,6 +98,12 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   const DielectricMaterial& top = L.top;
   const bool top_smooth = top.roughness.effectively_smooth();
   // Reflection off the coating itself (zero for a smooth coating: its mirror lobe is a delta).
+  if (L.walk_table) {
+    Spectrum f = L.coat ? dielectric_f(top, wo, wi, mode) : Spectrum();
+    if (!L.walks) return f;
+    const Spectrum& r = std::get<DiffuseMaterial>(L.base.m).reflectance;
+    return f + L.walk_table->f(r, wo.z, wi.z);
+  }
   Spectrum f = L.coat ? dielectric_f(top, wo, wi, mode) * float(L.samples) : Spectrum();
   if (!L.walks) return f / float(L.samples);
   Rng rng(key_of(wo, wi));
@@ -198,6 +221,18 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
     return bs;
   }
   Rng rng(key_of(wo, Vec3(uc, u.x, u.y)));
+  if (L.walk_table) {
+    // Into the layer (probability enter(cos wo)): the walks' direction out is drawn cosine-
+    // distributed and weighed by the table's f, in place of a walk.
+    const CoatWalkTable& t = *L.walk_table;
+    const float p_enter = lookup(t.enter, wo.z);
+    Vec3 wi = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
+    if (!(p_enter > 0) || wi.z <= 0) return std::nullopt;
+    const Spectrum f = t.f(std::get<DiffuseMaterial>(L.base.m).reflectance, wo.z, wi.z);
+    const float pdf = p_enter * cosine_hemisphere_pdf_solid_angle(wi.z);
+    if (flip) wi = -wi;
+    return BsdfSample{f, wi, pdf, kReflection | kGlossy, 1};
+  }
   Spectrum f = bs->f * std::fabs(bs->wi.z);
   float pdf = bs->pdf_solid_angle;
   Vec3 w = bs->wi;
@@ -236,13 +271,137 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
 }
 
 Layer layer_of(const Material& m, BsdfPart part) {
-  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m))
-    return Layer(d->layer, DiffuseMaterial{d->reflectance}, part);
+  if (auto* d = std::get_if<CoatedDiffuseMaterial>(&m)) {
+    Layer l(d->layer, DiffuseMaterial{d->reflectance}, part);
+    if (d->walk_table && d->walk_table->made_for(d->layer)) l.walk_table = d->walk_table;
+    return l;
+  }
   const auto& c = std::get<CoatedConductorMaterial>(m);
   return Layer(c.layer, c.conductor, part);
 }
 
+// Point (i, j) of a k x k grid over the unit square, crowded toward x = 1 (x = 1 - (1 - s)^2 for
+// cell middles s), and its weight in an integral over the square (the mean of the weights is 1).
+// The coat's sampling (microfacet normals by visible area) reaches its steep slopes there.
+Vec2 grid_point(int i, int j, int k, float* weight) {
+  const float s = (float(i) + 0.5f) / float(k);
+  *weight = 2 * (1 - s);
+  return {1 - (1 - s) * (1 - s), (float(j) + 0.5f) / float(k)};
+}
+
 }  // namespace
+
+Spectrum CoatWalkTable::f(const Spectrum& reflectance, float cos_o, float cos_i) const {
+  const float ab = lookup(a, std::fabs(cos_o)) * lookup(b, std::fabs(cos_i));
+  Spectrum out;
+  for (int c = 0; c < Spectrum::kChannels; ++c) {
+    const float r = reflectance[c], x = r * rho;
+    float visits_sum = 0;  // 1 + x + ... + x^(visits - 1)
+    for (int v = 0; v < visits; ++v) visits_sum = 1 + x * visits_sum;
+    out[c] = ab * r * visits_sum;
+  }
+  return out;
+}
+
+std::shared_ptr<const CoatWalkTable> make_coat_walk_table(const CoatLayer& layer) {
+  if (layer.roughness.alpha_x != layer.roughness.alpha_y) return nullptr;
+  auto t = std::make_shared<CoatWalkTable>();
+  t->layer = layer;
+  t->visits = std::max(0, (layer.max_depth + 1) / 2);
+  const DielectricMaterial top{layer.eta, layer.roughness, nullptr};
+  const bool smooth = top.roughness.effectively_smooth();
+  const float d = layer.thickness;
+  // Radiance transport. In importance transport the way in loses its 1 / eta^2 and the way out
+  // gains it: the product, a reflection's f, is the same.
+  const TransportMode mode = TransportMode::kRadiance;
+  // A smooth coat refracts and reflects deterministically: one point is the integral.
+  const int k = smooth ? 1 : kGrid;
+  tbb::parallel_for(0, CoatWalkTable::kNodes, [&](int j) {
+    const float c = std::max(node_cos(j), 1e-6f);  // node 0 just above grazing
+    const Vec3 w(std::sqrt(std::fmax(0.0f, 1 - c * c)), 0, c);
+    double in_sum = 0, nee_sum = 0, exit_sum = 0, out_usable = 0, enter = 0;
+    const TrowbridgeReitz distribution(top.roughness.alpha_x, top.roughness.alpha_y);
+    for (int iy = 0; iy < k; ++iy)
+      for (int ix = 0; ix < k; ++ix) {
+        float g;
+        const Vec2 u = grid_point(ix, iy, k, &g);
+        // A: into the layer from w, across it to the base (the walk's first steps).
+        auto in = dielectric_sample(top, w, 0.5f, u, mode, kTransmission);
+        if (usable(in)) {
+          in_sum += g * in->f[0] * std::fabs(in->wi.z) / in->pdf_solid_angle *
+                    layer_transmittance(d, in->wi);
+          // The coat's sample of both lobes takes this way in with probability 1 - Fresnel.
+          const float cos_m = smooth ? w.z : dot(w, distribution.sample_wm(w, u));
+          enter += g * (1 - fresnel_dielectric(cos_m, layer.eta));
+        }
+        // B, next-event estimation: the way out toward w presampled from w (adjoint), the base's
+        // f (R / pi, R outside) and the layer on the way; weighted against exits by base sampling
+        // unless the coat is smooth.
+        auto out = dielectric_sample(top, w, 0.5f, u, adjoint(mode), kTransmission);
+        if (usable(out)) {
+          out_usable += g;
+          const float cos_b = std::fabs(out->wi.z);
+          const float wt =
+              smooth ? 1 : power_heuristic(out->pdf_solid_angle, cos_b * float(kInvPi));
+          nee_sum += g * kInvPi * cos_b * wt * layer_transmittance(d, out->wi) /
+                     out->pdf_solid_angle * out->f[0];
+        }
+        if (smooth) continue;
+        // B, exits by base sampling: a cosine direction up from the base (weight R, outside),
+        // through the layer and the coat toward w. Its integrand peaks where the coat's
+        // refraction does (alpha 0.01: a cone of about 0.01 rad), so it is integrated over both
+        // the cosine grid and the coat's own samples, combined by the balance heuristic (either
+        // way the term is p_base g / (p_base + p_coat)).
+        auto exit_term = [&](Vec3 up, float p_coat) {
+          const float f_exit = dielectric_f(top, -up, w, mode)[0];
+          if (!(f_exit > 0)) return 0.0;
+          const float p_base = up.z * float(kInvPi);
+          const float wt = power_heuristic(p_base, dielectric_pdf(top, w, -up, kTransmission));
+          return double(p_base) * f_exit * layer_transmittance(d, up) * wt /
+                 (double(p_base) + p_coat);
+        };
+        const Vec3 up = sample_cosine_hemisphere(u);
+        exit_sum += g * exit_term(up, dielectric_pdf(top, w, -up, kTransmission));
+        if (usable(out) && out->wi.z < 0) exit_sum += g * exit_term(-out->wi, out->pdf_solid_angle);
+      }
+    const double n = double(k) * k;
+    t->a[j] = float(in_sum / n);
+    t->enter[j] = float(enter / n);
+    // The walk skips a sample whose way out cannot be drawn, exits included.
+    t->b[j] = float(nee_sum / n + out_usable / n * exit_sum / n);
+  });
+  // rho: from a cosine direction up from the base, across the layer, reflected by the coat from
+  // inside, back across the layer. Four dimensions (the direction up, the coat's sample): the
+  // points of the R4 sequence (Kronecker steps by powers of 1 / phi_4, phi_4^5 = phi_4 + 1),
+  // summed in fixed chunks so that the sum does not depend on the threads.
+  constexpr int kChunks = 64, kChunk = 4096;
+  constexpr double kPhi4 = 1.1673039782614187;
+  const double step[4] = {1 / kPhi4, 1 / (kPhi4 * kPhi4), 1 / (kPhi4 * kPhi4 * kPhi4),
+                          1 / (kPhi4 * kPhi4 * kPhi4 * kPhi4)};
+  std::array<double, kChunks> rho_sums{};
+  tbb::parallel_for(0, kChunks, [&](int chunk) {
+    for (int n = chunk * kChunk; n < (chunk + 1) * kChunk; ++n) {
+      float x[4];
+      for (int i = 0; i < 4; ++i) {
+        double v = 0.5 + step[i] * n;
+        x[i] = float(v - std::floor(v));
+      }
+      const Vec3 up = sample_cosine_hemisphere({x[0], x[1]});
+      auto r = dielectric_sample(top, -up, 0.5f, {x[2], x[3]}, mode, kReflection);
+      if (usable(r))
+        rho_sums[chunk] += layer_transmittance(d, up) * r->f[0] * std::fabs(r->wi.z) /
+                           r->pdf_solid_angle * layer_transmittance(d, r->wi);
+    }
+  });
+  double rho_sum = 0;
+  for (double s : rho_sums) rho_sum += s;
+  t->rho = float(rho_sum / (double(kChunks) * kChunk));
+  for (int j = 0; j < CoatWalkTable::kNodes; ++j)
+    if (!std::isfinite(t->a[j]) || !std::isfinite(t->b[j]) || !std::isfinite(t->enter[j]))
+      return nullptr;
+  if (!std::isfinite(t->rho)) return nullptr;
+  return t;
+}
 
 Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part) {
   return layered_f(layer_of(m, part), wo, wi, mode);

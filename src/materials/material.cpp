@@ -67,7 +67,7 @@ struct Resolver {
   Material operator()(const CoatedDiffuseDesc& d) const {
     CoatLayer layer = d.layer;
     layer.roughness = rough(d.layer.roughness, d.roughness_tex);
-    return CoatedDiffuseMaterial{eval(d.reflectance), layer};
+    return CoatedDiffuseMaterial{eval(d.reflectance), layer, d.walk_table.get()};
   }
 };
 

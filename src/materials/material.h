@@ -89,10 +89,15 @@ struct CoatLayer {
   int max_depth = 10, samples = 1;
 };
 
+struct CoatWalkTable;  // materials/layered.h
+
 // pbrt-v4's "coateddiffuse": the coat over a Lambertian base.
 struct CoatedDiffuseMaterial {
   Spectrum reflectance{0.5f};
   CoatLayer layer;
+  // The walks' expectation for this coat (owned by the scene's description), or null: f is then
+  // the stochastic walk's estimate.
+  const CoatWalkTable* walk_table = nullptr;
 };
 
 // pbrt-v4's "coatedconductor": the coat over a conductor base (smooth or rough).
@@ -142,6 +147,8 @@ struct CoatedDiffuseDesc {
   SpectrumParam reflectance{SpectrumCurve(0.5f)};
   CoatLayer layer;
   RoughnessTextures roughness_tex;  // the coat's
+  // For the constant coat (make_coat_walk_table); null when the roughness is textured.
+  std::shared_ptr<const CoatWalkTable> walk_table;
 };
 struct CoatedConductorDesc {
   ConductorDesc conductor;

@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "materials/layered.h"
 #include "scene/flatten_internal.h"
 #include "scene/spectra.h"
 
@@ -193,6 +194,7 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
     CoatedDiffuseDesc c;
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
     c.layer = coat_layer(ps, e, "", &c.roughness_tex);
+    if (!c.roughness_tex.any()) c.walk_table = make_coat_walk_table(c.layer);
     m = c;
   } else if (e.name == "coatedconductor") {
     CoatedConductorDesc c;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "materials/layered.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
 #include "scene/ply.h"
@@ -1839,6 +1840,23 @@ TEST(SceneParams, CoatedDiffuse) {
   EXPECT_EQ(d.layer.max_depth, 10);
   EXPECT_EQ(d.layer.samples, 1);
   EXPECT_TRUE(d.layer.roughness.effectively_smooth());
+  // Each constant coat gets its walks' table, which reaches the resolved material.
+  ASSERT_TRUE(c.walk_table);
+  EXPECT_TRUE(c.walk_table->made_for(c.layer));
+  const Wavelengths wl = sample_wavelengths(0.5f);
+  EXPECT_EQ(std::get<CoatedDiffuseMaterial>(resolve_material(m, wl)).walk_table,
+            c.walk_table.get());
+  ASSERT_TRUE(d.walk_table);
+  EXPECT_TRUE(d.walk_table->made_for(d.layer));
+}
+
+TEST(SceneParams, CoatedDiffuseWithTexturedRoughnessHasNoWalkTable) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nTexture \"r\" \"float\" \"checkerboard\" \"float tex1\" 0.1 \"float tex2\" "
+      "0.3\nMaterial \"coateddiffuse\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"));
+  const auto& c = std::get<CoatedDiffuseDesc>(ls.scene.materials[ls.scene.objects[0].material]);
+  EXPECT_TRUE(c.roughness_tex.any());
+  EXPECT_FALSE(c.walk_table);
 }
 
 TEST(SceneParams, CoatedConductor) {
