@@ -173,6 +173,16 @@ float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
     wo = -wo;
     wi = -wi;
   }
+  if (L.walk_table) {
+    // layered_sample's density, exactly: the coat's reflection (as drawn there) and the walks'
+    // cosine lobe.
+    if (wo.z == 0 || wi.z <= 0) return 0;
+    float p = L.coat ? dielectric_pdf(L.top, wo, wi,
+                                      L.walks ? kReflection | kTransmission : unsigned(kReflection))
+                     : 0;
+    if (L.walks) p += lookup(L.walk_table->enter, wo.z) * cosine_hemisphere_pdf_solid_angle(wi.z);
+    return p;
+  }
   float sum = 0;
   if (wi.z > 0 && wo.z > 0) {
     const DielectricMaterial& top = L.top;
