@@ -35,10 +35,14 @@ float node_cos(int j) {
   return x * x;
 }
 
+// The table's value at cos_theta: its cell found on the square-root scale of the nodes, linear in
+// cos inside it (exact for the values proportional to cos near grazing that a smooth coat has).
 float lookup(const std::array<float, CoatWalkTable::kNodes>& t, float cos_theta) {
-  float x = std::sqrt(std::clamp(cos_theta, 0.0f, 1.0f)) * (CoatWalkTable::kNodes - 1);
-  int j = std::min(int(x), CoatWalkTable::kNodes - 2);
-  return t[j] + (t[j + 1] - t[j]) * (x - float(j));
+  const float c = std::clamp(cos_theta, 0.0f, 1.0f);
+  const int j =
+      std::min(int(std::sqrt(c) * (CoatWalkTable::kNodes - 1)), CoatWalkTable::kNodes - 2);
+  const float c0 = node_cos(j), c1 = node_cos(j + 1);
+  return t[j] + (t[j + 1] - t[j]) * ((c - c0) / (c1 - c0));
 }
 
 // A sample that can be used: it exists, carries value and has a density.
@@ -86,6 +90,15 @@ struct Layer {
     return c && c->roughness.traced();
   }
 };
+
+// With a walk table, the probability of drawing the walks' lobe: their share of the coat's own
+// draws (enter), kept inside (0, 1) where both lobes are wanted so that neither goes undrawn; all
+// draws for the walks' part alone, none for the coat's.
+float walks_share(const Layer& L, float cos_o) {
+  if (!L.walks) return 0;
+  if (!L.coat) return 1;
+  return std::clamp(lookup(L.walk_table->enter, cos_o), 1e-3f, 0.999f);
+}
 
 Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   // Two-sided: seen from below, the material is the same as from above.
@@ -174,14 +187,11 @@ float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
     wi = -wi;
   }
   if (L.walk_table) {
-    // layered_sample's density, exactly: the coat's reflection (as drawn there) and the walks'
-    // cosine lobe.
+    // layered_sample's mixture, exactly.
     if (wo.z == 0 || wi.z <= 0) return 0;
-    float p = L.coat ? dielectric_pdf(L.top, wo, wi,
-                                      L.walks ? kReflection | kTransmission : unsigned(kReflection))
-                     : 0;
-    if (L.walks) p += lookup(L.walk_table->enter, wo.z) * cosine_hemisphere_pdf_solid_angle(wi.z);
-    return p;
+    const float q = walks_share(L, wo.z);
+    const float coat = L.coat ? (1 - q) * dielectric_pdf(L.top, wo, wi, kReflection) : 0;
+    return coat + q * cosine_hemisphere_pdf_solid_angle(wi.z);
   }
   float sum = 0;
   if (wi.z > 0 && wo.z > 0) {
@@ -221,6 +231,28 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
   const bool flip = wo.z < 0;
   if (flip) wo = -wo;
   const DielectricMaterial& top = L.top;
+  if (L.walk_table) {
+    // A mixture of the two lobes: the walks' (the table's f) with probability q, cosine-
+    // distributed; else the coat's reflection, drawn as the coat draws it. Every weight is exact
+    // for the table's f.
+    const float q = walks_share(L, wo.z);
+    if (uc < q) {
+      Vec3 wi = sample_cosine_hemisphere(u);
+      if (wi.z <= 0) return std::nullopt;
+      const Spectrum f =
+          L.walk_table->f(std::get<DiffuseMaterial>(L.base.m).reflectance, wo.z, wi.z);
+      const float pdf = q * cosine_hemisphere_pdf_solid_angle(wi.z);
+      if (flip) wi = -wi;
+      return BsdfSample{f, wi, pdf, kReflection | kGlossy, 1};
+    }
+    if (!L.coat) return std::nullopt;
+    auto bs = dielectric_sample(top, wo, (uc - q) / (1 - q), u, mode, kReflection);
+    if (!usable(bs)) return std::nullopt;
+    bs->pdf_solid_angle *= 1 - q;
+    if (flip) bs->wi = -bs->wi;
+    if (top.roughness.traced()) bs->flags |= kTraced;
+    return bs;
+  }
   auto bs = dielectric_sample(top, wo, uc, u, mode,
                               L.walks ? kReflection | kTransmission : unsigned(kReflection));
   if (!usable(bs)) return std::nullopt;
@@ -231,18 +263,6 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
     return bs;
   }
   Rng rng(key_of(wo, Vec3(uc, u.x, u.y)));
-  if (L.walk_table) {
-    // Into the layer (probability enter(cos wo)): the walks' direction out is drawn cosine-
-    // distributed and weighed by the table's f, in place of a walk.
-    const CoatWalkTable& t = *L.walk_table;
-    const float p_enter = lookup(t.enter, wo.z);
-    Vec3 wi = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
-    if (!(p_enter > 0) || wi.z <= 0) return std::nullopt;
-    const Spectrum f = t.f(std::get<DiffuseMaterial>(L.base.m).reflectance, wo.z, wi.z);
-    const float pdf = p_enter * cosine_hemisphere_pdf_solid_angle(wi.z);
-    if (flip) wi = -wi;
-    return BsdfSample{f, wi, pdf, kReflection | kGlossy, 1};
-  }
   Spectrum f = bs->f * std::fabs(bs->wi.z);
   float pdf = bs->pdf_solid_angle;
   Vec3 w = bs->wi;
@@ -307,7 +327,11 @@ Spectrum CoatWalkTable::f(const Spectrum& reflectance, float cos_o, float cos_i)
   for (int c = 0; c < Spectrum::kChannels; ++c) {
     const float r = reflectance[c], x = r * rho;
     float visits_sum = 0;  // 1 + x + ... + x^(visits - 1)
-    for (int v = 0; v < visits; ++v) visits_sum = 1 + x * visits_sum;
+    if (visits > 16 && x < 0.99f) {
+      visits_sum = (1 - std::pow(x, float(visits))) / (1 - x);
+    } else {
+      for (int v = 0; v < visits; ++v) visits_sum = 1 + x * visits_sum;
+    }
     out[c] = ab * r * visits_sum;
   }
   return out;

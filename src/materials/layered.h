@@ -33,9 +33,10 @@ std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, V
 // reflects back to it; N = (max_depth + 1) / 2 visits to the base within max_depth bounces. A, B
 // and rho are integrals over the coat's own sampling, computed once per coat on a grid (about 0.2 s
 // of CPU for a rough coat), so f is the stochastic walk's expectation (within about 1e-3) without
-// its noise or its cost. Sampling keeps the coat's own draw; where that goes into the layer
-// (probability enter(cos wo)), the direction out is cosine-distributed and weighed by the table's
-// f, in place of a walk. The density for MIS (layered_pdf) stays the walk's estimate.
+// its noise or its cost. The material is then a plain BSDF of two lobes, the coat's reflection and
+// the walks' table, sampled as a mixture: the walks with probability enter(cos wo) (their share of
+// the coat's own draws), cosine-distributed, else the coat's reflection; layered_pdf is that
+// mixture's density, exactly.
 struct CoatWalkTable {
   static constexpr int kNodes = 64;  // node j at cos = (j / (kNodes - 1))^2: dense near grazing
   CoatLayer layer;                   // the coat it was made for

@@ -38,6 +38,9 @@ class Flattener {
   std::map<std::string, int> named_material_ids_;
   std::map<std::string, int> medium_ids_;
   std::set<std::string> building_materials_;
+  // The coateddiffuse walk tables made so far: materials with the same coat share one.
+  std::vector<std::shared_ptr<const CoatWalkTable>> coat_walk_tables_;
+  std::shared_ptr<const CoatWalkTable> coat_walk_table(const CoatLayer& layer);
   // The data files read so far (LoadedScene::data_files), and the same as a set.
   std::vector<std::string> data_files_;
   std::set<std::string> data_file_set_;

@@ -126,6 +126,14 @@ ConductorDesc Flattener::conductor_desc(const ParamSet& ps, const FileLoc& loc,
 // The coat of pbrt-v4's coated materials; prefix names the coat's roughness and eta
 // ("interface." in coatedconductor). A scattering medium inside the layer (albedo > 0) is not
 // modelled.
+std::shared_ptr<const CoatWalkTable> Flattener::coat_walk_table(const CoatLayer& layer) {
+  for (const auto& t : coat_walk_tables_)
+    if (t->made_for(layer)) return t;
+  auto t = make_coat_walk_table(layer);
+  if (t) coat_walk_tables_.push_back(t);
+  return t;
+}
+
 CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
                                 RoughnessTextures* tex) {
   CoatLayer c;
@@ -194,7 +202,7 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
     CoatedDiffuseDesc c;
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
     c.layer = coat_layer(ps, e, "", &c.roughness_tex);
-    if (!c.roughness_tex.any()) c.walk_table = make_coat_walk_table(c.layer);
+    if (!c.roughness_tex.any()) c.walk_table = coat_walk_table(c.layer);
     m = c;
   } else if (e.name == "coatedconductor") {
     CoatedConductorDesc c;
