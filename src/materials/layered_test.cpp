@@ -114,30 +114,33 @@ TEST(CoatedDiffuse, AbsorbingBaseAndLayerReflectLess) {
   EXPECT_GT(grey.mean, fresnel_dielectric(0.8f, 1.5f));
 }
 
+// Direction bins over the sphere: kBinsCos in |cos theta| by kBinsPhi in azimuth, per hemisphere.
+constexpr int kBinsCos = 6, kBinsPhi = 8, kBins = 2 * kBinsCos * kBinsPhi;
+int direction_bin(Vec3 w) {
+  int i = std::min(kBinsCos - 1, int(std::fabs(w.z) * kBinsCos));
+  float phi = std::atan2(w.y, w.x) + kPi;
+  int j = std::min(kBinsPhi - 1, int(phi / (2 * kPi) * kBinsPhi));
+  return (w.z < 0 ? kBinsCos * kBinsPhi : 0) + i * kBinsPhi + j;
+}
+
 // The random walk that samples directions and the estimator of f describe the same BSDF: per
 // direction bin, E[weight * 1(bin)] = integral over the bin of f cos.
 void expect_sampling_matches_evaluation(const Material& m, Vec3 wo) {
-  const int n_cos = 6, n_phi = 8, n = 300000;
-  auto bin = [&](Vec3 w) {
-    int i = std::min(n_cos - 1, int(std::fabs(w.z) * n_cos));
-    float phi = std::atan2(w.y, w.x) + kPi;
-    int j = std::min(n_phi - 1, int(phi / (2 * kPi) * n_phi));
-    return (w.z < 0 ? n_cos * n_phi : 0) + i * n_phi + j;
-  };
-  std::vector<MeanAccumulator> sampled(2 * n_cos * n_phi), evaluated(2 * n_cos * n_phi);
+  const int n = 300000;
+  std::vector<MeanAccumulator> sampled(kBins), evaluated(kBins);
   Rng rng(9);
   for (int k = 0; k < n; ++k) {
     auto s =
         bsdf_sample(m, wo, rng.uniform(), {rng.uniform(), rng.uniform()}, TransportMode::kRadiance);
     // Delta lobes (a smooth coat's mirror reflection) are not in f: leave them out.
-    int b = s && !s->is_specular() ? bin(s->wi) : -1;
+    int b = s && !s->is_specular() ? direction_bin(s->wi) : -1;
     for (int c = 0; c < int(sampled.size()); ++c)
       sampled[c].add(c == b ? double(s->f[0]) * std::fabs(s->wi.z) / s->pdf_solid_angle : 0.0);
     // Uniform over the sphere: z uniform, so the cos bins have equal measure.
     Vec3 wi = sample_uniform_sphere({rng.uniform(), rng.uniform()});
     double v = double(bsdf_f(m, wo, wi, TransportMode::kRadiance)[0]) * std::fabs(wi.z) /
                kUniformSpherePdfSolidAngle;
-    int bw = bin(wi);
+    int bw = direction_bin(wi);
     for (int c = 0; c < int(evaluated.size()); ++c) evaluated[c].add(c == bw ? v : 0.0);
   }
   // 96 bins at 4.5 sigma: a correct BSDF fails with probability about 1e-3.
@@ -168,26 +171,20 @@ TEST(CoatedDiffuse, WalkTablePdfIsTheSamplingDensity) {
   ASSERT_TRUE(table);
   c.walk_table = table.get();
   const Vec3 wo = direction(0.6f, 1.1f);
-  const int n_cos = 6, n_phi = 8, n = 200000;
-  auto bin = [&](Vec3 w) {
-    int i = std::min(n_cos - 1, int(std::fabs(w.z) * n_cos));
-    float phi = std::atan2(w.y, w.x) + kPi;
-    int j = std::min(n_phi - 1, int(phi / (2 * kPi) * n_phi));
-    return (w.z < 0 ? n_cos * n_phi : 0) + i * n_phi + j;
-  };
+  const int n = 200000;
   for (BsdfPart part : {BsdfPart::kAll, BsdfPart::kGathered, BsdfPart::kTraced}) {
-    std::vector<MeanAccumulator> sampled(2 * n_cos * n_phi), integrated(2 * n_cos * n_phi);
+    std::vector<MeanAccumulator> sampled(kBins), integrated(kBins);
     MeanAccumulator sampled_all, integrated_all;  // all bins: the probability of a sample
     Rng rng(17);
     for (int k = 0; k < n; ++k) {
       auto s = bsdf_sample(c, wo, rng.uniform(), {rng.uniform(), rng.uniform()},
                            TransportMode::kRadiance, part);
-      int b = s ? bin(s->wi) : -1;
+      int b = s ? direction_bin(s->wi) : -1;
       // Cosine-distributed directions: the walks' lobe is then integrated with little noise.
       Vec3 wi = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
       double p = bsdf_pdf(c, wo, wi, TransportMode::kRadiance, part) /
                  cosine_hemisphere_pdf_solid_angle(wi.z);
-      int bw = bin(wi);
+      int bw = direction_bin(wi);
       for (int i = 0; i < int(sampled.size()); ++i) {
         sampled[i].add(i == b ? 1.0 : 0.0);
         integrated[i].add(i == bw ? p : 0.0);
