@@ -614,12 +614,18 @@ TEST(Materials, MixFurnaceMatchesAnalyticRadiance) {
   RenderRun run = render_with(ls, "path", 256);
   Image img = run.film.image();
   std::vector<float> rms = run.film.rms();
+  // Every pixel sees the same furnace, so each pixel's error is judged by the pooled estimate
+  // of one pixel's standard error: a pixel's own is noisy, and the per-path values are skewed
+  // (low where no bright path came), so that it is low exactly where the pixel is.
   double sum = 0, var = 0;
   for (int i = 0; i < 256; ++i) {
-    float v = img.at(i % 16, i / 16).luminance();
-    EXPECT_NEAR(v, want, 4.5 * rms[size_t(i)] + 1e-3) << "pixel " << i;
-    sum += v, var += double(rms[size_t(i)]) * rms[size_t(i)];
+    sum += img.at(i % 16, i / 16).luminance();
+    var += double(rms[size_t(i)]) * rms[size_t(i)];
   }
+  const double pixel_sigma = std::sqrt(var / 256);
+  for (int i = 0; i < 256; ++i)
+    EXPECT_NEAR(img.at(i % 16, i / 16).luminance(), want, 4.5 * pixel_sigma + 1e-3)
+        << "pixel " << i;
   EXPECT_NEAR(sum / 256, want, 4.5 * std::sqrt(var) / 256);
   EXPECT_LT(std::sqrt(var) / 256, 0.005 * want);
 

@@ -8,18 +8,29 @@
 
 namespace bpm {
 
+// (cos a, sin a) for |a| <= pi/4 from their Taylor series, within 1e-8 of the true values (below
+// half a float ulp of either), without the range reduction of a library call: the samplers' hot
+// paths take their angles in this range.
+inline Vec2 cos_sin_quarter_turn(float a) {
+  const float a2 = a * a;
+  const float s =
+      a * (1 + a2 * (-1.f / 6 + a2 * (1.f / 120 + a2 * (-1.f / 5040 + a2 * (1.f / 362880)))));
+  const float c =
+      1 + a2 * (-0.5f +
+                a2 * (1.f / 24 + a2 * (-1.f / 720 + a2 * (1.f / 40320 + a2 * (-1.f / 3628800)))));
+  return {c, s};
+}
+
 inline Vec2 sample_uniform_disk_concentric(Vec2 u) {
   float ox = 2 * u.x - 1, oy = 2 * u.y - 1;
   if (ox == 0 && oy == 0) return {0, 0};
-  float r, theta;
-  if (std::fabs(ox) > std::fabs(oy)) {
-    r = ox;
-    theta = (kPi / 4) * (oy / ox);
-  } else {
-    r = oy;
-    theta = kPi / 2 - (kPi / 4) * (ox / oy);
+  if (std::fabs(ox) > std::fabs(oy)) {  // theta = (pi/4)(oy/ox)
+    const Vec2 cs = cos_sin_quarter_turn((kPi / 4) * (oy / ox));
+    return {ox * cs.x, ox * cs.y};
   }
-  return {r * std::cos(theta), r * std::sin(theta)};
+  // theta = pi/2 - a with a = (pi/4)(ox/oy): cos theta = sin a, sin theta = cos a.
+  const Vec2 cs = cos_sin_quarter_turn((kPi / 4) * (ox / oy));
+  return {oy * cs.y, oy * cs.x};
 }
 
 // Cosine-weighted direction about +z; pdf_solid_angle = cos(theta) / pi.

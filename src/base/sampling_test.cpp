@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "base/chi2_test_util.h"
@@ -57,6 +58,35 @@ TEST(EqualArea, EqualAreasOfTheSquareAreEqualSolidAngles) {
   }
   double p = 1.0 / cells, sigma = std::sqrt(n * p * (1 - p));
   for (int c = 0; c < cells; ++c) EXPECT_NEAR(count[size_t(c)], n * p, 4 * sigma) << "cell " << c;
+}
+
+TEST(CosSinQuarterTurn, WithinAFloatUlpOfTheLibrary) {
+  // Over the whole range |a| <= pi/4, against double-precision cos and sin of the same float a.
+  double worst = 0;
+  for (int k = -200000; k <= 200000; ++k) {
+    const float a = float(k) / 200000 * (kPi / 4);
+    const Vec2 cs = cos_sin_quarter_turn(a);
+    worst = std::max({worst, std::fabs(double(cs.x) - std::cos(double(a))),
+                      std::fabs(double(cs.y) - std::sin(double(a)))});
+  }
+  EXPECT_LT(worst, 1.2e-7);  // a float ulp at 1 is 1.19e-7
+}
+
+TEST(ConcentricDisk, SameMapAsThePolarFormula) {
+  // Shirley and Chiu's map: r = ox, theta = (pi/4)(oy/ox) where |ox| > |oy|, else r = oy,
+  // theta = pi/2 - (pi/4)(ox/oy); evaluated in double, it must equal the float map.
+  Rng rng(11);
+  for (int k = 0; k < 100000; ++k) {
+    const Vec2 u(rng.uniform(), rng.uniform());
+    const double ox = 2.0 * u.x - 1, oy = 2.0 * u.y - 1;
+    const bool wide = std::fabs(ox) > std::fabs(oy);
+    const double r = wide ? ox : oy,
+                 theta = wide ? (kPi / 4) * (oy / ox) : kPi / 2 - (kPi / 4) * (ox / oy);
+    const Vec2 d = sample_uniform_disk_concentric(u);
+    EXPECT_NEAR(d.x, r * std::cos(theta), 4e-7) << u.x << " " << u.y;
+    EXPECT_NEAR(d.y, r * std::sin(theta), 4e-7) << u.x << " " << u.y;
+  }
+  EXPECT_EQ(sample_uniform_disk_concentric({0.5f, 0.5f}).x, 0.0f);
 }
 
 TEST(Distribution2D, SamplesFollowTheWeights) {
