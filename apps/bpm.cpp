@@ -80,7 +80,8 @@ void print_bpm_summary(const nlohmann::json& d) {
       "bpm: light: %.3g photons, %.3g rays, %.2f Mrays/s, %.3g queries (%.2f M/s), %.1f "
       "batches/iteration, "
       "%.2f of the last backward photons hit\n"
-      "bpm: stages: eye %.2f s, trees %.2f s, light %.2f + %.2f s, accumulate %.2f s\n",
+      "bpm: stages: eye %.2f s, trees %.2f s, light trace %.2f + gather %.2f + apply %.2f s, "
+      "accumulate %.2f s\n",
       double(eye["camera_rays"].get<uint64_t>() + eye["bounce_rays"].get<uint64_t>() +
              eye["shadow_rays"].get<uint64_t>()),
       double(eye["backward_photons"].get<uint64_t>()),
@@ -92,7 +93,8 @@ void print_bpm_summary(const nlohmann::json& d) {
       double(light["queries"].get<uint64_t>()), light["queries_per_second"].get<double>() * 1e-6,
       light["batches_per_iteration"].get<double>(), light["coverage_mean"].get<double>(),
       st["eye"].get<double>(), st["tree_build"].get<double>(), st["light_trace"].get<double>(),
-      st["light_apply"].get<double>(), st["accumulate"].get<double>());
+      st["light_gather"].get<double>(), st["light_apply"].get<double>(),
+      st["accumulate"].get<double>());
 }
 
 void print_fpm_summary(const nlohmann::json& d) {

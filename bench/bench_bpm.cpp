@@ -1,9 +1,10 @@
 // Figures for the backward photon mapping integrator (prints them; never fails):
 //   1. trees: the kd-tree over whole integration spheres against the kd-tree over centres on the
 //      backward photon maps of a real render: build time, queries per second, light pass time;
-//   2. rays: eye-pass and light-pass rays per second beside bare Embree casting the same rays,
-//      and the light pass's time per photon beside pbrt-v4's sppm photon pass on the same scene
-//      file (when ../shared/tools/pbrt-v4/pbrt or --pbrt is there);
+//   2. rays: eye-pass and light-pass rays per second beside bare Embree casting the same rays;
+//      the light pass's time per photon, split into trace, gather and apply beside its rays
+//      alone, and beside pbrt-v4's sppm photon pass on the same scene file (when
+//      ../shared/tools/pbrt-v4/pbrt or --pbrt is there);
 //   3. equal time: relative MSE of bpm and path at equal render times against a converged
 //      reference (path with a long budget, cached next to the binary).
 //   bench_bpm [scene.pbrt] [--res WxH] [--iterations N] [--times 30,60] [--reference-time S]
@@ -80,8 +81,9 @@ void trees(const LoadedScene& ls, int iterations, int threads, const BpmSettings
     RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
     images[centres] = film.image();
     const auto& d = st.details;
-    double light_s =
-        d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+    double light_s = d["stages_s"]["light_trace"].get<double>() +
+                     d["stages_s"]["light_gather"].get<double>() +
+                     d["stages_s"]["light_apply"].get<double>();
     std::printf("%-8s %10.3f %12.2f %12.3g %14.2f %12.3f %10.2f\n", centres ? "centres" : "spheres",
                 d["maps"]["tree_build_s"].get<double>(),
                 d["maps"]["peak_tree_bytes"].get<double>() * 1e-6,
@@ -159,13 +161,14 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
   };
   for (int threads : {1, hw}) {
     std::vector<double> eye, eye_embree, eye_share, light, light_embree, light_share, us_photon,
-        rays_photon, pbrt_us, pbrt_rays;
+        rays_photon, pbrt_us, pbrt_rays, trace_us, gather_us, apply_us, embree_us, embree_share;
     for (int r = 0; r < kRepeats; ++r) {
       Film film(w, h);
       RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
       const auto& d = st.details;
-      const double light_s =
-          d["stages_s"]["light_trace"].get<double>() + d["stages_s"]["light_apply"].get<double>();
+      const double light_s = d["stages_s"]["light_trace"].get<double>() +
+                             d["stages_s"]["light_gather"].get<double>() +
+                             d["stages_s"]["light_apply"].get<double>();
       const double photons = double(d["light"]["photons"].get<uint64_t>()),
                    light_rays = double(d["light"]["light_rays"].get<uint64_t>());
       eye.push_back(d["eye"]["rays_per_second"].get<double>());
@@ -175,6 +178,11 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
       eye_embree.push_back(embree_replay(ls.scene, eye_log, threads));
       light_embree.push_back(embree_replay(ls.scene, light_log, threads));
       eye_share.push_back(eye.back() / eye_embree.back());
+      trace_us.push_back(d["stages_s"]["light_trace"].get<double>() / photons * 1e6);
+      gather_us.push_back(d["stages_s"]["light_gather"].get<double>() / photons * 1e6);
+      apply_us.push_back(d["stages_s"]["light_apply"].get<double>() / photons * 1e6);
+      embree_us.push_back(light_rays / photons / light_embree.back() * 1e6);
+      embree_share.push_back(embree_us.back() / trace_us.back());
       light_share.push_back(light.back() / light_embree.back());
       if (!pbrt.empty()) {
         PbrtPhotonCost c =
@@ -197,6 +205,14 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
     } else if (!pbrt.empty()) {
       std::printf("; pbrt-v4 failed to run");
     }
+    // Where a photon's time goes: tracing it (its rays, emission, scattering and each hit's
+    // leaf), gathering at its hits (their sort included), applying the entries (the emission
+    // guide's learning included); its rays alone in bare Embree.
+    std::printf(
+        "\n            medians: trace %.3f, gather %.3f, apply %.3f us per photon; its rays "
+        "alone in Embree %.3f us (%.0f%% of the trace)",
+        median(trace_us), median(gather_us), median(apply_us), median(embree_us),
+        100 * median(embree_share));
     std::printf("\n");
     if (hw == 1) break;
   }

@@ -97,6 +97,7 @@ void textures() {
   constant.replace(at, from.size(), "\"rgb reflectance\" [ 0.42 0.27 0.15 ]");
   std::printf("== slit-room: image-textured floor against a constant one, 2 runs each ==\n");
   std::printf("  %-10s %-6s %12s %12s %12s\n", "floor", "", "s / pass", "eye s", "light s");
+  // light s: the light pass's trace and gather (its apply left out).
   for (int run = 0; run < 2; ++run)
     for (const std::string* scene : {&textured, &constant}) {
       LoadedScene ls = flatten_scene(parse_scene_string(*scene, file.parent_path().string()));
@@ -105,7 +106,8 @@ void textures() {
         double eye = 0, light = 0;
         if (st.details.contains("stages_s")) {
           eye = st.details["stages_s"]["eye"].get<double>();
-          light = st.details["stages_s"]["light_trace"].get<double>();
+          light = st.details["stages_s"]["light_trace"].get<double>() +
+                  st.details["stages_s"]["light_gather"].get<double>();
         }
         std::printf("  %-10s %-6s %12.3f %12.3f %12.3f\n",
                     scene == &textured ? "texture" : "constant", integrator,

@@ -20,10 +20,6 @@ namespace {
 // Domain separation of photon streams from pixel streams.
 constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 // Adds the entries of one diffuse hit (its query was counted when it was recorded). Returns the
 // sum of the entries' contributions to their pixels (per unit of 1 / N), each times the pixel's
 // weight, when prm.pixel_weight is set.
@@ -312,16 +308,23 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   res.cut = false;
   res.batches = 0;
   res.coverage = 0;
-  res.trace_s = res.apply_s = 0;
+  res.trace_s = res.gather_s = res.apply_s = 0;
   res.peak_entry_bytes = 0;
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   const GroupSize group = group_size(n_bp);
+  // Every interval of the pass is charged to one stage: the time since the last lap.
+  auto t = std::chrono::steady_clock::now();
+  auto lap = [&t](double& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    stage += std::chrono::duration<double>(now - t).count();
+    t = now;
+  };
   for (uint64_t first = 0; first < total;) {
     const uint64_t count = std::min(group.photons, total - first);
-    auto t = std::chrono::steady_clock::now();
     const TraceResult tr =
         trace_group(scene, maps, prm, seed, pass_index, first, count, group.hits, guide, buf);
+    lap(res.trace_s);
     if (tr.kept == 0) {  // stopped before the group began
       res.cut = true;
       break;
@@ -340,16 +343,14 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
       const GatherRound round =
           n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : GatherRound{0, 0};
       const int kept = round.kept;
-      res.trace_s += seconds_since(t);
       size_t entries = 0;
       for (int g = done; g < done + kept; ++g)
         for (const auto& v : buf->chunks[size_t(g)]) entries += v.size();
       res.peak_entry_bytes = std::max(res.peak_entry_bytes, round.bytes);
       buf->counters.local().entries += entries;
-      t = std::chrono::steady_clock::now();
+      lap(res.gather_s);
       apply_entries(*buf, done, done + kept, masks.slots(), &res);
-      res.apply_s += seconds_since(t);
-      t = std::chrono::steady_clock::now();
+      lap(res.apply_s);
       ++res.batches;
       done += kept;
       // The limit ended the round: the lists' memory goes back, so that the next round has it.
@@ -376,7 +377,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
       });
       for (int c = 0; c < tr.chunks; ++c) guide->learn(buf->scores[size_t(c)]);
     }
-    res.apply_s += seconds_since(t);
+    lap(res.apply_s);
     if (res.cut) break;
   }
   struct Coverage {
@@ -397,6 +398,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
       });
   const size_t n_indirect = cov.indirect, covered = cov.covered;
   res.coverage = n_indirect ? double(covered) / double(n_indirect) : 1.0;
+  lap(res.apply_s);
 }
 
 }  // namespace bpm

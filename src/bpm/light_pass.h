@@ -104,7 +104,10 @@ struct LightPassResult {
   int batches = 0;  // gather rounds: one per group, more where the memory limit split one
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;
-  double trace_s = 0, apply_s = 0;
+  // Seconds, every part of the pass in one of them: tracing the photons (emission, rays,
+  // scattering, each hit's leaf); gathering at the hits (their sort by leaf, the backward photons
+  // found, their entries); applying the entries, the emission guide's learning and the coverage.
+  double trace_s = 0, gather_s = 0, apply_s = 0;
   size_t peak_entry_bytes = 0;
 };
 
