@@ -195,7 +195,10 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
     int spp = std::max(1, int((seconds - startup) / per_sample));
     double t = run_pbrt(pbrt, copy, spp, out, 2);
     fs::remove(copy);
-    if (t < 0) continue;
+    if (t < 0) {
+      std::printf("  %-28s failed to run at %d spp\n", v.label.c_str(), spp);
+      continue;
+    }
     Image img = read_exr(out);
     if (img.width != ref.width || img.height != ref.height) {
       std::printf("  %-28s wrote %dx%d, not the reference's %dx%d\n", v.label.c_str(), img.width,

@@ -84,8 +84,8 @@ inline std::string scene_copy_with(const std::string& path,
 }
 
 // Runs pbrt-v4 with `threads` threads and `spp` samples (iterations for sppm); returns its wall
-// time, or a negative value when it failed. With `stats`, pbrt-v4's statistics (--stats) are
-// appended to *stats.
+// time, or a negative value when it failed (its exit status and last output line then go to
+// stderr). With `stats`, pbrt-v4's statistics (--stats) are appended to *stats.
 inline double run_pbrt(const std::string& pbrt, const std::string& scene, int spp,
                        const std::string& out, int threads, std::string* stats = nullptr) {
   auto quoted = [](const std::string& p) { return "'" + p + "'"; };
@@ -96,10 +96,17 @@ inline double run_pbrt(const std::string& pbrt, const std::string& scene, int sp
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return -1;
   char buf[4096];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;)
-    if (stats) stats->append(buf, n);
+  std::string output;
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) output.append(buf, n);
   const int rc = ::pclose(p);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  if (stats) stats->append(output);
+  if (rc != 0) {
+    while (!output.empty() && output.back() == '\n') output.pop_back();
+    const size_t line = output.rfind('\n');
+    std::fprintf(stderr, "pbrt-v4 failed (status %d, %d spp, %s): %s\n", rc, spp, scene.c_str(),
+                 output.substr(line == std::string::npos ? 0 : line + 1).c_str());
+  }
   return rc == 0 ? s : -1;
 }
 

@@ -215,6 +215,8 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
     // 3. Light pass: a fixed number of photons, in groups.
     run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
                    guide.empty() ? nullptr : &guide, &light_result);
+    // Its time counts even if the iteration is dropped below: its rays reach the counters.
+    tot.add_light_pass_time(light_result);
     // The film averages iterations with equal weights, so an iteration the budget cut to a share
     // f of its photons adds variance ~ 1/f to a mean of n: with n - 1 whole ones, keeping it
     // helps only when ((n - 1) + 1/f) / n^2 < 1 / (n - 1), about f > 1/2. A later iteration with

@@ -20,11 +20,14 @@ void BpmTotals::add_maps(const BackwardMaps& maps) {
   }
 }
 
-void BpmTotals::add_light_pass(const LightPassResult& r) {
-  batches += uint64_t(r.batches);
+void BpmTotals::add_light_pass_time(const LightPassResult& r) {
   light_trace_s += r.trace_s;
   light_gather_s += r.gather_s;
   light_apply_s += r.apply_s;
+}
+
+void BpmTotals::add_light_pass(const LightPassResult& r) {
+  batches += uint64_t(r.batches);
   peak_entry_bytes = std::max(peak_entry_bytes, r.peak_entry_bytes);
   coverage_sum += r.coverage;
   emitted += r.emitted;

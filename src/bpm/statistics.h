@@ -29,6 +29,8 @@ struct BpmTotals {
 
   // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.
   void add_maps(const BackwardMaps& maps);
+  // The stage times of every light pass run, and the rest of the passes kept in the image.
+  void add_light_pass_time(const LightPassResult& r);
   void add_light_pass(const LightPassResult& r);
 };
 
