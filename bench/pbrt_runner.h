@@ -1,6 +1,7 @@
 // Running pbrt-v4 beside bpm in a benchmark: where its binary is, a copy of a scene file with some
 // directives replaced (the integrator, the film's resolution), and a timed run.
 #pragma once
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -84,8 +85,9 @@ inline std::string scene_copy_with(const std::string& path,
 }
 
 // Runs pbrt-v4 with `threads` threads and `spp` samples (iterations for sppm); returns its wall
-// time, or a negative value when it failed (its exit status and last output line then go to
-// stderr). With `stats`, pbrt-v4's statistics (--stats) are appended to *stats.
+// time, or a negative value when it failed (how it ended and its last output line then go to
+// stderr). With `stats`, pbrt-v4's statistics (--stats) of a run that succeeded are appended to
+// *stats.
 inline double run_pbrt(const std::string& pbrt, const std::string& scene, int spp,
                        const std::string& out, int threads, std::string* stats = nullptr) {
   auto quoted = [](const std::string& p) { return "'" + p + "'"; };
@@ -100,14 +102,28 @@ inline double run_pbrt(const std::string& pbrt, const std::string& scene, int sp
   for (size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) output.append(buf, n);
   const int rc = ::pclose(p);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-  if (stats) stats->append(output);
-  if (rc != 0) {
-    while (!output.empty() && output.back() == '\n') output.pop_back();
-    const size_t line = output.rfind('\n');
-    std::fprintf(stderr, "pbrt-v4 failed (status %d, %d spp, %s): %s\n", rc, spp, scene.c_str(),
-                 output.substr(line == std::string::npos ? 0 : line + 1).c_str());
+  if (rc == 0) {
+    if (stats) stats->append(output);
+    return s;
   }
-  return rc == 0 ? s : -1;
+  // pclose gives a wait status: an exit code, or the signal that ended pbrt-v4 (9: out of memory).
+  char how[64];
+  if (rc == -1)
+    std::snprintf(how, sizeof how, "pclose failed");
+  else if (WIFEXITED(rc))
+    std::snprintf(how, sizeof how, "exit %d", WEXITSTATUS(rc));
+  else if (WIFSIGNALED(rc))
+    std::snprintf(how, sizeof how, "signal %d", WTERMSIG(rc));
+  else
+    std::snprintf(how, sizeof how, "status %d", rc);
+  while (!output.empty() && std::isspace(static_cast<unsigned char>(output.back())))
+    output.pop_back();
+  const size_t line = output.rfind('\n');
+  const std::string last =
+      output.empty() ? "(no output)" : output.substr(line == std::string::npos ? 0 : line + 1);
+  std::fprintf(stderr, "pbrt-v4 failed (%s, %d spp, %s): %s\n", how, spp, scene.c_str(),
+               last.c_str());
+  return -1;
 }
 
 // The number after `label` in pbrt-v4's statistics (the last one on its line), or -1.

@@ -205,6 +205,7 @@ RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
         if (pass == 0)
           check_memory("bpm's backward photons and trees at " + size, used, opt.memory_budget,
                        advice);
+        tot.build_s += since(t);
         return PassResult{false, 0, "", "memory"};
       }
       lp.entry_bytes_limit = std::max<size_t>(1, size_t(double(opt.memory_budget) - used));
