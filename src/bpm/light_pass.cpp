@@ -34,7 +34,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     // Resolved per backward photon when any material is textured (resolve_photon_materials).
     const Material& m = prm.photon_materials.empty() ? prm.materials->materials[bp.material]
                                                      : prm.photon_materials[g];
-    Spectrum value = photon_contribution(m, bp.ng, bp.ns, bp.wo, h.wi, h.flux);
+    Spectrum value = photon_contribution(m, h.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
     const float d2 = length_squared(h.p - bp.p), r2 = bp.radius * bp.radius;

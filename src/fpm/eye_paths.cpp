@@ -46,7 +46,7 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
     const ForwardPhoton& ph = map.photons[i];
     if (!usable(ph)) return;
     ++c.photons_used;
-    sums.add(photon_contribution(v.m(), sp.ng, sp.ns, v.wo, ph.wi, ph.flux) *
+    sums.add(photon_contribution(v.m(), ph.ng, sp.ns, v.wo, ph.wi, ph.flux) *
                  hero_join_factor(eye_hero_only, ph.hero_only),
              length_squared(ph.p - sp.p), r * r);
   });

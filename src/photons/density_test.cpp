@@ -41,6 +41,55 @@ TEST(PhotonContribution, LambertianShortcutEqualsTheBsdf) {
   EXPECT_GT(nonzero, 500);
 }
 
+// Photons that cross a facet under uniform radiance arrive in proportion to |wi.ng_photon|. Their
+// mean contribution at a point of a neighbouring facet (tilted 40 degrees, as on a curved mesh,
+// with its shading normal tilted 20 degrees the other way) is the reflected radiance: (R / pi^2)
+// times the integral of |wi.ns| over the directions above the photon's facet and the shading
+// surface, per unit of flux / pi. The weight |wi.ns| / |wi.ng_photon| exceeds t for a share of
+// about 1 / t^2 of the photons. Weighed by the point's own geometric normal instead, it would
+// exceed t for a share of about 1 / t (photons that graze the point's plane, not their facet):
+// rare photons of unbounded weight, whose mean does not exist.
+TEST(PhotonContribution, PhotonsOfATiltedFacetAverageToTheReflectedRadiance) {
+  DiffuseMaterial d;
+  for (int c = 0; c < Spectrum::kChannels; ++c) d.reflectance[c] = 0.5f;
+  const Material m = d;
+  auto tilted = [](float degrees) {
+    const float a = degrees * kPi / 180;
+    return Vec3{std::sin(a), 0, std::cos(a)};
+  };
+  const Vec3 n_photon = tilted(40), ns = tilted(-20);
+  const Vec3 wo = normalize(Vec3{-0.3f, 0.2f, 1});
+  const Frame photon_frame = Frame::from_z(n_photon);
+  Rng rng(11);
+  const int n = 400000;
+  double sum = 0, sum2 = 0, largest = 0;
+  for (int k = 0; k < n; ++k) {
+    const Vec3 wi = photon_frame.to_world(sample_cosine_hemisphere({rng.uniform(), rng.uniform()}));
+    const double v = photon_contribution(m, n_photon, ns, wo, wi, Spectrum(1.0f))[0];
+    sum += v;
+    sum2 += v * v;
+    largest = std::max(largest, v);
+  }
+  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+  // The integral of max(0, wi.ns) over the hemisphere of n_photon, by quadrature on the sphere.
+  double integral = 0;
+  const int steps = 1000;
+  for (int i = 0; i < steps; ++i)
+    for (int j = 0; j < 2 * steps; ++j) {
+      const double theta = (i + 0.5) * kPi / steps, phi = (j + 0.5) * kPi / steps;
+      const Vec3 w{float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
+                   float(std::cos(theta))};
+      const float c = dot(w, ns);
+      if (dot(w, n_photon) > 0 && c > 0)
+        integral += c * std::sin(theta) * (kPi / steps) * (kPi / steps);
+    }
+  const double expected = 0.5 / kPi * integral / kPi;
+  EXPECT_NEAR(mean, expected, 4 * se + 1e-4 * expected);
+  // Of 400000 photons, the largest weighs about sqrt(400000) = 630 times the mean; a 1 / t tail
+  // would give one near 400000 times.
+  EXPECT_LT(largest, 3000 * expected);
+}
+
 // radius_bias from the sums a density gives over the three nested discs: one whose disc averages
 // are L0 + a rho^2 + b rho at radius rho. The three-radius model recovers a r^2 + b r exactly; the
 // two-radius one recovers a r^2 when b = 0, and sees 2 (1 - 1 / sqrt 2) = 0.586 of the r term.
