@@ -73,6 +73,21 @@ std::vector<SceneEntry> default_scenes() {
       shared_cornell.parent_path().parent_path() / "staircase2" / "scene-v4-standin.pbrt";
   if (fs::exists(staircase))
     s.push_back({"staircase2", staircase.lexically_normal().string(), "path", "256x256"});
+  // The other shared scenes bpm renders, at the resolutions of the conformance table: small
+  // lights on glossy plates (veach-mis), a coated figure under one area light (killeroo-simple),
+  // plastic, glass and metal under three area lights (coffee).
+  const fs::path shared = shared_cornell.parent_path().parent_path();
+  const std::vector<SceneEntry> more = {
+      {"veach-mis", (shared / "veach-mis" / "scene-v4.pbrt").string(), "path", "320x180"},
+      {"killeroo-simple", (shared / "killeroo-simple" / "killeroo-simple.pbrt").string(), "path",
+       "200x200"},
+      {"coffee", (shared / "coffee" / "scene-v4.pbrt").string(), "path", "200x250"},
+  };
+  for (SceneEntry e : more)
+    if (fs::exists(e.path)) {
+      e.path = fs::path(e.path).lexically_normal().string();
+      s.push_back(e);
+    }
   return s;
 }
 
