@@ -29,7 +29,7 @@ struct PhotonEntry {
   // the backward photon (the inner half of its disc) and kQuarterBit within r / 2 (the inner
   // quarter), for the bias estimate (radius_bias in photons/density.h).
   uint32_t key;
-  Spectrum value;  // flux * f * |cos_s| / |cos_g|, before 1 / (pi r^2 N)
+  Spectrum value;  // flux * f * |wi.ns| / |wi.ng of the photon's hit|, before 1 / (pi r^2 N)
   static constexpr uint32_t kInnerBit = 1u << 31, kQuarterBit = 1u << 30;
   static constexpr uint32_t kIndexMask = kQuarterBit - 1;
   uint32_t backward_photon() const { return key & kIndexMask; }

@@ -4,10 +4,10 @@
 // area of the surface it hit, so it stands for incident radiance times |wi.ng_photon|, while the
 // BSDF wants it times the shading cosine |wi.ns|. ng_photon is the geometric normal where the
 // photon hit, not the gathering point's: the photons of a disc on a curved or faceted surface lie
-// on other facets, and a photon that grazes the point's own plane but not its facet (|wi.ng| near
-// 0) would otherwise weigh without bound. Photons arrive in proportion to |wi.ng_photon|, so the
-// factor's mean is finite. Only the gathered lobes count (BsdfPart): the eye paths go on through
-// the traced ones.
+// on other facets, and a photon that grazes the point's own plane but not its facet (|wi.ng_point|
+// near 0) would otherwise weigh without bound. Photons arrive in proportion to |wi.ng_photon|, so
+// the factor's mean is finite. Only the gathered lobes count (BsdfPart): the eye paths go on
+// through the traced ones.
 #pragma once
 #include <cmath>
 
