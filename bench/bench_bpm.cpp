@@ -29,6 +29,7 @@
 #include "embree_replay.h"
 #include "film/image_io.h"
 #include "pbrt_runner.h"
+#include "photon_floor.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 
@@ -149,6 +150,11 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
   std::printf("recorded %zu eye closest-hit + %zu shadow rays, %zu light rays (%d iterations)\n",
               eye_log.closest_rays.size(), eye_log.shadow_rays.size(),
               light_log.closest_rays.size(), iterations);
+  // The floor loop's photons, and its rays (photon_floor.h).
+  constexpr uint64_t kFloorPhotons = 1000000;
+  RayLog floor_log, chain_log;
+  photon_floor(ls.scene, kFloorPhotons, 1, &floor_log);
+  photon_floor<true>(ls.scene, kFloorPhotons, 1, &chain_log);
   if (pbrt.empty())
     std::printf(
         "pbrt-v4 not found (../shared/tools/pbrt-v4/pbrt or --pbrt): no photon pass anchor\n");
@@ -161,7 +167,8 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
   };
   for (int threads : {1, hw}) {
     std::vector<double> eye, eye_embree, eye_share, light, light_embree, light_share, us_photon,
-        rays_photon, pbrt_us, pbrt_rays, trace_us, gather_us, apply_us, embree_us, embree_share;
+        rays_photon, pbrt_us, pbrt_rays, trace_us, gather_us, apply_us, embree_us, embree_share,
+        floor, floor_embree, floor_share, chain_share;
     for (int r = 0; r < kRepeats; ++r) {
       Film film(w, h);
       RenderStats st = run(ls, "bpm", iterations, 0, threads, bs, &film);
@@ -184,6 +191,13 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
       embree_us.push_back(light_rays / photons / light_embree.back() * 1e6);
       embree_share.push_back(embree_us.back() / trace_us.back());
       light_share.push_back(light.back() / light_embree.back());
+      const FloorRun fr = photon_floor(ls.scene, kFloorPhotons, threads);
+      floor.push_back(double(fr.rays) / fr.seconds);
+      floor_embree.push_back(embree_replay(ls.scene, floor_log, threads));
+      floor_share.push_back(floor.back() / floor_embree.back());
+      const FloorRun cr = photon_floor<true>(ls.scene, kFloorPhotons, threads);
+      chain_share.push_back(double(cr.rays) / cr.seconds /
+                            embree_replay(ls.scene, chain_log, threads));
       if (!pbrt.empty()) {
         PbrtPhotonCost c =
             pbrt_photon_cost(pbrt, scene_path, ls, iterations, bs.photons_per_iteration, threads);
@@ -213,6 +227,12 @@ void rays(const LoadedScene& ls, const std::string& scene_path, int iterations,
         "alone in Embree %.3f us (%.0f%% of the trace)",
         median(trace_us), median(gather_us), median(apply_us), median(embree_us),
         100 * median(embree_share));
+    std::printf(
+        "\n            floor (emission, hit points, diffuse bounces; nothing else): %.2f Mrays/s "
+        "vs Embree %.2f on its own rays (%.0f%%)",
+        median(floor) * 1e-6, median(floor_embree) * 1e-6, 100 * median(floor_share));
+    std::printf("; its chain of rays alone (emissions made before, no hit points): %.0f%%",
+                100 * median(chain_share));
     std::printf("\n");
     if (hw == 1) break;
   }
