@@ -35,8 +35,8 @@ inline std::optional<Ray> emitted_ray(const RenderScene& scene, const Wavelength
   const int li = scene.light_distribution.sample(rng.uniform(), &pmf);
   const Light& light = scene.lights[size_t(li)];
   const Vec2 u_pos{rng.uniform(), rng.uniform()}, u_dir{rng.uniform(), rng.uniform()};
-  const auto le = light_sample_le(light, scene.light_shape(light), u_pos, u_dir,
-                                  scene.bounds_info, wm.wl, wm.light_spectrum(li));
+  const auto le = light_sample_le(light, scene.light_shape(light), u_pos, u_dir, scene.bounds_info,
+                                  wm.wl, wm.light_spectrum(li));
   if (!le) return std::nullopt;
   return Ray{length_squared(le->n_light) > 0
                  ? offset_origin(le->origin, le->n_light, le->direction, le->origin_error)
@@ -87,8 +87,8 @@ FloorRun photon_floor(const RenderScene& scene, uint64_t photons, int threads,
         const SurfacePoint sp = scene.surface(ray, h);
         if (rng.uniform() < 0.5f) break;
         const Vec3 n_up = dot(sp.ng, ray.d) < 0 ? sp.ng : -sp.ng;
-        const Vec3 d = Frame::from_z(n_up).to_world(
-            sample_cosine_hemisphere({rng.uniform(), rng.uniform()}));
+        const Vec3 d =
+            Frame::from_z(n_up).to_world(sample_cosine_hemisphere({rng.uniform(), rng.uniform()}));
         ray = Ray{offset_origin(sp.p, n_up, d, sp.error), d, kInf};
       }
     }

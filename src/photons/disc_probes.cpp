@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace bpm {
@@ -70,12 +71,84 @@ bool blocked_along(const RenderScene& scene, Vec3 a, Vec3 b, int object, Vec3 ng
   return false;
 }
 
+// The point of triangle abc nearest to p (by the region of the triangle's plane p projects to:
+// a corner, an edge or the inside).
+Vec3 nearest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const float d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const Vec3 cp = p - c;
+  const float d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const float denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+float distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
+  const Vec3 ab = b - a;
+  const float len2 = length_squared(ab);
+  const float t = len2 > 0 ? std::clamp(dot(p - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+  return length(p - (a + ab * t));
+}
+
+// Whether the disc is whole on plain sight of the geometry near it, so that probes would find no
+// cut: everything within 2 radii of the point (the probes' origins and paths) is a triangle of
+// its own mesh, lying in its tangent plane (within 0.8 degrees and a hundredth of the radius), and
+// no border of the mesh comes within the radius. Anything else (another object, a crease, a
+// curved surface, a border, a mesh with alpha, an analytic disk) leaves the question to the probes.
+// One query of Embree's tree, where the probes cast nine rays or more.
+bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, float radius) {
+  const Object& obj = scene.objects[size_t(object)];
+  const auto* mesh = std::get_if<TriangleMesh>(&obj.shape);
+  if (!mesh || obj.has_alpha() || mesh->open_edges.empty() || mesh->face_normals.empty())
+    return false;
+  constexpr float kFlatCos = 0.9999f;
+  const float reach = 2 * radius, off_plane = 0.01f * radius + 4 * sp.error;
+  bool whole = true;
+  // Embree visits every primitive of a leaf its bounds reach: each is judged by its distance.
+  scene.for_each_near(sp.p, reach, [&](int o, int prim) {
+    const auto* m = std::get_if<TriangleMesh>(&scene.objects[size_t(o)].shape);
+    if (!m) {
+      const Bounds3 box = world_bounds(scene.objects[size_t(o)].shape, prim);
+      const Vec3 q(std::clamp(sp.p.x, box.lo.x, box.hi.x), std::clamp(sp.p.y, box.lo.y, box.hi.y),
+                   std::clamp(sp.p.z, box.lo.z, box.hi.z));
+      return length_squared(q - sp.p) > reach * reach || (whole = false);
+    }
+    const uint32_t* v = &m->indices[3 * size_t(prim)];
+    const Vec3 a = m->positions[v[0]], b = m->positions[v[1]], c = m->positions[v[2]];
+    const Vec3 q = nearest_on_triangle(sp.p, a, b, c);
+    if (length_squared(q - sp.p) > reach * reach) return true;
+    if (o != object) return whole = false;
+    if (std::fabs(dot(mesh->face_normals[size_t(prim)], sp.ng)) < kFlatCos ||
+        std::fabs(dot(q - sp.p, sp.ng)) > off_plane)
+      return whole = false;
+    const Vec3 corner[3] = {a, b, c};
+    for (int e = 0; e < 3; ++e)
+      if ((mesh->open_edges[size_t(prim)] >> e & 1) &&
+          distance_to_segment(sp.p, corner[e], corner[(e + 1) % 3]) < radius)
+        return whole = false;
+    return true;
+  });
+  return whole;
+}
+
 }  // namespace
 
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays) {
   static_assert(kDiscProbes == RenderScene::kBundle);
+  if (plainly_whole(scene, sp, object, radius)) return {0xff, 0};  // as if every probe found it
   const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
   const Frame frame = Frame::from_z(n);
   // Unit directions a common rotation apart, in a bit-reversed order of angles so that each
@@ -175,7 +248,9 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
                                                         : scene.surface(ray, h).ng;
     if (std::fabs(dot(ng, sp.ng)) < normal_cos) {
       out.cut |= bit;  // a crease: photons there do not count
-    } else if (length_squared(ray.o + ray.d * h.t - sp.p) <= radius * radius) {
+    } else if (length_squared(ray.o + ray.d * h.t - sp.p) <= radius * radius * (1 + 1e-4f)) {
+      // (The slack keeps a probe aimed at the rim, whose hit rounds to just outside, from
+      // reading as a cut.)
       out.found |= bit;
     } else if (travelled + h.t < to_target[i]) {
       out.cut |= bit;  // the surface rises out of the sphere before the target

@@ -47,7 +47,9 @@ enum class PhotonSurfaces { kOwnObject, kAnyObject };
 // that holds photons, its normal compared with its sign as fpm's gather does). A wall in between
 // stops it; past an edge it misses the surface; another object's surface in the disc's plane (floor
 // tiles) is a cut unless it counts. Where the surface curves away below the plane, the probe
-// meets it outside the sphere and says nothing. The probes count in rays.probe_rays.
+// meets it outside the sphere and says nothing. The probes count in rays.probe_rays. A disc with
+// nothing within two radii but flat triangles of its own mesh, and no border of the mesh inside
+// it, is whole on sight of the scene's tree: then no probe is cast and every bit of `found` is set.
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays);

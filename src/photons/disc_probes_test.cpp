@@ -1,8 +1,8 @@
 // The disc probes measure the share of a gathering disc where photons can land: all of it on an
 // open floor, the part left of a wall or of a table top's edge (the disc less a circular segment),
 // all of it under an overhang or behind glass; where one map holds every object's photons (fpm),
-// other objects count too; and the screen test marks the pixels near where the camera sees an
-// edge.
+// other objects count too; a disc with only its own flat mesh near it is whole without probes;
+// and the screen test marks the pixels near where the camera sees an edge.
 #include "photons/disc_probes.h"
 
 #include <gtest/gtest.h>
@@ -141,6 +141,51 @@ TEST(DiscProbes, OverhangsAndGlassDoNotCut) {
   LoadedScene glass = flatten_scene(parse_scene_string(
       kHeader + floor_at(0) + "Material \"dielectric\" \"float eta\" 1.5\n" + kWall));
   EXPECT_NEAR(shares(glass, 0, Vec3(-0.3f, 0, 0), 200).mean, 1.0, 1e-6);
+}
+
+// A disc with nothing near it but its own flat mesh, no border within it, is whole without a
+// probe (one query of the scene's tree); near a border, a wall, a crease or a sphere the probes
+// run, and find the cut where there is one.
+TEST(DiscProbes, PlainlyWholeDiscsCastNoProbes) {
+  struct Case {
+    std::string name, scene;
+    Vec3 p;
+    bool probed, cut;
+  };
+  // A floor folded up by 70 degrees at x = 0.4 (one mesh): past the fold photons meet a normal
+  // the gather does not take (normal_cos 0.5).
+  const std::string crease =
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3 3 2 4 3 4 5] \"point3 P\" [-10 0 "
+      "-10  -10 0 10  0.4 0 10  0.4 0 -10  1.4 2.75 10  1.4 2.75 -10]\n";
+  const std::string sphere =
+      "AttributeBegin\nTranslate 0 1.6 0\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n";
+  const std::vector<Case> cases = {
+      {"open floor", floor_at(0), Vec3(0.3f, 0, -0.2f), false, false},
+      {"the floor's border", floor_at(0), Vec3(9.7f, 0, 0), true, true},
+      {"a wall inside the disc", floor_at(0) + kWall, Vec3(-0.3f, 0, 0), true, true},
+      {"a wall within two radii", floor_at(0) + kWall, Vec3(-0.8f, 0, 0), true, false},
+      {"a wall farther", floor_at(0) + kWall, Vec3(-1.2f, 0, 0), false, false},
+      {"a crease inside the disc", crease, Vec3(0.1f, 0, 0), true, true},
+      {"a sphere above", floor_at(0) + sphere, Vec3(0, 0, 0), true, false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    LoadedScene ls = flatten_scene(parse_scene_string(kHeader + c.scene));
+    SurfacePoint sp;
+    sp.p = c.p;
+    sp.ng = sp.ns = Vec3(0, 1, 0);
+    Rng rng(stream_key(2, 0));
+    PathCounters rays;
+    uint8_t cut = 0;
+    for (int i = 0; i < 50; ++i) {
+      DiscProbes d = probe_disc(ls.scene, sp, Vec3(0, 1, 0), 0, PhotonSurfaces::kOwnObject, 0.5f,
+                                0.5f, rng, rays);
+      if (!c.probed) ASSERT_EQ(d.found, 0xff);
+      cut |= d.cut;
+    }
+    EXPECT_EQ(rays.probe_rays > 0, c.probed);
+    EXPECT_EQ(cut != 0, c.cut);
+  }
 }
 
 TEST(DiscProbes, SpheresAndCylindersAreNotProbed) {

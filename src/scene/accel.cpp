@@ -225,6 +225,33 @@ class Accel {
     }
   }
 
+  // Embree's point query: visit for each primitive whose bounds come within `radius` of p.
+  void visit_near(Vec3 p, float radius, RenderScene::NearVisit visit, void* ctx) const {
+    struct Query {
+      RenderScene::NearVisit visit;
+      void* ctx;
+      bool stopped;
+    } q{visit, ctx, false};
+    RTCPointQuery pq;
+    pq.x = p.x;
+    pq.y = p.y;
+    pq.z = p.z;
+    pq.time = 0;
+    pq.radius = radius;
+    RTCPointQueryContext pctx;
+    rtcInitPointQueryContext(&pctx);
+    rtcPointQuery(
+        scene_, &pq, &pctx,
+        [](RTCPointQueryFunctionArguments* args) {
+          auto* q = static_cast<Query*>(args->userPtr);
+          if (q->stopped || q->visit(q->ctx, int(args->geomID), int(args->primID))) return false;
+          q->stopped = true;  // a radius of zero ends the traversal
+          args->query->radius = 0;
+          return true;
+        },
+        &q);
+  }
+
   // Whether anything lies along the ray (occluded), or any emitting surface (meets_emitter).
   bool occluded(const Ray& ray) const { return any_hit(scene_, ray); }
   bool meets_emitter(const Ray& ray) const { return any_hit(emitters_, ray); }
@@ -267,7 +294,10 @@ RenderScene& RenderScene::operator=(RenderScene&&) noexcept = default;
 
 void RenderScene::commit() {
   for (Object& o : objects)
-    if (auto* m = std::get_if<TriangleMesh>(&o.shape)) m->compute_face_normals();
+    if (auto* m = std::get_if<TriangleMesh>(&o.shape)) {
+      m->compute_face_normals();
+      m->compute_open_edges();
+    }
   bounds = Bounds3();
   for (const Object& o : objects)
     for (int p = 0; p < primitive_count(o.shape); ++p) bounds.expand(world_bounds(o.shape, p));
@@ -292,6 +322,9 @@ void RenderScene::intersect_bundle(const Ray* rays, int n, Hit* hits, bool* foun
   accel_->intersect_coherent(rays, n, hits, found);
 }
 bool RenderScene::occluded_ray(const Ray& ray) const { return accel_->occluded(ray); }
+void RenderScene::visit_near(Vec3 p, float radius, NearVisit visit, void* ctx) const {
+  accel_->visit_near(p, radius, visit, ctx);
+}
 bool RenderScene::may_reach_emitter(const Ray& ray) const {
   return !infinite_lights.empty() || accel_->meets_emitter(ray);
 }

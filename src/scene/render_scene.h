@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "base/ray.h"
@@ -66,6 +67,19 @@ class RenderScene {
   // found[i] says whether ray i hit, and hits[i] where.
   static constexpr int kBundle = 8;
   void intersect_bundle(const Ray* rays, int n, Hit* hits, bool* found) const;
+  // Calls visit(object, primitive) for every primitive whose bounds come within `radius` of p (a
+  // superset of those that do), until it returns false.
+  template <class Visit>
+  void for_each_near(Vec3 p, float radius, Visit&& visit) const {
+    visit_near(
+        p, radius,
+        [](void* v, int object, int primitive) {
+          return (*static_cast<std::remove_reference_t<Visit>*>(v))(object, primitive);
+        },
+        &visit);
+  }
+  using NearVisit = bool (*)(void* ctx, int object, int primitive);
+  void visit_near(Vec3 p, float radius, NearVisit visit, void* ctx) const;
   // True when something blocks the open segment between a and b.
   bool occluded(Vec3 a, Vec3 b) const;
   bool occluded_ray(const Ray& ray) const;

@@ -1,7 +1,12 @@
 #include "scene/shapes.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <type_traits>
 
 namespace bpm {
@@ -192,6 +197,41 @@ void TriangleMesh::compute_face_normals() {
   for (size_t t = 0; t < face_normals.size(); ++t)
     face_normals[t] = face_normal(positions[indices[3 * t]], positions[indices[3 * t + 1]],
                                   positions[indices[3 * t + 2]]);
+}
+
+void TriangleMesh::compute_open_edges() {
+  // Every edge, keyed by its two end positions (their bits, the smaller end first), so that
+  // triangles that repeat their corners' vertices (a seam of uvs or normals) still meet; sorted,
+  // an edge shared by exactly two triangles is inside the mesh.
+  struct EdgeRef {
+    std::array<uint32_t, 6> key;
+    uint32_t triangle;
+    uint8_t edge;
+  };
+  auto bits = [&](uint32_t v) {
+    std::array<uint32_t, 3> b;
+    std::memcpy(b.data(), &positions[v], sizeof(b));
+    return b;
+  };
+  const size_t n = size_t(triangle_count());
+  std::vector<EdgeRef> edges(3 * n);
+  tbb::parallel_for(size_t(0), n, [&](size_t t) {
+    for (uint8_t e = 0; e < 3; ++e) {
+      std::array<uint32_t, 3> a = bits(indices[3 * t + e]), b = bits(indices[3 * t + (e + 1) % 3]);
+      if (b < a) std::swap(a, b);
+      edges[3 * t + e] = {{a[0], a[1], a[2], b[0], b[1], b[2]}, uint32_t(t), e};
+    }
+  });
+  tbb::parallel_sort(edges.begin(), edges.end(),
+                     [](const EdgeRef& x, const EdgeRef& y) { return x.key < y.key; });
+  open_edges.assign(n, 0);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i + 1;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    if (j - i != 2)
+      for (size_t k = i; k < j; ++k) open_edges[edges[k].triangle] |= uint8_t(1u << edges[k].edge);
+    i = j;
+  }
 }
 
 SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) {

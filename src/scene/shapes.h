@@ -1,6 +1,7 @@
 // Render-time shapes: triangle meshes in world space, and analytic spheres, disks and cylinders
 // kept in their object space (a tessellated sphere would bend caustics wrongly).
 #pragma once
+#include <cstdint>
 #include <variant>
 #include <vector>
 
@@ -20,8 +21,13 @@ struct TriangleMesh {
   // Each triangle's unit cross(p0 - p2, p1 - p2) before flip_normal, so that a hit does not
   // compute it (RenderScene::commit fills it; surface_point computes it when it is empty).
   std::vector<Vec3> face_normals;
+  // Per triangle, bit e: its edge from corner e to corner (e + 1) % 3 is open, a border of the
+  // mesh: no other triangle has an edge between the same two positions, or more than one has
+  // (RenderScene::commit fills it).
+  std::vector<uint8_t> open_edges;
   int triangle_count() const { return int(indices.size() / 3); }
   void compute_face_normals();
+  void compute_open_edges();
 };
 
 struct Sphere {

@@ -1,10 +1,12 @@
 // Tests of the analytic cylinder (intersections against a closed-form reference in double
 // precision, partial cylinders, surface points, bounds, the Embree scene) and of alpha masks in
-// the Embree scene (meshes through the filter functions, analytic shapes in their callbacks).
+// the Embree scene (meshes through the filter functions, analytic shapes in their callbacks), and
+// of a mesh's open edges and the scene's query of primitives near a point.
 #include "scene/shapes.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "base/rng.h"
@@ -257,6 +259,67 @@ TEST(Alpha, TexturedAlphaCutsOutTheCheckerboardCells) {
     EXPECT_GT(hits, 1500);
     EXPECT_GT(passes, 1500);
   }
+}
+
+// A quad's two triangles share their diagonal; its four sides are open. Corners repeated as
+// vertices of their own (a seam of uvs) still meet by position. An edge of three triangles (a fin
+// on the quad's diagonal) counts as open: no one surface goes on across it.
+TEST(TriangleMesh, OpenEdgesAreTheBordersOfTheMesh) {
+  TriangleMesh quad;
+  quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  quad.compute_open_edges();
+  // Triangle 0: edges 0-1 and 1-2 open, 2-0 (the diagonal) shared; triangle 1: 0-2 shared.
+  EXPECT_EQ(quad.open_edges, (std::vector<uint8_t>{0b011, 0b110}));
+  TriangleMesh split = quad;
+  split.positions = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  split.indices = {0, 1, 2, 3, 4, 5};
+  split.compute_open_edges();
+  EXPECT_EQ(split.open_edges, quad.open_edges);
+  TriangleMesh fin = quad;
+  fin.positions.push_back({0.5f, 1, 0.5f});
+  fin.indices.insert(fin.indices.end(), {0, 2, 4});
+  fin.compute_open_edges();
+  EXPECT_EQ(fin.open_edges[0], 0b111);
+  EXPECT_EQ(fin.open_edges[1], 0b111);
+  EXPECT_EQ(fin.open_edges[2], 0b111);
+}
+
+// The query visits every primitive within the radius (and may visit more), and stops when told.
+TEST(RenderScene, ForEachNearVisitsThePrimitivesWithinTheRadius) {
+  RenderScene scene;
+  for (int k = 0; k < 50; ++k) {  // small triangles along x, one object each
+    TriangleMesh m;
+    const float x = float(k);
+    m.positions = {{x, 0, 0}, {x + 0.5f, 0, 0}, {x, 0, 0.5f}};
+    m.indices = {0, 1, 2};
+    Object o;
+    o.shape = m;
+    scene.objects.push_back(o);
+  }
+  Sphere ball;
+  ball.world_from_object = Transform::translate(Vec3(10, 2, 0));
+  ball.radius = 0.5f;
+  Object o;
+  o.shape = ball;
+  scene.objects.push_back(o);
+  scene.commit();
+  std::vector<int> seen;
+  scene.for_each_near(Vec3(20.2f, 0.1f, 0.1f), 1.2f, [&](int object, int prim) {
+    EXPECT_EQ(prim, 0);
+    seen.push_back(object);
+    return true;
+  });
+  for (int k : {19, 20, 21}) EXPECT_NE(std::find(seen.begin(), seen.end(), k), seen.end()) << k;
+  seen.clear();
+  scene.for_each_near(Vec3(10, 1.2f, 0), 0.5f, [&](int object, int) {
+    seen.push_back(object);
+    return true;
+  });
+  EXPECT_NE(std::find(seen.begin(), seen.end(), 50), seen.end()) << "the sphere";
+  int visits = 0;
+  scene.for_each_near(Vec3(25, 0, 0), 100.0f, [&](int, int) { return ++visits < 3; });
+  EXPECT_EQ(visits, 3);
 }
 
 }  // namespace
