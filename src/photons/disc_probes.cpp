@@ -102,40 +102,47 @@ float distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
 }
 
 // Whether the disc is whole on plain sight of the geometry near it, so that probes would find no
-// cut: everything within 2 radii of the point (the probes' origins and paths) is a triangle of
-// its own mesh, lying in its tangent plane (within 0.8 degrees and a hundredth of the radius), and
-// no border of the mesh comes within the radius. Anything else (another object, a crease, a
-// curved surface, a border, a mesh with alpha, an analytic disk) leaves the question to the probes.
-// One query of Embree's tree, where the probes cast nine rays or more.
-bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, float radius) {
+// cut: everything within two radii of the point (the probes' origins and paths) is a triangle of
+// its own mesh lying in its tangent plane (its normal within 0.26 degrees, or normal_cos if
+// tighter, and its nearest point within twice the point's error bound), and no border of the mesh
+// comes within the radius. Anything else (another object, a crease, a curved surface, a border, a
+// mesh with alpha, an analytic disk, more than 64 triangles near it) leaves the question to the
+// probes. One query of Embree's tree, where the probes cast nine rays or more. NaN from a
+// degenerate triangle fails every test.
+bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, float radius,
+                   float normal_cos) {
   const Object& obj = scene.objects[size_t(object)];
   const auto* mesh = std::get_if<TriangleMesh>(&obj.shape);
   if (!mesh || obj.has_alpha() || mesh->open_edges.empty() || mesh->face_normals.empty())
     return false;
-  constexpr float kFlatCos = 0.9999f;
-  const float reach = 2 * radius, off_plane = 0.01f * radius + 4 * sp.error;
+  // Within reach: the probes' origins (up to sqrt 3 radii above the point, lifted off it), their
+  // paths to the disc and the rays skimming it. A triangle 0.26 degrees off the plane rises
+  // r / 200 at the disc's rim, where a probe's hit still counts as inside the sphere. Vertices of
+  // one plane are off it by their rounding, far below the point's error bound.
+  const float lift = std::fmax(sp.error, 1e-30f) * 4;  // as probe_disc lifts its rays
+  const float flat_cos = std::fmax(0.99999f, normal_cos), reach = 2 * radius + 2 * lift,
+              off_plane = 2 * sp.error;
   bool whole = true;
-  // Embree visits every primitive of a leaf its bounds reach: each is judged by its distance.
+  int visits = 0;
+  // Embree visits every primitive of a leaf its bounds reach: each is judged by the distance of
+  // its bounds (never more than its own), and the point's own triangles by their nearest point.
   scene.for_each_near(sp.p, reach, [&](int o, int prim) {
-    const auto* m = std::get_if<TriangleMesh>(&scene.objects[size_t(o)].shape);
-    if (!m) {
-      const Bounds3 box = world_bounds(scene.objects[size_t(o)].shape, prim);
-      const Vec3 q(std::clamp(sp.p.x, box.lo.x, box.hi.x), std::clamp(sp.p.y, box.lo.y, box.hi.y),
-                   std::clamp(sp.p.z, box.lo.z, box.hi.z));
-      return length_squared(q - sp.p) > reach * reach || (whole = false);
-    }
-    const uint32_t* v = &m->indices[3 * size_t(prim)];
-    const Vec3 a = m->positions[v[0]], b = m->positions[v[1]], c = m->positions[v[2]];
-    const Vec3 q = nearest_on_triangle(sp.p, a, b, c);
-    if (length_squared(q - sp.p) > reach * reach) return true;
+    if (++visits > 64) return whole = false;
+    const Bounds3 box = world_bounds(scene.objects[size_t(o)].shape, prim);
+    const Vec3 nearest_in_box(std::clamp(sp.p.x, box.lo.x, box.hi.x),
+                              std::clamp(sp.p.y, box.lo.y, box.hi.y),
+                              std::clamp(sp.p.z, box.lo.z, box.hi.z));
+    if (length_squared(nearest_in_box - sp.p) > reach * reach) return true;
     if (o != object) return whole = false;
-    if (std::fabs(dot(mesh->face_normals[size_t(prim)], sp.ng)) < kFlatCos ||
-        std::fabs(dot(q - sp.p, sp.ng)) > off_plane)
+    const uint32_t* v = &mesh->indices[3 * size_t(prim)];
+    const Vec3 corner[3] = {mesh->positions[v[0]], mesh->positions[v[1]], mesh->positions[v[2]]};
+    const Vec3 q = nearest_on_triangle(sp.p, corner[0], corner[1], corner[2]);
+    if (!(std::fabs(dot(mesh->face_normals[size_t(prim)], sp.ng)) >= flat_cos) ||
+        !(std::fabs(dot(q - sp.p, sp.ng)) <= off_plane))
       return whole = false;
-    const Vec3 corner[3] = {a, b, c};
     for (int e = 0; e < 3; ++e)
       if ((mesh->open_edges[size_t(prim)] >> e & 1) &&
-          distance_to_segment(sp.p, corner[e], corner[(e + 1) % 3]) < radius)
+          !(distance_to_segment(sp.p, corner[e], corner[(e + 1) % 3]) > radius * 1.001f))
         return whole = false;
     return true;
   });
@@ -148,7 +155,8 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays) {
   static_assert(kDiscProbes == RenderScene::kBundle);
-  if (plainly_whole(scene, sp, object, radius)) return {0xff, 0};  // as if every probe found it
+  if (plainly_whole(scene, sp, object, radius, normal_cos))
+    return {0xff, 0};  // as if every probe found it
   const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
   const Frame frame = Frame::from_z(n);
   // Unit directions a common rotation apart, in a bit-reversed order of angles so that each

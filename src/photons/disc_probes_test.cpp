@@ -151,6 +151,7 @@ TEST(DiscProbes, PlainlyWholeDiscsCastNoProbes) {
     std::string name, scene;
     Vec3 p;
     bool probed, cut;
+    float error = 0;  // the point's error bound
   };
   // A floor folded up by 70 degrees at x = 0.4 (one mesh): past the fold photons meet a normal
   // the gather does not take (normal_cos 0.5).
@@ -167,6 +168,13 @@ TEST(DiscProbes, PlainlyWholeDiscsCastNoProbes) {
       {"a wall farther", floor_at(0) + kWall, Vec3(-1.2f, 0, 0), false, false},
       {"a crease inside the disc", crease, Vec3(0.1f, 0, 0), true, true},
       {"a sphere above", floor_at(0) + sphere, Vec3(0, 0, 0), true, false},
+      {"a double-sided floor's border",
+       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3 0 2 1 0 3 2] \"point3 P\" [-10 0 "
+       "-10  -10 0 10  10 0 10  10 0 -10]\n",
+       Vec3(9.7f, 0, -5), true, true},
+      // Probes lifted 0.2 off the point by its error bound: the reach grows by twice that.
+      {"a wall farther, a large error bound", floor_at(0) + kWall, Vec3(-1.2f, 0, 0), true, false,
+       0.05f},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
@@ -174,13 +182,16 @@ TEST(DiscProbes, PlainlyWholeDiscsCastNoProbes) {
     SurfacePoint sp;
     sp.p = c.p;
     sp.ng = sp.ns = Vec3(0, 1, 0);
+    sp.error = c.error;
     Rng rng(stream_key(2, 0));
     PathCounters rays;
     uint8_t cut = 0;
     for (int i = 0; i < 50; ++i) {
       DiscProbes d = probe_disc(ls.scene, sp, Vec3(0, 1, 0), 0, PhotonSurfaces::kOwnObject, 0.5f,
                                 0.5f, rng, rays);
-      if (!c.probed) ASSERT_EQ(d.found, 0xff);
+      if (!c.probed) {
+        ASSERT_EQ(d.found, 0xff);
+      }
       cut |= d.cut;
     }
     EXPECT_EQ(rays.probe_rays > 0, c.probed);

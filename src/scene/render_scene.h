@@ -5,7 +5,6 @@
 
 #include <memory>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include "base/ray.h"
@@ -70,11 +69,11 @@ class RenderScene {
   // Calls visit(object, primitive) for every primitive whose bounds come within `radius` of p (a
   // superset of those that do), until it returns false.
   template <class Visit>
-  void for_each_near(Vec3 p, float radius, Visit&& visit) const {
+  void for_each_near(Vec3 p, float radius, Visit visit) const {
     visit_near(
         p, radius,
         [](void* v, int object, int primitive) {
-          return (*static_cast<std::remove_reference_t<Visit>*>(v))(object, primitive);
+          return (*static_cast<Visit*>(v))(object, primitive);
         },
         &visit);
   }

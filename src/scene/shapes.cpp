@@ -200,35 +200,54 @@ void TriangleMesh::compute_face_normals() {
 }
 
 void TriangleMesh::compute_open_edges() {
-  // Every edge, keyed by its two end positions (their bits, the smaller end first), so that
-  // triangles that repeat their corners' vertices (a seam of uvs or normals) still meet; sorted,
-  // an edge shared by exactly two triangles is inside the mesh.
-  struct EdgeRef {
-    std::array<uint32_t, 6> key;
-    uint32_t triangle;
-    uint8_t edge;
-  };
+  // Vertices at the same position (their bits) are one corner, so that triangles that repeat
+  // their corners' vertices (a seam of uvs or normals) still meet: each vertex's id is the first
+  // vertex at its position.
+  std::vector<uint32_t> by_position(positions.size()), id(positions.size());
+  for (uint32_t v = 0; v < uint32_t(positions.size()); ++v) by_position[v] = v;
   auto bits = [&](uint32_t v) {
     std::array<uint32_t, 3> b;
     std::memcpy(b.data(), &positions[v], sizeof(b));
     return b;
   };
+  tbb::parallel_sort(by_position.begin(), by_position.end(), [&](uint32_t a, uint32_t b) {
+    return std::pair(bits(a), a) < std::pair(bits(b), b);
+  });
+  for (size_t i = 0; i < by_position.size(); ++i)
+    id[by_position[i]] = i > 0 && bits(by_position[i]) == bits(by_position[i - 1])
+                             ? id[by_position[i - 1]]
+                             : by_position[i];
+  // Every edge by its two corners' ids; sorted, the triangles of an edge lie together.
+  struct EdgeRef {
+    uint64_t key;
+    uint32_t triangle;
+    uint8_t edge;
+  };
   const size_t n = size_t(triangle_count());
   std::vector<EdgeRef> edges(3 * n);
   tbb::parallel_for(size_t(0), n, [&](size_t t) {
     for (uint8_t e = 0; e < 3; ++e) {
-      std::array<uint32_t, 3> a = bits(indices[3 * t + e]), b = bits(indices[3 * t + (e + 1) % 3]);
-      if (b < a) std::swap(a, b);
-      edges[3 * t + e] = {{a[0], a[1], a[2], b[0], b[1], b[2]}, uint32_t(t), e};
+      const uint32_t a = id[indices[3 * t + e]], b = id[indices[3 * t + (e + 1) % 3]];
+      edges[3 * t + e] = {uint64_t(std::min(a, b)) << 32 | std::max(a, b), uint32_t(t), e};
     }
   });
-  tbb::parallel_sort(edges.begin(), edges.end(),
-                     [](const EdgeRef& x, const EdgeRef& y) { return x.key < y.key; });
+  tbb::parallel_sort(edges.begin(), edges.end(), [](const EdgeRef& x, const EdgeRef& y) {
+    return std::pair(x.key, x.triangle) < std::pair(y.key, y.triangle);
+  });
+  // An edge is inside the mesh when exactly two triangles have it and their third corners lie on
+  // either side of it (each triangle's cross(b - a, c - a) against the other's points away): not
+  // two faces of a double-sided sheet, nor a sheet folded back on itself.
+  auto across = [&](const EdgeRef& r) {
+    const uint32_t* v = &indices[3 * size_t(r.triangle)];
+    uint32_t a = v[r.edge], b = v[(r.edge + 1) % 3];
+    if (id[b] < id[a]) std::swap(a, b);  // the edge taken the same way for both triangles
+    return cross(positions[b] - positions[a], positions[v[(r.edge + 2) % 3]] - positions[a]);
+  };
   open_edges.assign(n, 0);
   for (size_t i = 0; i < edges.size();) {
     size_t j = i + 1;
     while (j < edges.size() && edges[j].key == edges[i].key) ++j;
-    if (j - i != 2)
+    if (j - i != 2 || !(dot(across(edges[i]), across(edges[i + 1])) < 0))
       for (size_t k = i; k < j; ++k) open_edges[edges[k].triangle] |= uint8_t(1u << edges[k].edge);
     i = j;
   }

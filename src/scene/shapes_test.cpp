@@ -283,6 +283,17 @@ TEST(TriangleMesh, OpenEdgesAreTheBordersOfTheMesh) {
   EXPECT_EQ(fin.open_edges[0], 0b111);
   EXPECT_EQ(fin.open_edges[1], 0b111);
   EXPECT_EQ(fin.open_edges[2], 0b111);
+  // Both faces of a double-sided quad: its sides have two triangles each, but on the same side of
+  // them (no surface beyond), and the diagonal has four.
+  TriangleMesh two_sided = quad;
+  two_sided.indices = {0, 1, 2, 0, 2, 3, 0, 2, 1, 0, 3, 2};
+  two_sided.compute_open_edges();
+  EXPECT_EQ(two_sided.open_edges, (std::vector<uint8_t>{0b111, 0b111, 0b111, 0b111}));
+  // A quad folded flat onto itself along its diagonal: the diagonal is a border.
+  TriangleMesh folded = quad;
+  folded.positions[3] = {1, 0, 0};
+  folded.compute_open_edges();
+  EXPECT_EQ(folded.open_edges[0] & 0b100, 0b100);
 }
 
 // The query visits every primitive within the radius (and may visit more), and stops when told.
