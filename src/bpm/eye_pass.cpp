@@ -96,7 +96,7 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
             may_cut_discs(scene.objects[size_t(v.object())].shape)) {
           const DiscProbes probes =
               probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
-                         prm.normal_cos, rng, counters.rays);
+                         prm.normal_cos, rng, counters.rays, v.hit.primitive);
           bp.disc_found = probes.found;
           bp.disc_cut = probes.cut;
           probed_whole = probes.cut == 0;

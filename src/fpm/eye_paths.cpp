@@ -97,7 +97,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
             !may_cut_discs(scene.objects[size_t(v.object())].shape))
           return DiscProbes{};
         const DiscProbes d = probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject,
-                                        r, prm.fpm->normal_cos, rng, c.rays);
+                                        r, prm.fpm->normal_cos, rng, c.rays, v.hit.primitive);
         if (!d.cut) whole_radius = r;
         return d;
       };

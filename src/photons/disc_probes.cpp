@@ -107,10 +107,11 @@ float distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
 // tighter, and its nearest point within twice the point's error bound), and no border of the mesh
 // comes within the radius. Anything else (another object, a crease, a curved surface, a border, a
 // mesh with alpha, an analytic disk, more than 64 triangles near it) leaves the question to the
-// probes. One query of Embree's tree, where the probes cast nine rays or more. NaN from a
+// probes. One query of Embree's tree, where the probes cast nine rays or more; none when the
+// point's own triangle (`primitive`, -1 when not known) has a neighbour off its plane. NaN from a
 // degenerate triangle fails every test.
-bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, float radius,
-                   float normal_cos) {
+bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, int primitive,
+                   float radius, float normal_cos) {
   const Object& obj = scene.objects[size_t(object)];
   const auto* mesh = std::get_if<TriangleMesh>(&obj.shape);
   if (!mesh || obj.has_alpha() || mesh->open_edges.empty() || mesh->face_normals.empty())
@@ -122,6 +123,16 @@ bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object,
   const float lift = std::fmax(sp.error, 1e-30f) * 4;  // as probe_disc lifts its rays
   const float flat_cos = std::fmax(0.99999f, normal_cos), reach = 2 * radius + 2 * lift,
               off_plane = 2 * sp.error;
+  // On a curved or finely folded mesh the point's own triangle has a neighbour off its plane, and
+  // when the triangle is no wider than the reach that neighbour lies within it: the query would
+  // find it, at a cost; the probes decide at once.
+  if (primitive >= 0 && (mesh->open_edges[size_t(primitive)] & TriangleMesh::kBentBit)) {
+    const uint32_t* v = &mesh->indices[3 * size_t(primitive)];
+    const Vec3 a = mesh->positions[v[0]], b = mesh->positions[v[1]], c = mesh->positions[v[2]];
+    if (std::fmax(length_squared(b - a), std::fmax(length_squared(c - b), length_squared(a - c))) <=
+        reach * reach)
+      return false;
+  }
   bool whole = true;
   int visits = 0;
   // Embree visits every primitive of a leaf its bounds reach: each is judged by the distance of
@@ -153,9 +164,9 @@ bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object,
 
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
-                      PathCounters& rays) {
+                      PathCounters& rays, int primitive) {
   static_assert(kDiscProbes == RenderScene::kBundle);
-  if (plainly_whole(scene, sp, object, radius, normal_cos))
+  if (plainly_whole(scene, sp, object, primitive, radius, normal_cos))
     return {0xff, 0};  // as if every probe found it
   const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
   const Frame frame = Frame::from_z(n);

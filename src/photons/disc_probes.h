@@ -50,9 +50,11 @@ enum class PhotonSurfaces { kOwnObject, kAnyObject };
 // meets it outside the sphere and says nothing. The probes count in rays.probe_rays. A disc with
 // nothing within two radii but flat triangles of its own mesh, and no border of the mesh inside
 // it, is whole on sight of the scene's tree: then no probe is cast and every bit of `found` is set.
+// `primitive` (the triangle the point lies on, when known) lets a point on a curved or folded
+// mesh skip that look.
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
-                      PathCounters& rays);
+                      PathCounters& rays, int primitive = -1);
 
 // Whether the probes apply to the shape: not to spheres and cylinders, whose surface inside a
 // gathering sphere is whole (on a sphere its area is pi r^2 exactly, Archimedes' hat-box theorem)

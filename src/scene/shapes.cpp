@@ -247,8 +247,17 @@ void TriangleMesh::compute_open_edges() {
   for (size_t i = 0; i < edges.size();) {
     size_t j = i + 1;
     while (j < edges.size() && edges[j].key == edges[i].key) ++j;
-    if (j - i != 2 || !(dot(across(edges[i]), across(edges[i + 1])) < 0))
+    if (j - i != 2 || !(dot(across(edges[i]), across(edges[i + 1])) < 0)) {
       for (size_t k = i; k < j; ++k) open_edges[edges[k].triangle] |= uint8_t(1u << edges[k].edge);
+    } else {
+      // Two neighbours: each one's cross product, turned as the edge runs, is the other's negated
+      // normal when the two lie in one plane.
+      const Vec3 a = normalize(across(edges[i])), b = normalize(across(edges[i + 1]));
+      if (!(-dot(a, b) >= 0.99999f)) {
+        open_edges[edges[i].triangle] |= kBentBit;
+        open_edges[edges[i + 1].triangle] |= kBentBit;
+      }
+    }
     i = j;
   }
 }

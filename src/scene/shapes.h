@@ -21,10 +21,11 @@ struct TriangleMesh {
   // Each triangle's unit cross(p0 - p2, p1 - p2) before flip_normal, so that a hit does not
   // compute it (RenderScene::commit fills it; surface_point computes it when it is empty).
   std::vector<Vec3> face_normals;
-  // Per triangle, bit e: its edge from corner e to corner (e + 1) % 3 is open, a border of the
-  // mesh: no other triangle has an edge between the same two positions, or more than one has
-  // (RenderScene::commit fills it).
+  // Per triangle, bit e (0-2): its edge from corner e to corner (e + 1) % 3 is open, a border of
+  // the mesh (compute_open_edges says when); bit kBentBit: a neighbour across one of its edges
+  // lies off its plane by more than 0.26 degrees (RenderScene::commit fills it).
   std::vector<uint8_t> open_edges;
+  static constexpr uint8_t kBentBit = 8;
   int triangle_count() const { return int(indices.size() / 3); }
   void compute_face_normals();
   void compute_open_edges();

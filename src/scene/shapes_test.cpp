@@ -283,6 +283,12 @@ TEST(TriangleMesh, OpenEdgesAreTheBordersOfTheMesh) {
   EXPECT_EQ(fin.open_edges[0], 0b111);
   EXPECT_EQ(fin.open_edges[1], 0b111);
   EXPECT_EQ(fin.open_edges[2], 0b111);
+  // A corner lifted: the two triangles meet at an angle across the diagonal, both bent.
+  TriangleMesh bent = quad;
+  bent.positions[3] = {0, 0.5f, 1};
+  bent.compute_open_edges();
+  EXPECT_EQ(bent.open_edges,
+            (std::vector<uint8_t>{0b011 | TriangleMesh::kBentBit, 0b110 | TriangleMesh::kBentBit}));
   // Both faces of a double-sided quad: its sides have two triangles each, but on the same side of
   // them (no surface beyond), and the diagonal has four.
   TriangleMesh two_sided = quad;
