@@ -90,294 +90,415 @@ double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
                 lp.photon_materials.capacity() * sizeof(Material));
 }
 
+// One render of bpm: what its iterations share, and what each leaves to the next. iteration() is
+// the paper's Fig. 3, one method a stage; the round's end (integrator/control.h) merges what the
+// round's iterations learnt (guided emission, the pixels' emission statistics and running means),
+// and save and load keep it across a checkpoint.
+class BpmRender {
+ public:
+  BpmRender(const LoadedScene& ls, const IntegratorOptions& opt, const BpmSettings& settings,
+            Film* film);
+  PassResult iteration(int pass, const RenderControl& control);
+  // The round's end and the checkpoint, as run_passes calls them.
+  IntegratorState state();
+  // The render's statistics once run_passes has filled `stats`.
+  RenderStats finish(RenderStats stats);
+
+ private:
+  // The four stages of an iteration. Each returns false when the iteration is dropped.
+  bool eye_pass(const WavelengthMaterials& wm, float scale, int pass, int it,
+                const RenderControl& control);
+  bool build_maps(int pass, const RenderControl& control, LightPassParams* lp);
+  bool light_pass(const LightPassParams& lp, int pass, int it);
+  void accumulate(const WavelengthMaterials& wm);
+  PassResult progress() const;
+
+  // What the round learnt, as sums that add across processes (IntegratorState::learnt, merge,
+  // keep_learnt), and the checkpoint.
+  void learnt(std::vector<double>* out);
+  void merge(const std::vector<double>& sums);
+  void keep_learnt(const std::vector<double>& sums);
+  void save(ByteWriter& w);
+  void load(ByteReader& r);
+  std::pair<EmissionCost, EmissionCost> round_cost() const;
+  void set_emission_samples();
+  // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
+  double reserve_memory() const;
+
+  const LoadedScene& ls_;
+  const RenderScene& scene_;
+  const IntegratorOptions& opt_;
+  const BpmSettings s_;
+  Film* film_;
+  const size_t n_pixels_;
+  const CameraSampler camera_;
+  const float pixel_angle_;
+  PixelMasks masks_;
+  EyePixels eye_;
+  tbb::enumerable_thread_specific<ObjectPhotonLists> thread_lists_;
+  tbb::enumerable_thread_specific<EyeCounters> eye_counters_;
+  BackwardMaps maps_;
+  LightPassBuffers light_;
+  LightPassResult light_result_;  // of the last light pass; its arrays are reused
+  PixelSums pixel_sums_;
+  BpmTotals tot_;
+  // Guided emission learns from each iteration's photons, scored relative to the pixels they
+  // reach; the pixels' values are the running means of their estimates. Both change at the end
+  // of a round (integrator/control.h): estimate_new_ holds the round's sums and counts until then.
+  EmissionGuide guide_;
+  std::vector<double> estimate_sum_, estimate_new_;
+  std::vector<uint32_t> estimate_count_;
+  std::vector<float> pixel_weight_;
+  // Carried from one iteration to the next, and merged at the end of each round: what the
+  // pixels' extra emission samples cost (their sample counts follow from it); counted_: the
+  // counters' totals at the last round.
+  EmissionCost cost_sum_, cost_new_, counted_;
+  const std::string size_;  // WxH, for messages
+  const double fixed_bytes_;
+  // In a scene where no light path can be a caustic, the backward photons that accept only
+  // caustics (half of them at D = 0) would gather nothing: they are not made.
+  const bool caustics_;
+  // Disc probes at first vertices near edges only (photons/disc_probes.h); with a radius in
+  // world units the radii on screen are unknown, and every disc is probed.
+  NearEdges near_edges_;
+};
+
+const char* const kMemoryAdvice =
+    "lower --resolution or --diffuse-depth (or the radii: --k0, --k1, --radius), or raise "
+    "--memory";
+
+BpmSettings checked_settings(const BpmSettings& settings, size_t n_pixels) {
+  BpmSettings s = settings;
+  s.photons_per_iteration = photons_for(settings, n_pixels);
+  check(s);
+  return s;
+}
+
+EyeCounters eye_exemplar(const IntegratorOptions& opt) {
+  EyeCounters c;
+  c.rays.observer = opt.eye_ray_observer;
+  return c;
+}
+
+BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
+                     const BpmSettings& settings, Film* film)
+    : ls_(ls),
+      scene_(ls.scene),
+      opt_(opt),
+      s_(checked_settings(settings, size_t(film->width()) * size_t(film->height()))),
+      film_(film),
+      n_pixels_(size_t(film->width()) * size_t(film->height())),
+      camera_(ls.camera, ls.filter, film->width(), film->height(), opt.seed),
+      pixel_angle_(std::sqrt(camera_.camera().pixel_solid_angle())),
+      masks_(film->width(), film->height(), tbb::this_task_arena::max_concurrency()),
+      eye_(n_pixels_),
+      thread_lists_([this] { return ObjectPhotonLists(scene_.objects.size()); }),
+      eye_counters_(eye_exemplar(opt)),
+      guide_(s_.guide_emission ? EmissionGuide(scene_) : EmissionGuide()),
+      estimate_sum_(n_pixels_, 0.0),
+      estimate_new_(2 * n_pixels_, 0.0),
+      estimate_count_(n_pixels_, 0),
+      size_(std::to_string(film->width()) + "x" + std::to_string(film->height())),
+      fixed_bytes_(reserve_memory()),
+      caustics_(may_have_caustics(scene_)),
+      near_edges_(s_.disc_probes && s_.radius <= 0, scene_, camera_.camera(), ls.film.width,
+                  ls.film.height, ls.filter.radius) {
+  pixel_sums_.places = s_.diffuse_depth + 2;
+  LightCounters light_exemplar;
+  light_exemplar.observer = opt.light_ray_observer;
+  light_.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
+}
+
+// An eye path leaves at most D + 2 backward photons (two at x_1 when D = 0, one at each other
+// diffuse vertex): the worst iteration must fit the memory budget before the first one starts.
+// The light pass holds the hits of a group of photons, and its entries get what the film, the
+// actual maps and those hits leave (applied in more rounds).
+double BpmRender::reserve_memory() const {
+  const double fixed_bytes =
+      double(film_->bytes()) + double(n_pixels_) * kPixelBytes +
+      light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),
+                           n_pixels_ * size_t(s_.diffuse_depth + 2));
+  check_memory("bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) +
+                   " (up to " + std::to_string(s_.diffuse_depth + 2) +
+                   " backward photons per pixel and iteration)",
+               fixed_bytes + double(n_pixels_) * (s_.diffuse_depth + 2) * kBackwardPhotonBytes,
+               opt_.memory_budget, kMemoryAdvice);
+  return fixed_bytes;
+}
+
+// Fig. 3: one iteration, an independent estimate of the image.
+PassResult BpmRender::iteration(int pass, const RenderControl& control) {
+  const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
+  const float scale = radius_scale(s_, it);
+  // One set of wavelengths for every eye and light path of the iteration.
+  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
+  // 1. Eye pass: backward photons, and the light the eye paths count themselves.
+  if (!eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
+  // 2. Per-object sphere trees over the backward photons.
+  LightPassParams lp{&wm, opt_.max_depth, s_.normal_cos, {}};
+  if (!build_maps(pass, control, &lp)) return PassResult{false, 0, "", "memory"};
+  // 3. Light pass: a fixed number of photons, in groups.
+  if (!light_pass(lp, pass, it)) return PassResult{false, 0, "", ""};
+  // 4. Accumulation of the iteration into the film; masks balanced for the next one.
+  accumulate(wm);
+  return progress();
+}
+
+bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, int it,
+                         const RenderControl& control) {
+  const auto t = Clock::now();
+  EyePassParams ep{&wm,
+                   s_.diffuse_depth,
+                   opt_.max_depth,
+                   s_.k0 * pixel_angle_ * scale,
+                   s_.k1 * pixel_angle_ * scale,
+                   s_.emission_samples,
+                   s_.radius * scale,
+                   caustics_,
+                   s_.normal_cos,
+                   s_.disc_probes,
+                   &near_edges_};
+  // Where the first vertices' discs are probed: near edges, within this iteration's radii.
+  near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
+  const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,
+                                     {thread_lists_, eye_counters_});
+  tot_.eye_s += since(t);
+  // An eye pass cut short (an interrupt, or the time budget after the first iteration) leaves
+  // pixels without their estimate: the iteration is dropped.
+  return complete;
+}
+
+bool BpmRender::build_maps(int pass, const RenderControl& control, LightPassParams* lp) {
+  const auto t = Clock::now();
+  std::vector<ObjectPhotonLists*> lists;
+  for (ObjectPhotonLists& l : thread_lists_) lists.push_back(&l);
+  build_backward_maps(lists, scene_.objects.size(), s_.centre_tree, &maps_);
+  // The time budget holds inside an iteration: its light pass ends early with the photons
+  // traced so far (the iteration is still a complete estimate, only noisier).
+  lp->stop = [&control] { return control.stop_requested(); };
+  resolve_photon_materials(maps_, lp);
+  if (!guide_.empty() && !pixel_weight_.empty()) lp->pixel_weight = &pixel_weight_;
+  if (opt_.memory_budget > 0) {
+    // The eye pass's lists keep their memory for the next iteration: a second copy of the
+    // backward photons (counted by their number, not the lists' capacities, which depend on
+    // how the threads shared the pixels: a budget decision must not).
+    const double list_bytes = double(maps_.photons.size() * sizeof(BackwardPhoton));
+    const double used = fixed_bytes_ + maps_bytes(maps_, *lp) + list_bytes;
+    // Over the budget (the estimate before the first iteration assumed typical trees and no
+    // textured materials): an error in the first iteration, which has nothing to keep; later,
+    // the render ends with the iterations so far and says why.
+    if (used > double(opt_.memory_budget)) {
+      if (pass == 0)
+        check_memory("bpm's backward photons and trees at " + size_, used, opt_.memory_budget,
+                     kMemoryAdvice);
+      tot_.build_s += since(t);
+      return false;
+    }
+    lp->entry_bytes_limit = std::max<size_t>(1, size_t(double(opt_.memory_budget) - used));
+  }
+  tot_.build_s += since(t);
+  tot_.add_maps(maps_);
+  return true;
+}
+
+bool BpmRender::light_pass(const LightPassParams& lp, int pass, int it) {
+  run_light_pass(scene_, maps_, lp, s_, masks_, opt_.seed, it, &light_,
+                 guide_.empty() ? nullptr : &guide_, &light_result_);
+  // Its time counts even if the iteration is dropped below: its rays reach the counters.
+  tot_.add_light_pass_time(light_result_);
+  // The film averages iterations with equal weights, so an iteration the budget cut to a share
+  // f of its photons adds variance ~ 1/f to a mean of n: with n - 1 whole ones, keeping it
+  // helps only when ((n - 1) + 1/f) / n^2 < 1 / (n - 1), about f > 1/2. A later iteration with
+  // less than half its photons is dropped; the first is always kept (an image needs one).
+  if (light_result_.cut && pass > 0 &&
+      2 * light_result_.emitted < uint64_t(s_.photons_per_iteration))
+    return false;
+  tot_.add_light_pass(light_result_);
+  return true;
+}
+
+void BpmRender::accumulate(const WavelengthMaterials& wm) {
+  const auto t = Clock::now();
+  accumulate_iteration(maps_, &light_result_, &eye_, wm.wl, ls_.film.max_component_value, s_, film_,
+                       &pixel_sums_, guide_.empty() ? nullptr : &estimate_new_);
+  tot_.accumulate_s += since(t);
+  masks_.rebuild(eye_.cost_ns);
+}
+
+PassResult BpmRender::progress() const {
+  PassResult r;
+  for (const EyeCounters& c : eye_counters_) r.rays += c.rays.total();
+  for (const LightCounters& c : light_.counters) r.rays += c.light_rays;
+  char text[128];
+  std::snprintf(text, sizeof text, "  %zu backward photons  coverage %.2f%s", maps_.photons.size(),
+                light_result_.coverage,
+                light_result_.cut ? "  (light pass cut short by the budget)" : "");
+  r.progress = text;
+  return r;
+}
+
+// The round's costs so far: cost_new_ (kept from a checkpoint or another process's share) and
+// what the counters added since the last round; and the counters' totals now.
+std::pair<EmissionCost, EmissionCost> BpmRender::round_cost() const {
+  EmissionCost now, round = cost_new_;
+  for (const EyeCounters& c : eye_counters_) {
+    now.v[0] += double(c.rays.total());
+    now.v[1] += double(c.pixels);
+    now.v[2] += double(c.emission_samples);
+    now.v[3] += double(c.emission_rays);
+  }
+  for (const LightCounters& c : light_.counters) now.v[0] += double(c.light_rays);
+  for (size_t k = 0; k < now.v.size(); ++k) round.v[k] += now.v[k] - counted_.v[k];
+  return {round, now};
+}
+
+void BpmRender::set_emission_samples() {
+  const double ratio = cost_sum_.ratio();
+  for (size_t p = 0; p < n_pixels_; ++p)
+    eye_.emission_samples[p] =
+        eye_.sees_emission[p]
+            ? uint16_t(emission_sample_count(eye_.emission_stats[p], ratio, s_.emission_samples))
+            : 1;
+}
+
+constexpr size_t kStats = EmissionStats<double>::kValues;
+
+// The learnt sums: per pixel whether it saw emission, then its emission statistics, the round's
+// costs, and with guided emission the guide's cells and the pixels' estimate sums and counts.
+void BpmRender::learnt(std::vector<double>* out) {
+  for (uint8_t& saw : eye_.saw_emission) {
+    out->push_back(saw);
+    saw = 0;
+  }
+  for (EmissionStats<double>& st : eye_.round_stats) {
+    out->insert(out->end(), st.v.begin(), st.v.end());
+    st = {};
+  }
+  const auto [round, now] = round_cost();
+  out->insert(out->end(), round.v.begin(), round.v.end());
+  counted_ = now;
+  cost_new_ = {};
+  if (guide_.empty()) return;
+  guide_.take_learnt(out);
+  out->insert(out->end(), estimate_new_.begin(), estimate_new_.end());
+  std::fill(estimate_new_.begin(), estimate_new_.end(), 0.0);
+}
+
+void BpmRender::merge(const std::vector<double>& sums) {
+  const size_t pixel_values = (1 + kStats) * n_pixels_ + EmissionCost().v.size();
+  // Rounded to float before they join, as the guide's sums below.
+  const double* stats = sums.data() + n_pixels_;
+  for (size_t p = 0; p < n_pixels_; ++p) {
+    std::array<double, kStats>& st = eye_.emission_stats[p].v;
+    for (size_t k = 0; k < kStats; ++k) st[k] += double(float(stats[kStats * p + k]));
+    if (sums[p] > 0) eye_.sees_emission[p] = 1;
+  }
+  const double* c = stats + kStats * n_pixels_;
+  for (size_t k = 0; k < cost_sum_.v.size(); ++k) cost_sum_.v[k] += double(float(c[k]));
+  set_emission_samples();
+  if (guide_.empty()) return;
+  // A round's sums are rounded to float precision before they join: processes add their
+  // shares in another order than one process adds passes, and a difference in the last bits
+  // of a sum would move a boundary of the guided density, so that the same seed would draw
+  // other photons.
+  std::vector<double> learnt(sums.size() - pixel_values);
+  for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[pixel_values + i]));
+  guide_.merge(learnt.data());
+  tot_.guide_moved = guide_.moved();
+  const double* e = learnt.data() + 2 * guide_.cells();
+  for (size_t p = 0; p < n_pixels_; ++p) {
+    estimate_sum_[p] += e[2 * p];
+    estimate_count_[p] += uint32_t(e[2 * p + 1]);
+  }
+  update_pixel_weights(estimate_sum_, estimate_count_, &pixel_weight_);
+}
+
+void BpmRender::keep_learnt(const std::vector<double>& sums) {
+  const size_t pixel_values = (1 + kStats) * n_pixels_ + EmissionCost().v.size();
+  const double* stats = sums.data() + n_pixels_;
+  for (size_t p = 0; p < n_pixels_; ++p) {
+    eye_.saw_emission[p] = sums[p] > 0;
+    std::copy_n(stats + kStats * p, kStats, eye_.round_stats[p].v.begin());
+  }
+  const double* c = stats + kStats * n_pixels_;
+  std::copy_n(c, cost_new_.v.size(), cost_new_.v.begin());
+  if (guide_.empty()) return;
+  guide_.keep_learnt(sums.data() + pixel_values);
+  const double* e = sums.data() + pixel_values + 2 * guide_.cells();
+  estimate_new_.assign(e, e + 2 * n_pixels_);
+}
+
+void BpmRender::save(ByteWriter& w) {
+  w.put_vector(eye_.sees_emission);
+  w.put_vector(eye_.saw_emission);
+  w.put_vector(eye_.emission_stats);
+  w.put_vector(eye_.round_stats);
+  w.put(cost_sum_.v);
+  w.put(round_cost().first.v);  // the counters start from zero when the render goes on
+  w.put(uint8_t(!guide_.empty()));
+  if (guide_.empty()) return;
+  guide_.save(w);
+  w.put_vector(estimate_sum_);
+  w.put_vector(estimate_count_);
+  w.put_vector(estimate_new_);
+}
+
+void BpmRender::load(ByteReader& r) {
+  eye_.sees_emission = r.get_vector<uint8_t>();
+  eye_.saw_emission = r.get_vector<uint8_t>();
+  eye_.emission_stats = r.get_vector<EmissionStats<double>>();
+  eye_.round_stats = r.get_vector<EmissionStats<double>>();
+  if (eye_.sees_emission.size() != n_pixels_ || eye_.saw_emission.size() != n_pixels_ ||
+      eye_.emission_stats.size() != n_pixels_ || eye_.round_stats.size() != n_pixels_)
+    throw Error(r.what() + " is truncated or corrupt (pixels that see emission)");
+  cost_sum_.v = r.get<std::array<double, 4>>();
+  cost_new_.v = r.get<std::array<double, 4>>();
+  // The counters start again from zero.
+  counted_ = {};
+  set_emission_samples();
+  if (r.get<uint8_t>() != uint8_t(!guide_.empty()))
+    throw Error(r.what() + " differs in guided emission (--no-guide)");
+  if (guide_.empty()) return;
+  guide_.load(r);
+  estimate_sum_ = r.get_vector<double>();
+  estimate_count_ = r.get_vector<uint32_t>();
+  estimate_new_ = r.get_vector<double>();
+  if (estimate_sum_.size() != n_pixels_ || estimate_count_.size() != n_pixels_ ||
+      estimate_new_.size() != 2 * n_pixels_)
+    throw Error(r.what() + " is truncated or corrupt (pixel estimates)");
+  update_pixel_weights(estimate_sum_, estimate_count_, &pixel_weight_);
+}
+
+IntegratorState BpmRender::state() {
+  IntegratorState state;
+  state.learnt = [this](std::vector<double>* out) { learnt(out); };
+  state.merge = [this](const std::vector<double>& sums) { merge(sums); };
+  state.keep_learnt = [this](const std::vector<double>& sums) { keep_learnt(sums); };
+  state.save = [this](ByteWriter& w) { save(w); };
+  state.load = [this](ByteReader& r) { load(r); };
+  return state;
+}
+
+RenderStats BpmRender::finish(RenderStats stats) {
+  for (const EyeCounters& c : eye_counters_) tot_.eye.add(c);
+  for (const LightCounters& c : light_.counters) tot_.light.add(c);
+  stats.rays = tot_.eye.rays;
+  stats.light_rays = tot_.light.light_rays;
+  stats.details = to_json(tot_, s_, stats.passes, n_pixels_);
+  return stats;
+}
+
 }  // namespace
 
 RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                        const BpmSettings& settings, Film* film) {
-  const size_t n_pixels = size_t(film->width()) * size_t(film->height());
-  BpmSettings s = settings;
-  s.photons_per_iteration = photons_for(settings, n_pixels);
-  check(s);
-  const RenderScene& scene = ls.scene;
-  const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
-  const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
-
-  PixelMasks masks(film->width(), film->height(), tbb::this_task_arena::max_concurrency());
-  EyePixels eye(n_pixels);
-  tbb::enumerable_thread_specific<ObjectPhotonLists> thread_lists(
-      [&] { return ObjectPhotonLists(scene.objects.size()); });
-  EyeCounters eye_exemplar;
-  eye_exemplar.rays.observer = opt.eye_ray_observer;
-  tbb::enumerable_thread_specific<EyeCounters> eye_counters(eye_exemplar);
-  BackwardMaps maps;
-  LightPassBuffers light;
-  LightPassResult light_result;  // of the last light pass; its arrays are reused
-  PixelSums pixel_sums;
-  pixel_sums.places = s.diffuse_depth + 2;
-  LightCounters light_exemplar;
-  light_exemplar.observer = opt.light_ray_observer;
-  light.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
-  BpmTotals tot;
-  // Guided emission learns from each iteration's photons, scored relative to the pixels they
-  // reach; the pixels' values are the running means of their estimates. Both change at the end
-  // of a round (integrator/control.h): estimate_new holds the round's sums and counts until then.
-  EmissionGuide guide = s.guide_emission ? EmissionGuide(scene) : EmissionGuide();
-  std::vector<double> estimate_sum(n_pixels, 0.0), estimate_new(2 * n_pixels, 0.0);
-  std::vector<uint32_t> estimate_count(n_pixels, 0);
-  std::vector<float> pixel_weight;
-
-  // An eye path leaves at most D + 2 backward photons (two at x_1 when D = 0, one at each other
-  // diffuse vertex): the worst iteration must fit the memory budget before the first one starts.
-  // The light pass holds the hits of a group of photons, and its entries get what the film, the
-  // actual maps and those hits leave (applied in more rounds).
-  const std::string size = std::to_string(film->width()) + "x" + std::to_string(film->height());
-  const std::string advice =
-      "lower --resolution or --diffuse-depth (or the radii: --k0, --k1, --radius), or raise "
-      "--memory";
-  const double fixed_bytes =
-      double(film->bytes()) + double(n_pixels) * kPixelBytes +
-      light_pass_hit_bytes(opt.max_depth, tbb::this_task_arena::max_concurrency(),
-                           n_pixels * size_t(s.diffuse_depth + 2));
-  check_memory("bpm at " + size + " with diffuse depth " + std::to_string(s.diffuse_depth) +
-                   " (up to " + std::to_string(s.diffuse_depth + 2) +
-                   " backward photons per pixel and iteration)",
-               fixed_bytes + double(n_pixels) * (s.diffuse_depth + 2) * kBackwardPhotonBytes,
-               opt.memory_budget, advice);
-
-  // In a scene where no light path can be a caustic, the backward photons that accept only
-  // caustics (half of them at D = 0) would gather nothing: they are not made.
-  const bool caustics = may_have_caustics(scene);
-
-  // Disc probes at first vertices near edges only (photons/disc_probes.h); with a radius in world
-  // units the radii on screen are unknown, and every disc is probed.
-  NearEdges near_edges(s.disc_probes && s.radius <= 0, scene, camera.camera(), ls.film.width,
-                       ls.film.height, ls.filter.radius);
-
-  auto iteration = [&](int pass, const RenderControl& control) {
-    const int it = opt.first_iteration + pass;  // the index random streams and radii follow
-    const float scale = radius_scale(s, it);
-    // One set of wavelengths for every eye and light path of the iteration.
-    const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
-
-    // 1. Eye pass: backward photons, and the light the eye paths count themselves.
-    auto t = Clock::now();
-    EyePassParams ep{&wm,
-                     s.diffuse_depth,
-                     opt.max_depth,
-                     s.k0 * pixel_angle * scale,
-                     s.k1 * pixel_angle * scale,
-                     s.emission_samples,
-                     s.radius * scale,
-                     caustics,
-                     s.normal_cos,
-                     s.disc_probes,
-                     &near_edges};
-    // Where the first vertices' discs are probed: near edges, within this iteration's radii.
-    near_edges.mark(s.k0 * scale, s.k1 * scale);
-    bool complete = run_eye_pass(scene, ep, camera, masks, control, pass, it, &eye,
-                                 {thread_lists, eye_counters});
-    tot.eye_s += since(t);
-    // An eye pass cut short (an interrupt, or the time budget after the first iteration) leaves
-    // pixels without their estimate: the iteration is dropped.
-    if (!complete) return PassResult{false, 0, "", ""};
-
-    // 2. Per-object sphere trees over the backward photons.
-    t = Clock::now();
-    std::vector<ObjectPhotonLists*> lists;
-    for (ObjectPhotonLists& l : thread_lists) lists.push_back(&l);
-    build_backward_maps(lists, scene.objects.size(), s.centre_tree, &maps);
-    LightPassParams lp{&wm, opt.max_depth, s.normal_cos, {}};
-    // The time budget holds inside an iteration: its light pass ends early with the photons
-    // traced so far (the iteration is still a complete estimate, only noisier).
-    lp.stop = [&] { return control.stop_requested(); };
-    resolve_photon_materials(maps, &lp);
-    if (!guide.empty() && !pixel_weight.empty()) lp.pixel_weight = &pixel_weight;
-    if (opt.memory_budget > 0) {
-      // The eye pass's lists keep their memory for the next iteration: a second copy of the
-      // backward photons (counted by their number, not the lists' capacities, which depend on
-      // how the threads shared the pixels: a budget decision must not).
-      const double list_bytes = double(maps.photons.size() * sizeof(BackwardPhoton));
-      const double used = fixed_bytes + maps_bytes(maps, lp) + list_bytes;
-      // Over the budget (the estimate before the first iteration assumed typical trees and no
-      // textured materials): an error in the first iteration, which has nothing to keep; later,
-      // the render ends with the iterations so far and says why.
-      if (used > double(opt.memory_budget)) {
-        if (pass == 0)
-          check_memory("bpm's backward photons and trees at " + size, used, opt.memory_budget,
-                       advice);
-        tot.build_s += since(t);
-        return PassResult{false, 0, "", "memory"};
-      }
-      lp.entry_bytes_limit = std::max<size_t>(1, size_t(double(opt.memory_budget) - used));
-    }
-    tot.build_s += since(t);
-    tot.add_maps(maps);
-
-    // 3. Light pass: a fixed number of photons, in groups.
-    run_light_pass(scene, maps, lp, s, masks, opt.seed, it, &light,
-                   guide.empty() ? nullptr : &guide, &light_result);
-    // Its time counts even if the iteration is dropped below: its rays reach the counters.
-    tot.add_light_pass_time(light_result);
-    // The film averages iterations with equal weights, so an iteration the budget cut to a share
-    // f of its photons adds variance ~ 1/f to a mean of n: with n - 1 whole ones, keeping it
-    // helps only when ((n - 1) + 1/f) / n^2 < 1 / (n - 1), about f > 1/2. A later iteration with
-    // less than half its photons is dropped; the first is always kept (an image needs one).
-    if (light_result.cut && pass > 0 &&
-        2 * light_result.emitted < uint64_t(s.photons_per_iteration))
-      return PassResult{false, 0, "", ""};
-    tot.add_light_pass(light_result);
-
-    // 4. Accumulation of the iteration into the film; masks balanced for the next one.
-    t = Clock::now();
-    accumulate_iteration(maps, &light_result, &eye, wm.wl, ls.film.max_component_value, s, film,
-                         &pixel_sums, guide.empty() ? nullptr : &estimate_new);
-    tot.accumulate_s += since(t);
-    masks.rebuild(eye.cost_ns);
-
-    PassResult r;
-    for (const EyeCounters& c : eye_counters) r.rays += c.rays.total();
-    for (const LightCounters& c : light.counters) r.rays += c.light_rays;
-    char progress[128];
-    std::snprintf(progress, sizeof progress, "  %zu backward photons  coverage %.2f%s",
-                  maps.photons.size(), light_result.coverage,
-                  light_result.cut ? "  (light pass cut short by the budget)" : "");
-    r.progress = progress;
-    return r;
-  };
-  // Carried from one iteration to the next, and merged at the end of each round: the pixels'
-  // emission statistics and what their extra samples cost (their sample counts follow from them),
-  // what the guide learnt and the pixels' running means (the pixel weights follow from them).
-  EmissionCost cost_sum, cost_new, counted;  // counted: the counters' totals at the last round
-  // The round's costs so far: cost_new (kept from a checkpoint or another process's share) and
-  // what the counters added since the last round.
-  auto round_cost = [&] {
-    EmissionCost now, round = cost_new;
-    for (const EyeCounters& c : eye_counters) {
-      now.v[0] += double(c.rays.total());
-      now.v[1] += double(c.pixels);
-      now.v[2] += double(c.emission_samples);
-      now.v[3] += double(c.emission_rays);
-    }
-    for (const LightCounters& c : light.counters) now.v[0] += double(c.light_rays);
-    for (size_t k = 0; k < now.v.size(); ++k) round.v[k] += now.v[k] - counted.v[k];
-    return std::pair{round, now};
-  };
-  auto set_emission_samples = [&] {
-    const double ratio = cost_sum.ratio();
-    for (size_t p = 0; p < n_pixels; ++p)
-      eye.emission_samples[p] =
-          eye.sees_emission[p]
-              ? uint16_t(emission_sample_count(eye.emission_stats[p], ratio, s.emission_samples))
-              : 1;
-  };
-  IntegratorState state;
-  state.learnt = [&](std::vector<double>* out) {
-    for (uint8_t& saw : eye.saw_emission) {
-      out->push_back(saw);
-      saw = 0;
-    }
-    for (EmissionStats<double>& st : eye.round_stats) {
-      out->insert(out->end(), st.v.begin(), st.v.end());
-      st = {};
-    }
-    const auto [round, now] = round_cost();
-    out->insert(out->end(), round.v.begin(), round.v.end());
-    counted = now;
-    cost_new = {};
-    if (guide.empty()) return;
-    guide.take_learnt(out);
-    out->insert(out->end(), estimate_new.begin(), estimate_new.end());
-    std::fill(estimate_new.begin(), estimate_new.end(), 0.0);
-  };
-  constexpr size_t kStats = EmissionStats<double>::kValues;
-  const size_t pixel_values = (1 + kStats) * n_pixels + EmissionCost().v.size();
-  state.merge = [&](const std::vector<double>& sums) {
-    // Rounded to float before they join, as the guide's sums below.
-    const double* stats = sums.data() + n_pixels;
-    for (size_t p = 0; p < n_pixels; ++p) {
-      std::array<double, kStats>& st = eye.emission_stats[p].v;
-      for (size_t k = 0; k < kStats; ++k) st[k] += double(float(stats[kStats * p + k]));
-      if (sums[p] > 0) eye.sees_emission[p] = 1;
-    }
-    const double* c = stats + kStats * n_pixels;
-    for (size_t k = 0; k < cost_sum.v.size(); ++k) cost_sum.v[k] += double(float(c[k]));
-    set_emission_samples();
-    if (guide.empty()) return;
-    // A round's sums are rounded to float precision before they join: processes add their
-    // shares in another order than one process adds passes, and a difference in the last bits
-    // of a sum would move a boundary of the guided density, so that the same seed would draw
-    // other photons.
-    std::vector<double> learnt(sums.size() - pixel_values);
-    for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[pixel_values + i]));
-    guide.merge(learnt.data());
-    tot.guide_moved = guide.moved();
-    const double* e = learnt.data() + 2 * guide.cells();
-    for (size_t p = 0; p < n_pixels; ++p) {
-      estimate_sum[p] += e[2 * p];
-      estimate_count[p] += uint32_t(e[2 * p + 1]);
-    }
-    update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
-  };
-  state.keep_learnt = [&](const std::vector<double>& sums) {
-    const double* stats = sums.data() + n_pixels;
-    for (size_t p = 0; p < n_pixels; ++p) {
-      eye.saw_emission[p] = sums[p] > 0;
-      std::copy_n(stats + kStats * p, kStats, eye.round_stats[p].v.begin());
-    }
-    const double* c = stats + kStats * n_pixels;
-    std::copy_n(c, cost_new.v.size(), cost_new.v.begin());
-    if (guide.empty()) return;
-    guide.keep_learnt(sums.data() + pixel_values);
-    const double* e = sums.data() + pixel_values + 2 * guide.cells();
-    estimate_new.assign(e, e + 2 * n_pixels);
-  };
-  state.save = [&](ByteWriter& w) {
-    w.put_vector(eye.sees_emission);
-    w.put_vector(eye.saw_emission);
-    w.put_vector(eye.emission_stats);
-    w.put_vector(eye.round_stats);
-    w.put(cost_sum.v);
-    w.put(round_cost().first.v);  // the counters start from zero when the render goes on
-    w.put(uint8_t(!guide.empty()));
-    if (guide.empty()) return;
-    guide.save(w);
-    w.put_vector(estimate_sum);
-    w.put_vector(estimate_count);
-    w.put_vector(estimate_new);
-  };
-  state.load = [&](ByteReader& r) {
-    eye.sees_emission = r.get_vector<uint8_t>();
-    eye.saw_emission = r.get_vector<uint8_t>();
-    eye.emission_stats = r.get_vector<EmissionStats<double>>();
-    eye.round_stats = r.get_vector<EmissionStats<double>>();
-    if (eye.sees_emission.size() != n_pixels || eye.saw_emission.size() != n_pixels ||
-        eye.emission_stats.size() != n_pixels || eye.round_stats.size() != n_pixels)
-      throw Error(r.what() + " is truncated or corrupt (pixels that see emission)");
-    cost_sum.v = r.get<std::array<double, 4>>();
-    cost_new.v = r.get<std::array<double, 4>>();
-    // The counters start again from zero.
-    counted = {};
-    set_emission_samples();
-    if (r.get<uint8_t>() != uint8_t(!guide.empty()))
-      throw Error(r.what() + " differs in guided emission (--no-guide)");
-    if (guide.empty()) return;
-    guide.load(r);
-    estimate_sum = r.get_vector<double>();
-    estimate_count = r.get_vector<uint32_t>();
-    estimate_new = r.get_vector<double>();
-    if (estimate_sum.size() != n_pixels || estimate_count.size() != n_pixels ||
-        estimate_new.size() != 2 * n_pixels)
-      throw Error(r.what() + " is truncated or corrupt (pixel estimates)");
-    update_pixel_weights(estimate_sum, estimate_count, &pixel_weight);
-  };
+  BpmRender bpm(ls, opt, settings, film);
   RenderStats stats;
-  run_passes(opt, film, "iteration", iteration, &stats, state);
-  for (const EyeCounters& c : eye_counters) tot.eye.add(c);
-  for (const LightCounters& c : light.counters) tot.light.add(c);
-  stats.rays = tot.eye.rays;
-  stats.light_rays = tot.light.light_rays;
-  stats.details = to_json(tot, s, stats.passes, n_pixels);
-  return stats;
+  run_passes(
+      opt, film, "iteration",
+      [&bpm](int pass, const RenderControl& control) { return bpm.iteration(pass, control); },
+      &stats, bpm.state());
+  return bpm.finish(stats);
 }
 
 }  // namespace bpm
