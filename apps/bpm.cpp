@@ -262,116 +262,153 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
   return rec;
 }
 
-// With several processes (mpirun), process 0 alone prints and writes; the others render.
-int run_render(RenderArgs a, Team* team, bool* rendering) {
-  const bool root = !team || team->rank() == 0;
-  if (!root) a.quiet = true;
-  auto t_start = Clock::now();
-  ParsedScene parsed = parse_scene_file(a.scene);
-  const IntegratorSettings file_settings{bpm_settings_from_file(parsed.integrator),
-                                         fpm_settings_from_file(parsed.integrator)};
-  double t_parse = seconds_since(t_start);
+// The scene file read and flattened, with the photon methods' settings from its Integrator line
+// (read and checked right after parsing, before the scene is built).
+struct SceneRead {
+  ParsedScene parsed;
+  IntegratorSettings file;
+  LoadedScene ls;
+  double parse_s = 0, build_s = 0;
+};
 
-  auto t1 = Clock::now();
-  LoadedScene ls = flatten_scene(parsed);
-  double t_build = seconds_since(t1);
-
-  if (!a.resolution.empty()) set_resolution(a.resolution, &ls.film);
+SceneRead read_scene(const RenderArgs& a) {
+  SceneRead r;
+  auto t = Clock::now();
+  r.parsed = parse_scene_file(a.scene);
+  r.file = {bpm_settings_from_file(r.parsed.integrator),
+            fpm_settings_from_file(r.parsed.integrator)};
+  r.parse_s = seconds_since(t);
+  t = Clock::now();
+  r.ls = flatten_scene(r.parsed);
+  r.build_s = seconds_since(t);
+  if (!a.resolution.empty()) set_resolution(a.resolution, &r.ls.film);
   // The file's integrator decides only without --integrator; then say how it was read.
-  if (a.integrator.empty() && !ls.render.integrator_note.empty())
-    warning(ls.render.integrator_directive.loc, ls.render.integrator_note);
-  RenderOptions opt = render_options(a, ls, file_settings);
+  if (a.integrator.empty() && !r.ls.render.integrator_note.empty())
+    warning(r.ls.render.integrator_directive.loc, r.ls.render.integrator_note);
+  return r;
+}
+
+// The output paths, from -o or the Film's filename; fails before rendering when the output folder
+// does not exist.
+OutputPaths checked_output_paths(const RenderArgs& a, const LoadedScene& ls) {
   std::string out = a.output;
   if (out.empty()) out = std::filesystem::path(ls.film.filename).stem().string() + ".exr";
   OutputPaths paths = output_paths(out);
-  // Fail before rendering when the output folder does not exist.
   auto dir = std::filesystem::path(paths.exr).parent_path();
   if (!dir.empty() && !std::filesystem::is_directory(dir))
     throw Error("output folder \"" + dir.string() + "\" does not exist");
+  return paths;
+}
 
-  if (!a.quiet)
-    std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n",
-                 a.scene.c_str(), ls.scene.objects.size(), ls.scene.triangle_count(),
-                 ls.scene.lights.size(), ls.film.width, ls.film.height, opt.integrator.c_str());
-  // The film and the images written from it (and a checkpoint's copy of the film, when one is
-  // kept; with other processes, the film process 0 receives and the one it adds) must fit before
-  // anything is allocated.
+// The film and the images written from it (and a checkpoint's copy of the film, when one is kept;
+// with other processes, the film process 0 receives and the one it adds) must fit before
+// anything is allocated.
+void check_film_memory(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt,
+                       bool keep_checkpoint, bool team) {
   const double pixels = double(ls.film.width) * double(ls.film.height);
-  const bool keep_checkpoint = opt.write_every_s > 0 || !a.resume.empty();
   check_memory("a " + std::to_string(ls.film.width) + "x" + std::to_string(ls.film.height) +
                    " film with its outputs",
                pixels * (double(Film::bytes_per_pixel(a.m_images)) *
                              (1 + (keep_checkpoint ? 1 : 0) + (team ? 2 : 0)) +
                          kOutputBytesPerPixel),
                opt.memory_budget, "lower --resolution or --m-images, or raise --memory");
-  Film film(ls.film.width, ls.film.height, a.m_images);
+}
+
+// --resume: the checkpoint, checked against this render; the film's sums are process 0's alone
+// (the others' films hold their passes until a round ends); every process takes the render state.
+void resume_from(const RenderArgs& a, const nlohmann::json& identity, bool root,
+                 Checkpoint* resumed, Film* film, RenderOptions* opt) {
+  *resumed = read_checkpoint(a.resume);
+  check_identity(resumed->identity, identity, a.resume);
+  ByteReader r(resumed->film, "checkpoint \"" + a.resume + "\"");
+  if (root) film->load(r);
+  std::vector<uint8_t>().swap(resumed->film);
+  opt->resume = &resumed->state;
+  if (!a.quiet)
+    std::fprintf(stderr, "bpm: resuming %s after %d %s\n", a.resume.c_str(), resumed->state.passes,
+                 opt->integrator == "path" ? "passes" : "iterations");
+}
+
+// Intermediate outputs: the images so far and a JSON record that says the render is running.
+void write_intermediate(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt,
+                        const Film& film, const OutputPaths& paths, int passes) {
+  write_images(paths, film, ls.film.imaging_ratio);
+  nlohmann::json rec;
+  rec["scene"] = a.scene;
+  rec["settings"] = {
+      {"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
+  rec["result"] = {{"passes", passes},
+                   {"stop_reason", "running"},
+                   {"relative_error_delta", film.relative_error()},
+                   {"relative_error_delta_total", film.relative_error_total()}};
+  write_text_atomic(paths.json, rec.dump(2) + "\n");
+}
+
+// What a finished render prints on stderr.
+void print_result(const RenderArgs& a, const RenderOptions& opt, const RenderStats& st,
+                  const Film& film, const OutputPaths& paths) {
+  if (film.dropped_samples() > 0)
+    std::fprintf(stderr,
+                 "bpm: warning: %llu samples had a non-finite or negative value (a numerical "
+                 "accident) and were recorded as black (result.dropped_samples in the JSON)\n",
+                 (unsigned long long)film.dropped_samples());
+  if (a.quiet) return;
+  if (opt.integrator == "bpm") print_bpm_summary(st.details);
+  if (opt.integrator == "fpm") print_fpm_summary(st.details);
+  char bias[64] = "";
+  if (film.has_bias())
+    std::snprintf(bias, sizeof bias, " (noise %.4f, bias %.4f)", st.relative_error,
+                  film.relative_error_bias());
+  std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f%s -> %s\n", st.passes,
+               opt.integrator == "path" ? "spp" : "iterations", st.render_seconds,
+               st.stop_reason.c_str(),
+               st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0,
+               film.relative_error_total(), bias, paths.exr.c_str());
+}
+
+// With several processes (mpirun), process 0 alone prints and writes; the others render.
+int run_render(RenderArgs a, Team* team, bool* rendering) {
+  const bool root = !team || team->rank() == 0;
+  if (!root) a.quiet = true;
+  const SceneRead scene = read_scene(a);
+  const LoadedScene& ls = scene.ls;
+  RenderOptions opt = render_options(a, ls, scene.file);
+  const OutputPaths paths = checked_output_paths(a, ls);
+  if (!a.quiet)
+    std::fprintf(stderr, "bpm: %s: %zu objects, %zu triangles, %zu lights, %dx%d, integrator %s\n",
+                 a.scene.c_str(), ls.scene.objects.size(), ls.scene.triangle_count(),
+                 ls.scene.lights.size(), ls.film.width, ls.film.height, opt.integrator.c_str());
   // A checkpoint is kept when outputs are written as the render goes, or when it resumes one
   // (so that it can be resumed again); it is written every --write-every and at the end.
   // (Only then: its fingerprint reads every scene and data file again.)
+  const bool keep_checkpoint = opt.write_every_s > 0 || !a.resume.empty();
+  check_film_memory(a, ls, opt, keep_checkpoint, team != nullptr);
+  Film film(ls.film.width, ls.film.height, a.m_images);
   const nlohmann::json identity =
-      keep_checkpoint ? render_identity(parsed.files, ls, opt, film.m_images()) : nlohmann::json();
+      keep_checkpoint ? render_identity(scene.parsed.files, ls, opt, film.m_images())
+                      : nlohmann::json();
   Checkpoint resumed;
-  if (!a.resume.empty()) {
-    resumed = read_checkpoint(a.resume);
-    check_identity(resumed.identity, identity, a.resume);
-    // The film's sums are process 0's alone (the others' films hold their passes until a round
-    // ends); every process takes the render state.
-    ByteReader r(resumed.film, "checkpoint \"" + a.resume + "\"");
-    if (root) film.load(r);
-    std::vector<uint8_t>().swap(resumed.film);
-    opt.resume = &resumed.state;
-    if (!a.quiet)
-      std::fprintf(stderr, "bpm: resuming %s after %d %s\n", a.resume.c_str(), resumed.state.passes,
-                   opt.integrator == "path" ? "passes" : "iterations");
-  }
+  if (!a.resume.empty()) resume_from(a, identity, root, &resumed, &film, &opt);
   if (keep_checkpoint && root)
     opt.save_state = [&](const RenderState& state) {
       const std::vector<uint8_t> bytes = encode_checkpoint(identity, film, state);
       write_bytes_atomic(paths.checkpoint, bytes.data(), bytes.size());
     };
   install_interrupt_handlers();
-  // Intermediate outputs: the images so far and a JSON record that says the render is running.
-  opt.checkpoint = [&](int passes) {
-    write_images(paths, film, ls.film.imaging_ratio);
-    nlohmann::json rec;
-    rec["scene"] = a.scene;
-    rec["settings"] = {
-        {"integrator", opt.integrator}, {"seed", opt.seed}, {"max_depth", opt.max_depth}};
-    rec["result"] = {{"passes", passes},
-                     {"stop_reason", "running"},
-                     {"relative_error_delta", film.relative_error()},
-                     {"relative_error_delta_total", film.relative_error_total()}};
-    write_text_atomic(paths.json, rec.dump(2) + "\n");
-  };
+  if (root)
+    opt.checkpoint = [&](int passes) { write_intermediate(a, ls, opt, film, paths, passes); };
   opt.team = team;
-  if (!root) opt.checkpoint = nullptr;
   *rendering = true;
   RenderStats st = render(ls, opt, &film);
   if (!root) return 0;
 
-  auto t3 = Clock::now();
+  auto t = Clock::now();
   write_images(paths, film, ls.film.imaging_ratio);
-  double t_write = seconds_since(t3);
-  nlohmann::json rec = run_record(a, ls, opt, st, film, paths, {t_parse, t_build, t_write});
+  const double write_s = seconds_since(t);
+  nlohmann::json rec =
+      run_record(a, ls, opt, st, film, paths, {scene.parse_s, scene.build_s, write_s});
   write_text_atomic(paths.json, rec.dump(2) + "\n");
-  if (film.dropped_samples() > 0)
-    std::fprintf(stderr,
-                 "bpm: warning: %llu samples had a non-finite or negative value (a numerical "
-                 "accident) and were recorded as black (result.dropped_samples in the JSON)\n",
-                 (unsigned long long)film.dropped_samples());
-  if (!a.quiet) {
-    if (opt.integrator == "bpm") print_bpm_summary(st.details);
-    if (opt.integrator == "fpm") print_fpm_summary(st.details);
-    char bias[64] = "";
-    if (film.has_bias())
-      std::snprintf(bias, sizeof bias, " (noise %.4f, bias %.4f)", st.relative_error,
-                    film.relative_error_bias());
-    std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f%s -> %s\n", st.passes,
-                 opt.integrator == "path" ? "spp" : "iterations", st.render_seconds,
-                 st.stop_reason.c_str(),
-                 st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0,
-                 film.relative_error_total(), bias, paths.exr.c_str());
-  }
+  print_result(a, opt, st, film, paths);
   return st.stop_reason == "interrupted" ? 130 : 0;
 }
 
@@ -392,6 +429,189 @@ int run_compare(const std::string& a_path, const std::string& b_path) {
   return 0;
 }
 
+// The flags of `bpm render`, in the manual's groups (docs/USAGE.md).
+const char* const kGeneral = "General";
+const char* const kBudgets = "Budgets (the first one reached ends the render)";
+const char* const kOutputs = "Outputs, checkpoints and the error estimate";
+const char* const kBpm =
+    "Backward photon mapping (--integrator bpm; the photon flags also apply to fpm)";
+const char* const kFpm = "Forward photon mapping (--integrator fpm)";
+
+void add_general_options(CLI::App* render, RenderArgs& ra) {
+  render->add_option("scene", ra.scene, "Scene file (.pbrt)")->required();
+  render
+      ->add_option("--integrator", ra.integrator,
+                   "Integrator: path, bpm or fpm; default: the scene file's")
+      ->check(CLI::IsMember({"path", "bpm", "fpm"}))
+      ->group(kGeneral);
+  render->add_option("--resolution", ra.resolution, "Image size WxH; default: the scene file's")
+      ->group(kGeneral);
+  render->add_option("--threads", ra.threads, "Worker threads; default: all cores")
+      ->check(CLI::Range(1, 4096))
+      ->group(kGeneral);
+  render
+      ->add_option("--seed", ra.seed,
+                   "Random seed; default: the sampler's seed in the file, else 0")
+      ->check(CLI::Range(int64_t(0), int64_t(1) << 62))
+      ->group(kGeneral);
+  render
+      ->add_option("--maxdepth", ra.max_depth,
+                   "Maximum scattering events; default: the file's maxdepth (5)")
+      ->check(CLI::Range(0, 100000))
+      ->group(kGeneral);
+  render->add_flag("-q,--quiet", ra.quiet, "No progress output")->group(kGeneral);
+}
+
+void add_budget_options(CLI::App* render, RenderArgs& ra) {
+  render->add_option("--spp", ra.spp, "Samples per pixel; default: the scene file's pixelsamples")
+      ->check(CLI::Range(1, 1 << 24))
+      ->group(kBudgets);
+  render
+      ->add_option("--iterations", ra.iterations,
+                   "Iterations (each one eye sample per pixel and a photon pass); same as --spp")
+      ->check(CLI::Range(1, 1 << 24))
+      ->group(kBudgets);
+  render
+      ->add_option("--time", ra.time,
+                   "Time budget in seconds (stops after the pass that exceeds it)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->group(kBudgets);
+  render
+      ->add_option(
+          "--accuracy", ra.accuracy,
+          "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->group(kBudgets);
+  render
+      ->add_option("--memory", ra.memory,
+                   "Memory budget for the render's data (film, photon maps, trees, photon "
+                   "entries), e.g. 512M or 8G; default: 3/4 of this machine's memory")
+      ->group(kBudgets);
+  render
+      ->add_flag("--no-adaptive", ra.no_adaptive,
+                 "Sample every pixel in every pass (by default pixels with a larger relative "
+                 "error get more passes)")
+      ->group(kBudgets);
+  render
+      ->add_option(
+          "--adaptive-floor", ra.adaptive_floor,
+          "Lowest probability of sampling a pixel in a pass under adaptive sampling (default 0.1)")
+      ->check(CLI::Range(0.01, 1.0))
+      ->group(kBudgets);
+}
+
+void add_output_options(CLI::App* render, RenderArgs& ra) {
+  render
+      ->add_option("-o,--output", ra.output,
+                   "Output EXR; PNG, .error.png and .json are written beside it")
+      ->group(kOutputs);
+  render
+      ->add_option("--write-every", ra.write_every,
+                   "Write the outputs so far, and OUT.checkpoint to resume from, every SECONDS "
+                   "(atomically)")
+      ->check(CLI::Range(0.1, 1e9))
+      ->group(kOutputs);
+  render
+      ->add_option("--resume", ra.resume,
+                   "Go on from a checkpoint (OUT.checkpoint of --write-every) of the same "
+                   "render: the same scene, resolution, integrator and settings; --spp and "
+                   "--iterations count the passes before it too")
+      ->group(kOutputs);
+  render
+      ->add_option("--m-images", ra.m_images,
+                   "Also estimate the error from M intermediate images (pass j to image j mod M; "
+                   "0: off; default 4)")
+      ->check(CLI::Range(0, 64))
+      ->group(kOutputs);
+}
+
+// The photon flags both photon methods read (PhotonSettings), then bpm's own.
+void add_photon_options(CLI::App* render, RenderArgs& ra) {
+  render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")
+      ->check(CLI::Range(1e-4, 1e4))
+      ->group(kBpm);
+  render
+      ->add_option("--k1", ra.k1,
+                   "Radius at the last diffuse vertex in pixel footprints (default 3)")
+      ->check(CLI::Range(1e-4, 1e4))
+      ->group(kBpm);
+  render
+      ->add_option("--radius-policy", ra.radius_policy, "fixed, or progressive shrinking (default)")
+      ->check(CLI::IsMember({"fixed", "progressive"}))
+      ->group(kBpm);
+  render
+      ->add_option("--alpha", ra.alpha,
+                   "Progressive radius alpha: r2 *= (i+alpha)/(i+1) (default 2/3)")
+      ->check(CLI::Range(1e-3, 0.999))
+      ->group(kBpm);
+  render
+      ->add_option("--photons", ra.photons,
+                   "Photons per iteration (default 100000 per 256x256 pixels, at least 100000; "
+                   "fpm: no more than --memory holds; file: integer photonsperiteration)")
+      ->check(CLI::Range(1, 1 << 30))
+      ->group(kBpm);
+  render
+      ->add_flag("--no-disc-probes", ra.no_disc_probes,
+                 "bpm and fpm: divide the photons an estimate gathers by its whole disc, even "
+                 "where a wall or an edge leaves photons part of it (file: bool discprobes false)")
+      ->group(kBpm);
+  render
+      ->add_flag("--debias", ra.debias,
+                 "bpm and fpm: record the image less its bias estimate (2 L(r/sqrt 2) - L(r) "
+                 "under --bias-model r2); noisier, and without a bias estimate of its own")
+      ->group(kBpm);
+  render
+      ->add_option("--bias-model", ra.bias_model,
+                   "bpm and fpm: how the radius bias is estimated: r2 (two radii, the leading r^2 "
+                   "term of a smooth density; default) or r2+r (three radii, also the r term of "
+                   "edges)")
+      ->check(CLI::IsMember({"r2", "r2+r"}))
+      ->group(kBpm);
+}
+
+void add_bpm_options(CLI::App* render, RenderArgs& ra) {
+  render
+      ->add_option("--diffuse-depth", ra.diffuse_depth,
+                   "Diffuse vertices before the last backward photon (0..3; default 0)")
+      ->check(CLI::Range(0, 3))
+      ->group(kBpm);
+  add_photon_options(render, ra);
+  render
+      ->add_flag(
+          "--no-guide", ra.no_guide,
+          "Emit photons in proportion to light power only, without learning where the camera "
+          "sees them (file: bool guideemission false)")
+      ->group(kBpm);
+  render
+      ->add_option("--radius", ra.radius,
+                   "Initial radius of every backward photon in scene units, in place of --k0 and "
+                   "--k1 (default 0: off; file: float radius, also pbrt-v4 sppm's)")
+      ->check(CLI::Range(0.0, 1e30))
+      ->group(kBpm);
+  render
+      ->add_option("--emission-samples", ra.emission_samples,
+                   "Most camera samples per iteration for light seen directly or through specular "
+                   "surfaces, in pixels that show any; each pixel takes what its measured "
+                   "variance pays for (default 8; file: integer emissionsamples)")
+      ->check(CLI::Range(1, 1024))
+      ->group(kBpm);
+  render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
+      ->check(CLI::IsMember({"spheres", "centres"}))
+      ->group(kBpm);
+}
+
+void add_fpm_options(CLI::App* render, RenderArgs& ra) {
+  render
+      ->add_flag("--final-gather", ra.final_gather,
+                 "Read indirect light one diffuse bounce after the first hit")
+      ->group(kFpm);
+  render
+      ->add_option("--knn", ra.knn,
+                   "Radius from the N nearest photons, capped by the k1 radius (0: off)")
+      ->check(CLI::Range(0, 100000))
+      ->group(kFpm);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -400,145 +620,11 @@ int main(int argc, char** argv) {
   RenderArgs ra;
   CLI::App* render =
       app.add_subcommand("render", "Render a pbrt-v4 scene to EXR, PNG, error PNG and JSON");
-  render->add_option("scene", ra.scene, "Scene file (.pbrt)")->required();
-  render
-      ->add_option("--integrator", ra.integrator,
-                   "Integrator: path, bpm or fpm; default: the scene file's")
-      ->check(CLI::IsMember({"path", "bpm", "fpm"}));
-  render->add_option("--spp", ra.spp, "Samples per pixel; default: the scene file's pixelsamples")
-      ->check(CLI::Range(1, 1 << 24));
-  render
-      ->add_option("--time", ra.time,
-                   "Time budget in seconds (stops after the pass that exceeds it)")
-      ->check(CLI::Range(0.0, 1e9));
-  render->add_option("--resolution", ra.resolution, "Image size WxH; default: the scene file's");
-  render->add_option("--threads", ra.threads, "Worker threads; default: all cores")
-      ->check(CLI::Range(1, 4096));
-  render
-      ->add_option("--seed", ra.seed,
-                   "Random seed; default: the sampler's seed in the file, else 0")
-      ->check(CLI::Range(int64_t(0), int64_t(1) << 62));
-  render
-      ->add_option("--maxdepth", ra.max_depth,
-                   "Maximum scattering events; default: the file's maxdepth (5)")
-      ->check(CLI::Range(0, 100000));
-  render->add_option("-o,--output", ra.output,
-                     "Output EXR; PNG, .error.png and .json are written beside it");
-  render->add_flag("-q,--quiet", ra.quiet, "No progress output");
-  render
-      ->add_option(
-          "--accuracy", ra.accuracy,
-          "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
-      ->check(CLI::Range(1e-6, 1.0));
-  render->add_flag("--no-adaptive", ra.no_adaptive,
-                   "Sample every pixel in every pass (by default pixels with a larger relative "
-                   "error get more passes)");
-  render
-      ->add_option(
-          "--adaptive-floor", ra.adaptive_floor,
-          "Lowest probability of sampling a pixel in a pass under adaptive sampling (default 0.1)")
-      ->check(CLI::Range(0.01, 1.0));
-  render
-      ->add_option("--m-images", ra.m_images,
-                   "Also estimate the error from M intermediate images (pass j to image j mod M; "
-                   "0: off; default 4)")
-      ->check(CLI::Range(0, 64));
-  render
-      ->add_option("--write-every", ra.write_every,
-                   "Write the outputs so far, and OUT.checkpoint to resume from, every SECONDS "
-                   "(atomically)")
-      ->check(CLI::Range(0.1, 1e9));
-  render->add_option("--resume", ra.resume,
-                     "Go on from a checkpoint (OUT.checkpoint of --write-every) of the same "
-                     "render: the same scene, resolution, integrator and settings; --spp and "
-                     "--iterations count the passes before it too");
-  render->add_option("--memory", ra.memory,
-                     "Memory budget for the render's data (film, photon maps, trees, photon "
-                     "entries), e.g. 512M or 8G; default: 3/4 of this machine's memory");
-  render
-      ->add_option("--iterations", ra.iterations,
-                   "Iterations (each one eye sample per pixel and a photon pass); same as --spp")
-      ->check(CLI::Range(1, 1 << 24));
-  const char* g = "Backward photon mapping (--integrator bpm)";
-  render
-      ->add_option("--diffuse-depth", ra.diffuse_depth,
-                   "Diffuse vertices before the last backward photon (0..3; default 0)")
-      ->check(CLI::Range(0, 3))
-      ->group(g);
-  render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")
-      ->check(CLI::Range(1e-4, 1e4))
-      ->group(g);
-  render
-      ->add_option("--k1", ra.k1,
-                   "Radius at the last diffuse vertex in pixel footprints (default 3)")
-      ->check(CLI::Range(1e-4, 1e4))
-      ->group(g);
-  render
-      ->add_option("--radius-policy", ra.radius_policy, "fixed, or progressive shrinking (default)")
-      ->check(CLI::IsMember({"fixed", "progressive"}))
-      ->group(g);
-  render
-      ->add_option("--alpha", ra.alpha,
-                   "Progressive radius alpha: r2 *= (i+alpha)/(i+1) (default 2/3)")
-      ->check(CLI::Range(1e-3, 0.999))
-      ->group(g);
-  render
-      ->add_option("--photons", ra.photons,
-                   "Photons per iteration (default 100000 per 256x256 pixels, at least 100000; "
-                   "fpm: no more than --memory holds; file: integer photonsperiteration)")
-      ->check(CLI::Range(1, 1 << 30))
-      ->group(g);
-  render
-      ->add_flag(
-          "--no-guide", ra.no_guide,
-          "Emit photons in proportion to light power only, without learning where the camera "
-          "sees them (file: bool guideemission false)")
-      ->group(g);
-  render
-      ->add_flag("--no-disc-probes", ra.no_disc_probes,
-                 "bpm and fpm: divide the photons an estimate gathers by its whole disc, even "
-                 "where a wall or an edge leaves photons part of it (file: bool discprobes false)")
-      ->group(g);
-  render
-      ->add_flag("--debias", ra.debias,
-                 "bpm and fpm: record the image less its bias estimate (2 L(r/sqrt 2) - L(r) "
-                 "under --bias-model r2); noisier, and without a bias estimate of its own")
-      ->group(g);
-  render
-      ->add_option("--bias-model", ra.bias_model,
-                   "bpm and fpm: how the radius bias is estimated: r2 (two radii, the leading r^2 "
-                   "term of a smooth density; default) or r2+r (three radii, also the r term of "
-                   "edges)")
-      ->check(CLI::IsMember({"r2", "r2+r"}))
-      ->group(g);
-  render
-      ->add_option("--radius", ra.radius,
-                   "Initial radius of every backward photon in scene units, in place of --k0 and "
-                   "--k1 (default 0: off; file: float radius, also pbrt-v4 sppm's)")
-      ->check(CLI::Range(0.0, 1e30))
-      ->group(g);
-  render
-      ->add_option("--emission-samples", ra.emission_samples,
-                   "Most camera samples per iteration for light seen directly or through specular "
-                   "surfaces, in pixels that show any; each pixel takes what its measured "
-                   "variance pays for (default 8; file: integer emissionsamples)")
-      ->check(CLI::Range(1, 1024))
-      ->group(g);
-  render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
-      ->check(CLI::IsMember({"spheres", "centres"}))
-      ->group(g);
-  const char* gf =
-      "Forward photon mapping (--integrator fpm; also uses --k0, --k1, --radius-policy, --alpha, "
-      "--photons)";
-  render
-      ->add_flag("--final-gather", ra.final_gather,
-                 "Read indirect light one diffuse bounce after the first hit")
-      ->group(gf);
-  render
-      ->add_option("--knn", ra.knn,
-                   "Radius from the N nearest photons, capped by the k1 radius (0: off)")
-      ->check(CLI::Range(0, 100000))
-      ->group(gf);
+  add_general_options(render, ra);
+  add_budget_options(render, ra);
+  add_output_options(render, ra);
+  add_bpm_options(render, ra);
+  add_fpm_options(render, ra);
 
   std::string cmp_a, cmp_b;
   CLI::App* compare =

@@ -21,13 +21,16 @@ namespace bpm {
 namespace {
 
 void check(const BpmSettings& s) {
-  if (s.diffuse_depth < 0 || s.diffuse_depth > 3) throw Error("bpm: diffuse depth must be in 0..3");
-  if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("bpm: radius factors k0 and k1 must be positive");
-  if (!(s.alpha > 0 && s.alpha < 1)) throw Error("bpm: alpha must be in (0, 1)");
-  if (s.photons_per_iteration <= 0) throw Error("bpm: photons per iteration must be positive");
+  if (s.diffuse_depth < 0 || s.diffuse_depth > 3)
+    throw Error("bpm: --diffuse-depth (file: diffusedepth) must be in 0..3");
+  if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("bpm: --k0 and --k1 (file: k0, k1) must be positive");
+  if (!(s.alpha > 0 && s.alpha < 1)) throw Error("bpm: --alpha (file: alpha) must be in (0, 1)");
+  if (s.photons_per_iteration <= 0)
+    throw Error("bpm: --photons (file: photonsperiteration) must be positive");
   if (s.emission_samples < 1 || s.emission_samples > 1024)
-    throw Error("bpm: emission samples must be in 1..1024");
-  if (!(s.radius >= 0) || !std::isfinite(s.radius)) throw Error("bpm: radius must not be negative");
+    throw Error("bpm: --emission-samples (file: emissionsamples) must be in 1..1024");
+  if (!(s.radius >= 0) || !std::isfinite(s.radius))
+    throw Error("bpm: --radius (file: radius) must not be negative");
 }
 
 // 1 / (value + floor) per pixel from the running means; the floor, a tenth of the image's mean

@@ -68,9 +68,10 @@ RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                        const FpmSettings& settings, Film* film) {
   FpmSettings s = settings;
   s.photons_per_iteration = photons_for(settings, size_t(film->width()) * size_t(film->height()));
-  if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: radius factors k0 and k1 must be positive");
-  if (s.photons_per_iteration <= 0) throw Error("fpm: photons per iteration must be positive");
-  if (s.knn < 0) throw Error("fpm: knn must not be negative");
+  if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: --k0 and --k1 (file: k0, k1) must be positive");
+  if (s.photons_per_iteration <= 0)
+    throw Error("fpm: --photons (file: photonsperiteration) must be positive");
+  if (s.knn < 0) throw Error("fpm: --knn (file: knn) must not be negative");
   const RenderScene& scene = ls.scene;
   const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
   const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
