@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
                     r.film.relative_error_bias(), total, measured,
                     measured > 0 ? total / measured : 0.0);
       }
-  std::printf("(ratio: reported total over measured; the issue asks for 0.67 to 1.5)\n\n");
+  std::printf("(ratio: reported total over measured; the target is 0.67 to 1.5)\n\n");
 
   std::printf("== rays to reach delta %.3g on the caustic scene, %dx%d ==\n", target, w, h);
   LoadedScene ls =
