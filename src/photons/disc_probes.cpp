@@ -160,6 +160,132 @@ bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object,
   return whole;
 }
 
+// Unit directions a common rotation apart, in a bit-reversed order of angles so that each nested
+// set of probes (0-1, 0-3, all) spreads around the point.
+constexpr float kC = 0.70710678f;
+constexpr float kCos[kDiscProbes] = {1, -1, 0, 0, kC, -kC, -kC, kC};
+constexpr float kSin[kDiscProbes] = {0, 0, 1, -1, kC, -kC, kC, -kC};
+constexpr float kTan60 = 1.7320508f;
+
+// The disc under test, and what its probes compare their hits with.
+struct Disc {
+  const RenderScene& scene;
+  const SurfacePoint& sp;
+  Vec3 n;  // the normal on wo's side
+  int object;
+  PhotonSurfaces where;
+  float radius, normal_cos;
+  float lift;  // keeps the origin off the surface
+  float skim;  // the height of blocked_along's rays
+  const TriangleMesh* mesh;
+
+  // Another object whose photons count here too (kAnyObject: one map holds them all).
+  bool counts(int o) const {
+    return o != object && where == PhotonSurfaces::kAnyObject && holds_photons(scene, o);
+  }
+};
+
+// What one probe says of the disc.
+enum class ProbeSays { kNothing, kFound, kCut };
+
+// The slope of the probes' origins over the disc. The origins must be in the open: under something
+// lower than they would be (an overhang near where a sphere touches the floor, a shelf over the
+// point), the probes start halfway up to it, at a lower angle.
+inline float open_slope(const Disc& d, PathCounters& rays) {
+  float slope = kTan60;
+  const Ray up{d.sp.p + d.n * d.lift, d.n, d.radius * kTan60};
+  Hit h;
+  count(rays, up);
+  if (d.scene.intersect(up, &h)) slope = 0.5f * h.t / d.radius;
+  return slope;
+}
+
+// Aims probe i at a point of the disc stratified by area, from above the point at `slope`.
+inline void aim_probes(const Disc& d, Vec3 u, Vec3 v, float slope, Rng& rng,
+                       Ray (&probes)[kDiscProbes], float (&to_target)[kDiscProbes]) {
+  for (int i = 0; i < kDiscProbes; ++i) {
+    const float rho = d.radius * std::sqrt((float(i) + rng.uniform()) / kDiscProbes);
+    const Vec3 target = d.sp.p + (u * kCos[i] + v * kSin[i]) * rho;
+    const Vec3 origin = d.sp.p + d.n * (rho * slope + d.lift);
+    const Vec3 to = target - origin;
+    to_target[i] = length(to);
+    // On past the target, to a surface that curves away below the tangent plane.
+    probes[i] = Ray{origin, to / to_target[i], 3 * to_target[i] + d.lift};
+  }
+}
+
+// Photons cross glass and interfaces: so does a probe (the rare case, one ray at a time). Moves
+// the probe on to the first surface it stops at; returns the distance it travelled before.
+inline float cross_to_surface(const Disc& d, Ray& ray, Hit& h, bool& found, PathCounters& rays) {
+  float travelled = 0;
+  for (int crossing = 0; found && h.object != d.object && crossing < 4; ++crossing) {
+    if (!lets_light_through(d.scene, h.object) || d.counts(h.object)) break;
+    const SurfacePoint at = d.scene.surface(ray, h);
+    travelled += h.t;
+    ray = Ray{offset_origin(at.p, at.ng, ray.d, at.error), ray.d, ray.t_max - h.t};
+    count(rays, ray);
+    found = d.scene.intersect(ray, &h);
+  }
+  return travelled;
+}
+
+// Another object before the target. Below the tangent plane, where only a surface that curves
+// away (or ends) lets a probe go: the probe says nothing. Above it, a wall standing on the
+// surface, or an overhang with surface under it (where a sphere rests on a floor), which photons
+// reach: a ray along the surface, just above it, tells them apart.
+inline ProbeSays judge_other_object(const Disc& d, const Ray& ray, const Hit& h, float travelled,
+                                    float to_target, PathCounters& rays) {
+  const float height = dot(ray.o + ray.d * h.t - d.sp.p, d.n);
+  // In the disc's plane: a neighbouring surface (floor tiles, say), whose photons are not
+  // gathered here (a map of their own, or a normal that disagrees).
+  if (std::fabs(height) <= d.skim) return ProbeSays::kCut;
+  if (height < 0) return ProbeSays::kNothing;
+  const Vec3 target = ray.o + ray.d * (to_target - travelled);
+  return blocked_along(d.scene, d.sp.p + d.n * d.skim, target + d.n * d.skim, d.object, d.sp.ng,
+                       d.normal_cos, rays)
+             ? ProbeSays::kCut
+             : ProbeSays::kFound;
+}
+
+// The probe hit the disc's own object. Either side: a probe from the front reaches no back face of
+// the object without crossing a front one first.
+inline ProbeSays judge_own_surface(const Disc& d, const Ray& ray, const Hit& h, float travelled,
+                                   float to_target) {
+  const Vec3 ng = d.mesh && !d.mesh->face_normals.empty()
+                      ? d.mesh->face_normals[size_t(h.primitive)]
+                      : d.scene.surface(ray, h).ng;
+  // A crease: photons there do not count.
+  if (std::fabs(dot(ng, d.sp.ng)) < d.normal_cos) return ProbeSays::kCut;
+  // (The slack keeps a probe aimed at the rim, whose hit rounds to just outside, from reading as a
+  // cut.)
+  if (length_squared(ray.o + ray.d * h.t - d.sp.p) <= d.radius * d.radius * (1 + 1e-4f))
+    return ProbeSays::kFound;
+  // The surface rises out of the sphere before the target.
+  if (travelled + h.t < to_target) return ProbeSays::kCut;
+  // Else the surface curves away below the target and meets the probe outside the sphere: the
+  // probe says nothing of the disc (on a sphere, the part of the surface inside the gathering
+  // sphere has area pi r^2 exactly, a whole disc's).
+  return ProbeSays::kNothing;
+}
+
+// What the probe says, from the surface it stopped at after `travelled`.
+inline ProbeSays judge_probe(const Disc& d, const Ray& ray, const Hit& h, bool found,
+                             float travelled, float to_target, PathCounters& rays) {
+  // Another object whose photons count as well, inside the sphere (a lower surface too: the
+  // gather takes its photons), with a normal that agrees as the gather compares them (signs
+  // included). Elsewhere it is any other object.
+  if (found && d.counts(h.object)) {
+    const Vec3 at = ray.o + ray.d * h.t;
+    if (length_squared(at - d.sp.p) <= d.radius * d.radius &&
+        dot(d.scene.surface(ray, h).ng, d.sp.ng) >= d.normal_cos)
+      return ProbeSays::kFound;
+  }
+  // Nothing (past an edge), or another object after the target: no surface here.
+  if (!found || (h.object != d.object && travelled + h.t >= to_target)) return ProbeSays::kCut;
+  if (h.object != d.object) return judge_other_object(d, ray, h, travelled, to_target, rays);
+  return judge_own_surface(d, ray, h, travelled, to_target);
+}
+
 }  // namespace
 
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
@@ -170,113 +296,35 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
     return {0xff, 0};  // as if every probe found it
   const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
   const Frame frame = Frame::from_z(n);
-  // Unit directions a common rotation apart, in a bit-reversed order of angles so that each
-  // nested set of probes (0-1, 0-3, all) spreads around the point.
-  constexpr float kC = 0.70710678f;
-  constexpr float kCos[kDiscProbes] = {1, -1, 0, 0, kC, -kC, -kC, kC};
-  constexpr float kSin[kDiscProbes] = {0, 0, 1, -1, kC, -kC, kC, -kC};
-  constexpr float kTan60 = 1.7320508f;
   const float rotation = 2 * kPi * rng.uniform();
   const Vec3 u = frame.s * std::cos(rotation) + frame.t * std::sin(rotation), v = cross(n, u);
-  const float lift = std::fmax(sp.error, 1e-30f) * 4;  // keeps the origin off the surface
-  // The origins must be in the open: under something lower than they would be (an overhang
-  // near where a sphere touches the floor, a shelf over the point), the probes start halfway up
-  // to it, at a lower angle.
-  float slope = kTan60;
-  {
-    const Ray up{sp.p + n * lift, n, radius * kTan60};
-    Hit h;
-    count(rays, up);
-    if (scene.intersect(up, &h)) slope = 0.5f * h.t / radius;
-  }
-  const float skim = std::fmax(lift, 1e-4f * radius);  // the height of blocked_along's rays
+  const float lift = std::fmax(sp.error, 1e-30f) * 4;
+  const Disc disc{scene,
+                  sp,
+                  n,
+                  object,
+                  where,
+                  radius,
+                  normal_cos,
+                  lift,
+                  std::fmax(lift, 1e-4f * radius),
+                  std::get_if<TriangleMesh>(&scene.objects[size_t(object)].shape)};
+  const float slope = open_slope(disc, rays);
   Ray probes[kDiscProbes];
   float to_target[kDiscProbes];
-  for (int i = 0; i < kDiscProbes; ++i) {
-    const float rho = radius * std::sqrt((float(i) + rng.uniform()) / kDiscProbes);
-    const Vec3 target = sp.p + (u * kCos[i] + v * kSin[i]) * rho;
-    const Vec3 origin = sp.p + n * (rho * slope + lift);
-    const Vec3 to = target - origin;
-    to_target[i] = length(to);
-    // On past the target, to a surface that curves away below the tangent plane.
-    probes[i] = Ray{origin, to / to_target[i], 3 * to_target[i] + lift};
-  }
+  aim_probes(disc, u, v, slope, rng, probes, to_target);
   Hit hits[kDiscProbes];
   bool found[kDiscProbes];
   scene.intersect_bundle(probes, kDiscProbes, hits, found);
   for (const Ray& r : probes) count(rays, r);
-  const auto* mesh = std::get_if<TriangleMesh>(&scene.objects[size_t(object)].shape);
-  // Another object whose photons count here too (kAnyObject: one map holds them all).
-  auto counts = [&](int o) {
-    return o != object && where == PhotonSurfaces::kAnyObject && holds_photons(scene, o);
-  };
   DiscProbes out;
   for (int i = 0; i < kDiscProbes; ++i) {
-    Hit& h = hits[i];
-    Ray& ray = probes[i];
-    float travelled = 0;
-    // Photons cross glass and interfaces: so does a probe (the rare case, one ray at a time).
-    for (int crossing = 0; found[i] && h.object != object && crossing < 4; ++crossing) {
-      if (!lets_light_through(scene, h.object) || counts(h.object)) break;
-      const SurfacePoint at = scene.surface(ray, h);
-      travelled += h.t;
-      ray = Ray{offset_origin(at.p, at.ng, ray.d, at.error), ray.d, ray.t_max - h.t};
-      count(rays, ray);
-      found[i] = scene.intersect(ray, &h);
-    }
+    const float travelled = cross_to_surface(disc, probes[i], hits[i], found[i], rays);
+    const ProbeSays says =
+        judge_probe(disc, probes[i], hits[i], found[i], travelled, to_target[i], rays);
     const uint8_t bit = uint8_t(1u << i);
-    // Another object whose photons count as well, inside the sphere (a lower surface too: the
-    // gather takes its photons), with a normal that agrees as the gather compares them (signs
-    // included). Elsewhere it is any other object.
-    if (found[i] && counts(h.object)) {
-      const Vec3 at = ray.o + ray.d * h.t;
-      if (length_squared(at - sp.p) <= radius * radius &&
-          dot(scene.surface(ray, h).ng, sp.ng) >= normal_cos) {
-        out.found |= bit;
-        continue;
-      }
-    }
-    // Nothing (past an edge), or another object after the target: no surface here.
-    if (!found[i] || (h.object != object && travelled + h.t >= to_target[i])) {
-      out.cut |= bit;
-      continue;
-    }
-    // Another object before the target. Below the tangent plane, where only a surface that
-    // curves away (or ends) lets a probe go: the probe says nothing. Above it, a wall standing on
-    // the surface, or an overhang with surface under it (where a sphere rests on a floor), which
-    // photons reach: a ray along the surface, just above it, tells them apart.
-    if (h.object != object) {
-      const float height = dot(ray.o + ray.d * h.t - sp.p, n);
-      // In the disc's plane: a neighbouring surface (floor tiles, say), whose photons are not
-      // gathered here (a map of their own, or a normal that disagrees).
-      if (std::fabs(height) <= skim) {
-        out.cut |= bit;
-        continue;
-      }
-      if (height < 0) continue;
-      const Vec3 target = ray.o + ray.d * (to_target[i] - travelled);
-      if (blocked_along(scene, sp.p + n * skim, target + n * skim, object, sp.ng, normal_cos, rays))
-        out.cut |= bit;
-      else
-        out.found |= bit;
-      continue;
-    }
-    // Either side: a probe from the front reaches no back face of the object without crossing a
-    // front one first.
-    const Vec3 ng = mesh && !mesh->face_normals.empty() ? mesh->face_normals[size_t(h.primitive)]
-                                                        : scene.surface(ray, h).ng;
-    if (std::fabs(dot(ng, sp.ng)) < normal_cos) {
-      out.cut |= bit;  // a crease: photons there do not count
-    } else if (length_squared(ray.o + ray.d * h.t - sp.p) <= radius * radius * (1 + 1e-4f)) {
-      // (The slack keeps a probe aimed at the rim, whose hit rounds to just outside, from
-      // reading as a cut.)
-      out.found |= bit;
-    } else if (travelled + h.t < to_target[i]) {
-      out.cut |= bit;  // the surface rises out of the sphere before the target
-    }
-    // Else the surface curves away below the target and meets the probe outside the sphere: the
-    // probe says nothing of the disc (on a sphere, the part of the surface inside the gathering
-    // sphere has area pi r^2 exactly, a whole disc's).
+    if (says == ProbeSays::kFound) out.found |= bit;
+    if (says == ProbeSays::kCut) out.cut |= bit;
   }
   return out;
 }
