@@ -32,6 +32,101 @@ int longest_axis(const Bounds3& b) {
   return d.x >= d.y && d.x >= d.z ? 0 : (d.y >= d.z ? 1 : 2);
 }
 
+Bounds3 sphere_bounds(const SphereRef& s) {
+  const Vec3 r(s.r, s.r, s.r);
+  return {s.c - r, s.c + r};
+}
+
+// The spheres on either side of a plane (one that crosses it on both), and their bounds.
+struct Sides {
+  std::vector<uint32_t> left, right;
+  Bounds3 lbounds, rbounds;
+};
+
+void split_at(const std::vector<uint32_t>& ids, const std::vector<SphereRef>& spheres, int axis,
+              float at, Sides& sides) {
+  sides.left.clear();
+  sides.right.clear();
+  sides.lbounds = sides.rbounds = Bounds3();
+  for (uint32_t i : ids) {
+    const SphereRef& s = spheres[i];
+    const Bounds3 e = sphere_bounds(s);
+    if (s.c[axis] - s.r < at) {
+      sides.left.push_back(i);
+      sides.lbounds.expand(e);
+    }
+    if (s.c[axis] + s.r >= at) {
+      sides.right.push_back(i);
+      sides.rbounds.expand(e);
+    }
+  }
+}
+
+// How many spheres split_at would put on each side.
+std::pair<size_t, size_t> count_sides(const std::vector<uint32_t>& ids,
+                                      const std::vector<SphereRef>& spheres, int axis, float at) {
+  size_t nl = 0, nr = 0;
+  for (uint32_t i : ids) {
+    const SphereRef& s = spheres[i];
+    nl += s.c[axis] - s.r < at;
+    nr += s.c[axis] + s.r >= at;
+  }
+  return std::pair{nl, nr};
+}
+
+struct Split {
+  int axis;
+  float at;
+  float cost;
+};
+
+// The plane: the median centre on the longest axis (balanced trees for clustered photons), over
+// every sphere in a small cell and over an even sample of them in a large one. Where many
+// centres share that coordinate (photons on a wall perpendicular to the axis) a plane through
+// them puts every such sphere on both sides and splits nothing; then the middle of the axis,
+// then the other axes. The first plane that separates some spheres is returned with its cost.
+// A small cell counts each candidate's sides before splitting; a large one (`large`) splits at
+// once into `sides` (it nearly always pays) and counts the sides it made.
+std::optional<Split> choose_split(const std::vector<uint32_t>& ids, const Bounds3& cell,
+                                  const std::vector<SphereRef>& spheres, bool large, Sides& sides) {
+  const size_t n = ids.size();
+  const int first_axis = longest_axis(cell);
+  std::optional<Split> best;
+  std::vector<float> cs;
+  for (int k = 0; k < 3 && !best; ++k) {
+    const int axis = (first_axis + k) % 3;
+    const float lo = cell.lo[axis], hi = cell.hi[axis];
+    if (!(hi > lo)) continue;
+    cs.clear();
+    const size_t step = large ? n / kMedianSample : 1;
+    for (size_t j = 0; j < n; j += step) cs.push_back(spheres[ids[j]].c[axis]);
+    std::nth_element(cs.begin(), cs.begin() + cs.size() / 2, cs.end());
+    for (float at : {cs[cs.size() / 2], 0.5f * (lo + hi)}) {
+      if (!(at > lo && at < hi)) continue;
+      size_t nl, nr;
+      if (large) {
+        split_at(ids, spheres, axis, at, sides);
+        nl = sides.left.size();
+        nr = sides.right.size();
+      } else {
+        std::tie(nl, nr) = count_sides(ids, spheres, axis, at);
+      }
+      if (nl < n && nr < n) {
+        const float pl = (at - lo) / (hi - lo);
+        best = Split{axis, at, kTraversalCost + pl * float(nl) + (1 - pl) * float(nr)};
+        break;
+      }
+    }
+  }
+  return best;
+}
+
+Bounds3 clip(Bounds3 c, const Bounds3& b) {
+  c.lo = vmax(c.lo, b.lo);
+  c.hi = vmin(c.hi, b.hi);
+  return c;
+}
+
 }  // namespace
 
 void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vector<uint32_t>* ids) {
@@ -55,10 +150,7 @@ void SphereKdTree::build(const std::vector<SphereRef>& spheres, const std::vecto
     for (uint32_t& item : items_) item = (*ids)[item];
 }
 
-Bounds3 SphereKdTree::extent(const SphereRef& s) {
-  const Vec3 r(s.r, s.r, s.r);
-  return {s.c - r, s.c + r};
-}
+Bounds3 SphereKdTree::extent(const SphereRef& s) { return sphere_bounds(s); }
 
 // `cell` is the node's region of space clipped to the bounds of its spheres (no query outside
 // their union finds anything).
@@ -72,105 +164,35 @@ void SphereKdTree::build_node(std::vector<uint32_t>& ids, Bounds3 cell, int dept
   };
   const size_t n = ids.size();
   if (n <= kMinLeaf || depth >= kMaxDepth) return make_leaf();
-  // The plane: the median centre on the longest axis (balanced trees for clustered photons), over
-  // every sphere in a small cell and over an even sample of them in a large one. Where many
-  // centres share that coordinate (photons on a wall perpendicular to the axis) a plane through
-  // them puts every such sphere on both sides and splits nothing; then the middle of the axis,
-  // then the other axes. The first plane that separates some spheres is kept if it pays.
-  // A small cell counts each candidate's sides before splitting; a large one splits at once
-  // (it nearly always pays) and counts the sides it made.
+  // The first plane that separates some spheres is kept if it pays.
   const bool large = n > kSampledMedianMin;
-  std::vector<uint32_t> left, right;
-  Bounds3 lbounds, rbounds;
-  auto split = [&](int axis, float at) {
-    left.clear();
-    right.clear();
-    lbounds = rbounds = Bounds3();
-    for (uint32_t i : ids) {
-      const SphereRef& s = spheres[i];
-      const Bounds3 e = extent(s);
-      if (s.c[axis] - s.r < at) {
-        left.push_back(i);
-        lbounds.expand(e);
-      }
-      if (s.c[axis] + s.r >= at) {
-        right.push_back(i);
-        rbounds.expand(e);
-      }
-    }
-  };
-  auto count = [&](int axis, float at) {
-    size_t nl = 0, nr = 0;
-    for (uint32_t i : ids) {
-      const SphereRef& s = spheres[i];
-      nl += s.c[axis] - s.r < at;
-      nr += s.c[axis] + s.r >= at;
-    }
-    return std::pair{nl, nr};
-  };
-  struct Split {
-    int axis;
-    float at;
-    float cost;
-  };
-  const int first_axis = longest_axis(cell);
-  std::optional<Split> best;
-  std::vector<float> cs;
-  for (int k = 0; k < 3 && !best; ++k) {
-    const int axis = (first_axis + k) % 3;
-    const float lo = cell.lo[axis], hi = cell.hi[axis];
-    if (!(hi > lo)) continue;
-    cs.clear();
-    const size_t step = large ? n / kMedianSample : 1;
-    for (size_t j = 0; j < n; j += step) cs.push_back(spheres[ids[j]].c[axis]);
-    std::nth_element(cs.begin(), cs.begin() + cs.size() / 2, cs.end());
-    for (float at : {cs[cs.size() / 2], 0.5f * (lo + hi)}) {
-      if (!(at > lo && at < hi)) continue;
-      size_t nl, nr;
-      if (large) {
-        split(axis, at);
-        nl = left.size();
-        nr = right.size();
-      } else {
-        std::tie(nl, nr) = count(axis, at);
-      }
-      if (nl < n && nr < n) {
-        const float pl = (at - lo) / (hi - lo);
-        best = Split{axis, at, kTraversalCost + pl * float(nl) + (1 - pl) * float(nr)};
-        break;
-      }
-    }
-  }
+  Sides sides;
+  const std::optional<Split> best = choose_split(ids, cell, spheres, large, sides);
   if (!best || best->cost >= float(n)) return make_leaf();
   const int axis = best->axis;
   const float at = best->at;
-  if (!large) split(axis, at);
+  if (!large) split_at(ids, spheres, axis, at, sides);
   std::vector<uint32_t>().swap(ids);
-  auto clip = [](Bounds3 c, const Bounds3& b) {
-    c.lo = vmax(c.lo, b.lo);
-    c.hi = vmin(c.hi, b.hi);
-    return c;
-  };
   Bounds3 lcell = cell, rcell = cell;
   lcell.hi[axis] = at;
   rcell.lo[axis] = at;
-  lcell = clip(lcell, lbounds);
-  rcell = clip(rcell, rbounds);
+  lcell = clip(lcell, sides.lbounds);
+  rcell = clip(rcell, sides.rbounds);
   uint32_t right_index;
   if (n >= kParallelMin) {
     // Both halves as subtrees of their own, appended in the order the serial build lays them out:
     // the tree is the same whatever the threads did.
     SphereKdTree l, r;
-    tbb::parallel_invoke([&] { l.build_node(left, lcell, depth + 1, spheres); },
-                         [&] { r.build_node(right, rcell, depth + 1, spheres); });
+    tbb::parallel_invoke([&] { l.build_node(sides.left, lcell, depth + 1, spheres); },
+                         [&] { r.build_node(sides.right, rcell, depth + 1, spheres); });
     append(l);
     right_index = uint32_t(nodes_.size());
     append(r);
   } else {
-    build_node(left, lcell, depth + 1, spheres);
-    std::vector<uint32_t>().swap(left);
+    build_node(sides.left, lcell, depth + 1, spheres);
+    std::vector<uint32_t>().swap(sides.left);
     right_index = uint32_t(nodes_.size());
-    build_node(right, rcell, depth + 1, spheres);
+    build_node(sides.right, rcell, depth + 1, spheres);
   }
   nodes_[self] = {at, uint32_t(axis), right_index, 0};
 }
