@@ -28,12 +28,11 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), 
 MANUAL_FILES = ["README.md"] + sorted(
     os.path.join("docs", f) for f in os.listdir(os.path.join(ROOT, "docs")) if f.endswith(".md"))
 
-# Examples render at this size; a command's own pass count N becomes ceil(N / 8), at most 8 (so
-# that an extended render still asks for more than the one it resumes), and a command without one
-# gets SMALL_PASSES.
+# Examples render at this size; a command's own pass count N becomes the bits of N, 1 + floor(log2
+# N) (so that an extended render still asks for more than the one it resumes), and a command
+# without one gets SMALL_PASSES.
 SMALL_RESOLUTION = "32x24"
 SMALL_PASSES = 2
-MOST_PASSES = 8
 EXAMPLE_TIMEOUT_S = 120
 
 
@@ -124,7 +123,7 @@ def shrink(args):
             i += 2
             continue
         if a in ("--spp", "--iterations") and i + 1 < len(args):
-            out += [a, str(min(-(-int(args[i + 1]) // 8), MOST_PASSES))]
+            out += [a, str(int(args[i + 1]).bit_length())]
             has_passes = True
             i += 2
             continue
