@@ -62,119 +62,200 @@ nlohmann::json to_json(const FpmTotals& t, const FpmSettings& s) {
   };
 }
 
-}  // namespace
+// One render of fpm: what its iterations share. iteration() reads as the algorithm, one method a
+// stage: light pass, maps, eye pass.
+class FpmRender {
+ public:
+  FpmRender(const LoadedScene& ls, const IntegratorOptions& opt, const FpmSettings& settings,
+            Film* film);
+  PassResult iteration(int pass, const RenderControl& control);
+  // The render's statistics once run_passes has filled `stats`.
+  RenderStats finish(RenderStats stats);
 
-RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
-                       const FpmSettings& settings, Film* film) {
+ private:
+  // The three stages of an iteration. light_pass returns false when the iteration is dropped.
+  bool light_pass(const WavelengthMaterials& wm, int pass, int it, const RenderControl& control);
+  void build_maps();
+  void eye_pass(const WavelengthMaterials& wm, int pass, int it, const RenderControl& control);
+  // Adds a pixel's estimate (and its bias) to the film.
+  void record(uint32_t pixel, const FpmEyeRadiance& r, const CameraSample& cs,
+              const WavelengthMaterials& wm);
+  PassResult progress() const;
+  // Fits the photon count to the memory budget and checks that the worst iteration fits; returns
+  // the photons per iteration.
+  uint64_t reserve_memory(const FpmSettings& settings);
+
+  const LoadedScene& ls_;
+  const RenderScene& scene_;
+  const IntegratorOptions& opt_;
+  FpmSettings s_;  // photons_per_iteration as reserve_memory fitted it
+  Film* film_;
+  const CameraSampler camera_;
+  const float pixel_angle_;
+  const int min_eye_vertices_;
+  const uint64_t n_photons_;
+  // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
+  NearEdges near_edges_;
+  ForwardMaps maps_;
+  tbb::enumerable_thread_specific<LightCounters> light_counters_;
+  tbb::enumerable_thread_specific<FpmEyeCounters> eye_counters_;
+  FpmTotals tot_;
+  uint64_t emitted_ = 0;  // photons the last light pass emitted
+};
+
+FpmSettings checked_settings(const FpmSettings& settings, size_t n_pixels) {
   FpmSettings s = settings;
-  s.photons_per_iteration = photons_for(settings, size_t(film->width()) * size_t(film->height()));
+  s.photons_per_iteration = photons_for(settings, n_pixels);
   if (!(s.k0 > 0) || !(s.k1 > 0)) throw Error("fpm: --k0 and --k1 (file: k0, k1) must be positive");
   if (s.photons_per_iteration <= 0)
     throw Error("fpm: --photons (file: photonsperiteration) must be positive");
   if (s.knn < 0) throw Error("fpm: --knn (file: knn) must not be negative");
-  const RenderScene& scene = ls.scene;
-  const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
-  const float pixel_angle = std::sqrt(camera.camera().pixel_solid_angle());
-  const int min_eye_vertices = s.final_gather ? 2 : 1;
-  // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
-  // for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
-  // joined map and in the tree. The worst iteration must fit the budget before the first one. Per
-  // pixel, beside the film: the disc probes' edges and near-edge marks.
-  const double fixed_bytes = double(film->bytes()) + 2.0 * film->width() * film->height();
-  const double stored_per_photon = std::max(0, opt.max_depth - min_eye_vertices + 1) + 1;
+  return s;
+}
+
+FpmRender::FpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
+                     const FpmSettings& settings, Film* film)
+    : ls_(ls),
+      scene_(ls.scene),
+      opt_(opt),
+      s_(checked_settings(settings, size_t(film->width()) * size_t(film->height()))),
+      film_(film),
+      camera_(ls.camera, ls.filter, film->width(), film->height(), opt.seed),
+      pixel_angle_(std::sqrt(camera_.camera().pixel_solid_angle())),
+      min_eye_vertices_(s_.final_gather ? 2 : 1),
+      n_photons_(reserve_memory(settings)),
+      near_edges_(s_.disc_probes, scene_, camera_.camera(), film->width(), film->height(),
+                  ls.filter.radius) {}
+
+// Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
+// for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
+// joined map and in the tree. The worst iteration must fit the budget before the first one. Per
+// pixel, beside the film: the disc probes' edges and near-edge marks.
+uint64_t FpmRender::reserve_memory(const FpmSettings& settings) {
+  const double fixed_bytes = double(film_->bytes()) + 2.0 * film_->width() * film_->height();
+  const double stored_per_photon = std::max(0, opt_.max_depth - min_eye_vertices_ + 1) + 1;
   const double photon_bytes =
       2 * sizeof(ForwardPhoton) + 2 * (sizeof(SphereRef) + sizeof(uint32_t));
   // The map holds a whole iteration's photons: the automatic count takes no more than the budget
   // holds at worst (but never fewer than 100000, which fail as a count set would).
-  if (settings.photons_per_iteration == 0 && opt.memory_budget > 0) {
+  if (settings.photons_per_iteration == 0 && opt_.memory_budget > 0) {
     const double fit =
-        (double(opt.memory_budget) - fixed_bytes) / (stored_per_photon * photon_bytes);
-    s.photons_per_iteration = int(std::clamp(fit, 100000.0, double(s.photons_per_iteration)));
+        (double(opt_.memory_budget) - fixed_bytes) / (stored_per_photon * photon_bytes);
+    s_.photons_per_iteration = int(std::clamp(fit, 100000.0, double(s_.photons_per_iteration)));
   }
-  const uint64_t n_photons = uint64_t(s.photons_per_iteration);
+  const uint64_t n_photons = uint64_t(s_.photons_per_iteration);
   check_memory("fpm with " + std::to_string(n_photons) + " photons per iteration and maxdepth " +
-                   std::to_string(opt.max_depth) + " (up to " +
+                   std::to_string(opt_.max_depth) + " (up to " +
                    std::to_string(int(stored_per_photon)) + " stored per photon)",
                fixed_bytes + double(n_photons) * stored_per_photon * photon_bytes,
-               opt.memory_budget, "lower --photons or --maxdepth, or raise --memory");
-  // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
-  NearEdges near_edges(s.disc_probes, scene, camera.camera(), film->width(), film->height(),
-                       ls.filter.radius);
-  ForwardMaps maps;
-  tbb::enumerable_thread_specific<LightCounters> light_counters;
-  tbb::enumerable_thread_specific<FpmEyeCounters> eye_counters;
-  FpmTotals tot;
+               opt_.memory_budget, "lower --photons or --maxdepth, or raise --memory");
+  return n_photons;
+}
 
-  auto iteration = [&](int pass, const RenderControl& control) {
-    const int it = opt.first_iteration + pass;  // the index random streams and radii follow
-    // One set of wavelengths for every eye and light path of the iteration.
-    const WavelengthMaterials wm(scene, iteration_wavelengths(opt.seed, it));
-    // 1. Light pass: a forward photon at every diffuse hit.
-    auto t = Clock::now();
-    // The time budget holds inside an iteration: the light pass may end early, with fewer photons.
-    const uint64_t emitted = trace_forward_photons(
-        scene, wm, opt.max_depth, min_eye_vertices, n_photons, opt.seed, it, light_counters,
-        [&] { return control.stop_requested(); }, &maps);
-    tot.light_s += since(t);
-    // After the first iteration, an eye pass would be cut at once: the iteration is dropped.
-    if (control.cut(pass)) return PassResult{false, 0, "", ""};
-    if (emitted < n_photons) ++tot.iterations_cut;
-    tot.emitted += emitted;
+PassResult FpmRender::iteration(int pass, const RenderControl& control) {
+  const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
+  // One set of wavelengths for every eye and light path of the iteration.
+  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
+  // 1. Light pass: a forward photon at every diffuse hit.
+  if (!light_pass(wm, pass, it, control)) return PassResult{false, 0, "", ""};
+  // 2. The maps, in chunk order (the same for any thread count), and their trees.
+  build_maps();
+  // 3. Eye pass.
+  eye_pass(wm, pass, it, control);
+  return progress();
+}
 
-    // 2. The maps, in chunk order (the same for any thread count), and their trees.
-    t = Clock::now();
-    build_forward_maps(&maps);
-    tot.stored +=
-        maps.global.photons.size();  // every photon once; the caustic map holds copies of some
-    tot.stored_caustic += maps.caustic.photons.size();
-    tot.build_s += since(t);
-    tot.peak_map_bytes =
-        std::max(tot.peak_map_bytes, maps.global.photon_bytes() + maps.caustic.photon_bytes());
-    tot.peak_tree_bytes =
-        std::max(tot.peak_tree_bytes, maps.global.tree.bytes() + maps.caustic.tree.bytes());
+bool FpmRender::light_pass(const WavelengthMaterials& wm, int pass, int it,
+                           const RenderControl& control) {
+  const auto t = Clock::now();
+  // The time budget holds inside an iteration: the light pass may end early, with fewer photons.
+  emitted_ = trace_forward_photons(
+      scene_, wm, opt_.max_depth, min_eye_vertices_, n_photons_, opt_.seed, it, light_counters_,
+      [&] { return control.stop_requested(); }, &maps_);
+  tot_.light_s += since(t);
+  // After the first iteration, an eye pass would be cut at once: the iteration is dropped.
+  if (control.cut(pass)) return false;
+  if (emitted_ < n_photons_) ++tot_.iterations_cut;
+  tot_.emitted += emitted_;
+  return true;
+}
 
-    // 3. Eye pass.
-    t = Clock::now();
-    float scale = radius_scale(s, it);
-    near_edges.mark(s.k0 * scale, s.k1 * scale);
-    FpmEyeParams ep{&wm,
-                    &s,
-                    opt.max_depth,
-                    s.k0 * pixel_angle * scale,
-                    s.k1 * pixel_angle * scale,
-                    double(emitted)};
-    for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
-      CameraSample cs = camera.sample(it, pixel);
-      const FpmEyeRadiance r = fpm_eye_radiance(scene, maps, ep, cs.ray, cs.rng,
-                                                eye_counters.local(), near_edges.at(pixel));
-      if (s.debias) {
-        record_pass(film, pixel, r.L - r.bias, wm.wl, cs.filter_weight, ls.film.max_component_value,
-                    true);
-        return;
-      }
-      if (r.bias.is_finite() && cs.filter_weight != 0 && recordable(r.L))
-        film->add_bias(int(pixel % uint32_t(film->width())), int(pixel / uint32_t(film->width())),
-                       spectrum_to_rgb(r.bias, wm.wl));
-      record_pass(film, pixel, r.L, wm.wl, cs.filter_weight, ls.film.max_component_value);
-    });
-    tot.eye_s += since(t);
+void FpmRender::build_maps() {
+  const auto t = Clock::now();
+  build_forward_maps(&maps_);
+  tot_.stored +=
+      maps_.global.photons.size();  // every photon once; the caustic map holds copies of some
+  tot_.stored_caustic += maps_.caustic.photons.size();
+  tot_.build_s += since(t);
+  tot_.peak_map_bytes =
+      std::max(tot_.peak_map_bytes, maps_.global.photon_bytes() + maps_.caustic.photon_bytes());
+  tot_.peak_tree_bytes =
+      std::max(tot_.peak_tree_bytes, maps_.global.tree.bytes() + maps_.caustic.tree.bytes());
+}
 
-    PassResult r;
-    for (const FpmEyeCounters& c : eye_counters) r.rays += c.rays.total();
-    for (const LightCounters& c : light_counters) r.rays += c.light_rays;
-    char progress[64];
-    std::snprintf(progress, sizeof progress, "  %zu photons stored", maps.global.photons.size());
-    r.progress = progress;
-    return r;
-  };
-  RenderStats stats;
-  run_passes(opt, film, "iteration", iteration, &stats);
-  for (const LightCounters& c : light_counters) tot.light.add(c);
-  for (const FpmEyeCounters& c : eye_counters) tot.eye.add(c);
-  stats.rays = tot.eye.rays;
-  stats.light_rays = tot.light.light_rays;
-  stats.details = to_json(tot, s);
+void FpmRender::eye_pass(const WavelengthMaterials& wm, int pass, int it,
+                         const RenderControl& control) {
+  const auto t = Clock::now();
+  float scale = radius_scale(s_, it);
+  near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
+  FpmEyeParams ep{&wm,
+                  &s_,
+                  opt_.max_depth,
+                  s_.k0 * pixel_angle_ * scale,
+                  s_.k1 * pixel_angle_ * scale,
+                  double(emitted_)};
+  for_each_sampled_pixel(film_->width(), film_->height(), control, pass, [&](uint32_t pixel) {
+    CameraSample cs = camera_.sample(it, pixel);
+    const FpmEyeRadiance r = fpm_eye_radiance(scene_, maps_, ep, cs.ray, cs.rng,
+                                              eye_counters_.local(), near_edges_.at(pixel));
+    record(pixel, r, cs, wm);
+  });
+  tot_.eye_s += since(t);
+}
+
+void FpmRender::record(uint32_t pixel, const FpmEyeRadiance& r, const CameraSample& cs,
+                       const WavelengthMaterials& wm) {
+  if (s_.debias) {
+    record_pass(film_, pixel, r.L - r.bias, wm.wl, cs.filter_weight, ls_.film.max_component_value,
+                true);
+    return;
+  }
+  if (r.bias.is_finite() && cs.filter_weight != 0 && recordable(r.L))
+    film_->add_bias(int(pixel % uint32_t(film_->width())), int(pixel / uint32_t(film_->width())),
+                    spectrum_to_rgb(r.bias, wm.wl));
+  record_pass(film_, pixel, r.L, wm.wl, cs.filter_weight, ls_.film.max_component_value);
+}
+
+PassResult FpmRender::progress() const {
+  PassResult r;
+  for (const FpmEyeCounters& c : eye_counters_) r.rays += c.rays.total();
+  for (const LightCounters& c : light_counters_) r.rays += c.light_rays;
+  char progress[64];
+  std::snprintf(progress, sizeof progress, "  %zu photons stored", maps_.global.photons.size());
+  r.progress = progress;
+  return r;
+}
+
+RenderStats FpmRender::finish(RenderStats stats) {
+  for (const LightCounters& c : light_counters_) tot_.light.add(c);
+  for (const FpmEyeCounters& c : eye_counters_) tot_.eye.add(c);
+  stats.rays = tot_.eye.rays;
+  stats.light_rays = tot_.light.light_rays;
+  stats.details = to_json(tot_, s_);
   return stats;
+}
+
+}  // namespace
+
+RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
+                       const FpmSettings& settings, Film* film) {
+  FpmRender fpm(ls, opt, settings, film);
+  RenderStats stats;
+  run_passes(
+      opt, film, "iteration",
+      [&fpm](int pass, const RenderControl& control) { return fpm.iteration(pass, control); },
+      &stats);
+  return fpm.finish(stats);
 }
 
 }  // namespace bpm
