@@ -96,6 +96,116 @@ struct TraceResult {
   bool stopped = false;  // prm.stop ended the trace (and the pass)
 };
 
+// What the chunks of a group share: the photons' streams (seed, pass, the group's first photon),
+// the group's photon count, and where their hits go.
+struct GroupTrace {
+  const RenderScene& scene;
+  const BackwardMaps& maps;
+  const LightPassParams& prm;
+  uint64_t seed;
+  int pass_index;
+  uint64_t first_photon, count;
+  const EmissionGuide* guide;
+  bool scored;  // the emissions are recorded for the guide's scores
+};
+
+// Traces chunk c of the group, recording its photons' hits and emissions and its counters.
+void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
+  const RenderScene& scene = g.scene;
+  const BackwardMaps& maps = g.maps;
+  const EmissionGuide* guide = g.guide;
+  LightCounters lc;
+  lc.observer = buf->counters.local().observer;
+  // Filled through lists of this thread's own (their memory taken from the chunk's, and given
+  // back): neighbouring chunks' list headers share cache lines, and other threads fill those.
+  std::vector<PendingHit> hits;
+  std::vector<EmittedPhoton> emitted;
+  hits.swap(buf->hits[size_t(c)]);
+  emitted.swap(buf->emitted[size_t(c)]);
+  hits.clear();
+  emitted.clear();
+  const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
+  const uint64_t last = std::min(first + kPhotonsPerChunk, g.count);
+  auto photon_rng = [&](uint64_t k) {
+    return Rng(stream_key(g.seed ^ kPhotonStream, uint64_t(g.pass_index), g.first_photon + k, 1));
+  };
+  // Each photon's stream is made one photon ahead, so that its part of the guide's table
+  // arrives while the photon before it is traced.
+  Rng next = photon_rng(first);
+  for (uint64_t k = first; k < last; ++k) {
+    Rng rng = next;
+    if (k + 1 < last) {
+      next = photon_rng(k + 1);
+      if (guide) guide->prefetch(next);
+    }
+    const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
+    const uint32_t photon = uint32_t(k - first);
+    // A backward photon adds at least one eye vertex; direct photons are never used
+    // (next-event estimation counts direct light).
+    trace_light_path(scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc,
+                     [&](const PhotonHit& h) {
+                       if (h.cls == PhotonClass::kDirect || !maps.has_photons(h.object)) return;
+                       ++lc.queries;
+                       const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
+                       if (bucket == BackwardMaps::kNoBucket) return;
+                       hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object,
+                                       int16_t(h.bounces), h.cls, h.hero_only});
+                     });
+    if (g.scored) emitted.push_back({e.cell, e.weight});
+  }
+  buf->hits[size_t(c)].swap(hits);
+  buf->emitted[size_t(c)].swap(emitted);
+  buf->chunk_counters[size_t(c)] = lc;
+}
+
+// Workers take chunks in order and stop taking them once the hits of the chunks traced reach
+// group_hits, or a stop is requested; at most one chunk per worker is traced past the prefix
+// kept. The prefix never needs a chunk no worker took: a worker skips chunk c only when the
+// chunks before it that have finished, all of them kept, already hold group_hits hits. So
+// without a stop request the prefix ends at group_hits or at the group's end. Returns per chunk
+// whether it ran.
+template <class Stop>
+std::vector<uint8_t> trace_chunks_in_order(const GroupTrace& g, int n_chunks, int workers,
+                                           uint64_t group_hits, Stop& stop, LightPassBuffers* buf) {
+  std::vector<uint8_t> ran(size_t(n_chunks), 0);
+  std::atomic<uint64_t> traced{0};
+  std::atomic<int> next{0};
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, workers, 1),
+      [&](const tbb::blocked_range<int>&) {
+        for (int c; (c = next.fetch_add(1)) < n_chunks;) {
+          if (c > 0 && (stop() || traced.load() >= group_hits)) break;
+          trace_chunk(g, c, buf);
+          ran[size_t(c)] = 1;
+          traced += buf->hits[size_t(c)].size();
+        }
+      },
+      tbb::simple_partitioner());
+  return ran;
+}
+
+// The longest prefix of the chunks that ran that starts before group_hits hits; its counters join
+// the thread's.
+TraceResult keep_prefix(const std::vector<uint8_t>& ran, int workers, uint64_t count,
+                        uint64_t group_hits, LightPassBuffers* buf) {
+  const int n_chunks = int(ran.size());
+  int kept = 0;
+  uint64_t kept_hits = 0;
+  while (kept < n_chunks && ran[size_t(kept)] && kept_hits < group_hits)
+    kept_hits += buf->hits[size_t(kept++)].size();
+  const bool stopped = kept < n_chunks && kept_hits < group_hits;
+  // A group ended by its hits leaves the lists past those it may use unused: their memory, from a
+  // larger group, goes back.
+  if (kept_hits >= group_hits)
+    for (size_t c = size_t(kept) + size_t(workers); c < buf->hits.size(); ++c) {
+      std::vector<PendingHit>().swap(buf->hits[c]);
+      std::vector<EmittedPhoton>().swap(buf->emitted[c]);
+    }
+  LightCounters& total = buf->counters.local();
+  for (int c = 0; c < kept; ++c) total.add(buf->chunk_counters[size_t(c)]);
+  return {std::min(count, uint64_t(kept) * kPhotonsPerChunk), kept, stopped};
+}
+
 // Trace: chunks of photons are traced in parallel, each recording its photons' hits and
 // emissions (and counters). A group keeps the longest prefix of its chunks that starts before
 // group_hits hits, so that its memory is bounded whatever the paths and its size does not depend
@@ -115,86 +225,12 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->emitted.resize(size_t(n_chunks));
     buf->chunk_counters.resize(size_t(n_chunks));
   }
-  const bool scored = guide && prm.pixel_weight;
-  auto trace_chunk = [&](int c) {
-    LightCounters lc;
-    lc.observer = buf->counters.local().observer;
-    // Filled through lists of this thread's own (their memory taken from the chunk's, and given
-    // back): neighbouring chunks' list headers share cache lines, and other threads fill those.
-    std::vector<PendingHit> hits;
-    std::vector<EmittedPhoton> emitted;
-    hits.swap(buf->hits[size_t(c)]);
-    emitted.swap(buf->emitted[size_t(c)]);
-    hits.clear();
-    emitted.clear();
-    const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
-    const uint64_t last = std::min(first + kPhotonsPerChunk, count);
-    auto photon_rng = [&](uint64_t k) {
-      return Rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), first_photon + k, 1));
-    };
-    // Each photon's stream is made one photon ahead, so that its part of the guide's table
-    // arrives while the photon before it is traced.
-    Rng next = photon_rng(first);
-    for (uint64_t k = first; k < last; ++k) {
-      Rng rng = next;
-      if (k + 1 < last) {
-        next = photon_rng(k + 1);
-        if (guide) guide->prefetch(next);
-      }
-      const EmissionDraw e = guide ? guide->sample(rng) : unguided_emission(scene, rng);
-      const uint32_t photon = uint32_t(k - first);
-      // A backward photon adds at least one eye vertex; direct photons are never used
-      // (next-event estimation counts direct light).
-      trace_light_path(scene, *prm.materials, prm.max_depth, 1, e, rng, lc,
-                       [&](const PhotonHit& h) {
-                         if (h.cls == PhotonClass::kDirect || !maps.has_photons(h.object)) return;
-                         ++lc.queries;
-                         const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
-                         if (bucket == BackwardMaps::kNoBucket) return;
-                         hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object,
-                                         int16_t(h.bounces), h.cls, h.hero_only});
-                       });
-      if (scored) emitted.push_back({e.cell, e.weight});
-    }
-    buf->hits[size_t(c)].swap(hits);
-    buf->emitted[size_t(c)].swap(emitted);
-    buf->chunk_counters[size_t(c)] = lc;
-  };
-  // Workers take chunks in order and stop taking them once the hits of the chunks traced reach
-  // group_hits, or a stop is requested; at most one chunk per worker is traced past the prefix
-  // kept. The prefix never needs a chunk no worker took: a worker skips chunk c only when the
-  // chunks before it that have finished, all of them kept, already hold group_hits hits. So
-  // without a stop request the prefix ends at group_hits or at the group's end.
+  const GroupTrace g{
+      scene, maps, prm, seed, pass_index, first_photon, count, guide, guide && prm.pixel_weight};
   const int workers = tbb::this_task_arena::max_concurrency();
-  std::vector<uint8_t> ran(size_t(n_chunks), 0);
-  std::atomic<uint64_t> traced{0};
-  std::atomic<int> next{0};
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, workers, 1),
-      [&](const tbb::blocked_range<int>&) {
-        for (int c; (c = next.fetch_add(1)) < n_chunks;) {
-          if (c > 0 && (stop() || traced.load() >= group_hits)) break;
-          trace_chunk(c);
-          ran[size_t(c)] = 1;
-          traced += buf->hits[size_t(c)].size();
-        }
-      },
-      tbb::simple_partitioner());
-  int kept = 0;
-  uint64_t kept_hits = 0;
-  while (kept < n_chunks && ran[size_t(kept)] && kept_hits < group_hits)
-    kept_hits += buf->hits[size_t(kept++)].size();
-  const bool stopped = kept < n_chunks && kept_hits < group_hits;
-  // A group ended by its hits leaves the lists past those it may use unused: their memory, from a
-  // larger group, goes back.
-  if (kept_hits >= group_hits)
-    for (size_t c = size_t(kept) + size_t(workers); c < buf->hits.size(); ++c) {
-      std::vector<PendingHit>().swap(buf->hits[c]);
-      std::vector<EmittedPhoton>().swap(buf->emitted[c]);
-    }
-  LightCounters& total = buf->counters.local();
-  for (int c = 0; c < kept; ++c) total.add(buf->chunk_counters[size_t(c)]);
-  return {std::min(count, uint64_t(kept) * kPhotonsPerChunk), kept, stopped};
+  const std::vector<uint8_t> ran =
+      trace_chunks_in_order(g, n_chunks, workers, group_hits, stop, buf);
+  return keep_prefix(ran, workers, count, group_hits, buf);
 }
 
 // The hits of the first `chunks` chunks in bucket order, and within a bucket in chunk and photon
@@ -291,15 +327,24 @@ double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons)
          2.0 * double(g.photons) * sizeof(EmittedPhoton);
 }
 
-void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
-                    const BpmSettings& s, const PixelMasks& masks, uint64_t seed, int pass_index,
-                    LightPassBuffers* buf, EmissionGuide* guide, LightPassResult* out) {
-  const uint64_t total = uint64_t(s.photons_per_iteration);
-  const size_t n_bp = maps.photons.size();
-  BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
-  // The arrays keep their memory from the last iteration (fresh pages cost a fault each), and
-  // only the flags are cleared: the sums of a backward photon are set at its first entry.
-  LightPassResult& res = *out;
+namespace {
+
+// Charges every interval of the pass to one stage: the time since the last lap.
+class StageClock {
+ public:
+  void lap(double& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    stage += std::chrono::duration<double>(now - t_).count();
+    t_ = now;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point t_ = std::chrono::steady_clock::now();
+};
+
+// The arrays keep their memory from the last iteration (fresh pages cost a fault each), and
+// only the flags are cleared: the sums of a backward photon are set at its first entry.
+void reset_result(size_t n_bp, LightPassResult& res) {
   res.reached.assign(n_bp, 0);
   res.flux.resize(n_bp);
   res.flux_inner.resize(n_bp);
@@ -310,21 +355,98 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   res.coverage = 0;
   res.trace_s = res.gather_s = res.apply_s = 0;
   res.peak_entry_bytes = 0;
+}
+
+// Rounds of gather and apply over the sorted hits: one, unless the entries reach the memory
+// limit; a round keeps a prefix of the gather chunks and the next goes on from there, so that the
+// entries are applied in the same order whatever the rounds.
+void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, const PixelMasks& masks,
+                      LightPassBuffers* buf, LightPassResult& res, StageClock& clock) {
+  const int n_gather = int((buf->order.size() + kHitsPerGather - 1) / kHitsPerGather);
+  if (buf->chunks.size() < size_t(n_gather)) buf->chunks.resize(size_t(n_gather));
+  int done = 0;
+  do {
+    const GatherRound round =
+        n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : GatherRound{0, 0};
+    const int kept = round.kept;
+    size_t entries = 0;
+    for (int g = done; g < done + kept; ++g)
+      for (const auto& v : buf->chunks[size_t(g)]) entries += v.size();
+    res.peak_entry_bytes = std::max(res.peak_entry_bytes, round.bytes);
+    buf->counters.local().entries += entries;
+    clock.lap(res.gather_s);
+    apply_entries(*buf, done, done + kept, masks.slots(), &res);
+    clock.lap(res.apply_s);
+    ++res.batches;
+    done += kept;
+    // The limit ended the round: the lists' memory goes back, so that the next round has it.
+    if (done < n_gather)
+      for (auto& by_slot : buf->chunks)
+        for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
+  } while (done < n_gather);
+}
+
+// Each photon's score is the sum of its hits', in the order of its path, as if it had been
+// emitted without guidance (weight removed); the guide learns them in photon order.
+void learn_scores(int chunks, LightPassBuffers* buf, EmissionGuide& guide) {
+  if (buf->scores.size() < size_t(chunks)) buf->scores.resize(size_t(chunks));
+  tbb::parallel_for(0, chunks, [&](int c) {
+    const std::vector<PendingHit>& hits = buf->hits[size_t(c)];
+    const std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
+    std::vector<CellScore>& scores = buf->scores[size_t(c)];
+    scores.clear();
+    size_t j = 0;
+    for (uint32_t p = 0; p < uint32_t(emitted.size()); ++p) {
+      float score = 0;
+      for (; j < hits.size() && hits[j].photon == p; ++j) score += hits[j].score;
+      scores.push_back({emitted[p].cell, emitted[p].weight > 0 ? score / emitted[p].weight : 0});
+    }
+  });
+  for (int c = 0; c < chunks; ++c) guide.learn(buf->scores[size_t(c)]);
+}
+
+// The share of the backward photons that accept indirect light which some photon reached (1 when
+// none accepts it).
+double coverage(const BackwardMaps& maps, const std::vector<uint8_t>& reached) {
+  struct Coverage {
+    size_t indirect = 0, covered = 0;
+  };
+  const Coverage cov = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, maps.photons.size(), 1 << 14), Coverage{},
+      [&](const tbb::blocked_range<size_t>& r, Coverage c) {
+        for (size_t g = r.begin(); g < r.end(); ++g)
+          if (maps.photons[g].accepts & kAcceptsIndirect) {
+            ++c.indirect;
+            c.covered += reached[g];
+          }
+        return c;
+      },
+      [](Coverage a, const Coverage& b) {
+        return Coverage{a.indirect + b.indirect, a.covered + b.covered};
+      });
+  const size_t n_indirect = cov.indirect, covered = cov.covered;
+  return n_indirect ? double(covered) / double(n_indirect) : 1.0;
+}
+
+}  // namespace
+
+void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                    const BpmSettings& s, const PixelMasks& masks, uint64_t seed, int pass_index,
+                    LightPassBuffers* buf, EmissionGuide* guide, LightPassResult* out) {
+  const uint64_t total = uint64_t(s.photons_per_iteration);
+  const size_t n_bp = maps.photons.size();
+  BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
+  LightPassResult& res = *out;
+  reset_result(n_bp, res);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   const GroupSize group = group_size(n_bp);
-  // Every interval of the pass is charged to one stage: the time since the last lap.
-  auto t = std::chrono::steady_clock::now();
-  auto lap = [&t](double& stage) {
-    const auto now = std::chrono::steady_clock::now();
-    stage += std::chrono::duration<double>(now - t).count();
-    t = now;
-  };
+  StageClock clock;
   for (uint64_t first = 0; first < total;) {
     const uint64_t count = std::min(group.photons, total - first);
     const TraceResult tr =
         trace_group(scene, maps, prm, seed, pass_index, first, count, group.hits, guide, buf);
-    lap(res.trace_s);
+    clock.lap(res.trace_s);
     if (tr.kept == 0) {  // stopped before the group began
       res.cut = true;
       break;
@@ -333,72 +455,13 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     res.emitted += tr.kept;
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
-    const int n_gather = int((buf->order.size() + kHitsPerGather - 1) / kHitsPerGather);
-    if (buf->chunks.size() < size_t(n_gather)) buf->chunks.resize(size_t(n_gather));
-    // Rounds of gather and apply: one, unless the entries reach the memory limit; a round keeps a
-    // prefix of the gather chunks and the next goes on from there, so that the entries are
-    // applied in the same order whatever the rounds.
-    int done = 0;
-    do {
-      const GatherRound round =
-          n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : GatherRound{0, 0};
-      const int kept = round.kept;
-      size_t entries = 0;
-      for (int g = done; g < done + kept; ++g)
-        for (const auto& v : buf->chunks[size_t(g)]) entries += v.size();
-      res.peak_entry_bytes = std::max(res.peak_entry_bytes, round.bytes);
-      buf->counters.local().entries += entries;
-      lap(res.gather_s);
-      apply_entries(*buf, done, done + kept, masks.slots(), &res);
-      lap(res.apply_s);
-      ++res.batches;
-      done += kept;
-      // The limit ended the round: the lists' memory goes back, so that the next round has it.
-      if (done < n_gather)
-        for (auto& by_slot : buf->chunks)
-          for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
-    } while (done < n_gather);
-    if (guide && prm.pixel_weight) {
-      // Each photon's score is the sum of its hits', in the order of its path, as if it had been
-      // emitted without guidance (weight removed); the guide learns them in photon order.
-      if (buf->scores.size() < size_t(tr.chunks)) buf->scores.resize(size_t(tr.chunks));
-      tbb::parallel_for(0, tr.chunks, [&](int c) {
-        const std::vector<PendingHit>& hits = buf->hits[size_t(c)];
-        const std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
-        std::vector<CellScore>& scores = buf->scores[size_t(c)];
-        scores.clear();
-        size_t j = 0;
-        for (uint32_t p = 0; p < uint32_t(emitted.size()); ++p) {
-          float score = 0;
-          for (; j < hits.size() && hits[j].photon == p; ++j) score += hits[j].score;
-          scores.push_back(
-              {emitted[p].cell, emitted[p].weight > 0 ? score / emitted[p].weight : 0});
-        }
-      });
-      for (int c = 0; c < tr.chunks; ++c) guide->learn(buf->scores[size_t(c)]);
-    }
-    lap(res.apply_s);
+    gather_and_apply(maps, prm, masks, buf, res, clock);
+    if (guide && prm.pixel_weight) learn_scores(tr.chunks, buf, *guide);
+    clock.lap(res.apply_s);
     if (res.cut) break;
   }
-  struct Coverage {
-    size_t indirect = 0, covered = 0;
-  };
-  const Coverage cov = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, n_bp, 1 << 14), Coverage{},
-      [&](const tbb::blocked_range<size_t>& r, Coverage c) {
-        for (size_t g = r.begin(); g < r.end(); ++g)
-          if (maps.photons[g].accepts & kAcceptsIndirect) {
-            ++c.indirect;
-            c.covered += res.reached[g];
-          }
-        return c;
-      },
-      [](Coverage a, const Coverage& b) {
-        return Coverage{a.indirect + b.indirect, a.covered + b.covered};
-      });
-  const size_t n_indirect = cov.indirect, covered = cov.covered;
-  res.coverage = n_indirect ? double(covered) / double(n_indirect) : 1.0;
-  lap(res.apply_s);
+  res.coverage = coverage(maps, res.reached);
+  clock.lap(res.apply_s);
 }
 
 }  // namespace bpm
