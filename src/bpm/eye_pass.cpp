@@ -40,11 +40,121 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
   return bp;
 }
 
+// What every vertex of one eye path shares: where its backward photons go, and its counters.
+struct EyePath {
+  const RenderScene& scene;
+  const EyePassParams& prm;
+  uint32_t pixel;
+  uint8_t near_edge;
+  Rng& rng;
+  ObjectPhotonLists& out;
+  EyeCounters& counters;
+};
+
+// Direct light at v by next-event estimation, shared by MIS with the BSDF sample that goes on.
+inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const PathState& s,
+                                BsdfPart part) {
+  return s.beta * sample_direct_light(path.scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                      v.wo_local, true, *path.prm.materials, path.rng,
+                                      path.counters.rays, part);
+}
+
+// Stores one backward photon at diffuse vertex v. Its disc is probed where it may be cut
+// (disc_probes.h); `whole`: a larger disc about the same point was probed and found whole, and so
+// is this one. Returns whether a probe found the disc whole.
+inline bool store_backward_photon(const EyePath& path, const PathVertex& v, const PathState& s,
+                                  int depth, int diffuse, bool seen_directly, uint8_t accepts,
+                                  bool whole) {
+  const EyePassParams& prm = path.prm;
+  BackwardPhoton bp = backward_photon_at(v, s, prm, path.pixel, depth, diffuse, accepts);
+  if (bp.radius <= 0 || s.beta.is_black()) return false;
+  const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
+  bool probed_whole = false;
+  if (prm.disc_probes && !whole && (!seen_directly || (path.near_edge & near_bit)) &&
+      may_cut_discs(path.scene.objects[size_t(v.object())].shape)) {
+    const DiscProbes probes =
+        probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
+                   prm.normal_cos, path.rng, path.counters.rays, v.hit.primitive);
+    bp.disc_found = probes.found;
+    bp.disc_cut = probes.cut;
+    probed_whole = probes.cut == 0;
+  }
+  path.out[size_t(v.object())].push_back(bp);
+  ++path.counters.backward_photons;
+  return probed_whole;
+}
+
+// Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first vertex is
+// also the last: two backward photons, one per radius.
+inline void store_backward_photons(const EyePath& path, const PathVertex& v, const PathState& s,
+                                   int depth, int diffuse, bool last) {
+  const EyePassParams& prm = path.prm;
+  // Seen straight from the camera: the screen around the pixel says whether its discs may be
+  // cut (disc_probes.h).
+  const bool seen_directly = diffuse == 1 && depth == 1;
+  auto store = [&](uint8_t accepts, bool whole) {
+    return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, whole);
+  };
+  if (!prm.caustics) {
+    if (last) store(kAcceptsIndirect, false);
+  } else if (!last) {
+    store(kAcceptsCaustic, false);
+  } else if (diffuse > 1 || prm.world_radius > 0 ||
+             prm.radius_per_length0 == prm.radius_per_length1) {
+    store(kAcceptsCaustic | kAcceptsIndirect, false);
+  } else {
+    const bool whole = store(kAcceptsIndirect, false);  // r1 > r0: the larger disc first
+    store(kAcceptsCaustic, whole && prm.radius_per_length0 < prm.radius_per_length1);
+  }
+}
+
+// The diffuse-th diffuse vertex: its direct light and backward photons, and at the last one the
+// light only a BSDF sample finds. Returns whether the path ends here (at the last one).
+inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, const PathState& s,
+                                     const EyeVertexChoice& choice, int depth, int diffuse,
+                                     Spectrum& L) {
+  bool last = diffuse == path.prm.diffuse_depth + 1;
+  // Direct light: shared by MIS with the BSDF sample that continues the path; at the last
+  // vertex, where the path ends, with one that only looks for the light (none where every
+  // light is a point or a direction: those next-event estimation counts in full).
+  L += direct_light_at(path, v, s, choice.part);
+  store_backward_photons(path, v, s, depth, diffuse, last);
+  if (last) {
+    L += direct_light_by_bsdf(path.scene, *path.prm.materials, v, s, choice.part, path.rng,
+                              path.counters.rays);
+    return true;
+  }
+  return false;
+}
+
+// Samples the BSDF at v and leaves the vertex along the sample; sets the weight of the emission
+// the next vertex sees. Returns false where the path ends (no sample, no throughput left).
+inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexChoice& choice,
+                    bool direct_here, int diffuse, PathState& s, EmitterWeight& emitter) {
+  float uc = path.rng.uniform();
+  Vec2 u{path.rng.uniform(), path.rng.uniform()};
+  // Radiance-mode sampling; for a non-reciprocal BSDF the lobe drawn is the light-direction one
+  // and the weight carries the ratio of the two BSDF values (the paper's Helmholtz
+  // compensation, section 2; see PhongMaterial).
+  auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);
+  if (!bs) return false;
+  s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+  if (s.beta.is_black()) return false;
+  if (choice.gather || (direct_here && !bs->is_specular()))
+    emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+  else
+    emitter = diffuse == 0 ? EmitterWeight::full() : EmitterWeight::none();
+  leave_vertex(path.scene, v, v.frame.to_world(bs->wi), s);
+  ++path.counters.rays.bounce_rays;
+  return true;
+}
+
 }  // namespace
 
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, Ray ray,
                            uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only, uint8_t near_edge) {
+  const EyePath path{scene, prm, pixel, near_edge, rng, out, counters};
   PathState s{ray};
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
@@ -73,78 +183,15 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm, R
     }
     if (is_diffuse) {
       ++diffuse;
-      bool last = diffuse == prm.diffuse_depth + 1;
-      // Seen straight from the camera: the screen around the pixel says whether its discs may be
-      // cut (disc_probes.h).
-      const bool seen_directly = diffuse == 1 && depth == 1;
-      // Direct light: shared by MIS with the BSDF sample that continues the path; at the last
-      // vertex, where the path ends, with one that only looks for the light (none where every
-      // light is a point or a direction: those next-event estimation counts in full).
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, *prm.materials, rng, counters.rays,
-                                        choice.part);
-      // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first
-      // vertex is also the last: two backward photons, one per radius.
-      // Each backward photon's disc is probed where it may be cut (disc_probes.h); `whole`: a
-      // larger disc about the same point was probed and found whole, and so is this one.
-      auto store = [&](uint8_t accepts, bool whole) {
-        BackwardPhoton bp = backward_photon_at(v, s, prm, pixel, depth, diffuse, accepts);
-        if (bp.radius <= 0 || s.beta.is_black()) return false;
-        const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
-        bool probed_whole = false;
-        if (prm.disc_probes && !whole && (!seen_directly || (near_edge & near_bit)) &&
-            may_cut_discs(scene.objects[size_t(v.object())].shape)) {
-          const DiscProbes probes =
-              probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
-                         prm.normal_cos, rng, counters.rays, v.hit.primitive);
-          bp.disc_found = probes.found;
-          bp.disc_cut = probes.cut;
-          probed_whole = probes.cut == 0;
-        }
-        out[size_t(v.object())].push_back(bp);
-        ++counters.backward_photons;
-        return probed_whole;
-      };
-      if (!prm.caustics) {
-        if (last) store(kAcceptsIndirect, false);
-      } else if (!last) {
-        store(kAcceptsCaustic, false);
-      } else if (diffuse > 1 || prm.world_radius > 0 ||
-                 prm.radius_per_length0 == prm.radius_per_length1) {
-        store(kAcceptsCaustic | kAcceptsIndirect, false);
-      } else {
-        const bool whole = store(kAcceptsIndirect, false);  // r1 > r0: the larger disc first
-        store(kAcceptsCaustic, whole && prm.radius_per_length0 < prm.radius_per_length1);
-      }
-      if (last) {
-        L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, counters.rays);
-        break;
-      }
+      if (gather_at_diffuse_vertex(path, v, s, choice, depth, diffuse, L)) break;
     }
     // A glossy specular vertex seen through specular ones only (a highlight): direct light by
     // next-event estimation, shared by MIS with the BSDF sample that goes on. After a diffuse
     // vertex the backward photons there count such light as a caustic.
     const bool direct_here =
         !is_diffuse && diffuse == 0 && bsdf_part_has_nondelta(v.m(), choice.part);
-    if (direct_here)
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, *prm.materials, rng, counters.rays,
-                                        choice.part);
-    float uc = rng.uniform();
-    Vec2 u{rng.uniform(), rng.uniform()};
-    // Radiance-mode sampling; for a non-reciprocal BSDF the lobe drawn is the light-direction one
-    // and the weight carries the ratio of the two BSDF values (the paper's Helmholtz
-    // compensation, section 2; see PhongMaterial).
-    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);
-    if (!bs) break;
-    s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
-    if (s.beta.is_black()) break;
-    if (is_diffuse || (direct_here && !bs->is_specular()))
-      emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
-    else
-      emitter = diffuse == 0 ? EmitterWeight::full() : EmitterWeight::none();
-    leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
-    ++counters.rays.bounce_rays;
+    if (direct_here) L += direct_light_at(path, v, s, choice.part);
+    if (!scatter(path, v, choice, direct_here, diffuse, s, emitter)) break;
   }
   return {L, emission ? *emission : L};
 }
