@@ -61,11 +61,116 @@ bool any_class(PhotonClass) { return true; }
 bool caustic_class(PhotonClass k) { return k == PhotonClass::kCaustic; }
 bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
 
+// What every vertex of one eye path shares.
+struct FpmPath {
+  const RenderScene& scene;
+  const ForwardMaps& maps;
+  const FpmEyeParams& prm;
+  Rng& rng;
+  FpmEyeCounters& c;
+  uint8_t near_edge;
+};
+
+// Direct light at v by next-event estimation, shared by MIS with the BSDF sample that goes on.
+inline Spectrum direct_light_at(const FpmPath& path, const PathVertex& v, const PathState& s,
+                                BsdfPart part) {
+  return s.beta * sample_direct_light(path.scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                      v.wo_local, true, *path.prm.materials, path.rng, path.c.rays,
+                                      part);
+}
+
+// The gathers at one diffuse vertex, adding their estimates to L and bias. The discs about v are
+// probed where they may be cut: at a vertex seen straight from the camera, where the screen
+// around the pixel shows an edge (near_bit of near_edge). A disc no larger than one found whole is
+// whole too.
+struct VertexGathers {
+  const FpmPath& path;
+  const PathVertex& v;
+  const PathState& s;
+  int depth;
+  Spectrum& L;
+  Spectrum& bias;
+  float whole_radius = 0;
+
+  template <class Accept>
+  void gather(const PhotonMap& map, float radius, uint8_t near_bit, Accept accept) {
+    const bool seen_directly = depth == 1;
+    auto probe = [&](float r) {
+      if (!path.prm.fpm->disc_probes || r <= whole_radius ||
+          (seen_directly && !(path.near_edge & near_bit)) ||
+          !may_cut_discs(path.scene.objects[size_t(v.object())].shape))
+        return DiscProbes{};
+      const DiscProbes d =
+          probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject, r,
+                     path.prm.fpm->normal_cos, path.rng, path.c.rays, v.hit.primitive);
+      if (!d.cut) whole_radius = r;
+      return d;
+    };
+    const Estimate e =
+        estimate(map, v, s.hero_only, radius, depth, path.prm, accept, probe, path.c);
+    L += s.beta * e.L;
+    bias += s.beta * e.bias;
+  }
+};
+
+// A diffuse vertex: x1 (`gathering` false) or, with final gathering, x2. Returns whether the path
+// ends here; sets `gathering` when a final gather leaves x1.
+inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, const PathState& s,
+                                     const EyeVertexChoice& choice, int depth, bool& gathering,
+                                     Spectrum& L, Spectrum& bias) {
+  const FpmEyeParams& prm = path.prm;
+  VertexGathers at{path, v, s, depth, L, bias};
+  float r1 = s.length * prm.radius_per_length1;
+  if (gathering) {
+    // x2: everything the global map holds, direct photons included.
+    at.gather(path.maps.global, r1, 1, any_class);
+    return true;
+  }
+  // x1: direct light by next-event estimation, shared by MIS with the BSDF sample that leaves
+  // x1 (points and directions, which no BSDF sample finds, in full); caustics from the
+  // caustic map.
+  L += direct_light_at(path, v, s, choice.part);
+  // Without final gathering the larger disc first (r1 > r0 by default): where it is whole,
+  // the caustic map's is too. The path ends here: its BSDF sample only looks for the light.
+  if (!prm.fpm->final_gather) {
+    at.gather(path.maps.global, r1, 1, indirect_class);
+    at.gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+    L += direct_light_by_bsdf(path.scene, *prm.materials, v, s, choice.part, path.rng, path.c.rays);
+    return true;
+  }
+  at.gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+  gathering = true;
+  return false;
+}
+
+// Samples the BSDF at v and leaves the vertex along the sample; sets the weight of the emission
+// the next vertex sees. Returns false where the path ends (no sample, no throughput left).
+inline bool scatter(const FpmPath& path, const PathVertex& v, const EyeVertexChoice& choice,
+                    bool direct_here, bool gathering, PathState& s, EmitterWeight& emitter) {
+  Vec2 u{path.rng.uniform(), path.rng.uniform()};  // drawn before uc
+  float uc = path.rng.uniform();
+  auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);
+  if (!bs) return false;
+  s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+  if (s.beta.is_black()) return false;
+  if (!gathering)
+    emitter = direct_here && !bs->is_specular() ? EmitterWeight::mis(bs->mis_pdf, v.sp.p)
+                                                : EmitterWeight::full();
+  else if (choice.gather && !bs->is_specular())  // the final gather's ray leaving x1
+    emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+  else
+    emitter = EmitterWeight::none();
+  leave_vertex(path.scene, v, v.frame.to_world(bs->wi), s);
+  ++path.c.rays.bounce_rays;
+  return true;
+}
+
 }  // namespace
 
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
                                 const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c,
                                 uint8_t near_edge) {
+  const FpmPath path{scene, maps, prm, rng, c, near_edge};
   PathState s{ray};
   Spectrum L, bias;
   int depth = 0;
@@ -85,71 +190,14 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
     const EyeVertexChoice choice = choose_eye_vertex(v, rng, s);
     const bool is_diffuse = choice.gather;
-    // The discs about v are probed where they may be cut: at a vertex seen straight from the
-    // camera, where the screen around the pixel shows an edge (near_bit of near_edge). A disc no
-    // larger than one found whole is whole too.
-    const bool seen_directly = depth == 1;
-    float whole_radius = 0;
-    auto gather = [&](const PhotonMap& map, float radius, uint8_t near_bit, auto accept) {
-      auto probe = [&](float r) {
-        if (!prm.fpm->disc_probes || r <= whole_radius ||
-            (seen_directly && !(near_edge & near_bit)) ||
-            !may_cut_discs(scene.objects[size_t(v.object())].shape))
-          return DiscProbes{};
-        const DiscProbes d = probe_disc(scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject,
-                                        r, prm.fpm->normal_cos, rng, c.rays, v.hit.primitive);
-        if (!d.cut) whole_radius = r;
-        return d;
-      };
-      const Estimate e = estimate(map, v, s.hero_only, radius, depth, prm, accept, probe, c);
-      L += s.beta * e.L;
-      bias += s.beta * e.bias;
-    };
-    if (is_diffuse) {
-      float r1 = s.length * prm.radius_per_length1;
-      if (gathering) {
-        // x2: everything the global map holds, direct photons included.
-        gather(maps.global, r1, 1, any_class);
-        break;
-      }
-      // x1: direct light by next-event estimation, shared by MIS with the BSDF sample that leaves
-      // x1 (points and directions, which no BSDF sample finds, in full); caustics from the
-      // caustic map.
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, *prm.materials, rng, c.rays, choice.part);
-      // Without final gathering the larger disc first (r1 > r0 by default): where it is whole,
-      // the caustic map's is too. The path ends here: its BSDF sample only looks for the light.
-      if (!prm.fpm->final_gather) {
-        gather(maps.global, r1, 1, indirect_class);
-        gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
-        L += direct_light_by_bsdf(scene, *prm.materials, v, s, choice.part, rng, c.rays);
-        break;
-      }
-      gather(maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
-      gathering = true;
-    }
+    if (is_diffuse && gather_at_diffuse_vertex(path, v, s, choice, depth, gathering, L, bias))
+      break;
     // A glossy specular vertex seen through specular ones only (a highlight): direct light by
     // next-event estimation, shared by MIS with the BSDF sample that goes on.
     const bool direct_here =
         !is_diffuse && !gathering && bsdf_part_has_nondelta(v.m(), choice.part);
-    if (direct_here)
-      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
-                                        v.wo_local, true, *prm.materials, rng, c.rays, choice.part);
-    Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
-    float uc = rng.uniform();
-    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, choice.part);
-    if (!bs) break;
-    s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
-    if (s.beta.is_black()) break;
-    if (!gathering)
-      emitter = direct_here && !bs->is_specular() ? EmitterWeight::mis(bs->mis_pdf, v.sp.p)
-                                                  : EmitterWeight::full();
-    else if (is_diffuse && !bs->is_specular())  // the final gather's ray leaving x1
-      emitter = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
-    else
-      emitter = EmitterWeight::none();
-    leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
-    ++c.rays.bounce_rays;
+    if (direct_here) L += direct_light_at(path, v, s, choice.part);
+    if (!scatter(path, v, choice, direct_here, gathering, s, emitter)) break;
   }
   return {L, bias};
 }
