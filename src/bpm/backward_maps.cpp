@@ -84,17 +84,11 @@ size_t gather_in_space(const std::vector<ObjectPhotonLists*>& per_thread, uint32
   return n;
 }
 
-}  // namespace
-
-size_t BackwardMaps::tree_bytes() const {
-  size_t b = 0;
-  for (const auto& t : sphere_trees) b += t.bytes();
-  for (const auto& t : centre_trees) b += t.bytes();
-  return b;
-}
-
-void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t object_count,
-                         bool centre_tree, BackwardMaps* maps) {
+// Each object's range of the photon array, from the threads' list sizes. The trees of the last
+// iteration are rebuilt in place (keeping their memory); those of objects without backward
+// photons are emptied.
+void lay_out_maps(const std::vector<ObjectPhotonLists*>& per_thread, size_t object_count,
+                  bool centre_tree, BackwardMaps* maps) {
   maps->centre_tree = centre_tree;
   maps->object_begin.assign(object_count + 1, 0);
   for (size_t o = 0; o < object_count; ++o) {
@@ -104,8 +98,6 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
     maps->object_begin[o + 1] = maps->object_begin[o] + uint32_t(n);
   }
   maps->photons.resize(maps->object_begin[object_count]);
-  // The trees of the last iteration are rebuilt in place (keeping their memory); those of objects
-  // without backward photons are emptied.
   if (centre_tree) {
     maps->sphere_trees.clear();
     maps->centre_trees.resize(2 * object_count);
@@ -121,54 +113,43 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
         else
           maps->sphere_trees[t].build({});
       }
+}
 
-  std::vector<uint32_t> order;
-  for (uint32_t o = 0; o < object_count; ++o)
-    if (maps->has_photons(int(o))) order.push_back(o);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    return maps->object_begin[a + 1] - maps->object_begin[a] >
-           maps->object_begin[b + 1] - maps->object_begin[b];
-  });
-  auto build_one = [&](uint32_t o) {
-    BackwardPhoton* dst = maps->photons.data() + maps->object_begin[o];
-    const size_t n = gather_in_space(per_thread, o, dst);
-    // Emptied, keeping their memory for the next iteration's eye pass (the memory budget counts
-    // two copies of every backward photon).
-    for (ObjectPhotonLists* l : per_thread)
-      if (o < l->size()) (*l)[o].clear();
-    // Per class (caustic, indirect), the spheres that accept it, in one pass over the records.
-    std::vector<SphereRef> spheres_of[2];
-    std::vector<uint32_t> ids_of[2];
-    for (int c = 0; c < 2; ++c) {
-      spheres_of[c].reserve(n);
-      ids_of[c].reserve(n);
-    }
-    constexpr uint8_t kAcceptsOf[2] = {kAcceptsCaustic, kAcceptsIndirect};
-    for (size_t k = 0; k < n; ++k) {
-      const BackwardPhoton& bp = dst[k];
-      for (int c = 0; c < 2; ++c)
-        if (bp.accepts & kAcceptsOf[c]) {
-          spheres_of[c].push_back({bp.p, bp.radius});
-          ids_of[c].push_back(maps->object_begin[o] + uint32_t(k));
-        }
-    }
-    for (int c = 0; c < 2; ++c) {
-      if (centre_tree)
-        maps->centre_trees[2 * o + c].build(spheres_of[c], &ids_of[c]);
-      else
-        maps->sphere_trees[2 * o + c].build(spheres_of[c], &ids_of[c]);
-    }
-  };
-  // The queue: each worker takes the largest object not yet taken.
-  std::atomic<size_t> next{0};
-  int workers = tbb::this_task_arena::max_concurrency();
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, workers, 1),
-      [&](const tbb::blocked_range<int>&) {
-        for (size_t k; (k = next.fetch_add(1)) < order.size();) build_one(order[k]);
-      },
-      tbb::simple_partitioner());
-  // Buckets: every node of a sphere tree (only leaves are used), one per non-empty centre tree.
+// Object o's photons into its range of the map, and its two trees.
+void build_object_map(std::vector<ObjectPhotonLists*>& per_thread, uint32_t o, bool centre_tree,
+                      BackwardMaps* maps) {
+  BackwardPhoton* dst = maps->photons.data() + maps->object_begin[o];
+  const size_t n = gather_in_space(per_thread, o, dst);
+  // Emptied, keeping their memory for the next iteration's eye pass (the memory budget counts
+  // two copies of every backward photon).
+  for (ObjectPhotonLists* l : per_thread)
+    if (o < l->size()) (*l)[o].clear();
+  // Per class (caustic, indirect), the spheres that accept it, in one pass over the records.
+  std::vector<SphereRef> spheres_of[2];
+  std::vector<uint32_t> ids_of[2];
+  for (int c = 0; c < 2; ++c) {
+    spheres_of[c].reserve(n);
+    ids_of[c].reserve(n);
+  }
+  constexpr uint8_t kAcceptsOf[2] = {kAcceptsCaustic, kAcceptsIndirect};
+  for (size_t k = 0; k < n; ++k) {
+    const BackwardPhoton& bp = dst[k];
+    for (int c = 0; c < 2; ++c)
+      if (bp.accepts & kAcceptsOf[c]) {
+        spheres_of[c].push_back({bp.p, bp.radius});
+        ids_of[c].push_back(maps->object_begin[o] + uint32_t(k));
+      }
+  }
+  for (int c = 0; c < 2; ++c) {
+    if (centre_tree)
+      maps->centre_trees[2 * o + c].build(spheres_of[c], &ids_of[c]);
+    else
+      maps->sphere_trees[2 * o + c].build(spheres_of[c], &ids_of[c]);
+  }
+}
+
+// Buckets: every node of a sphere tree (only leaves are used), one per non-empty centre tree.
+void number_buckets(size_t object_count, bool centre_tree, BackwardMaps* maps) {
   const size_t trees = 2 * object_count;
   maps->first_bucket.assign(trees + 1, 0);
   for (size_t t = 0; t < trees; ++t) {
@@ -176,6 +157,38 @@ void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t obj
         centre_tree ? (maps->centre_trees[t].empty() ? 0 : 1) : maps->sphere_trees[t].node_count();
     maps->first_bucket[t + 1] = maps->first_bucket[t] + n;
   }
+}
+
+}  // namespace
+
+size_t BackwardMaps::tree_bytes() const {
+  size_t b = 0;
+  for (const auto& t : sphere_trees) b += t.bytes();
+  for (const auto& t : centre_trees) b += t.bytes();
+  return b;
+}
+
+void build_backward_maps(std::vector<ObjectPhotonLists*>& per_thread, size_t object_count,
+                         bool centre_tree, BackwardMaps* maps) {
+  lay_out_maps(per_thread, object_count, centre_tree, maps);
+  std::vector<uint32_t> order;
+  for (uint32_t o = 0; o < object_count; ++o)
+    if (maps->has_photons(int(o))) order.push_back(o);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return maps->object_begin[a + 1] - maps->object_begin[a] >
+           maps->object_begin[b + 1] - maps->object_begin[b];
+  });
+  // The queue: each worker takes the largest object not yet taken.
+  std::atomic<size_t> next{0};
+  int workers = tbb::this_task_arena::max_concurrency();
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, workers, 1),
+      [&](const tbb::blocked_range<int>&) {
+        for (size_t k; (k = next.fetch_add(1)) < order.size();)
+          build_object_map(per_thread, order[k], centre_tree, maps);
+      },
+      tbb::simple_partitioner());
+  number_buckets(object_count, centre_tree, maps);
 }
 
 }  // namespace bpm
