@@ -38,6 +38,54 @@ void run_passes_alone(const IntegratorOptions& opt, Film* film, const PassFuncti
   }
 }
 
+// At the end of a round with several processes: what every process learnt is added up and merged,
+// and process 0's control state (its sampling probabilities) goes to every process.
+void end_team_round(Team& team, int passes, const IntegratorState& state, RenderControl& control) {
+  const bool root = team.rank() == 0;
+  if (state.learnt) {
+    std::vector<double> learnt;
+    state.learnt(&learnt);
+    team.sum(&learnt);
+    state.merge(learnt);
+  }
+  if (root) control.end_round(passes);
+  ByteWriter w;
+  if (root) control.save(w);
+  std::vector<uint8_t> c = w.take();
+  team.broadcast(&c);
+  ByteReader r(c, "the render state of process 0");
+  if (!root) control.load(r);
+}
+
+// Ended inside a round: what every process learnt in it goes to process 0's state unmerged, so
+// that its final checkpoint resumes the round as one process would.
+void keep_round_learnt(Team& team, int passes, const IntegratorState& state) {
+  if (!ends_round(passes) && state.learnt && state.keep_learnt) {
+    std::vector<double> learnt;
+    state.learnt(&learnt);
+    team.sum(&learnt);
+    if (team.rank() == 0) state.keep_learnt(learnt);
+  }
+}
+
+// What one process did: passes, rays, and seconds in its passes.
+struct ProcessShare {
+  uint64_t rays = 0;
+  int passes = 0;
+  double seconds = 0;
+};
+
+// Every process's share, in the statistics (the same on every process).
+void record_processes(Team& team, const ProcessShare& mine, RenderStats* stats) {
+  std::vector<std::vector<double>> rows =
+      team.gather({double(mine.passes), double(mine.rays), mine.seconds});
+  for (size_t r = 0; r < rows.size(); ++r)
+    stats->processes.push_back({{"rank", r},
+                                {"passes", int(rows[r][0])},
+                                {"rays", uint64_t(rows[r][1])},
+                                {"pass_seconds", rows[r][2]}});
+}
+
 // run_passes with several processes (integrator/team.h): round by round, each round's passes
 // shared out, then the films gathered, what was learnt added up and merged, and process 0's
 // decisions (sampling probabilities, go on or stop) sent to every process.
@@ -50,9 +98,7 @@ bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
   int passes = stats->passes;  // completed, over every process
   std::string reason, progress;
   bool any_cut = false;
-  uint64_t my_rays = 0;
-  int my_passes = 0;
-  double my_seconds = 0;
+  ProcessShare my;
   for (;;) {
     std::vector<uint8_t> go{uint8_t(root && control.keep_going(passes))};
     team.broadcast(&go);
@@ -70,15 +116,15 @@ bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
         if (!r.completed && reason.empty()) reason = r.stop_reason;
         return false;
       }
-      my_rays = r.rays;
+      my.rays = r.rays;
       progress = r.progress;
       return true;
     });
-    my_seconds += since(t);
-    my_passes += mine;
+    my.seconds += since(t);
+    my.passes += mine;
     // Over every process: completed passes, rays, cut passes, and integrator stop reasons (the
     // one there is: "memory").
-    std::vector<double> counts{double(mine), double(my_rays), double(control.cut_a_pass()),
+    std::vector<double> counts{double(mine), double(my.rays), double(control.cut_a_pass()),
                                double(reason == "memory")};
     team.sum(&counts);
     const int completed = int(counts[0]);
@@ -88,21 +134,7 @@ bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
     const bool cut = completed < end - passes;
     passes += completed;
     stats->passes = passes;
-    if (ends_round(passes)) {
-      if (state.learnt) {
-        std::vector<double> learnt;
-        state.learnt(&learnt);
-        team.sum(&learnt);
-        state.merge(learnt);
-      }
-      if (root) control.end_round(passes);
-      ByteWriter w;
-      if (root) control.save(w);
-      std::vector<uint8_t> c = w.take();
-      team.broadcast(&c);
-      ByteReader r(c, "the render state of process 0");
-      if (!root) control.load(r);
-    }
+    if (ends_round(passes)) end_team_round(team, passes, state, control);
     if (root) {
       control.after_pass(passes - 1, uint64_t(counts[1]), progress);
       if (!cut && control.checkpoint_due()) {
@@ -124,21 +156,8 @@ bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
       break;
     }
   }
-  // Ended inside a round: what every process learnt in it goes to process 0's state unmerged, so
-  // that its final checkpoint resumes the round as one process would.
-  if (!ends_round(passes) && state.learnt && state.keep_learnt) {
-    std::vector<double> learnt;
-    state.learnt(&learnt);
-    team.sum(&learnt);
-    if (root) state.keep_learnt(learnt);
-  }
-  std::vector<std::vector<double>> rows =
-      team.gather({double(my_passes), double(my_rays), my_seconds});
-  for (size_t r = 0; r < rows.size(); ++r)
-    stats->processes.push_back({{"rank", r},
-                                {"passes", int(rows[r][0])},
-                                {"rays", uint64_t(rows[r][1])},
-                                {"pass_seconds", rows[r][2]}});
+  keep_round_learnt(team, passes, state);
+  record_processes(team, my, stats);
   return any_cut;
 }
 
