@@ -337,77 +337,94 @@ Spectrum CoatWalkTable::f(const Spectrum& reflectance, float cos_o, float cos_i)
   return out;
 }
 
-std::shared_ptr<const CoatWalkTable> make_coat_walk_table(const CoatLayer& layer) {
-  if (layer.roughness.alpha_x != layer.roughness.alpha_y) return nullptr;
-  auto t = std::make_shared<CoatWalkTable>();
-  t->layer = layer;
-  t->visits = std::max(0, (layer.max_depth + 1) / 2);
-  const DielectricMaterial top{layer.eta, layer.roughness, nullptr};
-  const bool smooth = top.roughness.effectively_smooth();
-  const float d = layer.thickness;
-  // Radiance transport. In importance transport the way in loses its 1 / eta^2 and the way out
-  // gains it: the product, a reflection's f, is the same.
-  const TransportMode mode = TransportMode::kRadiance;
-  // A smooth coat refracts and reflects deterministically: one point is the integral.
-  const int k = smooth ? 1 : kGrid;
-  tbb::parallel_for(0, CoatWalkTable::kNodes, [&](int j) {
-    const float c = std::max(node_cos(j), 1e-6f);  // node 0 just above grazing
-    const Vec3 w(std::sqrt(std::fmax(0.0f, 1 - c * c)), 0, c);
-    double in_sum = 0, nee_sum = 0, exit_sum = 0, out_usable = 0, enter = 0;
-    const TrowbridgeReitz distribution(top.roughness.alpha_x, top.roughness.alpha_y);
-    for (int iy = 0; iy < k; ++iy)
-      for (int ix = 0; ix < k; ++ix) {
-        float g;
-        const Vec2 u = grid_point(ix, iy, k, &g);
-        // A: into the layer from w, across it to the base (the walk's first steps).
-        auto in = dielectric_sample(top, w, 0.5f, u, mode, kTransmission);
-        if (usable(in)) {
-          in_sum += g * in->f[0] * std::fabs(in->wi.z) / in->pdf_solid_angle *
-                    layer_transmittance(d, in->wi);
-          // The coat's sample of both lobes takes this way in with probability 1 - Fresnel.
-          const float cos_m = smooth ? w.z : dot(w, distribution.sample_wm(w, u));
-          enter += g * (1 - fresnel_dielectric(cos_m, layer.eta));
-        }
-        // B, next-event estimation: the way out toward w presampled from w (adjoint), the base's
-        // f (R / pi, R outside) and the layer on the way; weighted against exits by base sampling
-        // unless the coat is smooth.
-        auto out = dielectric_sample(top, w, 0.5f, u, adjoint(mode), kTransmission);
-        if (usable(out)) {
-          out_usable += g;
-          const float cos_b = std::fabs(out->wi.z);
-          const float wt =
-              smooth ? 1 : power_heuristic(out->pdf_solid_angle, cos_b * float(kInvPi));
-          nee_sum += g * kInvPi * cos_b * wt * layer_transmittance(d, out->wi) /
-                     out->pdf_solid_angle * out->f[0];
-        }
-        if (smooth) continue;
-        // B, exits by base sampling: a cosine direction up from the base (weight R, outside),
-        // through the layer and the coat toward w. Its integrand peaks where the coat's
-        // refraction does (alpha 0.01: a cone of about 0.01 rad), so it is integrated over both
-        // the cosine grid and the coat's own samples, combined by the balance heuristic (either
-        // way the term is p_base g / (p_base + p_coat)).
-        auto exit_term = [&](Vec3 up, float p_coat) {
-          const float f_exit = dielectric_f(top, -up, w, mode)[0];
-          if (!(f_exit > 0)) return 0.0;
-          const float p_base = up.z * float(kInvPi);
-          const float wt = power_heuristic(p_base, dielectric_pdf(top, w, -up, kTransmission));
-          return double(p_base) * f_exit * layer_transmittance(d, up) * wt /
-                 (double(p_base) + p_coat);
-        };
-        const Vec3 up = sample_cosine_hemisphere(u);
-        exit_sum += g * exit_term(up, dielectric_pdf(top, w, -up, kTransmission));
-        if (usable(out) && out->wi.z < 0) exit_sum += g * exit_term(-out->wi, out->pdf_solid_angle);
-      }
-    const double n = double(k) * k;
-    t->a[j] = float(in_sum / n);
-    t->enter[j] = float(enter / n);
-    // The walk skips a sample whose way out cannot be drawn, exits included.
-    t->b[j] = float(nee_sum / n + out_usable / n * exit_sum / n);
-  });
-  // rho: from a cosine direction up from the base, across the layer, reflected by the coat from
-  // inside, back across the layer. Four dimensions (the direction up, the coat's sample): the
-  // points of the R4 sequence (Kronecker steps by powers of 1 / phi_4, phi_4^5 = phi_4 + 1),
-  // summed in fixed chunks so that the sum does not depend on the threads.
+namespace {
+
+// The coat a table is made for, as its integrals see it.
+struct Coat {
+  const DielectricMaterial& top;
+  const CoatLayer& layer;
+  float d;  // the layer's thickness
+  bool smooth;
+  TransportMode mode;
+};
+
+// One node's sums over the grid: A (a, enter) and B (b) of CoatWalkTable.
+struct NodeSums {
+  double in = 0, nee = 0, exit = 0, out_usable = 0, enter = 0;
+};
+
+// A: into the layer from w, across it to the base (the walk's first steps).
+void add_way_in(const Coat& c, const TrowbridgeReitz& distribution, Vec3 w, Vec2 u, float g,
+                NodeSums& sums) {
+  auto in = dielectric_sample(c.top, w, 0.5f, u, c.mode, kTransmission);
+  if (usable(in)) {
+    sums.in +=
+        g * in->f[0] * std::fabs(in->wi.z) / in->pdf_solid_angle * layer_transmittance(c.d, in->wi);
+    // The coat's sample of both lobes takes this way in with probability 1 - Fresnel.
+    const float cos_m = c.smooth ? w.z : dot(w, distribution.sample_wm(w, u));
+    sums.enter += g * (1 - fresnel_dielectric(cos_m, c.layer.eta));
+  }
+}
+
+// B, exits by base sampling: a cosine direction up from the base (weight R, outside), through the
+// layer and the coat toward w. Its integrand peaks where the coat's refraction does (alpha 0.01:
+// a cone of about 0.01 rad), so it is integrated over both the cosine grid and the coat's own
+// samples, combined by the balance heuristic (either way the term is p_base g / (p_base +
+// p_coat)).
+double exit_term(const Coat& c, Vec3 w, Vec3 up, float p_coat) {
+  const float f_exit = dielectric_f(c.top, -up, w, c.mode)[0];
+  if (!(f_exit > 0)) return 0.0;
+  const float p_base = up.z * float(kInvPi);
+  const float wt = power_heuristic(p_base, dielectric_pdf(c.top, w, -up, kTransmission));
+  return double(p_base) * f_exit * layer_transmittance(c.d, up) * wt / (double(p_base) + p_coat);
+}
+
+// B: out of the layer toward w, by next-event estimation and (unless the coat is smooth) by exits
+// of base sampling.
+void add_way_out(const Coat& c, Vec3 w, Vec2 u, float g, NodeSums& sums) {
+  // B, next-event estimation: the way out toward w presampled from w (adjoint), the base's
+  // f (R / pi, R outside) and the layer on the way; weighted against exits by base sampling
+  // unless the coat is smooth.
+  auto out = dielectric_sample(c.top, w, 0.5f, u, adjoint(c.mode), kTransmission);
+  if (usable(out)) {
+    sums.out_usable += g;
+    const float cos_b = std::fabs(out->wi.z);
+    const float wt = c.smooth ? 1 : power_heuristic(out->pdf_solid_angle, cos_b * float(kInvPi));
+    sums.nee += g * kInvPi * cos_b * wt * layer_transmittance(c.d, out->wi) / out->pdf_solid_angle *
+                out->f[0];
+  }
+  if (c.smooth) return;
+  const Vec3 up = sample_cosine_hemisphere(u);
+  sums.exit += g * exit_term(c, w, up, dielectric_pdf(c.top, w, -up, kTransmission));
+  if (usable(out) && out->wi.z < 0)
+    sums.exit += g * exit_term(c, w, -out->wi, out->pdf_solid_angle);
+}
+
+// Node j of the table (a, enter, b) from a k x k grid of points.
+void fill_node(const Coat& c, int k, int j, CoatWalkTable* t) {
+  const float cos_w = std::max(node_cos(j), 1e-6f);  // node 0 just above grazing
+  const Vec3 w(std::sqrt(std::fmax(0.0f, 1 - cos_w * cos_w)), 0, cos_w);
+  NodeSums sums;
+  const TrowbridgeReitz distribution(c.top.roughness.alpha_x, c.top.roughness.alpha_y);
+  for (int iy = 0; iy < k; ++iy)
+    for (int ix = 0; ix < k; ++ix) {
+      float g;
+      const Vec2 u = grid_point(ix, iy, k, &g);
+      add_way_in(c, distribution, w, u, g, sums);
+      add_way_out(c, w, u, g, sums);
+    }
+  const double n = double(k) * k;
+  t->a[j] = float(sums.in / n);
+  t->enter[j] = float(sums.enter / n);
+  // The walk skips a sample whose way out cannot be drawn, exits included.
+  t->b[j] = float(sums.nee / n + sums.out_usable / n * sums.exit / n);
+}
+
+// rho: from a cosine direction up from the base, across the layer, reflected by the coat from
+// inside, back across the layer. Four dimensions (the direction up, the coat's sample): the
+// points of the R4 sequence (Kronecker steps by powers of 1 / phi_4, phi_4^5 = phi_4 + 1),
+// summed in fixed chunks so that the sum does not depend on the threads.
+float coat_rho(const Coat& c) {
   constexpr int kChunks = 64, kChunk = 4096;
   constexpr double kPhi4 = 1.1673039782614187;
   const double step[4] = {1 / kPhi4, 1 / (kPhi4 * kPhi4), 1 / (kPhi4 * kPhi4 * kPhi4),
@@ -421,15 +438,33 @@ std::shared_ptr<const CoatWalkTable> make_coat_walk_table(const CoatLayer& layer
         x[i] = float(v - std::floor(v));
       }
       const Vec3 up = sample_cosine_hemisphere({x[0], x[1]});
-      auto r = dielectric_sample(top, -up, 0.5f, {x[2], x[3]}, mode, kReflection);
+      auto r = dielectric_sample(c.top, -up, 0.5f, {x[2], x[3]}, c.mode, kReflection);
       if (usable(r))
-        rho_sums[chunk] += layer_transmittance(d, up) * r->f[0] * std::fabs(r->wi.z) /
-                           r->pdf_solid_angle * layer_transmittance(d, r->wi);
+        rho_sums[chunk] += layer_transmittance(c.d, up) * r->f[0] * std::fabs(r->wi.z) /
+                           r->pdf_solid_angle * layer_transmittance(c.d, r->wi);
     }
   });
   double rho_sum = 0;
   for (double s : rho_sums) rho_sum += s;
-  t->rho = float(rho_sum / (double(kChunks) * kChunk));
+  return float(rho_sum / (double(kChunks) * kChunk));
+}
+
+}  // namespace
+
+std::shared_ptr<const CoatWalkTable> make_coat_walk_table(const CoatLayer& layer) {
+  if (layer.roughness.alpha_x != layer.roughness.alpha_y) return nullptr;
+  auto t = std::make_shared<CoatWalkTable>();
+  t->layer = layer;
+  t->visits = std::max(0, (layer.max_depth + 1) / 2);
+  const DielectricMaterial top{layer.eta, layer.roughness, nullptr};
+  const bool smooth = top.roughness.effectively_smooth();
+  // Radiance transport. In importance transport the way in loses its 1 / eta^2 and the way out
+  // gains it: the product, a reflection's f, is the same.
+  const Coat coat{top, layer, layer.thickness, smooth, TransportMode::kRadiance};
+  // A smooth coat refracts and reflects deterministically: one point is the integral.
+  const int k = smooth ? 1 : kGrid;
+  tbb::parallel_for(0, CoatWalkTable::kNodes, [&](int j) { fill_node(coat, k, j, t.get()); });
+  t->rho = coat_rho(coat);
   for (int j = 0; j < CoatWalkTable::kNodes; ++j)
     if (!std::isfinite(t->a[j]) || !std::isfinite(t->b[j]) || !std::isfinite(t->enter[j]))
       return nullptr;
