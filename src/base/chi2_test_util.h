@@ -186,16 +186,11 @@ double integrate_cell(const Options& o, Pdf& pdf, int i, int j, int s) {
   return sum * dz * dphi;
 }
 
-// sample(Rng&) -> std::optional<Vec3>; pdf(Vec3) -> double (solid-angle density).
-template <class Sampler, class Pdf>
-Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
-  Result r;
-  const int n_cells = o.n_cos * o.n_phi;
-  const double n = double(o.n_samples);
-  r.alpha_per_test = sidak_alpha(o.alpha, o.n_tests);
-
-  // Histogram.
-  std::vector<double> observed(n_cells, 0.0);
+// Histogram of n_samples directions drawn by sample(Rng&) from one stream of `seed`; counts the
+// valid and the non-unit directions in r.
+template <class Sampler>
+std::vector<double> histogram(Sampler& sample, uint64_t seed, const Options& o, Result& r) {
+  std::vector<double> observed(o.n_cos * o.n_phi, 0.0);
   Rng rng(seed);
   for (long long k = 0; k < o.n_samples; ++k) {
     std::optional<Vec3> w = sample(rng);
@@ -207,35 +202,48 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
     ++r.n_valid;
     observed[cos_cell(o, w->z) * o.n_phi + phi_cell(o, *w)] += 1;
   }
+  return observed;
+}
 
-  // Expected counts.
-  std::vector<double> expected(n_cells);
-  double mass_half = 0;
+// Expected counts per cell of n samples, and the pdf's integral over the sphere in r.pdf_mass;
+// *mass_half: that integral at half the resolution.
+template <class Pdf>
+std::vector<double> expected_counts(Pdf& pdf, double n, const Options& o, Result& r,
+                                    double* mass_half) {
+  std::vector<double> expected(o.n_cos * o.n_phi);
   for (int i = 0; i < o.n_cos; ++i)
     for (int j = 0; j < o.n_phi; ++j) {
       double m = integrate_cell(o, pdf, i, j, o.sub);
       expected[i * o.n_phi + j] = m * n;
       r.pdf_mass += m;
-      mass_half += integrate_cell(o, pdf, i, j, std::max(1, o.sub / 2));
+      *mass_half += integrate_cell(o, pdf, i, j, std::max(1, o.sub / 2));
     }
-  for (int c = 0; c < n_cells; ++c)
-    if (expected[c] == 0) r.n_in_zero_cells += (long long)observed[c];
+  return expected;
+}
 
-  // Mass check: n_valid is binomial(n, pdf_mass) when the pdf is right; allow 5 standard
-  // deviations of that, twice the integration error estimate (the difference between the two
-  // resolutions, doubled because across discontinuities the error does not shrink monotonically)
-  // and 1e-5 for the float rounding of pdf values.
+// Mass check: n_valid is binomial(n, pdf_mass) when the pdf is right; allow 5 standard
+// deviations of that, twice the integration error estimate (the difference between the two
+// resolutions, doubled because across discontinuities the error does not shrink monotonically)
+// and 1e-5 for the float rounding of pdf values.
+inline void check_mass(double n, double mass_half, Result& r) {
   r.sample_mass = double(r.n_valid) / n;
   double pm = std::clamp(r.pdf_mass, 0.0, 1.0);
   r.mass_tolerance =
       5 * std::sqrt(pm * (1 - pm) / n) + 2 * std::fabs(r.pdf_mass - mass_half) + 1e-5;
   r.mass_mismatch = std::fabs(r.sample_mass - r.pdf_mass) > r.mass_tolerance;
+}
 
-  // Categories: cells plus "sampler failed".
+// The statistic over the categories (cells plus "sampler failed"), those with small expected
+// counts pooled, and its p-value, in r. Returns each unpooled category's contribution with its
+// cell (-1: the failures), for the report.
+inline std::vector<std::pair<double, int>> pooled_statistic(const std::vector<double>& expected,
+                                                            const std::vector<double>& observed,
+                                                            double n, const Options& o, Result& r) {
   struct Cat {
     double e, o;
     int cell;
   };
+  const int n_cells = int(expected.size());
   std::vector<Cat> cats;
   cats.reserve(n_cells + 1);
   for (int c = 0; c < n_cells; ++c) cats.push_back({expected[c], observed[c], c});
@@ -274,13 +282,20 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
   r.statistic = stat;
   r.dof = k - 1;
   r.p_value = r.dof >= 1 ? chi2_survival(stat, r.dof) : 0.0;
+  return contributions;
+}
 
+// The report: the outcome, then the six categories that contribute most.
+inline std::string report(const Result& r, std::vector<std::pair<double, int>> contributions,
+                          const std::vector<double>& expected, const std::vector<double>& observed,
+                          double n, const Options& o) {
   std::ostringstream os;
-  os << "chi2 = " << stat << ", dof = " << r.dof << ", p = " << r.p_value << " (reject below "
-     << r.alpha_per_test << "), pooled " << r.pooled_in << " categories into " << r.pooled_out
-     << "; sample mass " << r.sample_mass << " vs pdf mass " << r.pdf_mass << " (tolerance "
-     << r.mass_tolerance << (r.mass_mismatch ? ", MISMATCH" : "") << "); " << r.n_not_unit
-     << " non-unit directions; " << r.n_in_zero_cells << " samples in cells of zero pdf\n";
+  os << "chi2 = " << r.statistic << ", dof = " << r.dof << ", p = " << r.p_value
+     << " (reject below " << r.alpha_per_test << "), pooled " << r.pooled_in << " categories into "
+     << r.pooled_out << "; sample mass " << r.sample_mass << " vs pdf mass " << r.pdf_mass
+     << " (tolerance " << r.mass_tolerance << (r.mass_mismatch ? ", MISMATCH" : "") << "); "
+     << r.n_not_unit << " non-unit directions; " << r.n_in_zero_cells
+     << " samples in cells of zero pdf\n";
   std::sort(contributions.begin(), contributions.end(),
             [](auto& a, auto& b) { return a.first > b.first; });
   for (size_t q = 0; q < std::min<size_t>(6, contributions.size()); ++q) {
@@ -296,7 +311,24 @@ Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
        << "): observed " << observed[c] << ", expected " << expected[c] << ", contribution "
        << contributions[q].first << "\n";
   }
-  r.report = os.str();
+  return os.str();
+}
+
+// sample(Rng&) -> std::optional<Vec3>; pdf(Vec3) -> double (solid-angle density).
+template <class Sampler, class Pdf>
+Result run(Sampler&& sample, Pdf&& pdf, uint64_t seed, const Options& o = {}) {
+  Result r;
+  const double n = double(o.n_samples);
+  r.alpha_per_test = sidak_alpha(o.alpha, o.n_tests);
+  const std::vector<double> observed = histogram(sample, seed, o, r);
+  double mass_half = 0;
+  const std::vector<double> expected = expected_counts(pdf, n, o, r, &mass_half);
+  for (size_t c = 0; c < expected.size(); ++c)
+    if (expected[c] == 0) r.n_in_zero_cells += (long long)observed[c];
+  check_mass(n, mass_half, r);
+  const std::vector<std::pair<double, int>> contributions =
+      pooled_statistic(expected, observed, n, o, r);
+  r.report = report(r, contributions, expected, observed, n, o);
   return r;
 }
 
