@@ -833,7 +833,15 @@ void check_emission(const char* name, const Light& light, const Shape* shape,
         << name << " channel " << c;
 }
 
-TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
+// The photon starts outside the bounding sphere, heading through it.
+void expect_crosses_scene(const LightLeSample& s) {
+  Vec3 oc = kBounds.center - s.origin;
+  float along = dot(oc, s.direction);
+  EXPECT_GE(length(oc), kBounds.radius * 0.999f);
+  EXPECT_LE(length(oc - s.direction * along), kBounds.radius * 1.0001f);
+}
+
+TEST(LightSampleLe, MeanFluxIsPowerForPointSpotDistantAndInfiniteLights) {
   check_emission("point", Light(PointLight{Vec3(1, 2, 3), kL}), nullptr,
                  [](const LightLeSample& s) { EXPECT_EQ(length(s.origin - Vec3(1, 2, 3)), 0.0f); });
   SpotLight spot = make_spot();
@@ -841,19 +849,16 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     EXPECT_GE(dot(s.direction, spot.frame.n), spot.cos_falloff_end - 1e-5f);
   });
   Vec3 to_light = normalize(Vec3(0.3f, 1, -0.2f));
-  auto crosses_scene = [](const LightLeSample& s) {
-    // The photon starts outside the bounding sphere, heading through it.
-    Vec3 oc = kBounds.center - s.origin;
-    float along = dot(oc, s.direction);
-    EXPECT_GE(length(oc), kBounds.radius * 0.999f);
-    EXPECT_LE(length(oc - s.direction * along), kBounds.radius * 1.0001f);
-  };
   check_emission("distant", Light(DistantLight{to_light, kL}), nullptr,
                  [&](const LightLeSample& s) {
                    EXPECT_NEAR(dot(s.direction, to_light), -1.0f, 1e-5f);
-                   crosses_scene(s);
+                   expect_crosses_scene(s);
                  });
-  check_emission("uniform infinite", Light(UniformInfiniteLight{kL}), nullptr, crosses_scene);
+  check_emission("uniform infinite", Light(UniformInfiniteLight{kL}), nullptr,
+                 expect_crosses_scene);
+}
+
+TEST(LightSampleLe, MeanFluxIsPowerForTriangleLights) {
   for (bool two_sided : {false, true}) {
     Shape tri = make_triangle();
     AreaLight l = make_area_light(tri, two_sided);
@@ -869,6 +874,9 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     else
       EXPECT_EQ(back, 0);
   }
+}
+
+TEST(LightSampleLe, MeanFluxOfImageInfiniteLightIsItsFluxThroughTheScene) {
   for (bool equal_area : {true, false}) {
     ImageInfiniteLight im = make_image_light(equal_area);
     // The flux of an environment light through the scene's disk: its integrated radiance times
@@ -881,7 +889,7 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
                                {rng.uniform(), rng.uniform()}, kBounds, kWl);
       for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
       if (!s) continue;
-      crosses_scene(*s);
+      expect_crosses_scene(*s);
       // The photon travels away from the direction whose radiance it carries.
       Spectrum L = environment_radiance(light, -s->direction, kWl);
       EXPECT_GT(L[0], 0.0f);
@@ -890,39 +898,43 @@ TEST(LightSampleLe, MeanFluxIsPowerForEveryLight) {
     for (int c = 0; c < Spectrum::kChannels; ++c)
       expect_mean(est[c], expected[c], 0, equal_area ? "image equal-area" : "image lat-long");
   }
-  {
-    // An image area light: the flux is pi A times the mean texel radiance.
-    Shape tri = make_triangle();
-    AreaLight l = make_area_light(tri, false);
-    auto im = gradient_image(4, 4);
-    l.image = im;
-    l.image_scale = 1.5f;
-    l.image_mean = Rgb(0.0f);
-    for (int y = 0; y < 4; ++y)
-      for (int x = 0; x < 4; ++x) l.image_mean += im->texel(x, y, TexWrap::kClamp) / 16.0f;
-    Rng rng(91);
-    MeanAccumulator est[Spectrum::kChannels], radiance[Spectrum::kChannels];
-    for (int k = 0; k < 200000; ++k) {
-      auto s = light_sample_le(Light(l), &tri, {rng.uniform(), rng.uniform()},
-                               {rng.uniform(), rng.uniform()}, kBounds, kWl);
-      for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
-    }
-    // The mean radiance over the triangle by uniform points, against the flux over pi A.
-    for (int k = 0; k < 200000; ++k) {
-      float su = std::sqrt(rng.uniform()), v = rng.uniform();
-      SurfacePoint sp = surface_point(tri, 0, {su * (1 - v), su * v}, {});
-      Spectrum L = area_light_radiance(l, sp.ng, sp.uv, sp.ng, kWl);
-      for (int c = 0; c < Spectrum::kChannels; ++c) radiance[c].add(L[c]);
-    }
-    for (int c = 0; c < Spectrum::kChannels; ++c) {
-      double flux_over = est[c].mean / (M_PI * l.area);
-      EXPECT_NEAR(flux_over, radiance[c].mean,
-                  4 * (est[c].standard_error() / (M_PI * l.area) + radiance[c].standard_error()));
-    }
-    Rgb power = light_power(Light(l), kBounds);
-    for (int c = 0; c < 3; ++c)
-      EXPECT_NEAR(power[c], l.image_mean[c] * 1.5f * kPi * l.area, 1e-4f * power[c]);
+}
+
+TEST(LightSampleLe, MeanFluxOfImageAreaLightIsPiATimesMeanRadiance) {
+  // An image area light: the flux is pi A times the mean texel radiance.
+  Shape tri = make_triangle();
+  AreaLight l = make_area_light(tri, false);
+  auto im = gradient_image(4, 4);
+  l.image = im;
+  l.image_scale = 1.5f;
+  l.image_mean = Rgb(0.0f);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) l.image_mean += im->texel(x, y, TexWrap::kClamp) / 16.0f;
+  Rng rng(91);
+  MeanAccumulator est[Spectrum::kChannels], radiance[Spectrum::kChannels];
+  for (int k = 0; k < 200000; ++k) {
+    auto s = light_sample_le(Light(l), &tri, {rng.uniform(), rng.uniform()},
+                             {rng.uniform(), rng.uniform()}, kBounds, kWl);
+    for (int c = 0; c < Spectrum::kChannels; ++c) est[c].add(s ? double(s->flux[c]) : 0.0);
   }
+  // The mean radiance over the triangle by uniform points, against the flux over pi A.
+  for (int k = 0; k < 200000; ++k) {
+    float su = std::sqrt(rng.uniform()), v = rng.uniform();
+    SurfacePoint sp = surface_point(tri, 0, {su * (1 - v), su * v}, {});
+    Spectrum L = area_light_radiance(l, sp.ng, sp.uv, sp.ng, kWl);
+    for (int c = 0; c < Spectrum::kChannels; ++c) radiance[c].add(L[c]);
+  }
+  for (int c = 0; c < Spectrum::kChannels; ++c) {
+    double flux_over = est[c].mean / (M_PI * l.area);
+    EXPECT_NEAR(flux_over, radiance[c].mean,
+                4 * (est[c].standard_error() / (M_PI * l.area) + radiance[c].standard_error()));
+  }
+  Rgb power = light_power(Light(l), kBounds);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(power[c], l.image_mean[c] * 1.5f * kPi * l.area, 1e-4f * power[c]);
+}
+
+TEST(LightSampleLe, MeanFluxIsPowerForSphereAndCylinderLights) {
   Shape sphere = make_sphere(Vec3(1, 2, 3), 0.5f);
   check_emission("sphere", Light(make_area_light(sphere, false)), &sphere,
                  [&](const LightLeSample& s) {
