@@ -79,51 +79,37 @@ inline Spectrum direct_light_at(const FpmPath& path, const PathVertex& v, const 
                                       part);
 }
 
-// The gathers at one diffuse vertex, adding their estimates to L and bias. The discs about v are
-// probed where they may be cut: at a vertex seen straight from the camera, where the screen
-// around the pixel shows an edge (near_bit of near_edge). A disc no larger than one found whole is
-// whole too.
-struct VertexGathers {
-  const FpmPath& path;
-  const PathVertex& v;
-  const PathState& s;
-  int depth;
-  Spectrum& L;
-  Spectrum& bias;
-  float whole_radius = 0;
-
-  template <class Accept>
-  void gather(const PhotonMap& map, float radius, uint8_t near_bit, Accept accept) {
-    const bool seen_directly = depth == 1;
-    auto probe = [&](float r) {
-      if (!path.prm.fpm->disc_probes || r <= whole_radius ||
-          (seen_directly && !(path.near_edge & near_bit)) ||
-          !may_cut_discs(path.scene.objects[size_t(v.object())].shape))
-        return DiscProbes{};
-      const DiscProbes d =
-          probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject, r,
-                     path.prm.fpm->normal_cos, path.rng, path.c.rays, v.hit.primitive);
-      if (!d.cut) whole_radius = r;
-      return d;
-    };
-    const Estimate e =
-        estimate(map, v, s.hero_only, radius, depth, path.prm, accept, probe, path.c);
-    L += s.beta * e.L;
-    bias += s.beta * e.bias;
-  }
-};
-
 // A diffuse vertex: x1 (`gathering` false) or, with final gathering, x2. Returns whether the path
 // ends here; sets `gathering` when a final gather leaves x1.
 inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, const PathState& s,
                                      const EyeVertexChoice& choice, int depth, bool& gathering,
                                      Spectrum& L, Spectrum& bias) {
   const FpmEyeParams& prm = path.prm;
-  VertexGathers at{path, v, s, depth, L, bias};
+  // The discs about v are probed where they may be cut: at a vertex seen straight from the
+  // camera, where the screen around the pixel shows an edge (near_bit of near_edge). A disc no
+  // larger than one found whole is whole too.
+  const bool seen_directly = depth == 1;
+  float whole_radius = 0;
+  auto gather = [&](const PhotonMap& map, float radius, uint8_t near_bit, auto accept) {
+    auto probe = [&](float r) {
+      if (!prm.fpm->disc_probes || r <= whole_radius ||
+          (seen_directly && !(path.near_edge & near_bit)) ||
+          !may_cut_discs(path.scene.objects[size_t(v.object())].shape))
+        return DiscProbes{};
+      const DiscProbes d =
+          probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject, r,
+                     prm.fpm->normal_cos, path.rng, path.c.rays, v.hit.primitive);
+      if (!d.cut) whole_radius = r;
+      return d;
+    };
+    const Estimate e = estimate(map, v, s.hero_only, radius, depth, prm, accept, probe, path.c);
+    L += s.beta * e.L;
+    bias += s.beta * e.bias;
+  };
   float r1 = s.length * prm.radius_per_length1;
   if (gathering) {
     // x2: everything the global map holds, direct photons included.
-    at.gather(path.maps.global, r1, 1, any_class);
+    gather(path.maps.global, r1, 1, any_class);
     return true;
   }
   // x1: direct light by next-event estimation, shared by MIS with the BSDF sample that leaves
@@ -133,12 +119,12 @@ inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, c
   // Without final gathering the larger disc first (r1 > r0 by default): where it is whole,
   // the caustic map's is too. The path ends here: its BSDF sample only looks for the light.
   if (!prm.fpm->final_gather) {
-    at.gather(path.maps.global, r1, 1, indirect_class);
-    at.gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+    gather(path.maps.global, r1, 1, indirect_class);
+    gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
     L += direct_light_by_bsdf(path.scene, *prm.materials, v, s, choice.part, path.rng, path.c.rays);
     return true;
   }
-  at.gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+  gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
   gathering = true;
   return false;
 }
