@@ -371,7 +371,7 @@ void add_way_in(const Coat& c, const TrowbridgeReitz& distribution, Vec3 w, Vec2
 // a cone of about 0.01 rad), so it is integrated over both the cosine grid and the coat's own
 // samples, combined by the balance heuristic (either way the term is p_base g / (p_base +
 // p_coat)).
-double exit_term(const Coat& c, Vec3 w, Vec3 up, float p_coat) {
+inline double exit_term(const Coat& c, Vec3 w, Vec3 up, float p_coat) {
   const float f_exit = dielectric_f(c.top, -up, w, c.mode)[0];
   if (!(f_exit > 0)) return 0.0;
   const float p_base = up.z * float(kInvPi);
