@@ -3,7 +3,7 @@
 // thread (rate / (P T rate_1x1)). Prints figures; never fails.
 //   scaling [--scene FILE] [--integrator bpm] [--iterations N] [--res WxH] [--cores C]
 //           [--oversubscribe]
-// The figure the README quotes on 2 cores is 2 processes x 1 thread against 1 process x 2
+// The figure docs/MEASUREMENTS.md quotes on 2 cores is 2 processes x 1 thread against 1 process x 2
 // threads. Each configuration runs the same iterations with the same seed, so every run renders
 // the same image; the rate is iterations over the JSON's render seconds (start-up and writing the
 // outputs left out). Rounds (integrator/control.h) of one pass at first keep the other processes

@@ -11,7 +11,7 @@ namespace bpm {
 struct BpmSettings : PhotonSettings {
   // D of DESIGN.md: diffuse vertices an eye path passes before its last backward photon (0..3).
   // 0 by default: at equal time its error is lower than with 1 on every scene of bench/equal_time
-  // (README, "Choosing the diffuse depth").
+  // (docs/MEASUREMENTS.md, "Diffuse depth").
   int diffuse_depth = 0;
   // Use the kd-tree over sphere centres (range search with the largest radius) instead of the
   // kd-tree over whole integration spheres; for measuring the paper's claim (section 2).

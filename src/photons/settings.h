@@ -50,7 +50,7 @@ inline const char* to_string(RadiusPolicy p) {
 // Photons per iteration for an image of `pixels` pixels: the count set, or by default 100000 per
 // 256x256 pixels and at least 100000. A backward photon's radius is a few pixel footprints, so
 // this keeps the photons one finds per iteration, and with them the balance of eye and light
-// work, the same at every resolution (README, "Photons per iteration").
+// work, the same at every resolution (docs/MEASUREMENTS.md, "Photons per iteration").
 int photons_for(const PhotonSettings& s, size_t pixels);
 
 // Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.
