@@ -148,10 +148,12 @@ bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
     team.broadcast(&stop);
     if (stop[0]) {
       if (root) {
-        if (reason.empty())
-          control.keep_going(passes);
-        else
+        if (!reason.empty())
           control.stop(reason);
+        else if (control.keep_going(passes))
+          // Process 0 sees no budget reached: another process's clock (each keeps its own) ran
+          // out first, or it was interrupted.
+          control.stop(opt.time_limit_s > 0 ? "time" : "interrupted");
       }
       break;
     }
