@@ -187,6 +187,24 @@ struct StageSeconds {
   double parse, build, write;
 };
 
+// What each channel of OUT.exr holds, in which unit (docs/USAGE.md, Outputs).
+nlohmann::json image_units(bool bias) {
+  const char* image =
+      "linear sRGB of the spectral radiance times settings.imaging_ratio (iso / 100 "
+      "x shutter time), as pbrt-v4's rgb film";
+  nlohmann::json u = {{"R, G, B", image},
+                      {"rms.R, rms.G, rms.B, rms, rms_m_images*", "the image's"},
+                      {"Y", "cd/m^2 (luminance, without the imaging ratio)"},
+                      {"rms.Y", "cd/m^2"},
+                      {"passes", "samples"},
+                      {"result.relative_error_delta*", "relative (0.01 is 1%)"}};
+  if (bias) {
+    u["bias.R, bias.G, bias.B, total_error.R, total_error.G, total_error.B"] = "the image's";
+    u["bias.Y, total_error.Y"] = "cd/m^2";
+  }
+  return u;
+}
+
 // The JSON record of a finished render: how the image was made and what it cost.
 nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt,
                           const RenderStats& st, const Film& film, const OutputPaths& paths,
@@ -230,6 +248,11 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                    {"relative_error_delta_luminance", film.relative_error_luminance()},
                    {"m_images", film.m_images()},
                    {"relative_error_delta_m_images", film.relative_error_m_images()}};
+  const std::vector<float> y = film.luminance_image();
+  double y_sum = 0;
+  for (float v : y) y_sum += v;
+  rec["result"]["luminance_mean_cd_per_m2"] = y.empty() ? 0.0 : y_sum / double(y.size());
+  rec["units"] = image_units(film.has_bias());
   rec["rays"] = {
       {"camera", st.rays.camera_rays},
       {"bounce", st.rays.bounce_rays},

@@ -47,6 +47,7 @@ struct Tables {
   std::vector<float> d65;                        // unit-luminance D65
   std::vector<std::array<float, 3>> rgb_weight;  // sRGB of a unit spike at lambda, white balanced
   std::vector<std::array<float, 3>> rgb_weight_d65;  // the same times D65: a reflectance's colour
+  std::vector<float> luminance_weight;               // ybar / its integral
   // rgb_weight_d65 gathered onto nodes every kNodeStep nm (each 1 nm weight split between its two
   // nodes linearly): the exact colour of the spectrum that is linear between the nodes.
   static constexpr int kNodeStep = 5, kNodes = (kTableSize - 1) / kNodeStep + 1;
@@ -56,6 +57,7 @@ struct Tables {
     d65.resize(kTableSize);
     rgb_weight.resize(kTableSize);
     rgb_weight_d65.resize(kTableSize);
+    luminance_weight.resize(kTableSize);
     double d65_y = 0, white_xyz[3] = {0, 0, 0};
     for (int i = 0; i < kTableSize; ++i) {
       double l = kLambdaMin + i;
@@ -63,6 +65,8 @@ struct Tables {
       d65_y += d65_raw(l) * cie_y(float(l));
     }
     d65_scale = y_integral / d65_y;
+    for (int i = 0; i < kTableSize; ++i)
+      luminance_weight[i] = float(cie_y(float(kLambdaMin + i)) / y_integral);
     for (int i = 0; i < kTableSize; ++i) {
       double l = kLambdaMin + i;
       d65[i] = float(d65_raw(l) * d65_scale);
@@ -215,6 +219,17 @@ Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl) {
     for (int c = 0; c < 3; ++c) out[c] += w[c] * s;
   }
   return out;
+}
+
+float spectrum_to_luminance(const Spectrum& L, const Wavelengths& wl) {
+  const Tables& t = tables();
+  float y = 0;
+  for (int i = 0; i < Spectrum::kChannels; ++i) {
+    if (L[i] == 0 || wl.pdf[i] == 0) continue;
+    y += lerp_table(t.luminance_weight, wl.lambda[i], mix_float) * L[i] /
+         (wl.pdf[i] * Spectrum::kChannels);
+  }
+  return y;
 }
 
 float sigmoid_spectrum(const std::array<float, 3>& c, float lambda) {

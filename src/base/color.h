@@ -44,6 +44,10 @@ float wavelength_pdf(float lambda);
 // Linear sRGB of the Monte Carlo estimate L at the wavelengths wl (the film's sensor, pbrt-v4's
 // "cie1931").
 Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl);
+// The photopic luminance of the estimate L: the integral of L times the CIE 1931 ybar over that of
+// ybar, with no white balance. Light stated in pbrt-v4's photometric terms (a light's "power" in
+// lumens, "illuminance" in lux, a spectrum normalised to unit luminance) gives it in cd/m^2.
+float spectrum_to_luminance(const Spectrum& L, const Wavelengths& wl);
 
 // How a stated colour is read (as pbrt-v4's SpectrumType): reflectances are bounded by 1,
 // unbounded values (eta, k) may be anything non-negative, illuminants are emission spectra.

@@ -64,7 +64,37 @@ std::vector<float> Film::rms() const {
   std::vector<float> out(pixels_.size(), 0.0f);
   for_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
-    out[i] = standard_error(p.sum_y, p.sum_y2, p.passes);
+    out[i] = standard_error(p.sum_e[kY], p.sum_e2[kY], p.passes);
+  });
+  return out;
+}
+
+std::vector<float> Film::luminance_image() const {
+  std::vector<float> out(pixels_.size(), 0.0f);
+  for_pixels(pixels_.size(), [&](size_t i) {
+    const Pixel& p = pixels_[i];
+    if (p.sum_w != 0) out[i] = float(p.sum_wl[kY] / p.sum_w);
+  });
+  return out;
+}
+
+std::vector<float> Film::bias_luminance() const {
+  std::vector<float> out(pixels_.size(), 0.0f);
+  for (size_t i = 0; i < pixels_.size(); ++i) {
+    const Pixel& p = pixels_[i];
+    if (p.bias_passes > 0) out[i] = float(p.sum_b[kY] / p.bias_passes);
+  }
+  return out;
+}
+
+std::vector<float> Film::total_rms_luminance() const {
+  std::vector<float> out = rms();
+  for_pixels(pixels_.size(), [&](size_t i) {
+    const Pixel& p = pixels_[i];
+    if (p.bias_passes == 0) return;
+    const double b = p.sum_b[kY] / p.bias_passes;
+    const double se = standard_error(p.sum_b[kY], p.sum_b2[kY], p.bias_passes);
+    out[i] = float(std::sqrt(double(out[i]) * out[i] + std::fmax(0.0, b * b - se * se)));
   });
   return out;
 }
@@ -169,7 +199,7 @@ double Film::relative_error_luminance() const {
   for (size_t i = 0; i < pixels_.size(); ++i) {
     const Pixel& p = pixels_[i];
     if (p.passes == 0) continue;
-    double mean = p.sum_y / p.passes;
+    double mean = p.sum_e[kY] / p.passes;
     num += double(r[i]) * r[i];
     den += mean * mean;
   }
@@ -243,7 +273,7 @@ void Film::add(const Film& o) {
   for (size_t i = 0; i < pixels_.size(); ++i) {
     Pixel& p = pixels_[i];
     const Pixel& q = o.pixels_[i];
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < kChannels; ++c) {
       p.sum_wl[c] += q.sum_wl[c];
       p.sum_e[c] += q.sum_e[c];
       p.sum_e2[c] += q.sum_e2[c];
@@ -251,8 +281,6 @@ void Film::add(const Film& o) {
       p.sum_b2[c] += q.sum_b2[c];
     }
     p.sum_w += q.sum_w;
-    p.sum_y += q.sum_y;
-    p.sum_y2 += q.sum_y2;
     p.passes += q.passes;
     p.lit_passes += q.lit_passes;
     p.dropped += q.dropped;

@@ -1,7 +1,9 @@
 // Per-pixel accumulation of weighted radiance samples. A pixel is only ever written by the thread
-// rendering it, so no atomics are needed. Alongside the weighted sums, the film keeps per pixel the
-// sum and sum of squares of per-pass luminance estimates, from which the error estimate of the
-// paper's eq. (5) follows.
+// rendering it, so no atomics are needed. A film records four channels: the colour (linear sRGB,
+// R G B) and the photopic luminance Y, computed from the sample's wavelengths (cd/m^2 when the
+// scene states its light in pbrt-v4's photometric terms). Alongside the weighted sums, the film
+// keeps per pixel and channel the sum and sum of squares of the per-pass estimates, from which the
+// error estimate of the paper's eq. (5) follows.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -26,16 +28,25 @@ struct Image {
 // pixel.
 inline bool recordable(const Spectrum& L) { return L.is_finite() && !L.has_negative(); }
 
-// The colour a film records for a sample with radiance L at wavelengths wl: linear sRGB, with the
-// largest channel clamped to max_value (pbrt-v4's maxcomponentvalue); black unless recordable(L).
-// Colours may have negative channels: a single sample's few wavelengths can lie outside the sRGB
-// gamut.
-inline Rgb film_rgb(const Spectrum& L, const Wavelengths& wl, float max_value) {
-  if (!recordable(L)) return Rgb();
-  Rgb c = spectrum_to_rgb(L, wl);
-  float m = c.max_component();
-  if (m > max_value) c *= max_value / m;
-  return c;
+// What a film records of one sample: its colour and its luminance.
+struct FilmSample {
+  Rgb rgb;
+  float luminance = 0;
+};
+
+// The sample a film records for radiance L at wavelengths wl: linear sRGB and the luminance, both
+// scaled down when the largest colour channel exceeds max_value (pbrt-v4's maxcomponentvalue);
+// black unless recordable(L). Colours may have negative channels: a single sample's few
+// wavelengths can lie outside the sRGB gamut.
+inline FilmSample film_sample(const Spectrum& L, const Wavelengths& wl, float max_value) {
+  if (!recordable(L)) return {};
+  FilmSample f{spectrum_to_rgb(L, wl), spectrum_to_luminance(L, wl)};
+  const float m = f.rgb.max_component();
+  if (m > max_value) {
+    f.rgb *= max_value / m;
+    f.luminance *= max_value / m;
+  }
+  return f;
 }
 
 class Film {
@@ -51,23 +62,26 @@ class Film {
   }
   size_t bytes() const { return size_t(width_) * size_t(height_) * bytes_per_pixel(m_); }
 
-  void add_sample(int x, int y, const Rgb& L, float weight) {
+  void add_sample(int x, int y, const FilmSample& s, float weight) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
-    for (int c = 0; c < 3; ++c) {
-      p.sum_wl[c] += double(weight) * L[c];
-      p.pass_wl[c] += double(weight) * L[c];
+    const float v[kChannels] = {s.rgb[0], s.rgb[1], s.rgb[2], s.luminance};
+    for (int c = 0; c < kChannels; ++c) {
+      p.sum_wl[c] += double(weight) * v[c];
+      p.pass_wl[c] += double(weight) * v[c];
     }
     p.sum_w += weight;
     p.pass_w += weight;
   }
   // The photon methods' estimate of this pass's bias in the pixel (film colour, the same units as
   // its estimate): 2 (L(r) - L(r / sqrt 2)) from the photons gathered over the radius r and over
-  // the inner half of its area (bias.h). Called at most once per pass, before end_pass.
-  void add_bias(int x, int y, const Rgb& b) {
+  // the inner half of its area (bias.h), of the colour and the luminance. Called at most once per
+  // pass, before end_pass.
+  void add_bias(int x, int y, const Rgb& b, float b_luminance) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
-    for (int c = 0; c < 3; ++c) {
-      p.sum_b[c] += b[c];
-      p.sum_b2[c] += double(b[c]) * b[c];
+    const float v[kChannels] = {b[0], b[1], b[2], b_luminance};
+    for (int c = 0; c < kChannels; ++c) {
+      p.sum_b[c] += v[c];
+      p.sum_b2[c] += double(v[c]) * v[c];
     }
     ++p.bias_passes;
   }
@@ -82,16 +96,13 @@ class Film {
   void end_pass(int x, int y) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
     if (p.pass_w != 0) {
-      double e[3];
-      for (int c = 0; c < 3; ++c) {
+      double e[kChannels];
+      for (int c = 0; c < kChannels; ++c) {
         e[c] = p.pass_wl[c] / p.pass_w;
         p.sum_e[c] += e[c];
         p.sum_e2[c] += e[c] * e[c];
       }
       if (e[0] != 0 || e[1] != 0 || e[2] != 0) ++p.lit_passes;
-      double y_e = luminance(e);
-      p.sum_y += y_e;
-      p.sum_y2 += y_e * y_e;
       if (m_ > 0) {
         size_t k = 3 * ((size_t(y) * width_ + x) * size_t(m_) + size_t(pass_index_ % m_));
         for (int c = 0; c < 3; ++c) m_sum_[k + c] += e[c];
@@ -99,7 +110,7 @@ class Film {
       }
       ++p.passes;
     }
-    p.pass_wl[0] = p.pass_wl[1] = p.pass_wl[2] = p.pass_w = 0;
+    p.pass_wl[0] = p.pass_wl[1] = p.pass_wl[2] = p.pass_wl[3] = p.pass_w = 0;
   }
 
   Image image(float scale = 1) const;
@@ -107,6 +118,11 @@ class Film {
   // luminance.
   std::vector<float> rms_rgb() const;
   std::vector<float> rms() const;
+  // The luminance per pixel (the mean of its samples, as image()); its bias estimate (zero
+  // without one) and its total error, sqrt(rms^2 + bias^2) with the bias's noise taken out.
+  std::vector<float> luminance_image() const;
+  std::vector<float> bias_luminance() const;
+  std::vector<float> total_rms_luminance() const;
   // The image error delta (eq. 4) over the three channels, sqrt(sum RMS_ic^2 / sum L_ic^2): what
   // the accuracy budget and the progress line use, so that an error of colour counts; and delta
   // of the luminance alone.
@@ -151,16 +167,16 @@ class Film {
   static double luminance(const double* c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
   // eq. (4) from per-pixel standard errors of the three channels.
   double delta_rgb(const std::vector<float>& rms_rgb) const;
+  static constexpr int kChannels = 4, kY = 3;  // R, G, B and the luminance
   struct Pixel {
-    double sum_wl[3] = {0, 0, 0};
+    double sum_wl[kChannels] = {};
     double sum_w = 0;
-    double pass_wl[3] = {0, 0, 0}, pass_w = 0;
-    double sum_e[3] = {0, 0, 0}, sum_e2[3] = {0, 0, 0};  // per-pass estimates, per channel
-    double sum_y = 0, sum_y2 = 0;                        // and of their luminance
+    double pass_wl[kChannels] = {}, pass_w = 0;
+    double sum_e[kChannels] = {}, sum_e2[kChannels] = {};  // per-pass estimates, per channel
     int passes = 0;
-    int lit_passes = 0;                                  // passes whose estimate was not black
-    int dropped = 0;                                     // samples not recordable (drop_sample)
-    double sum_b[3] = {0, 0, 0}, sum_b2[3] = {0, 0, 0};  // per-pass bias estimates (add_bias)
+    int lit_passes = 0;                                    // passes whose estimate was not black
+    int dropped = 0;                                       // samples not recordable (drop_sample)
+    double sum_b[kChannels] = {}, sum_b2[kChannels] = {};  // per-pass bias estimates (add_bias)
     int bias_passes = 0;
   };
   int width_, height_;

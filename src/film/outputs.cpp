@@ -83,6 +83,14 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
     for (int c = 0; c < 3; ++c)
       add(std::string("total_error.") + "RGB"[c], channel(total, c, imaging_ratio));
   }
+  // The luminance in cd/m^2 (without the imaging ratio: a physical quantity), its standard error
+  // and, for the photon methods, its bias and total error.
+  add("Y", film.luminance_image());
+  add("rms.Y", film.rms());
+  if (film.has_bias()) {
+    add("bias.Y", film.bias_luminance());
+    add("total_error.Y", film.total_rms_luminance());
+  }
   if (film.m_images() > 0) {
     add("rms_m_images", scaled(film.rms_m_images(), imaging_ratio));
     std::vector<float> m_rgb = film.rms_m_images_rgb();

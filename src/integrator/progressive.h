@@ -99,13 +99,16 @@ inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wav
                         bool may_be_negative = false) {
   int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
   if (may_be_negative && L.is_finite()) {
-    Rgb c = spectrum_to_rgb(L, wl);
-    const float m = std::fmax(c.max_component(), -c.min_component());
-    if (m > max_component_value) c *= max_component_value / m;
-    film->add_sample(x, y, c, filter_weight);
+    FilmSample f{spectrum_to_rgb(L, wl), spectrum_to_luminance(L, wl)};
+    const float m = std::fmax(f.rgb.max_component(), -f.rgb.min_component());
+    if (m > max_component_value) {
+      f.rgb *= max_component_value / m;
+      f.luminance *= max_component_value / m;
+    }
+    film->add_sample(x, y, f, filter_weight);
   } else {
     if (!recordable(L)) film->drop_sample(x, y);
-    film->add_sample(x, y, film_rgb(L, wl, max_component_value), filter_weight);
+    film->add_sample(x, y, film_sample(L, wl, max_component_value), filter_weight);
   }
   film->end_pass(x, y);
 }
