@@ -1,5 +1,5 @@
 // bpm: command-line front end. `bpm render SCENE.pbrt` renders a pbrt-v4 scene; `bpm compare A.exr
-// B.exr` prints how two renders differ.
+// B.exr` prints how two renders differ; `bpm luminaire FILE.ies` writes a luminaire for pbrt-v4.
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
@@ -16,6 +16,7 @@
 #include "film/image_io.h"
 #include "film/outputs.h"
 #include "integrator/team.h"
+#include "lights/photometric_file.h"
 #include "render/checkpoint.h"
 #ifdef BPM_HAVE_MPI
 #include "render/mpi_team.h"
@@ -452,6 +453,57 @@ int run_compare(const std::string& a_path, const std::string& b_path) {
   return 0;
 }
 
+// `bpm luminaire FILE`: the image and the LightSource lines with which pbrt-v4 renders the
+// luminaire of a photometric file (lights/photometric_file.h), as bpm does when a goniometric
+// light names the file itself.
+struct LuminaireArgs {
+  std::string file, output;
+  int size = kLuminaireImageSize;
+};
+
+int run_luminaire(const LuminaireArgs& a) {
+  const PhotometricData d = read_photometric_file(a.file);
+  std::string out = a.output;
+  if (out.empty()) out = std::filesystem::path(a.file).stem().string() + ".exr";
+  if (std::filesystem::path(out).extension() != ".exr")
+    throw Error("luminaire image \"" + out + "\" must end in .exr");
+  Image img;
+  img.width = img.height = a.size;
+  for (float v : goniometric_image(d, a.size)) img.rgb.insert(img.rgb.end(), {v, v, v});
+  write_exr(out, img);
+  std::printf(
+      "# %s%s%s (%s): %.6g lm, the integral of its intensities; lamps %.6g lm%s\n"
+      "# The image holds candela toward each direction of pbrt-v4's goniometric light: the\n"
+      "# luminaire's nadir (gamma 0) along the light's -y, C 0 along +x and C 90 along -z.\n"
+      "AttributeBegin\n"
+      "  Translate 0 0 0    # where the luminaire is\n"
+      "  Rotate 90 1 0 0    # in a scene whose up is +z (nadir along -z, C 90 along +y); leave it\n"
+      "                     # out where up is +y\n"
+      "  LightSource \"goniometric\" \"string filename\" \"%s\"\n"
+      "AttributeEnd\n",
+      a.file.c_str(), d.name.empty() ? "" : ", ", d.name.c_str(), d.format.c_str(),
+      d.luminous_flux(), d.lamp_lumens, d.lamp_lumens > 0 ? "" : " (absolute photometry)",
+      out.c_str());
+  return 0;
+}
+
+void add_luminaire_command(CLI::App& app, LuminaireArgs& la) {
+  CLI::App* luminaire = app.add_subcommand(
+      "luminaire",
+      "Write the goniometric image of an IES or EULUMDAT file for pbrt-v4, and print the "
+      "LightSource lines that place it");
+  luminaire->add_option("file", la.file, "Photometric file (.ies or .ldt)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  luminaire->add_option("-o,--output", la.output,
+                        "The image (EXR); default: the file's name with .exr, in this folder");
+  luminaire
+      ->add_option("--size", la.size,
+                   "Side of the square image in texels (default " +
+                       std::to_string(kLuminaireImageSize) + ", as bpm reads the file itself)")
+      ->check(CLI::Range(16, 8192));
+}
+
 // The flags of `bpm render`, in the manual's groups (docs/USAGE.md).
 const char* const kGeneral = "General";
 const char* const kBudgets = "Budgets (the first one reached ends the render)";
@@ -655,6 +707,9 @@ int main(int argc, char** argv) {
   compare->add_option("a", cmp_a, "Image to test")->required()->check(CLI::ExistingFile);
   compare->add_option("b", cmp_b, "Reference image")->required()->check(CLI::ExistingFile);
 
+  LuminaireArgs la;
+  add_luminaire_command(app, la);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -691,6 +746,7 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(ra, team, &rendering);
     if (*compare) return run_compare(cmp_a, cmp_b);
+    if (app.got_subcommand("luminaire")) return run_luminaire(la);
   } catch (const std::exception& e) {
     return fail(e.what());
   }

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """The manual cannot drift from the program.
 
-  docs_test.py flags BPM       every flag that `bpm --help`, `bpm render --help` and `bpm compare
-                               --help` print is documented in docs/USAGE.md (a table row whose
+  docs_test.py flags BPM       every flag that `bpm --help` and each command's --help print
+                               (render, compare, luminaire) is documented in docs/USAGE.md (a table row whose
                                first cell starts with the flag), and every flag documented there
                                exists.
   docs_test.py examples BPM [--mpi]
@@ -42,7 +42,7 @@ EXAMPLE_TIMEOUT_S = 120
 def help_flags(bpm):
     """The long and short flags each command's --help prints, as {flag: command}."""
     flags = {}
-    for command in ([], ["render"], ["compare"]):
+    for command in ([], ["render"], ["compare"], ["luminaire"]):
         text = subprocess.run([bpm] + command + ["--help"], capture_output=True, text=True,
                               check=True).stdout
         for line in text.splitlines():

@@ -5,11 +5,21 @@
 // (taken as fully correlated between pixels, since the photon methods share an iteration's
 // wavelengths and photons), plus 1e-3 for the spectral fit of a white reflectance.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 
+#include "film/image_io.h"
+#include "lights/photometric_file.h"
 #include "test_util.h"
 
 namespace bpm {
@@ -141,6 +151,201 @@ TEST(Photometry, LuminanceMatchesTheColoursLuminance) {
     direct += y[p];
   }
   EXPECT_NEAR(direct / from_rgb, 1, 5e-3);
+}
+
+// ---- Luminaires from photometric files ----
+
+namespace fs = std::filesystem;
+
+// A scratch folder of the test's own.
+fs::path scratch() {
+  const fs::path dir =
+      fs::temp_directory_path() / ("bpm_photometry_" + std::to_string(::getpid()) + "_" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Runs a command; its exit status, and what it printed on stdout and stderr.
+std::pair<int, std::string> run(const std::string& cmd, const fs::path& dir) {
+  const std::string out = (dir / "out.txt").string();
+  const int status = std::system((cmd + " > " + out + " 2>&1").c_str());
+  std::ifstream in(out);
+  std::stringstream s;
+  s << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
+}
+
+// An asymmetric type C luminaire (planes every 15 degrees, gamma every 5): a downlight whose
+// light leans toward C 60, dark above 100 degrees.
+double asymmetric_intensity(double c, double g) {
+  if (g > 100) return 0;
+  const double base = 800 * std::cos(g * 0.9 * kPi / 180);
+  return std::max(0.0, base * (1 + 0.6 * std::cos((c - 60) * kPi / 180) * std::sin(g * kPi / 180)));
+}
+
+std::string asymmetric_ies() {
+  std::ostringstream s;
+  s << "IESNA:LM-63-2002\n[TEST] asymmetric\n[MANUFAC] bpm\n[LUMINAIRE] lean\nTILT=NONE\n"
+    << "1 -1 1 37 25 1 2 0.2 0.2 0.05\n1 1 30\n";
+  for (int j = 0; j <= 36; ++j) s << 5 * j << " ";
+  s << "\n";
+  for (int i = 0; i <= 24; ++i) s << 15 * i << " ";
+  s << "\n";
+  for (int i = 0; i <= 24; ++i) {
+    for (int j = 0; j <= 36; ++j) s << asymmetric_intensity(15 * i, 5 * j) << " ";
+    s << "\n";
+  }
+  return s.str();
+}
+
+// A camera 4 above a plane of reflectance 0.8, the luminaire 1.5 above it (nadir down, C 90
+// toward +y), the given integrator.
+std::string luminaire_scene(const std::string& file, const std::string& integrator, int size) {
+  return R"(LookAt 0 0 4  0 0 0  0 1 0
+Camera "perspective" "float fov" 70
+Film "rgb" "integer xresolution" )" +
+         std::to_string(size) + " \"integer yresolution\" " + std::to_string(size) + R"(
+PixelFilter "box"
+Integrator ")" +
+         integrator +
+         R"(" "integer maxdepth" 1
+WorldBegin
+AttributeBegin
+  Translate 0 0 1.5
+  Rotate 90 1 0 0
+  LightSource "goniometric" "string filename" ")" +
+         file + R"("
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.8 0.8 0.8]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-4 -4 0  4 -4 0  4 4 0  -4 4 0]
+)";
+}
+
+// `bpm luminaire` writes the image pbrt-v4 reads and says how to place it; a goniometric light
+// naming the IES file itself renders the very same image in bpm.
+TEST(Photometry, LuminaireImageAndFileRenderAlike) {
+  const fs::path dir = scratch();
+  std::ofstream(dir / "lean.ies") << asymmetric_ies();
+  auto [status, text] =
+      run("cd " + dir.string() + " && " + BPM_BINARY + " luminaire lean.ies -o lean.exr", dir);
+  ASSERT_EQ(status, 0) << text;
+  EXPECT_NE(text.find("LightSource \"goniometric\" \"string filename\" \"lean.exr\""),
+            std::string::npos)
+      << text;
+  const double flux = parse_ies(asymmetric_ies(), "lean.ies").luminous_flux();
+  char printed[64];
+  std::snprintf(printed, sizeof printed, "%.6g lm", flux);
+  EXPECT_NE(text.find(printed), std::string::npos) << text;
+  for (const char* file : {"lean.exr", "lean.ies"})
+    std::ofstream(dir / (std::string(file) + ".pbrt")) << luminaire_scene(file, "bpm", 24);
+  for (const char* file : {"lean.exr", "lean.ies"}) {
+    auto [s, t] = run(std::string(BPM_BINARY) + " render " + (dir / file).string() +
+                          ".pbrt --spp 4 -q -o " + (dir / file).string() + ".out.exr",
+                      dir);
+    ASSERT_EQ(s, 0) << t;
+  }
+  const Image a = read_exr((dir / "lean.exr.out.exr").string());
+  const Image b = read_exr((dir / "lean.ies.out.exr").string());
+  EXPECT_EQ(a.rgb, b.rgb);
+  fs::remove_all(dir);
+}
+
+// The illuminance a luminaire gives follows its table: L = rho I(C, gamma) cos(gamma) / (pi r^2)
+// on the plane below, for every integrator. The goniometric image is read at its nearest texel
+// (about 0.4 degrees), so the expected values get 0.5% besides the noise.
+TEST(Photometry, LuminaireIlluminanceFollowsItsTable) {
+  const fs::path dir = scratch();
+  std::ofstream(dir / "lean.ies") << asymmetric_ies();
+  const PhotometricData d = parse_ies(asymmetric_ies(), "lean.ies");
+  const double half = 4 * std::tan(35 * kPi / 180);  // half the side of the plane seen
+  auto expected = [&](double x, double y) {
+    // The camera looks down -z with +y up; pbrt-v4's raster x runs toward -x of the world here.
+    const double wx = -x * half, wy = -y * half, h = 1.5;
+    const double r2 = wx * wx + wy * wy + h * h, cos_g = h / std::sqrt(r2);
+    const double c = std::atan2(wy, wx) * 180 / kPi, g = std::acos(cos_g) * 180 / kPi;
+    return 0.8 * d.intensity(c, g) * cos_g / r2 / kPi;
+  };
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    std::ofstream(dir / "s.pbrt") << luminaire_scene("lean.ies", integrator, 16);
+    ParsedScene parsed = parse_scene_file((dir / "s.pbrt").string());
+    LoadedScene ls = flatten_scene(parsed);
+    Film film(ls.film.width, ls.film.height);
+    render(ls, quiet_options(ls, integrator, 16, 3), &film);
+    const std::vector<float> y = film.luminance_image(), rms = film.rms();
+    // Per quadrant of the image: its mean against the table's.
+    for (int q = 0; q < 4; ++q) {
+      Measured m;
+      int n = 0;
+      for (int j = 0; j < 16; ++j)
+        for (int i = 0; i < 16; ++i) {
+          if ((i >= 8) != bool(q & 1) || (j >= 8) != bool(q & 2)) continue;
+          const size_t p = size_t(j) * 16 + i;
+          m.mean += y[p];
+          m.error += rms[p];
+          // The pixel's mean over a 4 x 4 grid of points.
+          double e = 0;
+          for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+              e += expected(-1 + (i + (a + 0.5) / 4) / 8, -1 + (j + (b + 0.5) / 4) / 8);
+          m.expected += e / 16;
+          ++n;
+        }
+      m.mean /= n;
+      m.error /= n;
+      m.expected /= n;
+      EXPECT_NEAR(m.mean, m.expected, 3 * m.error + 5e-3 * m.expected)
+          << integrator << " quadrant " << q << ": Y " << m.mean << " against " << m.expected;
+    }
+  }
+  fs::remove_all(dir);
+}
+
+// A malformed photometric file stops the render before anything is written, with its line.
+TEST(Photometry, MalformedLuminaireIsALocatedError) {
+  const fs::path dir = scratch();
+  std::string ies = asymmetric_ies();
+  ies.replace(ies.find("1 -1 1 37"), 9, "1 -1 0 37");  // a candela multiplier of 0
+  std::ofstream(dir / "bad.ies") << ies;
+  std::ofstream(dir / "s.pbrt") << luminaire_scene("bad.ies", "path", 8);
+  auto [status, text] = run(std::string(BPM_BINARY) + " render " + (dir / "s.pbrt").string() +
+                                " -q -o " + (dir / "s.exr").string(),
+                            dir);
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(text.find("bad.ies:6:6: the candela multiplier must be positive"), std::string::npos)
+      << text;
+  EXPECT_FALSE(fs::exists(dir / "s.exr"));
+  fs::remove_all(dir);
+}
+
+// The same file in pbrt-v4 (with the image `bpm luminaire` wrote) and in bpm: image means within
+// 1% (when ../shared's pbrt-v4 is there).
+TEST(Photometry, LuminaireMatchesPbrtV4) {
+  const std::string shared = test::shared_dir();
+  const fs::path pbrt = fs::path(shared) / "tools" / "pbrt-v4" / "pbrt";
+  if (shared.empty() || !fs::exists(pbrt)) GTEST_SKIP() << "no ../shared/tools/pbrt-v4/pbrt";
+  const fs::path dir = scratch();
+  std::ofstream(dir / "lean.ies") << asymmetric_ies();
+  ASSERT_EQ(run("cd " + dir.string() + " && " + BPM_BINARY + " luminaire lean.ies", dir).first, 0);
+  std::ofstream(dir / "s.pbrt") << luminaire_scene("lean.exr", "path", 32);
+  auto [status, text] = run(pbrt.string() + " --quiet --nthreads 2 --spp 64 --seed 3 --outfile " +
+                                (dir / "pbrt.exr").string() + " " + (dir / "s.pbrt").string(),
+                            dir);
+  if (status != 0) GTEST_SKIP() << "pbrt-v4 did not run here: " << text;
+  ASSERT_EQ(run(std::string(BPM_BINARY) + " render " + (dir / "s.pbrt").string() +
+                    " --spp 64 -q -o " + (dir / "bpm.exr").string(),
+                dir)
+                .first,
+            0);
+  const Image a = read_exr((dir / "bpm.exr").string()), b = read_exr((dir / "pbrt.exr").string());
+  double ya = 0, yb = 0;
+  for (size_t i = 0; i < a.rgb.size(); i += 3) {
+    ya += 0.2126 * a.rgb[i] + 0.7152 * a.rgb[i + 1] + 0.0722 * a.rgb[i + 2];
+    yb += 0.2126 * b.rgb[i] + 0.7152 * b.rgb[i + 1] + 0.0722 * b.rgb[i + 2];
+  }
+  EXPECT_NEAR(ya / yb, 1, 0.01);
+  fs::remove_all(dir);
 }
 
 }  // namespace

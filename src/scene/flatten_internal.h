@@ -107,6 +107,7 @@ class Flattener {
   // light's "scale" and apply their kind's "power" or "illuminance" to it.
   SpectrumCurve light_spectrum(const ParamSet& ps, const std::string& name);
   std::shared_ptr<const TexImage> light_image(const ParamSet& ps, const std::string& light);
+  std::shared_ptr<const TexImage> luminaire_image(const ParamSet& ps);
   ImageInfiniteLight image_light(const LightEntity& e, const Param& file_param, float* scale);
   void add_light(const LightEntity& e, RenderScene* rs);
   void add_point_light(const LightEntity& e, float* scale, RenderScene* rs);

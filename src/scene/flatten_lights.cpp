@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "lights/photometric_file.h"
 #include "scene/flatten_internal.h"
 #include "scene/spectra.h"
 
@@ -128,7 +129,8 @@ void Flattener::add_goniometric_light(const LightEntity& e, float* scale, Render
   if (!ps.find_any("filename"))
     throw Error(e.loc, "goniometric light needs \"string filename\" (its intensity image)");
   GoniometricLight l;
-  l.image = light_image(ps, "goniometric");
+  const std::string file = ps.get_string("filename", "");
+  l.image = is_photometric_file(file) ? luminaire_image(ps) : light_image(ps, "goniometric");
   if (l.image->width != l.image->height)
     throw Error(ps.find_any("filename")->loc,
                 "goniometric image \"" + ps.get_string("filename", "") + "\" is " +
@@ -147,6 +149,22 @@ void Flattener::add_goniometric_light(const LightEntity& e, float* scale, Render
   }
   l.intensity = light_spectrum(ps, "I").scaled(*scale);
   rs->lights.push_back(std::move(l));
+}
+
+// A bpm extension: a goniometric light whose "filename" is a photometric file (IES LM-63 or
+// EULUMDAT) reads it as the image `bpm luminaire` writes for pbrt-v4 (lights/photometric_file.h),
+// in candela.
+std::shared_ptr<const TexImage> Flattener::luminaire_image(const ParamSet& ps) {
+  const std::string file = ps.get_string("filename", "");
+  fs::path path =
+      fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+  read_data_file(path.string());
+  auto image = std::make_shared<TexImage>();
+  image->width = image->height = kLuminaireImageSize;
+  image->channels = 1;
+  image->path = path.string();
+  image->texels = goniometric_image(read_photometric_file(path.string()), kLuminaireImageSize);
+  return image;
 }
 
 void Flattener::add_projection_light(const LightEntity& e, float* scale, RenderScene* rs) {
