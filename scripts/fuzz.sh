@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds the whole tree with clang in build-fuzz/ (ASan, UBSan and libFuzzer's coverage) and runs
 # each fuzz target for SECONDS (default 30) from its seed corpus: the scene parser with flattening,
-# the PLY reader, and image textures through OpenImageIO. Seeds come from scenes/ and fuzz/seeds/;
-# what a run learns is kept in build-fuzz/corpus/. A finding (crash, sanitizer report, leak, hang
+# the PLY reader, image textures through OpenImageIO, and the IES and EULUMDAT readers. Seeds come
+# from scenes/ and fuzz/seeds/; what a run learns is kept in build-fuzz/corpus/. A finding (crash, sanitizer report, leak, hang
 # over 10 s, more than 4 GiB) stops its target, leaves the input in build-fuzz/findings/ and makes
 # the script fail.
 # FUZZ_SEED fixes libFuzzer's random seed (CI uses 1); unset, each run draws its own.
@@ -12,7 +12,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_fuzzer ply_fuzzer image_fuzzer)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_fuzzer ply_fuzzer image_fuzzer photometric_fuzzer)
 build="$root/build-fuzz"
 
 "$root/scripts/install-deps.sh"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -250,6 +251,13 @@ PhotometricData IesReader::read() {
   if (!(lamp_factor > 0))
     fail(*t, "the ballast-lamp factor (\"future use\", 1) must be positive, not " + t->text);
   number("the input watts");
+  // Counted before anything is allocated for them: a header may claim any size.
+  const uint64_t values = uint64_t(n_v) + uint64_t(n_h) + uint64_t(n_v) * uint64_t(n_h);
+  if (tokens_.size() - next_ < values)
+    fail(int(lines_.size()), 1,
+         "the file ends before its " + std::to_string(n_h) + " x " + std::to_string(n_v) +
+             " candela values and their angles (" + std::to_string(tokens_.size() - next_) +
+             " numbers left)");
   d.gamma = angles(n_v, 0, 180, "vertical angle");
   const Token& h_first = next("the horizontal angles");
   --next_;

@@ -109,6 +109,10 @@ TEST(PhotometricFile, IesErrorsNameTheLine) {
   EXPECT_NE(error_of(ies("1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10\n")).find("lamp.ies:10"),
             std::string::npos)
       << "a table cut short";
+  EXPECT_NE(error_of(ies("1 -1 1 90000 90000 1 2 0 0 0\n1 1 0\n0 90\n0\n10\n"))
+                .find("the file ends before its 90000 x 90000 candela values"),
+            std::string::npos)
+      << "a header that claims a huge table";
   EXPECT_NE(error_of(ies("1 -1 1 2 1 1 2 0 0 0\n1 1 0\n0 90\n0\n10 -3\n"))
                 .find("lamp.ies:10:4: a candela value must not be negative"),
             std::string::npos);
