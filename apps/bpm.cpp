@@ -17,6 +17,7 @@
 #include "film/outputs.h"
 #include "integrator/team.h"
 #include "lights/photometric_file.h"
+#include "path/sensors.h"
 #include "render/checkpoint.h"
 #ifdef BPM_HAVE_MPI
 #include "render/mpi_team.h"
@@ -63,8 +64,10 @@ struct RenderArgs {
   bool no_adaptive = false;
   float adaptive_floor = 0.1f;
   int m_images = 4;
-  std::string memory;  // --memory; empty: default_memory_budget()
-  std::string resume;  // --resume: a checkpoint file
+  std::string memory;   // --memory; empty: default_memory_budget()
+  std::string resume;   // --resume: a checkpoint file
+  std::string sensors;  // --sensors: illuminance sensors
+  bool no_image = false;
 };
 
 // Bytes per pixel the outputs take while they are written (the image, its error channels and
@@ -181,6 +184,9 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   opt.adaptive_floor = a.adaptive_floor;
   opt.write_every_s = a.write_every;
   opt.memory_budget = a.memory.empty() ? default_memory_budget() : parse_memory_size(a.memory);
+  if (!a.sensors.empty()) opt.sensors = read_sensors(a.sensors);
+  if (a.no_image && a.sensors.empty()) throw Error("--no-image needs --sensors");
+  opt.image = !a.no_image;
   return opt;
 }
 
@@ -204,6 +210,28 @@ nlohmann::json image_units(bool bias) {
     u["bias.Y, total_error.Y"] = "cd/m^2";
   }
   return u;
+}
+
+// The record's outputs (the files written) and sensors.
+void record_outputs(const RenderArgs& a, const RenderOptions& opt, const Film& film,
+                    const OutputPaths& paths, nlohmann::json* rec) {
+  nlohmann::json& out = (*rec)["outputs"];
+  out = {{"json", paths.json}};
+  if (opt.image) {
+    out["exr"] = paths.exr;
+    out["png"] = paths.png;
+    out["error_png"] = paths.error_png;
+    if (film.has_bias()) out["bias_png"] = paths.bias_png;
+  }
+  if (opt.sensors.empty()) return;
+  out["sensors_csv"] = paths.sensors;
+  (*rec)["sensors"] = {{"file", a.sensors},
+                       {"count", opt.sensors.size()},
+                       {"samples_per_pass", kSensorSamplesPerPass},
+                       {"unit", "lux"},
+                       {"method",
+                        "path: next-event estimation and a cosine-distributed path at each sensor, "
+                        "in every pass, whatever the image's integrator"}};
 }
 
 // The JSON record of a finished render: how the image was made and what it cost.
@@ -267,9 +295,7 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                         {"materials", ls.scene.materials.size()},
                         {"warnings", warning_count()}};
   rec["peak_memory_bytes"] = uint64_t(ru.ru_maxrss) * 1024;
-  rec["outputs"] = {
-      {"exr", paths.exr}, {"png", paths.png}, {"error_png", paths.error_png}, {"json", paths.json}};
-  if (film.has_bias()) rec["outputs"]["bias_png"] = paths.bias_png;
+  record_outputs(a, opt, film, paths, &rec);
   if (opt.resume)
     rec["resumed"] = {{"checkpoint", a.resume},
                       {"passes_before", opt.resume->passes},
@@ -353,10 +379,20 @@ void resume_from(const RenderArgs& a, const nlohmann::json& identity, bool root,
                  opt->integrator == "path" ? "passes" : "iterations");
 }
 
+// The images (unless --no-image) and the sensors' CSV (with --sensors), each atomically.
+void write_outputs(const LoadedScene& ls, const RenderOptions& opt, const Film& film,
+                   const OutputPaths& paths) {
+  if (opt.image) write_images(paths, film, ls.film.imaging_ratio);
+  if (opt.sensors.empty()) return;
+  std::vector<std::array<float, 6>> sensors;
+  for (const Sensor& s : opt.sensors) sensors.push_back({s.p.x, s.p.y, s.p.z, s.n.x, s.n.y, s.n.z});
+  write_sensors_csv(paths.sensors, film, sensors);
+}
+
 // Intermediate outputs: the images so far and a JSON record that says the render is running.
 void write_intermediate(const RenderArgs& a, const LoadedScene& ls, const RenderOptions& opt,
                         const Film& film, const OutputPaths& paths, int passes) {
-  write_images(paths, film, ls.film.imaging_ratio);
+  write_outputs(ls, opt, film, paths);
   nlohmann::json rec;
   rec["scene"] = a.scene;
   rec["settings"] = {
@@ -407,10 +443,11 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
   // (Only then: its fingerprint reads every scene and data file again.)
   const bool keep_checkpoint = opt.write_every_s > 0 || !a.resume.empty();
   check_film_memory(a, ls, opt, keep_checkpoint, team != nullptr);
-  Film film(ls.film.width, ls.film.height, a.m_images);
+  Film film(ls.film.width, ls.film.height, a.m_images, opt.sensors.size());
+  std::vector<std::string> files = scene.parsed.files;
+  if (!a.sensors.empty()) files.push_back(a.sensors);  // a checkpoint holds these sensors' sums
   const nlohmann::json identity =
-      keep_checkpoint ? render_identity(scene.parsed.files, ls, opt, film.m_images())
-                      : nlohmann::json();
+      keep_checkpoint ? render_identity(files, ls, opt, film.m_images()) : nlohmann::json();
   Checkpoint resumed;
   if (!a.resume.empty()) resume_from(a, identity, root, &resumed, &film, &opt);
   if (keep_checkpoint && root)
@@ -427,7 +464,7 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
   if (!root) return 0;
 
   auto t = Clock::now();
-  write_images(paths, film, ls.film.imaging_ratio);
+  write_outputs(ls, opt, film, paths);
   const double write_s = seconds_since(t);
   nlohmann::json rec =
       run_record(a, ls, opt, st, film, paths, {scene.parse_s, scene.build_s, write_s});
@@ -591,6 +628,16 @@ void add_output_options(CLI::App* render, RenderArgs& ra) {
                    "Go on from a checkpoint (OUT.checkpoint of --write-every) of the same "
                    "render: the same scene, resolution, integrator and settings; --spp and "
                    "--iterations count the passes before it too")
+      ->group(kOutputs);
+  render
+      ->add_option("--sensors", ra.sensors,
+                   "Illuminance sensors, one a line (x y z nx ny nz, as Radiance's rtrace -I) or a "
+                   "grid (grid x y z ux uy uz vx vy vz nu nv); writes OUT.sensors.csv in lux")
+      ->check(CLI::ExistingFile)
+      ->group(kOutputs);
+  render
+      ->add_flag("--no-image", ra.no_image,
+                 "Render the sensors alone: no image, no EXR or PNG (needs --sensors)")
       ->group(kOutputs);
   render
       ->add_option("--m-images", ra.m_images,

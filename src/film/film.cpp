@@ -29,13 +29,22 @@ float standard_error(double sum, double sum2, int passes) {
 
 }  // namespace
 
-Film::Film(int width, int height, int m_images)
+Film::Film(int width, int height, int m_images, size_t sensors)
     : width_(width),
       height_(height),
       pixels_(size_t(width) * height),
+      sensors_(sensors),
       m_(m_images > 1 ? m_images : 0) {
   m_sum_.assign(pixels_.size() * size_t(m_) * 3, 0.0);
   m_count_.assign(pixels_.size() * size_t(m_), 0);
+}
+
+double Film::sensor_mean(size_t i) const {
+  return sensors_[i].passes > 0 ? sensors_[i].sum / sensors_[i].passes : 0;
+}
+
+double Film::sensor_standard_error(size_t i) const {
+  return standard_error(sensors_[i].sum, sensors_[i].sum2, sensors_[i].passes);
 }
 
 Image Film::image(float scale) const {
@@ -286,12 +295,19 @@ void Film::add(const Film& o) {
     p.dropped += q.dropped;
     p.bias_passes += q.bias_passes;
   }
+  BPM_CHECK(o.sensors_.size() == sensors_.size());
+  for (size_t i = 0; i < sensors_.size(); ++i) {
+    sensors_[i].sum += o.sensors_[i].sum;
+    sensors_[i].sum2 += o.sensors_[i].sum2;
+    sensors_[i].passes += o.sensors_[i].passes;
+  }
   for (size_t i = 0; i < m_sum_.size(); ++i) m_sum_[i] += o.m_sum_[i];
   for (size_t i = 0; i < m_count_.size(); ++i) m_count_[i] += o.m_count_[i];
 }
 
 void Film::clear() {
   std::fill(pixels_.begin(), pixels_.end(), Pixel{});
+  std::fill(sensors_.begin(), sensors_.end(), SensorSums{});
   std::fill(m_sum_.begin(), m_sum_.end(), 0.0);
   std::fill(m_count_.begin(), m_count_.end(), 0);
 }
@@ -303,6 +319,7 @@ void Film::save(ByteWriter& w) const {
   w.put_vector(pixels_);
   w.put_vector(m_sum_);
   w.put_vector(m_count_);
+  w.put_vector(sensors_);
 }
 
 void Film::load(ByteReader& r) {
@@ -317,9 +334,14 @@ void Film::load(ByteReader& r) {
   std::vector<Pixel> pixels = r.get_vector<Pixel>();
   std::vector<double> m_sum = r.get_vector<double>();
   std::vector<int> m_count = r.get_vector<int>();
+  std::vector<SensorSums> sensors = r.get_vector<SensorSums>();
   if (pixels.size() != pixels_.size() || m_sum.size() != m_sum_.size() ||
       m_count.size() != m_count_.size())
     throw Error(r.what() + " is truncated or corrupt (film sizes)");
+  if (sensors.size() != sensors_.size())
+    throw Error(r.what() + " holds " + std::to_string(sensors.size()) + " sensors, this render " +
+                std::to_string(sensors_.size()) + " (--sensors)");
+  sensors_ = std::move(sensors);
   pixels_ = std::move(pixels);
   m_sum_ = std::move(m_sum);
   m_count_ = std::move(m_count);

@@ -53,14 +53,18 @@ class Film {
  public:
   // m_images > 0 also keeps the paper's M intermediate images (section 4): pass j goes to image
   // j mod M (begin_pass), and the spread between the M images is a second error estimate.
-  Film(int width, int height, int m_images = 0);
+  // sensors: illuminance sensors (path/sensors.h) whose per-pass estimates the film keeps too.
+  Film(int width, int height, int m_images = 0, size_t sensors = 0);
   int width() const { return width_; }
   int height() const { return height_; }
   // What a film takes per pixel with m_images intermediate images, and what this one takes.
   static size_t bytes_per_pixel(int m_images) {
     return sizeof(Pixel) + size_t(m_images) * (3 * sizeof(double) + sizeof(int));
   }
-  size_t bytes() const { return size_t(width_) * size_t(height_) * bytes_per_pixel(m_); }
+  size_t bytes() const {
+    return size_t(width_) * size_t(height_) * bytes_per_pixel(m_) +
+           sensors_.size() * sizeof(SensorSums);
+  }
 
   void add_sample(int x, int y, const FilmSample& s, float weight) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
@@ -112,6 +116,18 @@ class Film {
     }
     p.pass_wl[0] = p.pass_wl[1] = p.pass_wl[2] = p.pass_wl[3] = p.pass_w = 0;
   }
+
+  // One pass's estimate of sensor i (each sensor written by one thread at a time), and per sensor
+  // the mean of its passes, the standard error of that mean (eq. 5) and its passes.
+  void add_sensor_pass(size_t i, double value) {
+    sensors_[i].sum += value;
+    sensors_[i].sum2 += value * value;
+    ++sensors_[i].passes;
+  }
+  size_t sensor_count() const { return sensors_.size(); }
+  double sensor_mean(size_t i) const;
+  double sensor_standard_error(size_t i) const;
+  int sensor_passes(size_t i) const { return sensors_[i].passes; }
 
   Image image(float scale = 1) const;
   // Per-pixel standard error (eq. 5) of the mean of each channel, R G B per pixel, and of the
@@ -179,8 +195,13 @@ class Film {
     double sum_b[kChannels] = {}, sum_b2[kChannels] = {};  // per-pass bias estimates (add_bias)
     int bias_passes = 0;
   };
+  struct SensorSums {
+    double sum = 0, sum2 = 0;
+    int passes = 0;
+  };
   int width_, height_;
   std::vector<Pixel> pixels_;
+  std::vector<SensorSums> sensors_;
   int m_ = 0;
   int pass_index_ = 0;
   std::vector<double> m_sum_;  // [pixel][image][channel]

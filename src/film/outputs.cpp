@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "base/error.h"
@@ -19,7 +20,22 @@ OutputPaths output_paths(const std::string& exr) {
           stem + ".error.png",
           stem + ".json",
           stem + ".bias.png",
-          stem + ".checkpoint"};
+          stem + ".checkpoint",
+          stem + ".sensors.csv"};
+}
+
+void write_sensors_csv(const std::string& path, const Film& film,
+                       const std::vector<std::array<float, 6>>& sensors) {
+  std::string text = "x,y,z,nx,ny,nz,illuminance_lux,standard_error_lux,bias_lux,passes\n";
+  char line[512];
+  for (size_t i = 0; i < sensors.size(); ++i) {
+    const std::array<float, 6>& s = sensors[i];
+    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,0,%d\n", s[0], s[1],
+                  s[2], s[3], s[4], s[5], film.sensor_mean(i), film.sensor_standard_error(i),
+                  film.sensor_passes(i));
+    text += line;
+  }
+  write_text_atomic(path, text);
 }
 
 // Per pixel, an error (R G B) relative to the pixel's value over the three channels (as eq. 4 per

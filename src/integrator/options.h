@@ -11,6 +11,10 @@
 #include "integrator/counters.h"
 
 namespace bpm {
+class Film;
+}
+
+namespace bpm {
 
 // What a render needs, besides its film, to go on exactly where it stopped: the passes done, the
 // render control's state (sampling probabilities) and the integrator's (what bpm's guide has
@@ -48,6 +52,9 @@ struct IntegratorOptions {
   const RenderState* resume = nullptr;
   // Several processes render this image together (integrator/team.h); null: this one alone.
   Team* team = nullptr;
+  // Called after each whole pass with its index (first_iteration + pass): illuminance sensors
+  // (path/sensors.h) record that pass's estimates in the film. Unset: no sensors.
+  std::function<void(int pass_index, Film* film)> sensor_pass;
   // Benchmarks only: sees every ray the passes trace, eye and light rays apart (bpm). Null in
   // renders; called from every rendering thread, so render with one thread when it is set.
   RayObserver* eye_ray_observer = nullptr;

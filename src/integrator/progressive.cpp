@@ -194,11 +194,18 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
     s.integrator = i.take();
     return s;
   };
+  // Illuminance sensors: each whole pass also estimates them (path/sensors.h).
+  const PassFunction with_sensors = [&](int p, const RenderControl& c) {
+    PassResult r = pass(p, c);
+    if (r.completed && !c.cut_a_pass()) opt.sensor_pass(opt.first_iteration + p, film);
+    return r;
+  };
+  const PassFunction& passes = opt.sensor_pass ? with_sensors : pass;
   bool cut = false;
   if (opt.team && opt.team->size() > 1) {
-    cut = run_team_passes(opt, film, pass, stats, state, control, snapshot);
+    cut = run_team_passes(opt, film, passes, stats, state, control, snapshot);
   } else {
-    run_passes_alone(opt, film, pass, stats, state, control, snapshot, first);
+    run_passes_alone(opt, film, passes, stats, state, control, snapshot, first);
     cut = control.cut_a_pass();
   }
   control.finish();

@@ -11,11 +11,12 @@
 namespace bpm {
 
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings,
-                       const Wavelengths& wl, Rng& rng, PathCounters& counters) {
+                       const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                       const EmitterWeight& first) {
   const WavelengthMaterials materials = WavelengthMaterials::resolved_per_point(scene, wl);
   PathState s{ray};
   Spectrum L;
-  EmitterWeight emitter = EmitterWeight::full();
+  EmitterWeight emitter = first;
   float eta_scale = 1;
   int depth = 0;
   ++counters.camera_rays;

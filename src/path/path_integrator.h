@@ -5,6 +5,7 @@
 #include "base/rng.h"
 #include "film/film.h"
 #include "integrator/counters.h"
+#include "integrator/direct_light.h"
 #include "integrator/options.h"
 #include "scene/flatten.h"
 
@@ -14,9 +15,12 @@ struct PathSettings {
   int max_depth = 5;  // scattering events, as pbrt-v4's maxdepth
 };
 
-// Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl.
+// Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl. `first` weighs the
+// emission of the first surface the ray meets (full for a camera ray; an illuminance sensor
+// weighs it against its own light sample, path/sensors.h).
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings,
-                       const Wavelengths& wl, Rng& rng, PathCounters& counters);
+                       const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                       const EmitterWeight& first = EmitterWeight::full());
 
 // Passes of one sample per pixel, each with its own eight wavelengths, until a budget ends the
 // render.

@@ -98,7 +98,7 @@ class MpiTeam : public Team {
       return;
     }
     // In rank order, so that the sums do not depend on which process answers first.
-    Film other(film->width(), film->height(), film->m_images());
+    Film other(film->width(), film->height(), film->m_images(), film->sensor_count());
     for (int r = 1; r < size_; ++r) {
       const std::vector<uint8_t> bytes = recv_bytes(r);
       ByteReader reader(bytes, "the film of process " + std::to_string(r));

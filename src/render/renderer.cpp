@@ -7,9 +7,27 @@
 #include "base/error.h"
 #include "bpm/bpm_integrator.h"
 #include "fpm/fpm_integrator.h"
+#include "integrator/progressive.h"
 #include "path/path_integrator.h"
+#include "path/sensors.h"
 
 namespace bpm {
+namespace {
+
+// Passes of the sensors alone, without an image (--no-image).
+RenderStats render_sensors_only(const RenderOptions& opt, Film* film) {
+  if (opt.sensors.empty()) throw Error("a render without an image needs sensors (--sensors)");
+  if (opt.accuracy > 0)
+    throw Error(
+        "--accuracy bounds the image's error: without an image (--no-image) give --spp "
+        "or --time");
+  RenderStats stats;
+  run_passes(
+      opt, film, "pass", [](int, const RenderControl&) { return PassResult{}; }, &stats);
+  return stats;
+}
+
+}  // namespace
 
 RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) {
   if (opt.integrator != "path" && opt.integrator != "bpm" && opt.integrator != "fpm")
@@ -19,9 +37,18 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
   if (opt.threads > 0)
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                   opt.threads);
-  if (opt.integrator == "bpm") return render_bpm(ls, opt, opt.bpm, film);
-  if (opt.integrator == "fpm") return render_fpm(ls, opt, opt.fpm, film);
-  return render_path(ls, opt, film);
+  if (opt.sensors.size() != film->sensor_count())
+    throw Error("the film has " + std::to_string(film->sensor_count()) + " sensors, the render " +
+                std::to_string(opt.sensors.size()));
+  RenderOptions o = opt;
+  if (!opt.sensors.empty())
+    o.sensor_pass = [&](int pass_index, Film* f) {
+      sensor_pass(ls.scene, opt.sensors, opt.max_depth, opt.seed, pass_index, f);
+    };
+  if (!opt.image) return render_sensors_only(o, film);
+  if (opt.integrator == "bpm") return render_bpm(ls, o, o.bpm, film);
+  if (opt.integrator == "fpm") return render_fpm(ls, o, o.fpm, film);
+  return render_path(ls, o, film);
 }
 
 }  // namespace bpm

@@ -8,6 +8,7 @@
 #include "film/film.h"
 #include "fpm/settings.h"
 #include "integrator/options.h"
+#include "path/sensors.h"
 #include "scene/flatten.h"
 
 namespace bpm {
@@ -16,6 +17,10 @@ struct RenderOptions : IntegratorOptions {
   std::string integrator = "path";  // path, bpm or fpm
   BpmSettings bpm;
   FpmSettings fpm;
+  // Illuminance sensors, estimated in every pass (the film must have as many); with image false,
+  // only they are rendered, by passes of their own.
+  std::vector<Sensor> sensors;
+  bool image = true;
 };
 
 // Options for a render of `ls` without a progress line, with the file's maxdepth and default
@@ -31,7 +36,7 @@ inline RenderOptions quiet_options(const LoadedScene& ls, const std::string& int
   return opt;
 }
 
-// Renders with options.integrator on at most options.threads threads (0: all).
+// Renders with options.integrator on at most options.threads threads (0: all), and the sensors.
 RenderStats render(const LoadedScene& scene, const RenderOptions& options, Film* film);
 
 }  // namespace bpm

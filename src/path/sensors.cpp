@@ -1,0 +1,160 @@
+#include "path/sensors.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "base/error.h"
+#include "base/sampling.h"
+#include "integrator/direct_light.h"
+#include "path/path_integrator.h"
+
+namespace bpm {
+namespace {
+
+// Numbers of one line with their columns; false at the first word that is not a number.
+bool numbers(const std::string& line, std::vector<double>* values, std::vector<int>* columns,
+             std::string* bad, int* bad_column) {
+  size_t k = 0;
+  while (k < line.size()) {
+    while (k < line.size() && std::isspace(static_cast<unsigned char>(line[k]))) ++k;
+    const size_t start = k;
+    while (k < line.size() && !std::isspace(static_cast<unsigned char>(line[k]))) ++k;
+    if (k == start) break;
+    const std::string word = line.substr(start, k - start);
+    char* end = nullptr;
+    const double v = std::strtod(word.c_str(), &end);
+    if (end != word.c_str() + word.size() || !std::isfinite(v)) {
+      *bad = word;
+      *bad_column = int(start + 1);
+      return false;
+    }
+    values->push_back(v);
+    columns->push_back(int(start + 1));
+  }
+  return true;
+}
+
+Vec3 vec(const std::vector<double>& v, size_t at) {
+  return {float(v[at]), float(v[at + 1]), float(v[at + 2])};
+}
+
+// The grid form: corner, edges u and v, cell counts; a sensor at each cell's centre.
+void add_grid(const std::vector<double>& v, const FileLoc& loc, std::vector<Sensor>* out) {
+  if (v.size() != 11)
+    throw Error(loc, "a grid needs 11 numbers (x y z, ux uy uz, vx vy vz, nu nv); it has " +
+                         std::to_string(v.size()));
+  const Vec3 corner = vec(v, 0), u = vec(v, 3), w = vec(v, 6);
+  const double nu = v[9], nv = v[10];
+  if (nu != std::floor(nu) || nv != std::floor(nv) || nu < 1 || nv < 1 || nu * nv > 1e7)
+    throw Error(loc, "a grid's cell counts must be whole numbers from 1, at most 10^7 cells");
+  const Vec3 n = cross(u, w);
+  if (!(length(n) > 0)) throw Error(loc, "a grid's edges u and v must not be parallel or zero");
+  for (int j = 0; j < int(nv); ++j)
+    for (int i = 0; i < int(nu); ++i)
+      out->push_back(
+          {corner + u * float((i + 0.5) / nu) + w * float((j + 0.5) / nv), normalize(n)});
+}
+
+}  // namespace
+
+std::vector<Sensor> parse_sensors(const std::string& text, const std::string& path) {
+  std::vector<Sensor> out;
+  std::istringstream in(text);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos) continue;
+    const bool grid = line.compare(first, 4, "grid") == 0;
+    std::vector<double> v;
+    std::vector<int> columns;
+    std::string bad;
+    int bad_column = 0;
+    if (!numbers(grid ? line.substr(first + 4) : line, &v, &columns, &bad, &bad_column))
+      throw Error(FileLoc{path, number, bad_column + (grid ? int(first) + 4 : 0)},
+                  "\"" + bad + "\" is not a number (a sensor is \"x y z nx ny nz\")");
+    const FileLoc loc{path, number, int(first) + 1};
+    if (grid) {
+      add_grid(v, loc, &out);
+      continue;
+    }
+    if (v.size() != 6)
+      throw Error(loc, "a sensor needs 6 numbers, x y z nx ny nz; this line has " +
+                           std::to_string(v.size()));
+    const Vec3 n = vec(v, 3);
+    if (!(length(n) > 0)) throw Error(loc, "a sensor's normal must not be zero");
+    out.push_back({vec(v, 0), normalize(n)});
+  }
+  if (out.empty()) throw Error(FileLoc{path, 1, 1}, "the sensor file holds no sensor");
+  return out;
+}
+
+std::vector<Sensor> read_sensors(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open sensor file \"" + path + "\"");
+  std::stringstream s;
+  s << in.rdbuf();
+  return parse_sensors(s.str(), path);
+}
+
+Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_depth,
+                           const Wavelengths& wl, Rng& rng) {
+  PathCounters counters;
+  const Frame frame = Frame::from_z(s.n);
+  // Rays leave from just above the sensor, so that a sensor on a surface does not see that
+  // surface; the light sample's distance and angle are the sensor's own.
+  const float lift = 1e-6f * scene.bounds_info.radius;
+  const Vec3 origin = s.p + s.n * lift;
+  Spectrum E;
+  // Next-event estimation: E = Li cos / p, by the power heuristic against the cosine sample.
+  if (!scene.lights.empty()) {
+    float pmf;
+    const int li = scene.light_distribution.sample(rng.uniform(), &pmf);
+    const Light& light = scene.lights[size_t(li)];
+    const Vec2 u{rng.uniform(), rng.uniform()};
+    auto ls = light_sample_li(light, scene.light_shape(light), s.p, u, scene.bounds_info, wl);
+    const float cos_theta = ls ? dot(ls->wi, s.n) : 0;
+    if (ls && cos_theta > 0 && ls->pdf_solid_angle > 0 && !ls->radiance.is_black()) {
+      const bool has_surface = length_squared(ls->n_light) > 0;
+      const Vec3 target = has_surface
+                              ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
+                              : ls->p_light;
+      if (!scene.occluded(origin, target)) {
+        const float p_light = pmf * ls->pdf_solid_angle;
+        const float w = ls->is_delta ? 1 : power_heuristic(p_light, cos_theta * kInvPi);
+        E += ls->radiance * (cos_theta * w / p_light);
+      }
+    }
+  }
+  // A cosine-distributed direction: E = pi L, the emission it finds weighted against the light
+  // sample, and the light beyond found as a camera path finds it.
+  const Vec3 local = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
+  const Vec3 wi = frame.to_world(local);
+  const EmitterWeight first = EmitterWeight::mis(local.z * kInvPi, origin);
+  E += path_radiance(scene, Ray{origin, wi, kInf}, PathSettings{max_depth}, wl, rng, counters,
+                     first) *
+       kPi;
+  return E;
+}
+
+void sensor_pass(const RenderScene& scene, const std::vector<Sensor>& sensors, int max_depth,
+                 uint64_t seed, int pass_index, Film* film) {
+  // A stream of its own for each (pass, sensor, sample), apart from the pixels' streams.
+  constexpr uint64_t kSensorStreams = 0x53454e534f525321ull;
+  tbb::parallel_for(size_t(0), sensors.size(), [&](size_t i) {
+    double sum = 0;
+    for (int k = 0; k < kSensorSamplesPerPass; ++k) {
+      Rng rng(stream_key(seed ^ kSensorStreams, uint64_t(pass_index), i, uint64_t(k)));
+      const Wavelengths wl = sample_wavelengths(rng.uniform());
+      const Spectrum E = sensor_irradiance(scene, sensors[i], max_depth, wl, rng);
+      if (E.is_finite() && !E.has_negative()) sum += spectrum_to_luminance(E, wl);
+    }
+    film->add_sensor_pass(i, sum / kSensorSamplesPerPass);
+  });
+}
+
+}  // namespace bpm
