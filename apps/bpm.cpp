@@ -201,7 +201,7 @@ nlohmann::json image_units(bool bias) {
       "x shutter time), as pbrt-v4's rgb film";
   nlohmann::json u = {{"R, G, B", image},
                       {"rms.R, rms.G, rms.B, rms, rms_m_images*", "the image's"},
-                      {"Y", "cd/m^2 (luminance, without the imaging ratio)"},
+                      {"luminance.Y", "cd/m^2 (without the imaging ratio)"},
                       {"rms.Y", "cd/m^2"},
                       {"passes", "samples"},
                       {"result.relative_error_delta*", "relative (0.01 is 1%)"}};
@@ -511,10 +511,11 @@ int run_luminaire(const LuminaireArgs& a) {
   std::printf(
       "# %s%s%s (%s): %.6g lm, the integral of its intensities; lamps %.6g lm%s\n"
       "# The image holds candela toward each direction of pbrt-v4's goniometric light: the\n"
-      "# luminaire's nadir (gamma 0) along the light's -y, C 0 along +x and C 90 along -z.\n"
+      "# luminaire's nadir (gamma 0) along the light's -y, C 0 along +x and C 90 along +z, so\n"
+      "# that C runs counterclockwise seen from above in pbrt-v4's left-handed coordinates.\n"
       "AttributeBegin\n"
       "  Translate 0 0 0    # where the luminaire is\n"
-      "  Rotate 90 1 0 0    # in a scene whose up is +z (nadir along -z, C 90 along +y); leave it\n"
+      "  Rotate 90 1 0 0    # in a scene whose up is +z (nadir along -z, C 90 along -y); leave it\n"
       "                     # out where up is +y\n"
       "  LightSource \"goniometric\" \"string filename\" \"%s\"\n"
       "AttributeEnd\n",

@@ -101,7 +101,8 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   }
   // The luminance in cd/m^2 (without the imaging ratio: a physical quantity), its standard error
   // and, for the photon methods, its bias and total error.
-  add("Y", film.luminance_image());
+  // A layer of its own: an EXR reader that finds a bare Y beside R, G, B may show it alone, grey.
+  add("luminance.Y", film.luminance_image());
   add("rms.Y", film.rms());
   if (film.has_bias()) {
     add("bias.Y", film.bias_luminance());

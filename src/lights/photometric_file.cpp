@@ -72,6 +72,8 @@ struct Planes {
     const auto stored = rows;
     for (const auto& [c, row] : stored) add(f(c), row);
   }
+  // Whether a plane lies at C = 0 (the table needs one: it wraps from 360 back to it).
+  bool covers_zero() const { return !rows.empty() && rows.begin()->first == 0; }
   // The table over [0, 360] with the plane at 0 repeated at 360.
   void to_table(PhotometricData* d) const {
     d->c.clear();
@@ -220,6 +222,8 @@ void IesReader::unfold(const std::vector<double>& h, const std::vector<std::vect
                       " degrees declare no type C symmetry (0 to 0, 90, 180 or up to 360; or 90 "
                       "to 270)");
   }
+  if (!p.covers_zero())
+    fail(h_first, "the horizontal angles leave no plane at C = 0 once unfolded");
   p.to_table(d);
 }
 
@@ -236,20 +240,27 @@ PhotometricData IesReader::read() {
   if (!(multiplier > 0)) fail(*t, "the candela multiplier must be positive, not " + t->text);
   const int n_v = count("the number of vertical angles", 2, 100000);
   const int n_h = count("the number of horizontal angles", 1, 100000);
-  const int type = int(number("the photometric type", &t));
-  if (type == 2 || type == 3)
-    fail(*t, std::string("type ") + (type == 2 ? "B" : "A") +
-                 " photometry is not supported (only type C, photometric type 1)");
-  if (type != 1) fail(*t, "the photometric type must be 1 (C), 2 (B) or 3 (A), not " + t->text);
-  const int units = int(number("the units type", &t));
-  if (units != 1 && units != 2) fail(*t, "the units type must be 1 (feet) or 2 (metres)");
+  const Token& type_token = next("the photometric type");
+  --next_;
+  const int type = count("the photometric type (1 C, 2 B, 3 A)", 1, 3);
+  if (type != 1)
+    fail(type_token, std::string("type ") + (type == 2 ? "B" : "A") +
+                         " photometry is not supported (only type C, photometric type 1)");
+  count("the units type (1 feet, 2 metres)", 1, 2);
   for (const char* what : {"the luminous opening's width", "its length", "its height"})
     number(what);
   const double ballast = number("the ballast factor", &t);
   if (!(ballast > 0)) fail(*t, "the ballast factor must be positive, not " + t->text);
+  // 1995 and earlier: the ballast-lamp photometric factor, which scales the candela values; 2002:
+  // "future use" (1); 2019: the file generation type, a code (1.00001 to 1.11011) that says how
+  // the file was made and scales nothing.
   const double lamp_factor = number("the ballast-lamp photometric factor", &t);
   if (!(lamp_factor > 0))
-    fail(*t, "the ballast-lamp factor (\"future use\", 1) must be positive, not " + t->text);
+    fail(*t,
+         "the ballast-lamp factor (or future use, or file generation type) must be "
+         "positive, not " +
+             t->text);
+  const bool scales = d.format < "IES LM-63-2002";
   number("the input watts");
   // Counted before anything is allocated for them: a header may claim any size.
   const uint64_t values = uint64_t(n_v) + uint64_t(n_h) + uint64_t(n_v) * uint64_t(n_h);
@@ -267,7 +278,9 @@ PhotometricData IesReader::read() {
     for (double& v : row) {
       v = number("the candela values", &t);
       if (v < 0) fail(*t, "a candela value must not be negative: " + t->text);
-      v *= multiplier * ballast * lamp_factor;
+      v *= multiplier * ballast * (scales ? lamp_factor : 1);
+      if (!(v <= 3e38))
+        fail(*t, "the candela value " + t->text + " times the multipliers is too large");
     }
   if (next_ < tokens_.size())
     fail(tokens_[next_], "\"" + tokens_[next_].text + "\" after the candela table (" +
@@ -334,7 +347,12 @@ PhotometricData EulumdatReader::read() {
     fail(4, "Mc = " + std::to_string(mc) +
                 " C planes cannot have the symmetry Isym = " + std::to_string(isym));
   std::vector<double> c(size_t(mc), 0.0), gamma(size_t(ng), 0.0);
-  for (int i = 0; i < mc; ++i) c[size_t(i)] = number(at + i, "C angle");
+  for (int i = 0; i < mc; ++i) {
+    c[size_t(i)] = number(at + i, "C angle");
+    if (c[size_t(i)] < 0 || c[size_t(i)] >= 360)
+      fail(at + i, "C angles must lie in 0 to 360 degrees (360 excluded)");
+    if (i > 0 && !(c[size_t(i)] > c[size_t(i) - 1])) fail(at + i, "C angles must increase");
+  }
   at += mc;
   for (int j = 0; j < ng; ++j) {
     gamma[size_t(j)] = number(at + j, "gamma angle");
@@ -358,18 +376,21 @@ PhotometricData EulumdatReader::read() {
       row[size_t(j)] = number(at, "intensity (cd/klm)");
       if (row[size_t(j)] < 0) fail(at, "an intensity must not be negative");
       row[size_t(j)] *= scale;
+      if (!(row[size_t(j)] <= 3e38)) fail(at, "an intensity times the lamp flux is too large");
     }
     p.add(c[size_t((k - 1) % mc)], row);
   }
   for (int n = at; n <= int(lines_.size()); ++n)
     if (!trim(lines_[size_t(n - 1)]).empty())
       fail(n, "\"" + trim(lines_[size_t(n - 1)]) + "\" after the intensity table");
+  const int c_line = 27 + 6 * sets + 10;
   if (isym == 2) p.mirror([](double a) { return 360 - a; });
   if (isym == 3) p.mirror([](double a) { return 180 - a; });
   if (isym == 4) {
     p.mirror([](double a) { return 180 - a; });
     p.mirror([](double a) { return 360 - a; });
   }
+  if (!p.covers_zero()) fail(c_line, "the stored C planes leave no plane at C = 0 once unfolded");
   d.gamma = gamma;
   p.to_table(&d);
   d.lamp_lumens = flux;
@@ -401,7 +422,7 @@ double PhotometricData::intensity(double c_deg, double gamma_deg) const {
 
 double PhotometricData::intensity(Vec3 w) const {
   const double cos_gamma = std::clamp(-double(w.y), -1.0, 1.0);
-  double c_deg = std::atan2(-double(w.z), double(w.x)) * kDegrees;
+  double c_deg = std::atan2(double(w.z), double(w.x)) * kDegrees;
   return intensity(c_deg, std::acos(cos_gamma) * kDegrees);
 }
 

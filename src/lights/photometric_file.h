@@ -4,11 +4,12 @@
 // symmetries the file declares unfolded) and the vertical angle gamma (0 at the nadir, 180
 // straight up), read by bilinear interpolation; zero outside the vertical angles the file covers.
 //
-// The luminaire's frame: gamma 0 (the nadir) along -y, C 0 along +x, C 90 along -z. It is the
+// The luminaire's frame: gamma 0 (the nadir) along -y, C 0 along +x, C 90 along +z. It is the
 // frame of pbrt-v4's goniometric light, whose image centre is the light's +y (the luminaire's
-// zenith), so that goniometric_image() gives the image pbrt-v4 expects; in a scene whose up is
-// +z, "Rotate 90 1 0 0" before the light puts the nadir along -z and C 90 along +y, which is
-// counterclockwise from C 0 seen from above, as LM-63 defines it.
+// zenith), so that goniometric_image() gives the image pbrt-v4 expects. pbrt-v4's coordinates are
+// left-handed (a camera that looks down -z with +y up sees +x on its left), so C runs
+// counterclockwise seen from above, as LM-63 defines it, in a scene whose up is +y as it stands,
+// and in one whose up is +z after "Rotate 90 1 0 0" (nadir along -z, C 90 along -y).
 #pragma once
 #include <string>
 #include <vector>

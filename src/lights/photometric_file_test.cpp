@@ -86,8 +86,8 @@ TEST(PhotometricFile, IesSymmetriesUnfold) {
   PhotometricData b = parse_ies(bilateral, "b.ies");
   EXPECT_NEAR(b.intensity(270, 90), 40, 1e-9);
   EXPECT_NEAR(b.intensity(300, 0), b.intensity(60, 0), 1e-9);
-  // C 90 lies along -z of the luminaire's frame, C 270 along +z.
-  EXPECT_NEAR(b.intensity(Vec3(0, 0, -1)), 40, 1e-6);
+  // C 90 lies along +z of the luminaire's frame, C 270 along -z.
+  EXPECT_NEAR(b.intensity(Vec3(0, 0, 1)), 40, 1e-6);
   // An asymmetric file: 0 to 270 degrees, back to the plane at 0 by 360.
   PhotometricData a =
       parse_ies(ies("1 -1 1 2 4 1 2 0 0 0\n1 1 0\n0 90\n0 90 180 270\n1 1\n2 2\n3 3\n4 4\n"), "a");
@@ -98,6 +98,17 @@ TEST(PhotometricFile, IesSymmetriesUnfold) {
   EXPECT_NEAR(h.intensity(0, 10), 2, 1e-9);
   EXPECT_NEAR(h.intensity(45, 10), 1.5, 1e-9);
   EXPECT_NEAR(h.intensity(315, 10), 2.5, 1e-9);
+}
+
+// The thirteenth number scales the candela values in 1995 and earlier files (the ballast-lamp
+// factor); in 2002 it is for future use and in 2019 it says how the file was made.
+TEST(PhotometricFile, BallastLampFactorScalesOnlyOldFiles) {
+  const std::string numbers = "1 -1 2 2 1 1 2 0 0 0\n0.5 1.1 0\n0 90\n0\n10 10\n";
+  EXPECT_NEAR(parse_ies("IESNA:LM-63-1995\nTILT=NONE\n" + numbers, "a").intensity(0, 45), 11, 1e-9);
+  EXPECT_NEAR(parse_ies("IESNA:LM-63-2002\nTILT=NONE\n" + numbers, "b").intensity(0, 45), 10, 1e-9);
+  PhotometricData d = parse_ies("IES:LM-63-2019\nTILT=NONE\n" + numbers, "c");
+  EXPECT_EQ(d.format, "IES LM-63-2019");
+  EXPECT_NEAR(d.intensity(0, 45), 10, 1e-9);
 }
 
 TEST(PhotometricFile, IesErrorsNameTheLine) {
@@ -160,10 +171,16 @@ std::string ldt(int isym, int mc, int ng, double (*f)(double, double)) {
 }
 
 double ldt_constant(double, double) { return 50; }
-// Symmetric about both planes: depends on |cos C|.
-double ldt_both(double c, double g) {
-  return 100 + 50 * std::fabs(std::cos(c * kPi / 180)) * g / 180;
+// A function of each symmetry alone (Isym 0: none; 2: about the C 0-180 plane, I(360 - C) =
+// I(C); 3: about the C 90-270 plane, I(180 - C) = I(C); 4: both), so that a plane read from the
+// wrong place shows.
+double deg(double a) { return a * kPi / 180; }
+double ldt_none(double c, double g) {
+  return (100 + 30 * std::cos(deg(c)) + 20 * std::sin(deg(c))) * (1 + g / 180);
 }
+double ldt_c0_180(double c, double g) { return (100 + 50 * std::cos(deg(c))) * (1 + g / 180); }
+double ldt_c90_270(double c, double g) { return (100 + 50 * std::sin(deg(c))) * (1 + g / 180); }
+double ldt_both(double c, double g) { return (100 + 50 * std::cos(deg(2 * c))) * (1 + g / 180); }
 
 TEST(PhotometricFile, EulumdatScalesByTheLampFluxAndUnfolds) {
   PhotometricData d = parse_eulumdat(ldt(1, 36, 19, ldt_constant), "a.ldt");
@@ -172,11 +189,13 @@ TEST(PhotometricFile, EulumdatScalesByTheLampFluxAndUnfolds) {
   EXPECT_EQ(d.lamp_lumens, 2000);
   EXPECT_NEAR(d.intensity(123, 77), 100, 1e-9);  // 50 cd/klm of 2000 lm
   EXPECT_NEAR(d.luminous_flux(), 4 * kPi * 100, 1e-6 * 4 * kPi * 100);
-  for (int isym : {0, 2, 3, 4}) {
-    PhotometricData s = parse_eulumdat(ldt(isym, 24, 7, ldt_both), "b.ldt");
-    for (double c : {0.0, 15.0, 105.0, 195.0, 285.0, 345.0})
-      EXPECT_NEAR(s.intensity(c, 60), 2 * ldt_both(c, 60), 1e-5 * ldt_both(c, 60))
-          << "Isym " << isym << " C " << c;  // the file holds six digits
+  const std::pair<int, double (*)(double, double)> cases[] = {
+      {0, ldt_none}, {2, ldt_c0_180}, {3, ldt_c90_270}, {4, ldt_both}};
+  for (const auto& [isym, f] : cases) {
+    PhotometricData s = parse_eulumdat(ldt(isym, 24, 7, f), "b.ldt");
+    for (int k = 0; k < 24; ++k)  // every plane, stored or unfolded; the file holds six digits
+      EXPECT_NEAR(s.intensity(15 * k, 60), 2 * f(15 * k, 60), 1e-5 * 2 * f(15 * k, 60))
+          << "Isym " << isym << " C " << 15 * k;
   }
   EXPECT_NE(error_of(ldt(4, 22, 7, ldt_both), true).find("cannot have the symmetry"),
             std::string::npos);

@@ -12,7 +12,8 @@ namespace bpm {
 namespace {
 
 constexpr char kMagic[8] = {'B', 'P', 'M', 'C', 'K', 'P', 'T', '\n'};
-constexpr uint32_t kVersion = 2;  // 2: bpm keeps emission statistics per pixel
+constexpr uint32_t kVersion = 3;  // 2: bpm keeps emission statistics per pixel; 3: the film
+                                  // keeps the luminance and the sensors
 
 std::string read_file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
