@@ -1,12 +1,13 @@
-// libFuzzer target: the photometric file readers (IES LM-63 and EULUMDAT), each given the input,
-// and a table that reads is unfolded into a small goniometric image. A bad file must end in
-// bpm::Error; anything else is a finding.
+// libFuzzer target: the photometric file readers (IES LM-63 and EULUMDAT) and the sensor file
+// reader, each given the input; a table that reads is unfolded into a small goniometric image. A
+// bad file must end in bpm::Error; anything else is a finding.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include "base/error.h"
 #include "lights/photometric_file.h"
+#include "path/sensors.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
@@ -17,6 +18,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       bpm::goniometric_image(d, 16);
     } catch (const bpm::Error&) {
     }
+  }
+  try {
+    bpm::parse_sensors(text, "fuzz.txt");
+  } catch (const bpm::Error&) {
   }
   return 0;
 }

@@ -114,6 +114,8 @@ TEST(Sensors, BadFilesAreLocatedErrors) {
   EXPECT_NE(sensor_error("grid 0 0 0 1 0 0 2 0 0 3 3\n").find("must not be parallel"),
             std::string::npos);
   EXPECT_NE(sensor_error("grid 0 0 0 1 0 0 0 1 0 3 0.5\n").find("cell counts"), std::string::npos);
+  EXPECT_NE(sensor_error("grid 0 0 0 1 0 0 0 1 0 1e4 1e4\n").find("more than 10^7 sensors"),
+            std::string::npos);
   EXPECT_NE(sensor_error("\n# nothing\n").find("holds no sensor"), std::string::npos);
   EXPECT_EQ(parse_sensors("1 2 3 0 0 2 # up\n", "s").at(0).n.z, 1.0f);
 }

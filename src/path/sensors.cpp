@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -14,6 +15,8 @@
 
 namespace bpm {
 namespace {
+
+constexpr double kMostSensors = 1e7;
 
 // Numbers of one line with their columns; false at the first word that is not a number.
 bool numbers(const std::string& line, std::vector<double>* values, std::vector<int>* columns,
@@ -49,8 +52,10 @@ void add_grid(const std::vector<double>& v, const FileLoc& loc, std::vector<Sens
                          std::to_string(v.size()));
   const Vec3 corner = vec(v, 0), u = vec(v, 3), w = vec(v, 6);
   const double nu = v[9], nv = v[10];
-  if (nu != std::floor(nu) || nv != std::floor(nv) || nu < 1 || nv < 1 || nu * nv > 1e7)
-    throw Error(loc, "a grid's cell counts must be whole numbers from 1, at most 10^7 cells");
+  if (nu != std::floor(nu) || nv != std::floor(nv) || nu < 1 || nv < 1)
+    throw Error(loc, "a grid's cell counts must be whole numbers from 1");
+  if (double(out->size()) + nu * nv > kMostSensors)
+    throw Error(loc, "more than 10^7 sensors in the file");
   const Vec3 n = cross(u, w);
   if (!(length(n) > 0)) throw Error(loc, "a grid's edges u and v must not be parallel or zero");
   for (int j = 0; j < int(nv); ++j)
@@ -87,6 +92,8 @@ std::vector<Sensor> parse_sensors(const std::string& text, const std::string& pa
                            std::to_string(v.size()));
     const Vec3 n = vec(v, 3);
     if (!(length(n) > 0)) throw Error(loc, "a sensor's normal must not be zero");
+    if (double(out.size()) + 1 > kMostSensors)
+      throw Error(loc, "more than 10^7 sensors in the file");
     out.push_back({vec(v, 0), normalize(n)});
   }
   if (out.empty()) throw Error(FileLoc{path, 1, 1}, "the sensor file holds no sensor");
