@@ -11,19 +11,12 @@
 #include <sstream>
 
 #include "base/sampling.h"
+#include "base/text.h"
 
 namespace bpm {
 namespace {
 
 constexpr double kDegrees = 180.0 / 3.14159265358979323846;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open photometric file \"" + path + "\"");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::vector<std::string> split_lines(const std::string& text) {
   std::vector<std::string> lines;
@@ -51,13 +44,6 @@ struct Token {
   std::string text;
   int line = 0, column = 0;
 };
-
-bool parse_number(const std::string& text, double* value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && std::isfinite(*value);
-}
 
 // The photometric planes as a file stores them, unfolded to [0, 360] by the symmetries it
 // declares: each mirror maps a stored angle to another (degrees), keeping its row.
@@ -147,18 +133,8 @@ size_t IesReader::read_header(PhotometricData* d) {
 
 void IesReader::tokenize(size_t first_line) {
   for (size_t i = first_line; i < lines_.size(); ++i) {
-    const std::string& line = lines_[i];
-    size_t k = 0;
-    while (k < line.size()) {
-      while (k < line.size() &&
-             (std::isspace(static_cast<unsigned char>(line[k])) || line[k] == ','))
-        ++k;
-      size_t start = k;
-      while (k < line.size() && !std::isspace(static_cast<unsigned char>(line[k])) &&
-             line[k] != ',')
-        ++k;
-      if (k > start) tokens_.push_back({line.substr(start, k - start), int(i + 1), int(start + 1)});
-    }
+    for (Word& w : split_words(lines_[i], ","))
+      tokens_.push_back({std::move(w.text), int(i + 1), w.column});
   }
 }
 
@@ -444,12 +420,14 @@ double PhotometricData::luminous_flux() const {
 PhotometricData parse_ies(const std::string& text, const std::string& path) {
   return IesReader(text, path).read();
 }
-PhotometricData read_ies(const std::string& path) { return parse_ies(read_text(path), path); }
+PhotometricData read_ies(const std::string& path) {
+  return parse_ies(read_text_file(path, "photometric file"), path);
+}
 PhotometricData parse_eulumdat(const std::string& text, const std::string& path) {
   return EulumdatReader(text, path).read();
 }
 PhotometricData read_eulumdat(const std::string& path) {
-  return parse_eulumdat(read_text(path), path);
+  return parse_eulumdat(read_text_file(path, "photometric file"), path);
 }
 
 bool is_photometric_file(const std::string& path) {

@@ -10,6 +10,7 @@
 
 #include "base/error.h"
 #include "base/sampling.h"
+#include "base/text.h"
 #include "integrator/direct_light.h"
 #include "path/path_integrator.h"
 
@@ -17,29 +18,6 @@ namespace bpm {
 namespace {
 
 constexpr double kMostSensors = 1e7;
-
-// Numbers of one line with their columns; false at the first word that is not a number.
-bool numbers(const std::string& line, std::vector<double>* values, std::vector<int>* columns,
-             std::string* bad, int* bad_column) {
-  size_t k = 0;
-  while (k < line.size()) {
-    while (k < line.size() && std::isspace(static_cast<unsigned char>(line[k]))) ++k;
-    const size_t start = k;
-    while (k < line.size() && !std::isspace(static_cast<unsigned char>(line[k]))) ++k;
-    if (k == start) break;
-    const std::string word = line.substr(start, k - start);
-    char* end = nullptr;
-    const double v = std::strtod(word.c_str(), &end);
-    if (end != word.c_str() + word.size() || !std::isfinite(v)) {
-      *bad = word;
-      *bad_column = int(start + 1);
-      return false;
-    }
-    values->push_back(v);
-    columns->push_back(int(start + 1));
-  }
-  return true;
-}
 
 Vec3 vec(const std::vector<double>& v, size_t at) {
   return {float(v[at]), float(v[at + 1]), float(v[at + 2])};
@@ -72,17 +50,17 @@ std::vector<Sensor> parse_sensors(const std::string& text, const std::string& pa
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     if (size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos) continue;
-    const bool grid = line.compare(first, 4, "grid") == 0;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<Word> words = split_words(line);
+    const bool grid = words[0].text == "grid";
     std::vector<double> v;
-    std::vector<int> columns;
-    std::string bad;
-    int bad_column = 0;
-    if (!numbers(grid ? line.substr(first + 4) : line, &v, &columns, &bad, &bad_column))
-      throw Error(FileLoc{path, number, bad_column + (grid ? int(first) + 4 : 0)},
-                  "\"" + bad + "\" is not a number (a sensor is \"x y z nx ny nz\")");
-    const FileLoc loc{path, number, int(first) + 1};
+    for (size_t k = grid ? 1 : 0; k < words.size(); ++k) {
+      v.push_back(0);
+      if (!parse_number(words[k].text, &v.back()))
+        throw Error(FileLoc{path, number, words[k].column},
+                    "\"" + words[k].text + "\" is not a number (a sensor is \"x y z nx ny nz\")");
+    }
+    const FileLoc loc{path, number, words[0].column};
     if (grid) {
       add_grid(v, loc, &out);
       continue;
@@ -101,11 +79,7 @@ std::vector<Sensor> parse_sensors(const std::string& text, const std::string& pa
 }
 
 std::vector<Sensor> read_sensors(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open sensor file \"" + path + "\"");
-  std::stringstream s;
-  s << in.rdbuf();
-  return parse_sensors(s.str(), path);
+  return parse_sensors(read_text_file(path, "sensor file"), path);
 }
 
 Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_depth,
@@ -113,30 +87,21 @@ Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_de
   PathCounters counters;
   const Frame frame = Frame::from_z(s.n);
   // Rays leave from just above the sensor, so that a sensor on a surface does not see that
-  // surface; the light sample's distance and angle are the sensor's own.
+  // surface; the light sample's distance and angle are the sensor's own (sp.error below).
   const float lift = 1e-6f * scene.bounds_info.radius;
   const Vec3 origin = s.p + s.n * lift;
-  Spectrum E;
-  // Next-event estimation: E = Li cos / p, by the power heuristic against the cosine sample.
-  if (!scene.lights.empty()) {
-    float pmf;
-    const int li = scene.light_distribution.sample(rng.uniform(), &pmf);
-    const Light& light = scene.lights[size_t(li)];
-    const Vec2 u{rng.uniform(), rng.uniform()};
-    auto ls = light_sample_li(light, scene.light_shape(light), s.p, u, scene.bounds_info, wl);
-    const float cos_theta = ls ? dot(ls->wi, s.n) : 0;
-    if (ls && cos_theta > 0 && ls->pdf_solid_angle > 0 && !ls->radiance.is_black()) {
-      const bool has_surface = length_squared(ls->n_light) > 0;
-      const Vec3 target = has_surface
-                              ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
-                              : ls->p_light;
-      if (!scene.occluded(origin, target)) {
-        const float p_light = pmf * ls->pdf_solid_angle;
-        const float w = ls->is_delta ? 1 : power_heuristic(p_light, cos_theta * kInvPi);
-        E += ls->radiance * (cos_theta * w / p_light);
-      }
-    }
-  }
+  // Next-event estimation at a white Lambertian surface standing for the sensor (f = 1 / pi,
+  // weighted by the power heuristic against the cosine sample below): pi times its radiance is
+  // the illuminance. The point lies on no object and in the scene's outer medium.
+  SurfacePoint sp;
+  sp.p = s.p;
+  sp.ng = sp.ns = s.n;
+  sp.error = lift;
+  const Material white = DiffuseMaterial{Spectrum(1.0f)};
+  const WavelengthMaterials wm = WavelengthMaterials::resolved_per_point(scene, wl);
+  Spectrum E =
+      sample_direct_light(scene, sp, -1, -1, white, frame, Vec3(0, 0, 1), true, wm, rng, counters) *
+      kPi;
   // A cosine-distributed direction: E = pi L, the emission it finds weighted against the light
   // sample, and the light beyond found as a camera path finds it.
   const Vec3 local = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});

@@ -111,6 +111,7 @@ inline TextureContext texture_context(const SurfacePoint& sp) { return {sp.p, sp
 // The medium a ray leaving a surface of `object` (geometric normal ng) toward w travels in, when
 // the ray that arrived was in `current`.
 inline int medium_toward(const RenderScene& scene, int object, Vec3 ng, Vec3 w, int current) {
+  if (object < 0) return current;  // a point on no object (an illuminance sensor)
   const Object& o = scene.objects[size_t(object)];
   if (o.medium_inside == o.medium_outside) return current;
   return dot(w, ng) > 0 ? o.medium_outside : o.medium_inside;

@@ -3,6 +3,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "base/text.h"
+
 namespace bpm {
 
 std::string Token::unquoted() const {
@@ -30,12 +32,7 @@ std::string Token::unquoted() const {
 }
 
 std::unique_ptr<Tokenizer> Tokenizer::from_file(const std::string& path, const FileLoc& from) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(from, "cannot open scene file \"" + path + "\"");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw Error(from, "error reading scene file \"" + path + "\"");
-  return std::unique_ptr<Tokenizer>(new Tokenizer(ss.str(), path));
+  return std::unique_ptr<Tokenizer>(new Tokenizer(read_text_file(path, "scene file", from), path));
 }
 
 std::unique_ptr<Tokenizer> Tokenizer::from_string(std::string text, std::string name) {
