@@ -4,8 +4,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <sstream>

@@ -2,10 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include <cctype>
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
 #include <sstream>
 
 #include "base/error.h"

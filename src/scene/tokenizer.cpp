@@ -1,8 +1,5 @@
 #include "scene/tokenizer.h"
 
-#include <fstream>
-#include <sstream>
-
 #include "base/text.h"
 
 namespace bpm {
