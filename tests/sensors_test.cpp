@@ -118,6 +118,8 @@ TEST(Sensors, BadFilesAreLocatedErrors) {
             std::string::npos);
   EXPECT_NE(sensor_error("\n# nothing\n").find("holds no sensor"), std::string::npos);
   EXPECT_EQ(parse_sensors("1 2 3 0 0 2 # up\n", "s").at(0).n.z, 1.0f);
+  // Lines of white space other than blanks and tabs (a vertical tab, a form feed) are empty.
+  EXPECT_EQ(parse_sensors("\v\n\f \n1 2 3 0 0 1\n", "s").size(), 1u);
 }
 
 }  // namespace

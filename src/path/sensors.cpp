@@ -47,8 +47,8 @@ std::vector<Sensor> parse_sensors(const std::string& text, const std::string& pa
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     if (size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::vector<Word> words = split_words(line);
+    if (words.empty()) continue;  // blank, or white space of any kind (\v, \f) only
     const bool grid = words[0].text == "grid";
     std::vector<double> v;
     for (size_t k = grid ? 1 : 0; k < words.size(); ++k) {
