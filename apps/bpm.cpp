@@ -225,13 +225,20 @@ void record_outputs(const RenderArgs& a, const RenderOptions& opt, const Film& f
   }
   if (opt.sensors.empty()) return;
   out["sensors_csv"] = paths.sensors;
-  (*rec)["sensors"] = {{"file", a.sensors},
-                       {"count", opt.sensors.size()},
-                       {"samples_per_pass", kSensorSamplesPerPass},
-                       {"unit", "lux"},
-                       {"method",
-                        "path: next-event estimation and a cosine-distributed path at each sensor, "
-                        "in every pass, whatever the image's integrator"}};
+  (*rec)["sensors"] = {
+      {"file", a.sensors},
+      {"count", opt.sensors.size()},
+      {"samples_per_pass", kSensorSamplesPerPass},
+      {"unit", "lux"},
+      {"method", opt.integrator == "path"
+                     ? "path: next-event estimation and a cosine-distributed path at each "
+                       "sensor, in every pass"
+                     : opt.integrator +
+                           ": direct light by next-event estimation and a "
+                           "cosine-distributed direction at each sensor; caustic and "
+                           "indirect light by the photons crossing a disc about it, of a "
+                           "backward photon's radius (at most half a grid cell), in every "
+                           "iteration"}};
 }
 
 // The JSON record of a finished render: how the image was made and what it cost.

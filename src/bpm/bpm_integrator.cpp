@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "base/error.h"
 #include "base/memory.h"
@@ -16,6 +17,7 @@
 #include "bpm/statistics.h"
 #include "integrator/progressive.h"
 #include "photons/emission_guide.h"
+#include "photons/sensor_discs.h"
 
 namespace bpm {
 namespace {
@@ -102,6 +104,8 @@ class BpmRender {
   BpmRender(const LoadedScene& ls, const IntegratorOptions& opt, const BpmSettings& settings,
             Film* film);
   PassResult iteration(int pass, const RenderControl& control);
+  // The sensors' estimates of the last iteration, into the film (IntegratorOptions::sensor_pass).
+  void record_sensors(Film* film) const { sensor_sums_.record(film); }
   // The round's end and the checkpoint, as run_passes calls them.
   IntegratorState state();
   // The render's statistics once run_passes has filled `stats`.
@@ -164,6 +168,9 @@ class BpmRender {
   // Disc probes at first vertices near edges only (photons/disc_probes.h); with a radius in
   // world units the radii on screen are unknown, and every disc is probed.
   NearEdges near_edges_;
+  // Illuminance sensors, when the render has them (photons/sensor_discs.h).
+  std::unique_ptr<SensorDiscs> sensors_;
+  SensorIteration sensor_sums_;
 };
 
 const char* const kMemoryAdvice =
@@ -205,7 +212,10 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       fixed_bytes_(reserve_memory()),
       caustics_(may_have_caustics(scene_)),
       near_edges_(s_.disc_probes && s_.radius <= 0, scene_, camera_.camera(), ls.film.width,
-                  ls.film.height, ls.filter.radius) {
+                  ls.film.height, ls.filter.radius),
+      sensors_(
+          make_sensor_discs(scene_, opt.sensors, camera_.camera().position(), pixel_angle_, s_)),
+      sensor_sums_(opt.sensors.size()) {
   pixel_sums_.places = s_.diffuse_depth + 2;
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
@@ -235,15 +245,23 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   const float scale = radius_scale(s_, it);
   // One set of wavelengths for every eye and light path of the iteration.
   const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
-  // 1. Eye pass: backward photons, and the light the eye paths count themselves.
-  if (!eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
+  // 1. Eye pass: backward photons, and the light the eye paths count themselves (no image: none).
+  if (opt_.image && !eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
   // 2. Per-object sphere trees over the backward photons.
   LightPassParams lp{&wm, opt_.max_depth, s_.normal_cos, {}};
   if (!build_maps(pass, control, &lp)) return PassResult{false, 0, "", "memory"};
+  if (sensors_) {
+    sensors_->set_scale(scale);
+    sensor_sums_.clear();
+    lp.sensors = sensors_.get();
+    lp.sensor_sums = &sensor_sums_;
+  }
   // 3. Light pass: a fixed number of photons, in groups.
   if (!light_pass(lp, pass, it)) return PassResult{false, 0, "", ""};
+  if (sensors_)
+    sensor_sums_.finish(scene_, *sensors_, s_.bias_model, opt_.seed, it, light_result_.emitted);
   // 4. Accumulation of the iteration into the film; masks balanced for the next one.
-  accumulate(wm);
+  if (opt_.image) accumulate(wm);
   return progress();
 }
 
@@ -495,10 +513,12 @@ RenderStats BpmRender::finish(RenderStats stats) {
 
 RenderStats render_bpm(const LoadedScene& ls, const IntegratorOptions& opt,
                        const BpmSettings& settings, Film* film) {
-  BpmRender bpm(ls, opt, settings, film);
+  IntegratorOptions o = opt;
+  BpmRender bpm(ls, o, settings, film);
+  if (!opt.sensors.empty()) o.sensor_pass = [&bpm](int, Film* f) { bpm.record_sensors(f); };
   RenderStats stats;
   run_passes(
-      opt, film, "iteration",
+      o, film, "iteration",
       [&bpm](int pass, const RenderControl& control) { return bpm.iteration(pass, control); },
       &stats, bpm.state());
   return bpm.finish(stats);

@@ -124,6 +124,9 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   emitted.swap(buf->emitted[size_t(c)]);
   hits.clear();
   emitted.clear();
+  const SensorDiscs* sensors = g.prm.sensors;
+  std::vector<SensorCrossing>& crossings = buf->crossings[size_t(c)];
+  crossings.clear();
   const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
   const uint64_t last = std::min(first + kPhotonsPerChunk, g.count);
   auto photon_rng = [&](uint64_t k) {
@@ -142,15 +145,21 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     const uint32_t photon = uint32_t(k - first);
     // A backward photon adds at least one eye vertex; direct photons are never used
     // (next-event estimation counts direct light).
-    trace_light_path(scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc,
-                     [&](const PhotonHit& h) {
-                       if (h.cls == PhotonClass::kDirect || !maps.has_photons(h.object)) return;
-                       ++lc.queries;
-                       const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
-                       if (bucket == BackwardMaps::kNoBucket) return;
-                       hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object,
-                                       int16_t(h.bounces), h.cls, h.hero_only});
-                     });
+    auto on_hit = [&](const PhotonHit& h) {
+      if (h.cls == PhotonClass::kDirect || !maps.has_photons(h.object)) return;
+      ++lc.queries;
+      const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
+      if (bucket == BackwardMaps::kNoBucket) return;
+      hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object, int16_t(h.bounces),
+                      h.cls, h.hero_only});
+    };
+    if (sensors) {
+      // A sensor adds no eye vertex: photons cross it after up to max_depth bounces.
+      SensorSegments segments{scene, *sensors, g.prm.materials->wl, crossings, g.prm.max_depth};
+      trace_light_path(scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit, segments);
+    } else {
+      trace_light_path(scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit);
+    }
     if (g.scored) emitted.push_back({e.cell, e.weight});
   }
   buf->hits[size_t(c)].swap(hits);
@@ -224,6 +233,7 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->hits.resize(size_t(n_chunks));
     buf->emitted.resize(size_t(n_chunks));
     buf->chunk_counters.resize(size_t(n_chunks));
+    buf->crossings.resize(size_t(n_chunks));
   }
   const GroupTrace g{
       scene, maps, prm, seed, pass_index, first_photon, count, guide, guide && prm.pixel_weight};
@@ -453,6 +463,8 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     }
     first += tr.kept;
     res.emitted += tr.kept;
+    if (prm.sensor_sums)
+      for (int c = 0; c < tr.chunks; ++c) prm.sensor_sums->add(buf->crossings[size_t(c)]);
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
     gather_and_apply(maps, prm, masks, buf, res, clock);

@@ -20,6 +20,7 @@
 #include "bpm/masks.h"
 #include "bpm/settings.h"
 #include "photons/light_path.h"
+#include "photons/sensor_discs.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -55,6 +56,10 @@ struct LightPassParams {
   // and a group's hits); 0: no limit. A group whose entries reach it applies them, frees them and
   // goes on gathering, in the same order: the image is the same.
   size_t entry_bytes_limit = 0;
+  // Illuminance sensors: the photons' crossings of their discs are added to sensor_sums, chunk by
+  // chunk in order. Null: none.
+  const SensorDiscs* sensors = nullptr;
+  SensorIteration* sensor_sums = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -83,8 +88,9 @@ struct EmittedPhoton {
 // chunk of a group's photons their hits and emissions, the hits in gather order, per gather chunk
 // the entry lists, per chunk its photons' scores, and the per-thread counters.
 struct LightPassBuffers {
-  std::vector<std::vector<PendingHit>> hits;        // [chunk]
-  std::vector<std::vector<EmittedPhoton>> emitted;  // [chunk]
+  std::vector<std::vector<PendingHit>> hits;           // [chunk]
+  std::vector<std::vector<EmittedPhoton>> emitted;     // [chunk]
+  std::vector<std::vector<SensorCrossing>> crossings;  // [chunk], with sensors
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]

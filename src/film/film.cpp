@@ -43,6 +43,10 @@ double Film::sensor_mean(size_t i) const {
   return sensors_[i].passes > 0 ? sensors_[i].sum / sensors_[i].passes : 0;
 }
 
+double Film::sensor_bias(size_t i) const {
+  return sensors_[i].passes > 0 ? sensors_[i].bias_sum / sensors_[i].passes : 0;
+}
+
 double Film::sensor_standard_error(size_t i) const {
   return standard_error(sensors_[i].sum, sensors_[i].sum2, sensors_[i].passes);
 }
@@ -299,6 +303,7 @@ void Film::add(const Film& o) {
   for (size_t i = 0; i < sensors_.size(); ++i) {
     sensors_[i].sum += o.sensors_[i].sum;
     sensors_[i].sum2 += o.sensors_[i].sum2;
+    sensors_[i].bias_sum += o.sensors_[i].bias_sum;
     sensors_[i].passes += o.sensors_[i].passes;
   }
   for (size_t i = 0; i < m_sum_.size(); ++i) m_sum_[i] += o.m_sum_[i];

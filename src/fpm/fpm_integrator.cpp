@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "base/error.h"
 #include "base/memory.h"
@@ -69,6 +70,8 @@ class FpmRender {
   FpmRender(const LoadedScene& ls, const IntegratorOptions& opt, const FpmSettings& settings,
             Film* film);
   PassResult iteration(int pass, const RenderControl& control);
+  // The sensors' estimates of the last iteration, into the film (IntegratorOptions::sensor_pass).
+  void record_sensors(Film* film) const { sensor_sums_.record(film); }
   // The render's statistics once run_passes has filled `stats`.
   RenderStats finish(RenderStats stats);
 
@@ -101,6 +104,9 @@ class FpmRender {
   tbb::enumerable_thread_specific<FpmEyeCounters> eye_counters_;
   FpmTotals tot_;
   uint64_t emitted_ = 0;  // photons the last light pass emitted
+  // Illuminance sensors, when the render has them (photons/sensor_discs.h).
+  std::unique_ptr<SensorDiscs> sensors_;
+  SensorIteration sensor_sums_;
 };
 
 FpmSettings checked_settings(const FpmSettings& settings, size_t n_pixels) {
@@ -125,7 +131,10 @@ FpmRender::FpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       min_eye_vertices_(s_.final_gather ? 2 : 1),
       n_photons_(reserve_memory(settings)),
       near_edges_(s_.disc_probes, scene_, camera_.camera(), film->width(), film->height(),
-                  ls.filter.radius) {}
+                  ls.filter.radius),
+      sensors_(
+          make_sensor_discs(scene_, opt.sensors, camera_.camera().position(), pixel_angle_, s_)),
+      sensor_sums_(opt.sensors.size()) {}
 
 // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
 // for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
@@ -156,8 +165,14 @@ PassResult FpmRender::iteration(int pass, const RenderControl& control) {
   const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
   // One set of wavelengths for every eye and light path of the iteration.
   const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
-  // 1. Light pass: a forward photon at every diffuse hit.
+  // 1. Light pass: a forward photon at every diffuse hit (and the sensors' crossings).
   if (!light_pass(wm, pass, it, control)) return PassResult{false, 0, "", ""};
+  if (sensors_) {
+    sensor_sums_.clear();
+    for (const ForwardMaps::Chunk& ch : maps_.chunks) sensor_sums_.add(ch.crossings);
+    sensor_sums_.finish(scene_, *sensors_, s_.bias_model, opt_.seed, it, emitted_);
+  }
+  if (!opt_.image) return progress();
   // 2. The maps, in chunk order (the same for any thread count), and their trees.
   build_maps();
   // 3. Eye pass.
@@ -169,9 +184,10 @@ bool FpmRender::light_pass(const WavelengthMaterials& wm, int pass, int it,
                            const RenderControl& control) {
   const auto t = Clock::now();
   // The time budget holds inside an iteration: the light pass may end early, with fewer photons.
+  if (sensors_) sensors_->set_scale(radius_scale(s_, it));
   emitted_ = trace_forward_photons(
       scene_, wm, opt_.max_depth, min_eye_vertices_, n_photons_, opt_.seed, it, light_counters_,
-      [&] { return control.stop_requested(); }, &maps_);
+      [&] { return control.stop_requested(); }, &maps_, sensors_.get());
   tot_.light_s += since(t);
   // After the first iteration, an eye pass would be cut at once: the iteration is dropped.
   if (control.cut(pass)) return false;
@@ -249,10 +265,12 @@ RenderStats FpmRender::finish(RenderStats stats) {
 
 RenderStats render_fpm(const LoadedScene& ls, const IntegratorOptions& opt,
                        const FpmSettings& settings, Film* film) {
-  FpmRender fpm(ls, opt, settings, film);
+  IntegratorOptions o = opt;
+  FpmRender fpm(ls, o, settings, film);
+  if (!opt.sensors.empty()) o.sensor_pass = [&fpm](int, Film* f) { fpm.record_sensors(f); };
   RenderStats stats;
   run_passes(
-      opt, film, "iteration",
+      o, film, "iteration",
       [&fpm](int pass, const RenderControl& control) { return fpm.iteration(pass, control); },
       &stats);
   return fpm.finish(stats);

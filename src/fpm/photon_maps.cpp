@@ -21,7 +21,8 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
                                int max_depth, int min_eye_vertices, uint64_t n_photons,
                                uint64_t seed, int pass_index,
                                tbb::enumerable_thread_specific<LightCounters>& counters,
-                               const std::function<bool()>& stop, ForwardMaps* maps) {
+                               const std::function<bool()>& stop, ForwardMaps* maps,
+                               const SensorDiscs* sensors) {
   const int n_chunks = int((n_photons + kPhotonsPerChunk - 1) / kPhotonsPerChunk);
   maps->chunks.resize(size_t(n_chunks));
   auto stop_now = [&] { return stop && stop(); };
@@ -30,20 +31,27 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
     ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
     ch.global.clear();
     ch.caustic.clear();
+    ch.crossings.clear();
     uint64_t first = uint64_t(c) * kPhotonsPerChunk,
              last = std::min(first + kPhotonsPerChunk, n_photons);
     for (uint64_t k = first; k < last; ++k) {
       Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
       const EmissionDraw e = unguided_emission(scene, rng);
-      trace_light_path(
-          scene, wm, max_depth, min_eye_vertices, e, rng, lc, [&](const PhotonHit& hit) {
-            if (hit.bounces + min_eye_vertices > max_depth) return;
-            ForwardPhoton ph{hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
-                             hit.cls,  hit.hero_only};
-            ch.global.push_back(ph);
-            if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
-            ++lc.entries;
-          });
+      auto store = [&](const PhotonHit& hit) {
+        if (hit.bounces + min_eye_vertices > max_depth) return;
+        ForwardPhoton ph{hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
+                         hit.cls,  hit.hero_only};
+        ch.global.push_back(ph);
+        if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
+        ++lc.entries;
+      };
+      if (sensors) {
+        // A sensor adds no eye vertex: photons cross it after up to max_depth bounces.
+        SensorSegments segments{scene, *sensors, wm.wl, ch.crossings, max_depth};
+        trace_light_path(scene, wm, max_depth, min_eye_vertices, e, rng, lc, store, segments);
+      } else {
+        trace_light_path(scene, wm, max_depth, min_eye_vertices, e, rng, lc, store);
+      }
     }
   });
   // The chunks past the kept ones leave the maps.

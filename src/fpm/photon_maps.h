@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "photons/light_path.h"
+#include "photons/sensor_discs.h"
 #include "photons/sphere_kdtree.h"
 #include "scene/render_scene.h"
 
@@ -37,6 +38,7 @@ struct ForwardMaps {
   // depend on the thread count.
   struct Chunk {
     std::vector<ForwardPhoton> global, caustic;
+    std::vector<SensorCrossing> crossings;  // of the illuminance sensors' discs, if any
   };
   std::vector<Chunk> chunks;
 };
@@ -45,12 +47,14 @@ struct ForwardMaps {
 // of wm and stores them. min_eye_vertices: the eye vertices the estimate adds (2 with final
 // gathering), so that no stored photon makes a path longer than max_depth. `stop`, asked before
 // each chunk of photons, may end the pass early (after its first chunk). Returns the photons
-// emitted into the maps: N of the density estimate.
+// emitted into the maps: N of the density estimate. With sensors, each chunk also records its
+// photons' crossings of their discs.
 uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMaterials& wm,
                                int max_depth, int min_eye_vertices, uint64_t n_photons,
                                uint64_t seed, int pass_index,
                                tbb::enumerable_thread_specific<LightCounters>& counters,
-                               const std::function<bool()>& stop, ForwardMaps* maps);
+                               const std::function<bool()>& stop, ForwardMaps* maps,
+                               const SensorDiscs* sensors = nullptr);
 
 // Joins the chunks into the two maps and builds their trees.
 void build_forward_maps(ForwardMaps* maps);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "integrator/counters.h"
+#include "integrator/sensors.h"
 
 namespace bpm {
 class Film;
@@ -52,8 +53,12 @@ struct IntegratorOptions {
   const RenderState* resume = nullptr;
   // Several processes render this image together (integrator/team.h); null: this one alone.
   Team* team = nullptr;
-  // Called after each whole pass with its index (first_iteration + pass): illuminance sensors
-  // (path/sensors.h) record that pass's estimates in the film. Unset: no sensors.
+  // Illuminance sensors (integrator/sensors.h), estimated in every pass by the integrator's own
+  // estimator (the film must have as many); with image false, only they are rendered.
+  std::vector<Sensor> sensors;
+  bool image = true;
+  // Called after each whole pass with its index (first_iteration + pass): the sensors record that
+  // pass's estimates in the film. Set by the integrator; unset: no sensors.
   std::function<void(int pass_index, Film* film)> sensor_pass;
   // Benchmarks only: sees every ray the passes trace, eye and light rays apart (bpm). Null in
   // renders; called from every rendering thread, so render with one thread when it is set.

@@ -95,6 +95,22 @@ struct PhotonHit {
   bool hero_only;  // the photon keeps its hero wavelength alone (PathState)
 };
 
+// A straight piece of a photon's path, from ray.o along ray.d up to t_max (in units of ray.d; kInf
+// where the photon leaves the scene) at a surface of geometric normal end_ng (zero when it leaves),
+// with the flux it starts with in `medium` (-1: vacuum), after `bounces` scattering events. The
+// illuminance sensors of the photon methods count the photons reaching them
+// (photons/sensor_discs.h).
+struct PhotonSegment {
+  const Ray& ray;
+  float t_max;
+  Vec3 end_ng;
+  const Spectrum& flux;
+  int medium;
+  PhotonClass cls;
+  int bounces;
+  bool hero_only;
+};
+
 // Unguided emission: a light in proportion to power, u_pos and u_dir uniform (five numbers).
 inline EmissionDraw unguided_emission(const RenderScene& scene, Rng& rng) {
   EmissionDraw e;
@@ -105,14 +121,22 @@ inline EmissionDraw unguided_emission(const RenderScene& scene, Rng& rng) {
   return e;
 }
 
+// What a photon reports beside its hits: on_segment(const PhotonSegment&) for each straight piece
+// of its path after at most `depth` scattering events (-1: none).
+struct NoSegments {
+  int depth = -1;
+  void operator()(const PhotonSegment&) const {}
+};
+
 // Traces one photon emitted as `e` says (unguided_emission, or an EmissionGuide's draw) at the
-// wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface. The path stops once
-// a further bounce could not make a path of at most max_depth scattering events with the
-// `min_eye_vertices` the estimator adds on the camera side.
-template <class OnHit>
+// wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface, where a further
+// bounce could still make a path of at most max_depth scattering events with the
+// `min_eye_vertices` the estimator adds on the camera side, and segments(const PhotonSegment&) for
+// the pieces of its path that segments.depth asks for. The path stops when neither wants more.
+template <class OnHit, class OnSegment = NoSegments>
 void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
                       int min_eye_vertices, const EmissionDraw& e, Rng& rng,
-                      LightCounters& counters, OnHit&& on_hit) {
+                      LightCounters& counters, OnHit&& on_hit, OnSegment&& segments = {}) {
   ++counters.photons;
   if (scene.lights.empty() || max_depth < min_eye_vertices || e.light_pmf == 0 || e.weight == 0)
     return;
@@ -133,20 +157,36 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
                              scene.objects[size_t(area->object)].medium_outside);
   int bounces = 0;
   bool all_specular = true;
+  const int hit_depth = max_depth - min_eye_vertices;  // the most bounces of a hit reported
+  const int depth = std::max(hit_depth, std::min(segments.depth, max_depth));
   ++counters.light_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    if (next_vertex(scene, wm, s, v, counters.light_rays, counters.observer) != StepEnd::kVertex)
-      break;
+    const PhotonClass cls = bounces == 0
+                                ? PhotonClass::kDirect
+                                : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
+    StepEnd end;
+    if (bounces <= segments.depth) {
+      // Each piece between the surfaces the photon passes (interfaces) with its flux at the start.
+      Spectrum flux = s.beta;
+      end = next_vertex(
+          scene, wm, s, v, counters.light_rays, counters.observer,
+          [&](const Hit& hit, const SurfacePoint& sp) {
+            segments(PhotonSegment{s.ray, hit.t, sp.ng, flux, s.medium, cls, bounces, s.hero_only});
+            flux = s.beta;
+          });
+      if (end == StepEnd::kEscaped)
+        segments(PhotonSegment{s.ray, kInf, Vec3(), flux, s.medium, cls, bounces, s.hero_only});
+    } else {
+      end = next_vertex(scene, wm, s, v, counters.light_rays, counters.observer);
+    }
+    if (end != StepEnd::kVertex) break;
     // A surface with gathered lobes (BsdfPart): the photon's estimate there sees those alone.
-    if (!bsdf_all_traced(v.m())) {
+    if (bounces <= hit_depth && !bsdf_all_traced(v.m())) {
       ++counters.diffuse_hits;
-      PhotonClass cls = bounces == 0
-                            ? PhotonClass::kDirect
-                            : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
       on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only});
     }
-    if (bounces + 1 + min_eye_vertices > max_depth) break;
+    if (bounces + 1 > depth) break;
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc

@@ -12,8 +12,9 @@ namespace bpm {
 namespace {
 
 constexpr char kMagic[8] = {'B', 'P', 'M', 'C', 'K', 'P', 'T', '\n'};
-constexpr uint32_t kVersion = 3;  // 2: bpm keeps emission statistics per pixel; 3: the film
-                                  // keeps the luminance and the sensors
+// 2: bpm keeps emission statistics per pixel; 3: the film keeps the luminance and the sensors;
+// 4: and the sensors' bias estimates.
+constexpr uint32_t kVersion = 4;
 
 std::string read_file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

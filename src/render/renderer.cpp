@@ -14,13 +14,8 @@
 namespace bpm {
 namespace {
 
-// Passes of the sensors alone, without an image (--no-image).
-RenderStats render_sensors_only(const RenderOptions& opt, Film* film) {
-  if (opt.sensors.empty()) throw Error("a render without an image needs sensors (--sensors)");
-  if (opt.accuracy > 0)
-    throw Error(
-        "--accuracy bounds the image's error: without an image (--no-image) give --spp "
-        "or --time");
+// The path tracer's passes of the sensors alone, without an image (--no-image).
+RenderStats render_path_sensors(const RenderOptions& opt, Film* film) {
   RenderStats stats;
   run_passes(
       opt, film, "pass", [](int, const RenderControl&) { return PassResult{}; }, &stats);
@@ -40,14 +35,20 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
   if (opt.sensors.size() != film->sensor_count())
     throw Error("the film has " + std::to_string(film->sensor_count()) + " sensors, the render " +
                 std::to_string(opt.sensors.size()));
+  if (!opt.image && opt.sensors.empty())
+    throw Error("a render without an image needs sensors (--sensors)");
+  if (!opt.image && opt.accuracy > 0)
+    throw Error(
+        "--accuracy bounds the image's error: without an image (--no-image) give --spp "
+        "or --time");
+  if (opt.integrator == "bpm") return render_bpm(ls, opt, opt.bpm, film);
+  if (opt.integrator == "fpm") return render_fpm(ls, opt, opt.fpm, film);
   RenderOptions o = opt;
   if (!opt.sensors.empty())
     o.sensor_pass = [&](int pass_index, Film* f) {
       sensor_pass(ls.scene, opt.sensors, opt.max_depth, opt.seed, pass_index, f);
     };
-  if (!opt.image) return render_sensors_only(o, film);
-  if (opt.integrator == "bpm") return render_bpm(ls, o, o.bpm, film);
-  if (opt.integrator == "fpm") return render_fpm(ls, o, o.fpm, film);
+  if (!opt.image) return render_path_sensors(o, film);
   return render_path(ls, o, film);
 }
 

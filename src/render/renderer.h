@@ -8,7 +8,6 @@
 #include "film/film.h"
 #include "fpm/settings.h"
 #include "integrator/options.h"
-#include "path/sensors.h"
 #include "scene/flatten.h"
 
 namespace bpm {
@@ -17,10 +16,6 @@ struct RenderOptions : IntegratorOptions {
   std::string integrator = "path";  // path, bpm or fpm
   BpmSettings bpm;
   FpmSettings fpm;
-  // Illuminance sensors, estimated in every pass (the film must have as many); with image false,
-  // only they are rendered, by passes of their own.
-  std::vector<Sensor> sensors;
-  bool image = true;
 };
 
 // Options for a render of `ls` without a progress line, with the file's maxdepth and default

@@ -1,0 +1,55 @@
+// Illuminance sensors: points with a normal where a render measures the illuminance (lux) of the
+// light arriving from the normal's hemisphere. A sensor does not block light: a point in mid-air
+// (a work plane) counts the light crossing it, a point on a surface the light arriving there.
+// Each integrator estimates them its own way (path/sensors.h, photons/sensor_discs.h) in every
+// pass; the film keeps each sensor's per-pass estimates, so every sensor has its standard error
+// (eq. 5 of the paper) as the pixels do. What every estimator shares is here: the sensors, their
+// file, and the direct light at a sensor.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "base/rng.h"
+#include "base/vec.h"
+#include "integrator/counters.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+struct Sensor {
+  Vec3 p;
+  Vec3 n;  // unit length
+  // The side of the grid cell the sensor stands for (the shorter edge), 0 for a single point.
+  float cell = 0;
+};
+
+// Reads a sensor file: one point a line, "x y z nx ny nz" (the input of Radiance's rtrace -I), or
+// a grid, "grid x y z ux uy uz vx vy vz nu nv": the rectangle with corner (x, y, z) and edges u
+// and v cut into nu x nv cells, a sensor at each cell's centre facing u x v (a lighting
+// program's calculation surface). Blank lines and text after '#' are ignored. Errors name the
+// file, line and column.
+std::vector<Sensor> read_sensors(const std::string& path);
+std::vector<Sensor> parse_sensors(const std::string& text, const std::string& path);
+
+// Samples per sensor in each pass of the estimators that sample light at the sensor.
+constexpr int kSensorSamplesPerPass = 16;
+// Domain separation of the sensors' random streams from the pixels' and the photons'.
+constexpr uint64_t kSensorStreams = 0x53454e534f525321ull;
+
+// Rays leave from this far above a sensor (times the scene's bounding radius), so that a sensor on
+// a surface does not see that surface.
+inline float sensor_lift(const RenderScene& scene) { return 1e-6f * scene.bounds_info.radius; }
+
+// Next-event estimation at a sensor: the illuminance of one light sample (at a white Lambertian
+// point on no object, in the scene's outer medium), weighted by the power heuristic against a
+// cosine-distributed direction from the sensor, whose emitters the caller weights by
+// EmitterWeight::mis(cos / pi, sensor point lifted).
+Spectrum sensor_light_sample(const RenderScene& scene, const Sensor& s,
+                             const WavelengthMaterials& wm, Rng& rng, PathCounters& counters);
+
+// The direct illuminance at a sensor from one sample: sensor_light_sample, and the emitters that a
+// cosine-distributed direction finds (through interfaces only), weighted against it.
+Spectrum sensor_direct_irradiance(const RenderScene& scene, const Sensor& s,
+                                  const WavelengthMaterials& wm, Rng& rng, PathCounters& counters);
+
+}  // namespace bpm
