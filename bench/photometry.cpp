@@ -1,16 +1,18 @@
-// Photometry against closed forms, in absolute units: for each case and integrator, the value
-// expected, the mean over several seeds of what the render reports (cd/m^2 of the luminance
+// Photometry against closed forms, in absolute units. First, for each case and integrator, the
+// value expected, the mean over several seeds of what the render reports (cd/m^2 of the luminance
 // channel at the image's centre pixels, or lux at a sensor), the error it states (its standard
 // error, and for the photon methods its bias estimate), the error it actually makes (the RMS over
-// the seeds of value - expected) and their ratio. Prints figures; never fails.
-//   photometry [--seeds N] [--passes N]
+// the seeds of value - expected) and their ratio. Then the sensor cases at equal time: each
+// integrator renders the sensors alone (--no-image) for the same seconds, and the RMS errors are
+// compared with path's in the same run. Prints figures; never fails.
+//   photometry [--seeds N] [--passes N] [--seconds S]
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
 
-#include "path/sensors.h"
+#include "integrator/sensors.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
@@ -63,6 +65,31 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
 )";
 }
 
+// A glass slab (eta 1.5, 0.1 thick, its top 1.1 over a black floor) under `light`: light from
+// straight above crosses it with (1 - R)^2 of its power, or (1 - R)^2 R^2 after one reflection at
+// each face (maxdepth 5 allows no more), R = ((eta - 1) / (eta + 1))^2; a point source at height
+// h looks to a point of the floor straight below it as if at h - t + t / eta (paraxial, exact on
+// the axis), or h - t + 3 t / eta after the reflections.
+constexpr double kR = 0.04, kSlabT = (1 - kR) * (1 - kR);
+std::string slab(const std::string& light) {
+  // A film of ordinary size: the photon methods' sensor radii are backward photons' (pixel
+  // footprints); only the sensors are rendered.
+  return R"(LookAt 0 4 0.01  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 128 "integer yresolution" 128
+Integrator "path" "integer maxdepth" 5
+WorldBegin
+)" + light + R"(
+Material "diffuse" "rgb reflectance" [0 0 0]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [-5 0 -5  5 0 -5  5 0 5  -5 0 5]
+Material "dielectric" "float eta" 1.5
+Shape "trianglemesh" "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  1 2 6 1 6 5
+                                        2 3 7 2 7 6  3 0 4 3 4 7]
+  "point3 P" [-5 1 -5  5 1 -5  5 1 5  -5 1 5  -5 1.1 -5  5 1.1 -5  5 1.1 5  -5 1.1 5]
+)";
+}
+
 std::vector<Case> cases() {
   const char* point = R"(LightSource "point" "point3 from" [0 0 1] "float power" 1000)";
   const std::string sphere = R"(LookAt 0 0 -0.5  0 0 1  0 1 0
@@ -98,16 +125,68 @@ Shape "sphere" "float radius" 1
        sphere,
        {{Vec3(0, -0.6f, 0.3f), Vec3(0, -1, 0)}},
        0.5 * 1000 / (area * 0.5)},
+      {"integrating sphere, 10 x 10 grid in mid-air facing down",
+       sphere,
+       parse_sensors("grid -0.6 -0.3 -0.6  1.2 0 0  0 0 1.2  10 10\n", "grid"),
+       0.5 * 1000 / (area * 0.5)},
+      {"distant 1000 lx through glass slab: E (1-R)^2 (1+R^2)",
+       slab(R"(LightSource "distant" "point3 from" [0 10 0] "point3 to" [0 0 0] "float illuminance" 1000)"),
+       {{Vec3(0, 0, 0), Vec3(0, 1, 0)}},
+       1000 * kSlabT * (1 + kR * kR)},
+      {"1000 lm sphere 3 m over glass slab (caustic): paraxial",
+       slab(R"(AttributeBegin
+  AreaLightSource "diffuse" "float power" 1000
+  Translate 0 3 0
+  Shape "sphere" "float radius" 0.02
+AttributeEnd)"),
+       {{Vec3(0, 0, 0), Vec3(0, 1, 0)}},
+       1000 / (4 * kPi) * kSlabT *
+           (1 / std::pow(3 - 0.1 + 0.1 / 1.5, 2) + kR * kR / std::pow(3 - 0.1 + 0.3 / 1.5, 2))},
   };
+}
+
+// The RMS over seeds (and sensors) of each render's stated error and of its actual error, and the
+// mean value.
+struct Summary {
+  double mean = 0, stated = 0, measured = 0;
+};
+
+Summary run_case(const Case& c, const LoadedScene& ls, const std::string& integrator, int seeds,
+                 int passes, double seconds) {
+  double sum = 0, stated2 = 0, error2 = 0;
+  for (int s = 0; s < seeds; ++s) {
+    Film film(ls.film.width, ls.film.height, 0, c.sensors.size());
+    RenderOptions opt = quiet_options(ls, integrator, passes, uint64_t(101 + s));
+    opt.sensors = c.sensors;
+    opt.image = c.sensors.empty();
+    if (seconds > 0) {
+      opt.spp = 1 << 30;
+      opt.time_limit_s = seconds;
+    }
+    render(ls, opt, &film);
+    std::vector<Reading> readings;
+    if (c.sensors.empty()) readings.push_back(centre_luminance(film));
+    for (size_t i = 0; i < c.sensors.size(); ++i)
+      readings.push_back({film.sensor_mean(i), film.sensor_total_error(i)});
+    for (const Reading& r : readings) {
+      sum += r.value;
+      stated2 += r.stated * r.stated;
+      error2 += (r.value - c.expected) * (r.value - c.expected);
+    }
+  }
+  const double n = double(seeds) * double(std::max<size_t>(c.sensors.size(), 1));
+  return {sum / n, std::sqrt(stated2 / n), std::sqrt(error2 / n)};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   int seeds = 8, passes = 64;
+  double seconds = 2;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--seeds")) seeds = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--passes")) passes = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--seconds")) seconds = std::atof(argv[i + 1]);
   }
   std::printf(
       "photometry: %d seeds of %d passes each; value and errors in cd/m^2 (luminance) or "
@@ -115,34 +194,34 @@ int main(int argc, char** argv) {
       seeds, passes);
   std::printf("%-58s %-5s %10s %10s %10s %10s %7s\n", "case", "", "expected", "mean", "stated",
               "measured", "ratio");
+  const std::vector<std::string> integrators{"path", "bpm", "fpm"};
   for (const Case& c : cases()) {
     const LoadedScene ls = flatten_scene(parse_scene_string(c.scene));
-    // Sensors are estimated by the path tracer's estimator whatever the integrator: path alone.
-    const std::vector<std::string> integrators =
-        c.sensors.empty() ? std::vector<std::string>{"path", "bpm", "fpm"}
-                          : std::vector<std::string>{"path"};
     for (const std::string& integrator : integrators) {
-      double sum = 0, stated2 = 0, error2 = 0;
-      for (int s = 0; s < seeds; ++s) {
-        Film film(ls.film.width, ls.film.height, 0, c.sensors.size());
-        RenderOptions opt = quiet_options(ls, integrator, passes, uint64_t(101 + s));
-        opt.sensors = c.sensors;
-        opt.image = c.sensors.empty();
-        render(ls, opt, &film);
-        Reading r = c.sensors.empty() ? centre_luminance(film)
-                                      : Reading{film.sensor_mean(0), film.sensor_standard_error(0)};
-        sum += r.value;
-        stated2 += r.stated * r.stated;
-        error2 += (r.value - c.expected) * (r.value - c.expected);
-      }
-      const double stated = std::sqrt(stated2 / seeds), measured = std::sqrt(error2 / seeds);
+      const Summary m = run_case(c, ls, integrator, seeds, passes, 0);
       std::printf("%-58s %-5s %10.5g %10.5g %10.3g %10.3g %7.2f\n", c.name, integrator.c_str(),
-                  c.expected, sum / seeds, stated, measured, stated / measured);
+                  c.expected, m.mean, m.stated, m.measured, m.stated / m.measured);
     }
   }
   std::printf(
-      "\n(stated: the RMS over seeds of the error each render reports; measured: the RMS "
-      "over seeds of value - expected; ratio: stated / measured, 1 when the estimate is "
-      "honest)\n");
+      "\n(stated: the RMS over seeds of the error each render reports, standard error and bias "
+      "estimate; measured: the RMS over seeds of value - expected; ratio: stated / measured, 1 "
+      "when the estimate is honest)\n\n");
+  std::printf("sensors alone at equal time: %d seeds of %g s each\n", seeds, seconds);
+  std::printf("%-58s %-5s %10s %10s %10s %12s\n", "case", "", "expected", "mean", "measured",
+              "path / this");
+  for (const Case& c : cases()) {
+    if (c.sensors.empty()) continue;
+    const LoadedScene ls = flatten_scene(parse_scene_string(c.scene));
+    double path_error = 0;
+    for (const std::string& integrator : integrators) {
+      const Summary m = run_case(c, ls, integrator, seeds, 0, seconds);
+      if (integrator == "path") path_error = m.measured;
+      std::printf("%-58s %-5s %10.5g %10.5g %10.3g %12.2f\n", c.name, integrator.c_str(),
+                  c.expected, m.mean, m.measured, path_error / m.measured);
+    }
+  }
+  std::printf("\n(path / this: path's RMS error over this integrator's, in the same run; above 1: "
+              "this one is ahead)\n");
   return 0;
 }

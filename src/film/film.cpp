@@ -47,6 +47,13 @@ double Film::sensor_bias(size_t i) const {
   return sensors_[i].passes > 0 ? sensors_[i].bias_sum / sensors_[i].passes : 0;
 }
 
+double Film::sensor_total_error(size_t i) const {
+  const SensorSums& s = sensors_[i];
+  const double se = sensor_standard_error(i), b = sensor_bias(i);
+  const double b_se = standard_error(s.bias_sum, s.bias_sum2, s.passes);
+  return std::sqrt(se * se + std::fmax(0.0, b * b - b_se * b_se));
+}
+
 double Film::sensor_standard_error(size_t i) const {
   return standard_error(sensors_[i].sum, sensors_[i].sum2, sensors_[i].passes);
 }
@@ -304,6 +311,7 @@ void Film::add(const Film& o) {
     sensors_[i].sum += o.sensors_[i].sum;
     sensors_[i].sum2 += o.sensors_[i].sum2;
     sensors_[i].bias_sum += o.sensors_[i].bias_sum;
+    sensors_[i].bias_sum2 += o.sensors_[i].bias_sum2;
     sensors_[i].passes += o.sensors_[i].passes;
   }
   for (size_t i = 0; i < m_sum_.size(); ++i) m_sum_[i] += o.m_sum_[i];

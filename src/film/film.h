@@ -119,17 +119,20 @@ class Film {
 
   // One pass's estimate of sensor i and the estimate of its bias (photon methods; each sensor
   // written by one thread at a time), and per sensor the mean of its passes, the standard error of
-  // that mean (eq. 5), the mean of the bias estimates and its passes.
+  // that mean (eq. 5), the mean of the bias estimates, the total error (as the pixels' total_rms:
+  // the standard error and the part of the bias estimate beyond its own noise) and its passes.
   void add_sensor_pass(size_t i, double value, double bias = 0) {
     sensors_[i].sum += value;
     sensors_[i].sum2 += value * value;
     sensors_[i].bias_sum += bias;
+    sensors_[i].bias_sum2 += bias * bias;
     ++sensors_[i].passes;
   }
   size_t sensor_count() const { return sensors_.size(); }
   double sensor_mean(size_t i) const;
   double sensor_standard_error(size_t i) const;
   double sensor_bias(size_t i) const;
+  double sensor_total_error(size_t i) const;
   int sensor_passes(size_t i) const { return sensors_[i].passes; }
 
   Image image(float scale = 1) const;
@@ -199,7 +202,7 @@ class Film {
     int bias_passes = 0;
   };
   struct SensorSums {
-    double sum = 0, sum2 = 0, bias_sum = 0;
+    double sum = 0, sum2 = 0, bias_sum = 0, bias_sum2 = 0;
     int passes = 0;
   };
   int width_, height_;

@@ -26,13 +26,15 @@ OutputPaths output_paths(const std::string& exr) {
 
 void write_sensors_csv(const std::string& path, const Film& film,
                        const std::vector<std::array<float, 6>>& sensors) {
-  std::string text = "x,y,z,nx,ny,nz,illuminance_lux,standard_error_lux,bias_lux,passes\n";
+  std::string text =
+      "x,y,z,nx,ny,nz,illuminance_lux,standard_error_lux,bias_lux,total_error_lux,passes\n";
   char line[512];
   for (size_t i = 0; i < sensors.size(); ++i) {
     const std::array<float, 6>& s = sensors[i];
-    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%d\n", s[0],
-                  s[1], s[2], s[3], s[4], s[5], film.sensor_mean(i), film.sensor_standard_error(i),
-                  film.sensor_bias(i), film.sensor_passes(i));
+    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%d\n",
+                  s[0], s[1], s[2], s[3], s[4], s[5], film.sensor_mean(i),
+                  film.sensor_standard_error(i), film.sensor_bias(i), film.sensor_total_error(i),
+                  film.sensor_passes(i));
     text += line;
   }
   write_text_atomic(path, text);
