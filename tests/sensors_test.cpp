@@ -105,8 +105,8 @@ Material "diffuse" "rgb reflectance" [0 0 0]
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
   "point3 P" [-5 0 -5  5 0 -5  5 0 5  -5 0 5]
 Material "dielectric" "float eta" 1.5
-Shape "trianglemesh" "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  1 2 6 1 6 5
-                                        2 3 7 2 7 6  3 0 4 3 4 7]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 5 1 0 4 5  1 6 2 1 5 6
+                                        2 7 3 2 6 7  3 4 0 3 7 4]
   "point3 P" [-5 1 -5  5 1 -5  5 1 5  -5 1 5  -5 1.1 -5  5 1.1 -5  5 1.1 5  -5 1.1 5]
 )";
   const std::vector<Sensor> sensors =

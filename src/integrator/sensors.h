@@ -21,6 +21,9 @@ struct Sensor {
   Vec3 n;  // unit length
   // The side of the grid cell the sensor stands for (the shorter edge), 0 for a single point.
   float cell = 0;
+  // For a sensor of a grid: the grid's cell counts and the sensor's index in it, j * nu + i (the
+  // sensors of a grid are consecutive); zero counts for a single point.
+  uint32_t grid_nu = 0, grid_nv = 0, grid_k = 0;
 };
 
 // Reads a sensor file: one point a line, "x y z nx ny nz" (the input of Radiance's rtrace -I), or

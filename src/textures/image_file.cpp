@@ -17,6 +17,7 @@ namespace fs = std::filesystem;
 // the folder it was built in, so a copied bpm still finds it while its build folder exists.
 struct Reader {
   ReadImageFileFn* read = nullptr;
+  DrawTextFn* draw_text = nullptr;
   std::string why_not;
 };
 
@@ -43,18 +44,26 @@ Reader load_reader() {
       continue;
     }
     r.read = reinterpret_cast<ReadImageFileFn*>(::dlsym(module, kImageReaderEntry));
-    if (r.read) return r;
-    r.why_not += "\n  " + place.string() + ": has no " + kImageReaderEntry +
-                 " (a module of another bpm version)";
+    r.draw_text = reinterpret_cast<DrawTextFn*>(::dlsym(module, kDrawTextEntry));
+    if (r.read && r.draw_text) return r;
+    r.why_not += "\n  " + place.string() + ": has no " + kImageReaderEntry + " or " +
+                 kDrawTextEntry + " (a module of another bpm version)";
+    r.read = nullptr;
+    r.draw_text = nullptr;
     ::dlclose(module);
   }
   return r;
 }
 
+const Reader& reader_module() {
+  static const Reader reader = load_reader();  // thread-safe, once per process
+  return reader;
+}
+
 }  // namespace
 
 ImageFile read_image_file(const std::string& path, double max_values) {
-  static const Reader reader = load_reader();  // thread-safe, once per process
+  const Reader& reader = reader_module();
   if (!reader.read)
     throw Error("cannot read image \"" + path + "\": bpm's image reader (" + kImageReaderModule +
                 ", built with bpm) was not found or not loaded:" + reader.why_not);
@@ -62,6 +71,17 @@ ImageFile read_image_file(const std::string& path, double max_values) {
   std::string error;
   if (!reader.read(path.c_str(), max_values, &img, &error)) throw Error(error);
   return img;
+}
+
+bool draw_text(float* rgb, int width, int height, int x, int y, const std::string& text, int size,
+               const float colour[3], int align, std::string* error) {
+  const Reader& reader = reader_module();
+  if (!reader.draw_text) {
+    *error = std::string("bpm's image module (") + kImageReaderModule +
+             ") was not found or not loaded:" + reader.why_not;
+    return false;
+  }
+  return reader.draw_text(rgb, width, height, x, y, text.c_str(), size, colour, align, error);
 }
 
 }  // namespace bpm

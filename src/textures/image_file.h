@@ -1,4 +1,5 @@
-// Reading image files (PNG, JPEG, TGA, EXR, PFM, HDR, TIFF, ...) through OpenImageIO.
+// Reading image files (PNG, JPEG, TGA, EXR, PFM, HDR, TIFF, ...) and drawing text (the legends of
+// false-colour pictures) through OpenImageIO.
 //
 // OpenImageIO brings about 250 shared libraries with it, and loading them costs every process
 // about 0.2 s before main, whether it reads an image or not. So bpm does not link it: the reader
@@ -29,5 +30,15 @@ inline constexpr const char* kImageReaderModule = "libbpm_image_reader.so";
 using ReadImageFileFn = bool(const char* path, double max_values, ImageFile* out,
                              std::string* error);
 inline constexpr const char* kImageReaderEntry = "bpm_read_image_file_v1";
+
+// Draws one line of `text` onto an RGB float image (width * height * 3, rows from the top), its
+// baseline at y, starting at x (align 0), centred on x (1) or ending at x (2), `size` pixels high,
+// in `colour`, with Debian's DejaVu Sans (fonts-dejavu-core) or else OpenImageIO's default font.
+// Returns false with the reason when it cannot (the module or a font missing).
+bool draw_text(float* rgb, int width, int height, int x, int y, const std::string& text, int size,
+               const float colour[3], int align, std::string* error);
+using DrawTextFn = bool(float* rgb, int width, int height, int x, int y, const char* text,
+                        int size, const float* colour, int align, std::string* error);
+inline constexpr const char* kDrawTextEntry = "bpm_draw_text_v1";
 
 }  // namespace bpm

@@ -1,7 +1,10 @@
-// The image reader module (see image_file.h): OpenImageIO behind one C entry point. Built as
-// libbpm_image_reader.so, not into bpmcore.
+// The image reader module (see image_file.h): OpenImageIO behind two C entry points, reading an
+// image and drawing text. Built as libbpm_image_reader.so, not into bpmcore.
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <filesystem>
 #include <type_traits>
 
 #include "textures/image_file.h"
@@ -41,3 +44,20 @@ extern "C" bool bpm_read_image_file_v1(const char* path, double max_values, bpm:
 
 // The declaration in image_file.h must match the definition.
 static_assert(std::is_same_v<decltype(bpm_read_image_file_v1), bpm::ReadImageFileFn>);
+
+extern "C" bool bpm_draw_text_v1(float* rgb, int width, int height, int x, int y, const char* text,
+                                 int size, const float* colour, int align, std::string* error) {
+  // Debian's fonts-dejavu-core; else OpenImageIO's own search for a default font.
+  static const char* const kFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+  std::error_code ec;
+  const std::string font = std::filesystem::exists(kFont, ec) ? kFont : "";
+  OIIO::ImageBuf buf(OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT), rgb);
+  const OIIO::ImageBufAlgo::TextAlignX x_align =
+      align == 0 ? OIIO::ImageBufAlgo::TextAlignX::Left
+                 : (align == 1 ? OIIO::ImageBufAlgo::TextAlignX::Center
+                               : OIIO::ImageBufAlgo::TextAlignX::Right);
+  if (OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, {colour, 3}, x_align)) return true;
+  *error = buf.geterror();
+  if (error->empty()) *error = "OpenImageIO could not draw text (no font found)";
+  return false;
+}
