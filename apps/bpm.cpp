@@ -212,6 +212,15 @@ nlohmann::json image_units(bool bias) {
   return u;
 }
 
+// The grids among the sensors, for OUT.sensors.png.
+std::vector<SensorGrid> sensor_grids(const std::vector<Sensor>& sensors) {
+  std::vector<SensorGrid> grids;
+  for (size_t i = 0; i < sensors.size(); ++i)
+    if (sensors[i].grid_nu > 0 && sensors[i].grid_k == 0)
+      grids.push_back({i, int(sensors[i].grid_nu), int(sensors[i].grid_nv)});
+  return grids;
+}
+
 // The record's outputs (the files written) and sensors.
 void record_outputs(const RenderArgs& a, const RenderOptions& opt, const Film& film,
                     const OutputPaths& paths, nlohmann::json* rec) {
@@ -221,10 +230,12 @@ void record_outputs(const RenderArgs& a, const RenderOptions& opt, const Film& f
     out["exr"] = paths.exr;
     out["png"] = paths.png;
     out["error_png"] = paths.error_png;
+    out["luminance_png"] = paths.luminance_png;
     if (film.has_bias()) out["bias_png"] = paths.bias_png;
   }
   if (opt.sensors.empty()) return;
   out["sensors_csv"] = paths.sensors;
+  if (!sensor_grids(opt.sensors).empty()) out["sensors_png"] = paths.sensors_png;
   (*rec)["sensors"] = {
       {"file", a.sensors},
       {"count", opt.sensors.size()},
@@ -386,7 +397,8 @@ void resume_from(const RenderArgs& a, const nlohmann::json& identity, bool root,
                  opt->integrator == "path" ? "passes" : "iterations");
 }
 
-// The images (unless --no-image) and the sensors' CSV (with --sensors), each atomically.
+// The images (unless --no-image), the sensors' CSV and the picture of their grids (with
+// --sensors), each atomically.
 void write_outputs(const LoadedScene& ls, const RenderOptions& opt, const Film& film,
                    const OutputPaths& paths) {
   if (opt.image) write_images(paths, film, ls.film.imaging_ratio);
@@ -394,6 +406,7 @@ void write_outputs(const LoadedScene& ls, const RenderOptions& opt, const Film& 
   std::vector<std::array<float, 6>> sensors;
   for (const Sensor& s : opt.sensors) sensors.push_back({s.p.x, s.p.y, s.p.z, s.n.x, s.n.y, s.n.z});
   write_sensors_csv(paths.sensors, film, sensors);
+  write_sensors_png(paths.sensors_png, film, sensor_grids(opt.sensors));
 }
 
 // Intermediate outputs: the images so far and a JSON record that says the render is running.

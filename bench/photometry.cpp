@@ -79,7 +79,8 @@ Camera "perspective" "float fov" 30
 Film "rgb" "integer xresolution" 128 "integer yresolution" 128
 Integrator "path" "integer maxdepth" 5
 WorldBegin
-)" + light + R"(
+)" + light +
+         R"(
 Material "diffuse" "rgb reflectance" [0 0 0]
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
   "point3 P" [-5 0 -5  5 0 -5  5 0 5  -5 0 5]
@@ -125,12 +126,12 @@ Shape "sphere" "float radius" 1
        sphere,
        {{Vec3(0, -0.6f, 0.3f), Vec3(0, -1, 0)}},
        0.5 * 1000 / (area * 0.5)},
-      {"integrating sphere, 10 x 10 grid in mid-air facing down",
-       sphere,
+      {"integrating sphere, 10 x 10 grid in mid-air facing down", sphere,
        parse_sensors("grid -0.6 -0.3 -0.6  1.2 0 0  0 0 1.2  10 10\n", "grid"),
        0.5 * 1000 / (area * 0.5)},
       {"distant 1000 lx through glass slab: E (1-R)^2 (1+R^2)",
-       slab(R"(LightSource "distant" "point3 from" [0 10 0] "point3 to" [0 0 0] "float illuminance" 1000)"),
+       slab(
+           R"(LightSource "distant" "point3 from" [0 10 0] "point3 to" [0 0 0] "float illuminance" 1000)"),
        {{Vec3(0, 0, 0), Vec3(0, 1, 0)}},
        1000 * kSlabT * (1 + kR * kR)},
       {"1000 lm sphere 3 m over glass slab (caustic): paraxial",
@@ -221,7 +222,8 @@ int main(int argc, char** argv) {
                   c.expected, m.mean, m.measured, path_error / m.measured);
     }
   }
-  std::printf("\n(path / this: path's RMS error over this integrator's, in the same run; above 1: "
-              "this one is ahead)\n");
+  std::printf(
+      "\n(path / this: path's RMS error over this integrator's, in the same run; above 1: "
+      "this one is ahead)\n");
   return 0;
 }

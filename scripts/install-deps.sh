@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build ccache pkg-config
   libembree-dev libtbb-dev
-  libopenexr-dev libpng-dev libopenimageio-dev
+  libopenexr-dev libpng-dev libopenimageio-dev fonts-dejavu-core
   libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 clang-format

@@ -77,7 +77,7 @@ TEST_F(Cli, RendersAllOutputs) {
   std::string scene = write("s.pbrt", kTinyScene);
   CliRun r = run("render " + scene + " -q --spp 3 --seed 5 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* f : {"out.exr", "out.png", "out.error.png", "out.json"})
+  for (const char* f : {"out.exr", "out.png", "out.luminance.png", "out.error.png", "out.json"})
     EXPECT_TRUE(fs::exists(dir_ / f)) << f;
   Image img = read_exr((dir_ / "out.exr").string());
   EXPECT_EQ(img.width, 32);
@@ -87,6 +87,36 @@ TEST_F(Cli, RendersAllOutputs) {
   EXPECT_EQ(rec["settings"]["seed"], 5);
   EXPECT_EQ(rec["result"]["stop_reason"], "samples");
   EXPECT_GT(rec["rays"]["total"].get<uint64_t>(), 32u * 24u * 3u);
+}
+
+// Sensors: the CSV with its units in the header, the picture of a grid (gone again when a later
+// render of the same name has no grid), with an image and without one, by every integrator.
+TEST_F(Cli, SensorOutputs) {
+  std::string scene = write("s.pbrt", kTinyScene);
+  const std::string grid = write("grid.txt", "grid -1 -1 -1.2  2 0 0  0 2 0  4 3\n");
+  const std::string point = write("point.txt", "0 0 -1.2  0 0 -1\n");
+  const std::string out = (dir_ / "out.exr").string();
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    CliRun r = run("render " + scene + " -q --spp 2 --integrator " + integrator + " --sensors " +
+                   grid + " -o " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir_ / "out.sensors.png")) << integrator;
+    std::ifstream csv(dir_ / "out.sensors.csv");
+    std::string header;
+    std::getline(csv, header);
+    EXPECT_EQ(header,
+              "x,y,z,nx,ny,nz,illuminance_lux,standard_error_lux,bias_lux,total_error_lux,passes");
+    auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+    EXPECT_EQ(rec["outputs"]["sensors_png"], (dir_ / "out.sensors.png").string());
+    EXPECT_EQ(rec["sensors"]["count"], 12);
+  }
+  CliRun r = run("render " + scene + " -q --spp 2 --integrator bpm --no-image --sensors " + point +
+                 " -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.sensors.png"));
+  auto rec = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
+  EXPECT_EQ(rec["sensors"]["count"], 1);
+  EXPECT_FALSE(rec["outputs"].contains("sensors_png"));
 }
 
 // OpenImageIO (about 250 libraries, 0.2 s at every start) is loaded only when a scene reads an

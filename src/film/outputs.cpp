@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
 
 #include "base/error.h"
 #include "film/image_io.h"
+#include "film/legend.h"
 
 namespace bpm {
 
@@ -21,7 +23,9 @@ OutputPaths output_paths(const std::string& exr) {
           stem + ".json",
           stem + ".bias.png",
           stem + ".checkpoint",
-          stem + ".sensors.csv"};
+          stem + ".sensors.csv",
+          stem + ".luminance.png",
+          stem + ".sensors.png"};
 }
 
 void write_sensors_csv(const std::string& path, const Film& film,
@@ -31,35 +35,24 @@ void write_sensors_csv(const std::string& path, const Film& film,
   char line[512];
   for (size_t i = 0; i < sensors.size(); ++i) {
     const std::array<float, 6>& s = sensors[i];
-    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%d\n",
-                  s[0], s[1], s[2], s[3], s[4], s[5], film.sensor_mean(i),
-                  film.sensor_standard_error(i), film.sensor_bias(i), film.sensor_total_error(i),
-                  film.sensor_passes(i));
+    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%d\n", s[0],
+                  s[1], s[2], s[3], s[4], s[5], film.sensor_mean(i), film.sensor_standard_error(i),
+                  film.sensor_bias(i), film.sensor_total_error(i), film.sensor_passes(i));
     text += line;
   }
   write_text_atomic(path, text);
 }
 
-// Per pixel, an error (R G B) relative to the pixel's value over the three channels (as eq. 4 per
-// pixel), 0 to 10% from blue through green to red.
-Image relative_false_colour(const Film& film, const std::vector<float>& rms) {
-  Image img = film.image();
-  Image out;
-  out.width = img.width;
-  out.height = img.height;
-  out.rgb.resize(img.rgb.size());
-  for (size_t i = 0; i < img.rgb.size() / 3; ++i) {
+std::vector<float> relative_error(const Film& film, const std::vector<float>& rms) {
+  const Image img = film.image();
+  std::vector<float> out(img.rgb.size() / 3);
+  for (size_t i = 0; i < out.size(); ++i) {
     double e2 = 0, v2 = 0;
     for (int c = 0; c < 3; ++c) {
       e2 += double(rms[3 * i + c]) * rms[3 * i + c];
       v2 += double(img.rgb[3 * i + c]) * img.rgb[3 * i + c];
     }
-    float rel = v2 > 1e-12 ? float(std::sqrt(e2 / v2)) : (e2 > 0 ? 1.0f : 0.0f);
-    float t = std::clamp(rel / 0.1f, 0.0f, 1.0f);
-    // blue (0) -> green (0.5) -> red (1)
-    out.rgb[3 * i] = std::clamp(2 * t - 1, 0.0f, 1.0f);
-    out.rgb[3 * i + 1] = 1 - std::fabs(2 * t - 1);
-    out.rgb[3 * i + 2] = std::clamp(1 - 2 * t, 0.0f, 1.0f);
+    out[i] = v2 > 1e-12 ? float(std::sqrt(e2 / v2)) : (e2 > 0 ? 1.0f : 0.0f);
   }
   return out;
 }
@@ -77,7 +70,58 @@ std::vector<float> channel(const std::vector<float>& rgb, int c, float s) {
   return out;
 }
 
+// A picture of values with its legend, written atomically; legend text that could not be drawn is
+// said once per process.
+void write_picture(const std::string& path, const std::vector<ValueBlock>& blocks,
+                   const ColourScale& scale) {
+  std::string warning;
+  const Image img = false_colour_picture(blocks, scale, &warning);
+  static std::once_flag said;
+  if (!warning.empty())
+    std::call_once(said, [&] { std::fprintf(stderr, "bpm: warning: %s\n", warning.c_str()); });
+  write_png_display(path, img);
+}
+
+// The relative error of each pixel, 0 to 10% and more, blue through green to red.
+void write_relative_error(const std::string& path, const Film& film,
+                          const std::vector<float>& error_rgb, const std::string& what) {
+  const std::vector<float> rel = relative_error(film, error_rgb);
+  ColourScale scale;
+  scale.hi = 0.1;
+  scale.ramp = ColourScale::kBlueRed;
+  scale.percent = true;
+  scale.title = what + " / value, linear scale";
+  write_picture(path, {{&rel, film.width(), film.height()}}, scale);
+}
+
 }  // namespace
+
+void write_sensors_png(const std::string& path, const Film& film,
+                       const std::vector<SensorGrid>& grids) {
+  if (grids.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);  // a picture of an earlier render would not match
+    return;
+  }
+  std::vector<std::vector<float>> values;
+  std::vector<float> all;
+  for (const SensorGrid& g : grids) {
+    std::vector<float> v(size_t(g.nu) * size_t(g.nv));
+    for (int j = 0; j < g.nv; ++j)
+      for (int i = 0; i < g.nu; ++i)  // v up: the last row of the grid on top
+        v[size_t(g.nv - 1 - j) * size_t(g.nu) + size_t(i)] =
+            float(film.sensor_mean(g.first + size_t(j) * size_t(g.nu) + size_t(i)));
+    all.insert(all.end(), v.begin(), v.end());
+    values.push_back(std::move(v));
+  }
+  std::vector<ValueBlock> blocks;
+  for (size_t k = 0; k < grids.size(); ++k) {
+    const int cells = std::max(grids[k].nu, grids[k].nv);
+    const int zoom = std::clamp(480 / cells, 1, 64);
+    blocks.push_back({&values[k], grids[k].nu, grids[k].nv, zoom, true});
+  }
+  write_picture(path, blocks, linear_scale(all, "illuminance, lux, linear scale"));
+}
 
 void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio) {
   Image img = film.image(imaging_ratio);
@@ -120,7 +164,11 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
   for (size_t k = 0; k < names.size(); ++k) extra.push_back({names[k], &values[k]});
   write_exr(paths.exr, img, extra);
   write_png(paths.png, img);
-  write_png_display(paths.error_png, relative_false_colour(film, total));
+  const std::vector<float> luminance = film.luminance_image();
+  write_picture(paths.luminance_png, {{&luminance, film.width(), film.height()}},
+                log_scale(luminance, "luminance, cd/m^2, log scale"));
+  write_relative_error(paths.error_png, film, total,
+                       film.has_bias() ? "total error (noise and bias)" : "standard error");
   if (!film.has_bias() && !paths.bias_png.empty()) {
     // No bias estimate (path, --debias): a bias PNG of an earlier render of OUT would not match.
     std::error_code ec;
@@ -131,7 +179,7 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
     std::vector<float> bias(total.size());
     for (size_t k = 0; k < bias.size(); ++k)
       bias[k] = std::sqrt(std::fmax(0.0f, total[k] * total[k] - rgb[k] * rgb[k]));
-    write_png_display(paths.bias_png, relative_false_colour(film, bias));
+    write_relative_error(paths.bias_png, film, bias, "bias estimate");
   }
 }
 

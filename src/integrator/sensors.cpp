@@ -34,8 +34,8 @@ void add_grid(const std::vector<double>& v, const FileLoc& loc, std::vector<Sens
   const float cell = float(std::min(length(u) / nu, length(w) / nv));
   for (int j = 0; j < int(nv); ++j)
     for (int i = 0; i < int(nu); ++i)
-      out->push_back({corner + u * float((i + 0.5) / nu) + w * float((j + 0.5) / nv),
-                      normalize(n), cell, uint32_t(nu), uint32_t(nv), uint32_t(j * int(nu) + i)});
+      out->push_back({corner + u * float((i + 0.5) / nu) + w * float((j + 0.5) / nv), normalize(n),
+                      cell, uint32_t(nu), uint32_t(nv), uint32_t(j * int(nu) + i)});
 }
 
 }  // namespace

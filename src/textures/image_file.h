@@ -37,8 +37,8 @@ inline constexpr const char* kImageReaderEntry = "bpm_read_image_file_v1";
 // Returns false with the reason when it cannot (the module or a font missing).
 bool draw_text(float* rgb, int width, int height, int x, int y, const std::string& text, int size,
                const float colour[3], int align, std::string* error);
-using DrawTextFn = bool(float* rgb, int width, int height, int x, int y, const char* text,
-                        int size, const float* colour, int align, std::string* error);
+using DrawTextFn = bool(float* rgb, int width, int height, int x, int y, const char* text, int size,
+                        const float* colour, int align, std::string* error);
 inline constexpr const char* kDrawTextEntry = "bpm_draw_text_v1";
 
 }  // namespace bpm

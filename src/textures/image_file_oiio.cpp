@@ -56,7 +56,8 @@ extern "C" bool bpm_draw_text_v1(float* rgb, int width, int height, int x, int y
       align == 0 ? OIIO::ImageBufAlgo::TextAlignX::Left
                  : (align == 1 ? OIIO::ImageBufAlgo::TextAlignX::Center
                                : OIIO::ImageBufAlgo::TextAlignX::Right);
-  if (OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, {colour, 3}, x_align)) return true;
+  if (OIIO::ImageBufAlgo::render_text(buf, x, y, text, size, font, {colour, 3}, x_align))
+    return true;
   *error = buf.geterror();
   if (error->empty()) *error = "OpenImageIO could not draw text (no font found)";
   return false;
