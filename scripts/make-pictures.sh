@@ -35,3 +35,12 @@ picture room2-bpm scenes/room2.pbrt --integrator bpm --iterations 300 --seed 1
 cp "$tmp/bias.bias.png" docs/caustic-sphere-bias.png
 echo "make-pictures: docs/caustic-sphere-bias.png: the .bias.png of bpm render" \
   "scenes/caustic-sphere.pbrt --integrator bpm --iterations 256 --radius-policy fixed --k0 4 --k1 4 --seed 1"
+# The false-colour luminance and the work plane's illuminance of the office: OUT.luminance.png and
+# OUT.sensors.png.
+"$bpm" render scenes/office-downlight.pbrt --sensors scenes/office-downlight-sensors.txt \
+  --iterations 200 --seed 1 -q -o "$tmp/office.exr"
+cp "$tmp/office.luminance.png" docs/office-downlight-luminance.png
+cp "$tmp/office.sensors.png" docs/office-downlight-sensors.png
+echo "make-pictures: docs/office-downlight-luminance.png, docs/office-downlight-sensors.png: the" \
+  ".luminance.png and .sensors.png of bpm render scenes/office-downlight.pbrt --sensors" \
+  "scenes/office-downlight-sensors.txt --iterations 200 --seed 1"

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs, builds and renders the bundled Cornell box with backward photon mapping to out/cornell-box.{exr,png,error.png,json}.
+# Installs, builds and renders the bundled Cornell box with backward photon mapping to
+# out/cornell-box.{exr,png,luminance.png,error.png,bias.png,json}.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/build.sh"
