@@ -91,6 +91,34 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 5 1 0 4 5  1
 )";
 }
 
+// Configuration factors of a point to a rectangle a x b: on a plane parallel to it at distance c,
+// under one corner; on a perpendicular plane, c from the line where the planes meet, in front of
+// one corner (heat transfer's catalogues; tests/sensors_test.cpp checks them by quadrature).
+double parallel_factor(double a, double b, double c) {
+  const double A = a / c, B = b / c, sa = std::sqrt(1 + A * A), sb = std::sqrt(1 + B * B);
+  return (A / sa * std::atan(B / sa) + B / sb * std::atan(A / sb)) / (2 * kPi);
+}
+double perpendicular_factor(double a, double b, double c) {
+  const double d = std::sqrt(c * c + b * b);
+  return (std::atan(a / c) - c / d * std::atan(a / d)) / (2 * kPi);
+}
+
+// Two Lambertian rectangles of 100 cd/m^2, far apart: 1 x 2 at 1.5 over (0, 0, 0), and 1 x 2 in
+// the plane x = 101.5, 1.5 from (100, -10, 0).
+const char* const kRectangles = R"(LookAt 0.5 -3 1  0.5 1 1  0 0 1
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+Integrator "path" "integer maxdepth" 5
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "blackbody L" 5000 "float scale" 100 "bool twosided" true
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point3 P" [0 1.5 0  1 1.5 0  1 1.5 2  0 1.5 2]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point3 P" [101.5 -10 0  101.5 -10 1  101.5 -8 1  101.5 -8 0]
+AttributeEnd
+)";
+
 std::vector<Case> cases() {
   const char* point = R"(LightSource "point" "point3 from" [0 0 1] "float power" 1000)";
   const std::string sphere = R"(LookAt 0 0 -0.5  0 0 1  0 1 0
@@ -129,6 +157,14 @@ Shape "sphere" "float radius" 1
       {"integrating sphere, 10 x 10 grid in mid-air facing down", sphere,
        parse_sensors("grid -0.6 -0.3 -0.6  1.2 0 0  0 0 1.2  10 10\n", "grid"),
        0.5 * 1000 / (area * 0.5)},
+      {"Lambertian rectangle, parallel plane: E = pi L F",
+       kRectangles,
+       {{Vec3(0, 0, 0), Vec3(0, 1, 0)}},
+       kPi * 100 * parallel_factor(1, 2, 1.5)},
+      {"Lambertian rectangle, perpendicular plane: E = pi L F",
+       kRectangles,
+       {{Vec3(100, -10, 0), Vec3(0, 1, 0)}},
+       kPi * 100 * perpendicular_factor(1, 2, 1.5)},
       {"distant 1000 lx through glass slab: E (1-R)^2 (1+R^2)",
        slab(
            R"(LightSource "distant" "point3 from" [0 10 0] "point3 to" [0 0 0] "float illuminance" 1000)"),

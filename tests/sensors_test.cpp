@@ -88,6 +88,41 @@ Shape "sphere" "float radius" 1
   expect_lux(film, 1, rho * phi / (area * (1 - rho)), "in mid-air, away from the light");
 }
 
+// A Lambertian rectangle of luminance 100 cd/m^2 (a blackbody scaled to it): at a point facing it
+// on a parallel plane, under one corner, and at a point on a perpendicular plane, in front of one
+// corner, the illuminance is pi L F with F the configuration factor of the point to the rectangle
+// (the closed forms of heat transfer's catalogues, checked by quadrature).
+TEST_P(SensorsBy, LambertianRectangleFollowsTheConfigurationFactors) {
+  const std::string scene = R"(LookAt 0.5 -3 1  0.5 1 1  0 0 1
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+Integrator "path" "integer maxdepth" 5
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "blackbody L" 5000 "float scale" 100 "bool twosided" true
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point3 P" [0 1.5 0  1 1.5 0  1 1.5 2  0 1.5 2]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+    "point3 P" [101.5 -10 0  101.5 -10 1  101.5 -8 1  101.5 -8 0]
+AttributeEnd
+)";
+  // The first rectangle, 1 x 2, 1.5 over the point (0, 0, 0) facing +y; the second, 1 wide along
+  // z and 2 high along y, stands in the plane x = 101.5, 1.5 from the point (100, -10, 0) facing
+  // +y (each point sees the other's rectangle behind it, or 10^-5 of its own).
+  const std::vector<Sensor> sensors = parse_sensors("0 0 0  0 1 0\n100 -10 0  0 1 0\n", "s");
+  const Film film = render_sensors(scene, sensors, 64, GetParam());
+  auto parallel = [](double a, double b, double c) {
+    const double A = a / c, B = b / c, sa = std::sqrt(1 + A * A), sb = std::sqrt(1 + B * B);
+    return (A / sa * std::atan(B / sa) + B / sb * std::atan(A / sb)) / (2 * kPi);
+  };
+  auto perpendicular = [](double a, double b, double c) {
+    const double d = std::sqrt(c * c + b * b);
+    return (std::atan(a / c) - c / d * std::atan(a / d)) / (2 * kPi);
+  };
+  expect_lux(film, 0, kPi * 100 * parallel(1, 2, 1.5), "parallel");
+  expect_lux(film, 1, kPi * 100 * perpendicular(1, 2, 1.5), "perpendicular");
+}
+
 // A distant light of 1000 lux straight down through a horizontal glass slab (eta 1.5) onto a
 // black floor: under the slab the illuminance is 1000 (1 - R)^2 (1 + R^2) with R = ((eta - 1) /
 // (eta + 1))^2, the light that crosses both faces directly or after one reflection at each (the
