@@ -295,6 +295,8 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                    {"relative_error_delta_luminance", film.relative_error_luminance()},
                    {"m_images", film.m_images()},
                    {"relative_error_delta_m_images", film.relative_error_m_images()}};
+  if (film.sensor_count() > 0)
+    rec["result"]["relative_error_delta_sensors"] = film.sensor_relative_error();
   const std::vector<float> y = film.luminance_image();
   double y_sum = 0;
   for (float v : y) y_sum += v;
@@ -439,11 +441,15 @@ void print_result(const RenderArgs& a, const RenderOptions& opt, const RenderSta
   if (film.has_bias())
     std::snprintf(bias, sizeof bias, " (noise %.4f, bias %.4f)", st.relative_error,
                   film.relative_error_bias());
-  std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f%s -> %s\n", st.passes,
+  char sensors[48] = "";
+  if (film.sensor_count() > 0)
+    std::snprintf(sensors, sizeof sensors, ", sensors' delta %.4f", film.sensor_relative_error());
+  std::fprintf(stderr, "bpm: %d %s in %.2f s (%s), %.2f Mrays/s, delta %.4f%s%s -> %s\n", st.passes,
                opt.integrator == "path" ? "spp" : "iterations", st.render_seconds,
                st.stop_reason.c_str(),
                st.render_seconds > 0 ? st.total_rays() / st.render_seconds * 1e-6 : 0.0,
-               film.relative_error_total(), bias, paths.exr.c_str());
+               film.relative_error_total(), bias, sensors,
+               opt.image ? paths.exr.c_str() : paths.sensors.c_str());
 }
 
 // With several processes (mpirun), process 0 alone prints and writes; the others render.

@@ -156,6 +156,22 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 5 1 0 4 5  1
   expect_lux(film, 2, through, "in mid-air under the slab");
 }
 
+// --accuracy bounds the sensors' delta (eq. 4 over them) too: without an image it alone ends the
+// render.
+TEST_P(SensorsBy, AccuracyBoundsTheSensorsError) {
+  const std::vector<Sensor> sensors = parse_sensors("0 0 0 0 0 1\n0.5 0 0 0 0 1\n", "s.txt");
+  LoadedScene ls = test::load(kPlane);
+  RenderOptions opt = quiet_options(ls, GetParam(), 1 << 20, 5);
+  opt.sensors = sensors;
+  opt.image = false;
+  opt.accuracy = 0.002;
+  Film film(ls.film.width, ls.film.height, 0, sensors.size());
+  const RenderStats st = render(ls, opt, &film);
+  EXPECT_EQ(st.stop_reason, "accuracy");
+  EXPECT_LE(film.sensor_relative_error(), 0.002);
+  EXPECT_GT(film.sensor_relative_error(), 0);
+}
+
 // The sensors' estimates depend on the seed and the pass only, not on the threads; the path
 // tracer's are the same with an image and without one.
 TEST_P(SensorsBy, EstimatesDoNotDependOnThreadsOrTheImage) {

@@ -54,6 +54,15 @@ double Film::sensor_total_error(size_t i) const {
   return std::sqrt(se * se + std::fmax(0.0, b * b - b_se * b_se));
 }
 
+double Film::sensor_relative_error() const {
+  double e2 = 0, v2 = 0;
+  for (size_t i = 0; i < sensors_.size(); ++i) {
+    e2 += std::pow(sensor_total_error(i), 2);
+    v2 += std::pow(sensor_mean(i), 2);
+  }
+  return v2 > 0 ? std::sqrt(e2 / v2) : 0;
+}
+
 double Film::sensor_standard_error(size_t i) const {
   return standard_error(sensors_[i].sum, sensors_[i].sum2, sensors_[i].passes);
 }

@@ -133,6 +133,8 @@ class Film {
   double sensor_standard_error(size_t i) const;
   double sensor_bias(size_t i) const;
   double sensor_total_error(size_t i) const;
+  // delta (eq. 4) over the sensors: sqrt(sum total error^2 / sum value^2), 0 without sensors.
+  double sensor_relative_error() const;
   int sensor_passes(size_t i) const { return sensors_[i].passes; }
 
   Image image(float scale = 1) const;

@@ -110,11 +110,13 @@ void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra
   int passes = done + 1;
   double t = elapsed();
   bool print = opt_.progress && (t - last_progress_ >= 0.5 || passes == opt_.spp);
-  // The total error: noise, and for the photon methods their bias estimate as well.
+  // The total error: noise, and for the photon methods their bias estimate as well; with sensors,
+  // the larger of the image's and the sensors' (without an image, the sensors' alone).
   if (opt_.accuracy > 0 || print) {
     bias_ = film_.relative_error_bias();
     delta_ =
         std::sqrt(std::pow(film_.relative_error(), 2) + bias_ * bias_);  // relative_error_total
+    if (film_.sensor_count() > 0) delta_ = std::max(delta_, film_.sensor_relative_error());
   }
   if (!print) return;
   last_progress_ = t;

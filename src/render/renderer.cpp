@@ -37,10 +37,6 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
                 std::to_string(opt.sensors.size()));
   if (!opt.image && opt.sensors.empty())
     throw Error("a render without an image needs sensors (--sensors)");
-  if (!opt.image && opt.accuracy > 0)
-    throw Error(
-        "--accuracy bounds the image's error: without an image (--no-image) give --spp "
-        "or --time");
   if (opt.integrator == "bpm") return render_bpm(ls, opt, opt.bpm, film);
   if (opt.integrator == "fpm") return render_fpm(ls, opt, opt.fpm, film);
   RenderOptions o = opt;
