@@ -55,7 +55,7 @@ TEST(Legend, PictureHasTheValuesAndALegendWithText) {
   EXPECT_EQ(warning, "");
   EXPECT_EQ(img.width, 360);
   EXPECT_GT(img.height, 20);
-  EXPECT_EQ(brightness(img.at(5, 5)), brightness(s.colour(0)));     // value 0, black
+  EXPECT_EQ(brightness(img.at(5, 5)), brightness(s.colour(0)));       // value 0, black
   EXPECT_EQ(brightness(img.at(15, 15)), brightness(s.colour(0.25)));  // row 1, column 1
   int dark = 0;
   for (int y = 28; y < 28 + 18; ++y)
