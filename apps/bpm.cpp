@@ -245,11 +245,10 @@ void record_outputs(const RenderArgs& a, const RenderOptions& opt, const Film& f
                      ? "path: next-event estimation and a cosine-distributed path at each "
                        "sensor, in every pass"
                      : opt.integrator +
-                           ": direct light by next-event estimation and a "
-                           "cosine-distributed direction at each sensor; caustic and "
-                           "indirect light by the photons crossing a disc about it, of a "
-                           "backward photon's radius (at most half a grid cell), in every "
-                           "iteration"}};
+                           ": the path tracer's estimate at each sensor less the light "
+                           "that reaches it through traced lobes only, and that light (caustics) "
+                           "from the caustic photons reaching a disc about it of a backward "
+                           "photon's radius (at most half a grid cell), in every iteration"}};
 }
 
 // The JSON record of a finished render: how the image was made and what it cost.

@@ -245,6 +245,13 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   const float scale = radius_scale(s_, it);
   // One set of wavelengths for every eye and light path of the iteration.
   const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
+  if (!opt_.image && !caustics_) {
+    // Sensors alone in a scene without caustics: the photons would add nothing, the paths from
+    // the sensors find everything.
+    sensor_sums_.clear();
+    sensor_sums_.finish(scene_, *sensors_, opt_.max_depth, s_.bias_model, opt_.seed, it, 0);
+    return progress();
+  }
   // 1. Eye pass: backward photons, and the light the eye paths count themselves (no image: none).
   if (opt_.image && !eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
   // 2. Per-object sphere trees over the backward photons.
@@ -259,7 +266,8 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   // 3. Light pass: a fixed number of photons, in groups.
   if (!light_pass(lp, pass, it)) return PassResult{false, 0, "", ""};
   if (sensors_)
-    sensor_sums_.finish(scene_, *sensors_, s_.bias_model, opt_.seed, it, light_result_.emitted);
+    sensor_sums_.finish(scene_, *sensors_, opt_.max_depth, s_.bias_model, opt_.seed, it,
+                        light_result_.emitted);
   // 4. Accumulation of the iteration into the film; masks balanced for the next one.
   if (opt_.image) accumulate(wm);
   return progress();

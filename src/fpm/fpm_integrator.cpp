@@ -170,7 +170,7 @@ PassResult FpmRender::iteration(int pass, const RenderControl& control) {
   if (sensors_) {
     sensor_sums_.clear();
     for (const ForwardMaps::Chunk& ch : maps_.chunks) sensor_sums_.add(ch.crossings);
-    sensor_sums_.finish(scene_, *sensors_, s_.bias_model, opt_.seed, it, emitted_);
+    sensor_sums_.finish(scene_, *sensors_, opt_.max_depth, s_.bias_model, opt_.seed, it, emitted_);
   }
   if (!opt_.image) return progress();
   // 2. The maps, in chunk order (the same for any thread count), and their trees.

@@ -8,6 +8,7 @@
 #include "base/sampling.h"
 #include "base/text.h"
 #include "integrator/direct_light.h"
+#include "integrator/path_radiance.h"
 
 namespace bpm {
 namespace {
@@ -78,11 +79,13 @@ std::vector<Sensor> read_sensors(const std::string& path) {
   return parse_sensors(read_text_file(path, "sensor file"), path);
 }
 
+namespace {
+
+// Next-event estimation at a white Lambertian surface (f = 1 / pi) standing for the sensor: pi
+// times its radiance is the illuminance. The light sample's distance and angle are the sensor's
+// own (sp.error: the rays leave from the lifted point).
 Spectrum sensor_light_sample(const RenderScene& scene, const Sensor& s,
                              const WavelengthMaterials& wm, Rng& rng, PathCounters& counters) {
-  // A white Lambertian surface (f = 1 / pi) standing for the sensor: pi times its radiance is the
-  // illuminance. The light sample's distance and angle are the sensor's own (sp.error: the rays
-  // leave from the lifted point).
   SurfacePoint sp;
   sp.p = s.p;
   sp.ng = sp.ns = s.n;
@@ -93,18 +96,22 @@ Spectrum sensor_light_sample(const RenderScene& scene, const Sensor& s,
          kPi;
 }
 
-Spectrum sensor_direct_irradiance(const RenderScene& scene, const Sensor& s,
-                                  const WavelengthMaterials& wm, Rng& rng, PathCounters& counters) {
+}  // namespace
+
+Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_depth,
+                           const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                           bool caustics_elsewhere) {
+  const WavelengthMaterials wm = WavelengthMaterials::resolved_per_point(scene, wl);
   Spectrum E = sensor_light_sample(scene, s, wm, rng, counters);
-  if (!scene.bsdf_finds_lights) return E;  // points and directions: the light sample's alone
-  // A cosine-distributed direction (E = pi L) and the emitter it reaches, through interfaces only.
+  // A cosine-distributed direction: E = pi L, the emission it finds weighted against the light
+  // sample, and the light beyond found as a camera path finds it.
   const Vec3 origin = s.p + s.n * sensor_lift(scene);
   const Vec3 local = sample_cosine_hemisphere({rng.uniform(), rng.uniform()});
-  PathState st{Ray{origin, Frame::from_z(s.n).to_world(local), kInf}, Spectrum(kPi)};
-  if (!scene.may_reach_emitter(st.ray)) return E;
-  ++counters.bounce_rays;
-  PathVertex v;
-  next_eye_vertex(scene, wm, st, v, counters, EmitterWeight::mis(local.z * kInvPi, origin), E);
+  const Vec3 wi = Frame::from_z(s.n).to_world(local);
+  const EmitterWeight first = EmitterWeight::mis(local.z * kInvPi, origin);
+  E += path_radiance(scene, Ray{origin, wi, kInf}, PathSettings{max_depth, caustics_elsewhere}, wl,
+                     rng, counters, first) *
+       kPi;
   return E;
 }
 

@@ -4,7 +4,7 @@
 // Each integrator estimates them its own way (path/sensors.h, photons/sensor_discs.h) in every
 // pass; the film keeps each sensor's per-pass estimates, so every sensor has its standard error
 // (eq. 5 of the paper) as the pixels do. What every estimator shares is here: the sensors, their
-// file, and the direct light at a sensor.
+// file, and the path tracer's estimate at a sensor.
 #pragma once
 #include <string>
 #include <vector>
@@ -43,16 +43,14 @@ constexpr uint64_t kSensorStreams = 0x53454e534f525321ull;
 // a surface does not see that surface.
 inline float sensor_lift(const RenderScene& scene) { return 1e-6f * scene.bounds_info.radius; }
 
-// Next-event estimation at a sensor: the illuminance of one light sample (at a white Lambertian
-// point on no object, in the scene's outer medium), weighted by the power heuristic against a
-// cosine-distributed direction from the sensor, whose emitters the caller weights by
-// EmitterWeight::mis(cos / pi, sensor point lifted).
-Spectrum sensor_light_sample(const RenderScene& scene, const Sensor& s,
-                             const WavelengthMaterials& wm, Rng& rng, PathCounters& counters);
-
-// The direct illuminance at a sensor from one sample: sensor_light_sample, and the emitters that a
-// cosine-distributed direction finds (through interfaces only), weighted against it.
-Spectrum sensor_direct_irradiance(const RenderScene& scene, const Sensor& s,
-                                  const WavelengthMaterials& wm, Rng& rng, PathCounters& counters);
+// The spectral irradiance at a sensor from one sample (the luminance of it is the illuminance):
+// next-event estimation at a white Lambertian point standing for the sensor (on no object, in the
+// scene's outer medium), weighted by multiple importance sampling against a cosine-distributed
+// direction whose path then goes on as a camera path does (path_radiance). With
+// caustics_elsewhere, the light that reaches the sensor through traced lobes only is left out:
+// the photon methods count it with photons.
+Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_depth,
+                           const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                           bool caustics_elsewhere = false);
 
 }  // namespace bpm

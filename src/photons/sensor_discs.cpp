@@ -127,7 +127,7 @@ void SensorDiscs::reach(const RenderScene& scene, const Wavelengths& wl, const P
 
 void SensorDiscs::cross(const RenderScene& scene, const Wavelengths& wl, const PhotonSegment& seg,
                         std::vector<SensorCrossing>* out) const {
-  if (seg.cls == PhotonClass::kDirect) return;
+  if (seg.cls != PhotonClass::kCaustic) return;
   // Sensors on the surface the segment ends at: those within their radius of the end.
   if (std::isfinite(seg.t_max) && tree_->spheres.node_count() > 0) {
     const Vec3 end = seg.ray.o + seg.ray.d * seg.t_max;
@@ -185,19 +185,19 @@ void SensorIteration::add(const std::vector<SensorCrossing>& crossings) {
   }
 }
 
-void SensorIteration::finish(const RenderScene& scene, const SensorDiscs& discs, BiasModel model,
-                             uint64_t seed, int it, uint64_t emitted) {
+void SensorIteration::finish(const RenderScene& scene, const SensorDiscs& discs, int max_depth,
+                             BiasModel model, uint64_t seed, int it, uint64_t emitted) {
   estimate_.assign(discs.size(), 0.0);
   bias_.assign(discs.size(), 0.0);
   tbb::parallel_for(size_t(0), discs.size(), [&](size_t i) {
-    double direct = 0;
+    double traced = 0;  // what the paths from the sensor find: all but the caustics
     PathCounters counters;
     for (int k = 0; k < kSensorSamplesPerPass; ++k) {
       Rng rng(stream_key(seed ^ kSensorStreams, uint64_t(it), i, uint64_t(k)));
       const Wavelengths wl = sample_wavelengths(rng.uniform());
-      const WavelengthMaterials wm = WavelengthMaterials::resolved_per_point(scene, wl);
-      const Spectrum E = sensor_direct_irradiance(scene, discs.sensor(i), wm, rng, counters);
-      if (E.is_finite() && !E.has_negative()) direct += spectrum_to_luminance(E, wl);
+      const Spectrum E = sensor_irradiance(scene, discs.sensor(i), max_depth, wl, rng, counters,
+                                           /*caustics_elsewhere=*/true);
+      if (E.is_finite() && !E.has_negative()) traced += spectrum_to_luminance(E, wl);
     }
     const float r = discs.radius(i);
     const float norm = float(1 / (kPi * double(r) * r * double(std::max<uint64_t>(emitted, 1))));
@@ -205,7 +205,7 @@ void SensorIteration::finish(const RenderScene& scene, const SensorDiscs& discs,
     sums.all = Spectrum(float(all_[i]));
     sums.half = Spectrum(float(half_[i]));
     sums.quarter = Spectrum(float(quarter_[i]));
-    estimate_[i] = direct / kSensorSamplesPerPass + all_[i] * norm;
+    estimate_[i] = traced / kSensorSamplesPerPass + all_[i] * norm;
     bias_[i] = radius_bias(sums, norm, model)[0];
   });
 }

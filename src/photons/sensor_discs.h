@@ -1,14 +1,18 @@
-// Illuminance sensors (integrator/sensors.h) as the photon methods estimate them: each sensor is a
-// disc of radius r at its point, facing its normal, that blocks no light, a backward photon of
-// transmittance 1 with no camera. The flux of the photons that reach the disc from its front, over
-// the disc's area and the photons emitted, estimates the illuminance there. A sensor in mid-air
-// counts the photons whose paths cross its disc; a sensor on a surface (one that its point lies
-// on) counts the photons that land on a surface within r of it whose normal agrees with its own
-// (as a backward photon gathers: a disc in its tangent plane would miss a concave surface's
-// photons). Either counts a photon only where the sensor's point sees it (a shadow ray), so that
-// light beside an object standing on the sensor's plane does not reach a sensor under it. As at
-// an eye path's diffuse vertex, direct light is next-event estimation's (sensor_direct_irradiance)
-// and photons straight from a light are left out: the photons give the caustic and indirect light.
+// Illuminance sensors (integrator/sensors.h) as the photon methods estimate them: a sensor is a
+// backward photon of transmittance 1 with no camera, where the caustics come from photons and the
+// rest from paths traced from the sensor, as at the first diffuse vertex of an eye path that goes
+// on (DESIGN.md's D = 1). The paths are the path tracer's (sensor_irradiance) without the light
+// that reaches the sensor through traced lobes only; that light, a caustic, comes from the
+// iteration's caustic photons that reach a disc of radius r at the sensor's point, facing its
+// normal, that blocks no light: their flux over the disc's area and the photons emitted. A sensor
+// in mid-air counts the photons whose paths cross its disc from its front; a sensor on a surface
+// (one that its point lies on) counts the photons that land on a surface within r of it whose
+// normal agrees with its own (as a backward photon gathers: a disc in its tangent plane would
+// miss a concave surface's photons). Either counts a photon only where the sensor's point sees it
+// (a shadow ray), so that light beside an object standing on the sensor's plane does not reach a
+// sensor under it. Light through glass from a point or a distant light, which no path from the
+// sensor can find, is found so; light that paths find well (direct, diffuse interreflection) is
+// left to them.
 //
 // A disc's radius is a backward photon's at that point: k1 pixel footprints at the sensor's
 // distance from the camera, at most half the side of its grid cell (so that neighbouring cells do
@@ -53,7 +57,7 @@ class SensorDiscs {
   bool on_surface(size_t i) const { return on_surface_[i] != 0; }
   // The radii of an iteration: base radius times `scale` (radius_scale); rebuilds the tree.
   void set_scale(float scale);
-  // Appends the sensors a caustic or indirect photon's segment reaches (direct ones reach none).
+  // Appends the sensors a caustic photon's segment reaches (other photons reach none).
   void cross(const RenderScene& scene, const Wavelengths& wl, const PhotonSegment& segment,
              std::vector<SensorCrossing>* out) const;
 
@@ -97,11 +101,11 @@ class SensorIteration {
   explicit SensorIteration(size_t sensors) : all_(sensors), half_(sensors), quarter_(sensors) {}
   void clear();
   void add(const std::vector<SensorCrossing>& crossings);
-  // The estimates of iteration `it` once `emitted` photons crossed the discs: direct light by
-  // kSensorSamplesPerPass samples (streams keyed by seed, it, sensor) plus the photons' density,
-  // kept until record() adds them to the film.
-  void finish(const RenderScene& scene, const SensorDiscs& discs, BiasModel model, uint64_t seed,
-              int it, uint64_t emitted);
+  // The estimates of iteration `it` once `emitted` photons crossed the discs: the paths of
+  // kSensorSamplesPerPass samples (streams keyed by seed, it, sensor) plus the caustic photons'
+  // density, kept until record() adds them to the film.
+  void finish(const RenderScene& scene, const SensorDiscs& discs, int max_depth, BiasModel model,
+              uint64_t seed, int it, uint64_t emitted);
   void record(Film* film) const;
 
  private:

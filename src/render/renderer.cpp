@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 
 #include <memory>
@@ -15,10 +16,15 @@ namespace bpm {
 namespace {
 
 // The path tracer's passes of the sensors alone, without an image (--no-image).
-RenderStats render_path_sensors(const RenderOptions& opt, Film* film) {
+RenderStats render_path_sensors(const RenderOptions& opt, Film* film,
+                                const tbb::enumerable_thread_specific<PathCounters>& counters) {
   RenderStats stats;
-  run_passes(
-      opt, film, "pass", [](int, const RenderControl&) { return PassResult{}; }, &stats);
+  auto pass = [&](int, const RenderControl&) {
+    PassResult r;
+    for (const PathCounters& c : counters) r.rays += c.total();
+    return r;
+  };
+  run_passes(opt, film, "pass", pass, &stats);
   return stats;
 }
 
@@ -40,12 +46,15 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
   if (opt.integrator == "bpm") return render_bpm(ls, opt, opt.bpm, film);
   if (opt.integrator == "fpm") return render_fpm(ls, opt, opt.fpm, film);
   RenderOptions o = opt;
+  tbb::enumerable_thread_specific<PathCounters> sensor_counters;
   if (!opt.sensors.empty())
     o.sensor_pass = [&](int pass_index, Film* f) {
-      sensor_pass(ls.scene, opt.sensors, opt.max_depth, opt.seed, pass_index, f);
+      sensor_pass(ls.scene, opt.sensors, opt.max_depth, opt.seed, pass_index, f, sensor_counters);
     };
-  if (!opt.image) return render_path_sensors(o, film);
-  return render_path(ls, o, film);
+  RenderStats stats =
+      opt.image ? render_path(ls, o, film) : render_path_sensors(o, film, sensor_counters);
+  for (const PathCounters& c : sensor_counters) stats.rays.add(c);
+  return stats;
 }
 
 }  // namespace bpm

@@ -1,0 +1,65 @@
+#include "integrator/path_radiance.h"
+
+#include <cmath>
+
+#include "integrator/path_vertex.h"
+
+namespace bpm {
+
+Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings,
+                       const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                       const EmitterWeight& first) {
+  const WavelengthMaterials materials = WavelengthMaterials::resolved_per_point(scene, wl);
+  PathState s{ray};
+  Spectrum L;
+  EmitterWeight emitter = first;
+  float eta_scale = 1;
+  int depth = 0;
+  bool all_traced = settings.caustics_elsewhere;  // every vertex so far sampled a traced lobe
+  ++counters.camera_rays;
+  for (int guard = 0; guard < 10000; ++guard) {
+    PathVertex v;
+    if (next_eye_vertex(scene, materials, s, v, counters, emitter, L) != StepEnd::kVertex) break;
+    if (depth++ == settings.max_depth) break;
+    if (v.wo_local.z == 0) break;
+    keep_hero_wavelength_at(v, s);
+    if (all_traced) {
+      // Light reaching v and leaving it through a gathered lobe, then traced lobes to the origin.
+      if (bsdf_part_has_nondelta(v.m(), BsdfPart::kGathered)) {
+        L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                          v.wo_local, true, materials, rng, counters,
+                                          BsdfPart::kGathered);
+        L += direct_light_by_bsdf(scene, materials, v, s, BsdfPart::kGathered, rng, counters);
+      }
+    } else if (!bsdf_is_specular(v.m())) {
+      L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
+                                        v.wo_local, true, materials, rng, counters);
+    }
+
+    float uc = rng.uniform();
+    Vec2 u{rng.uniform(), rng.uniform()};
+    auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance);
+    if (!bs) break;
+    s.beta *= bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+    emitter = bs->is_specular() ? EmitterWeight::full() : EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+    // Past a vertex of the traced-only path the emission found is counted elsewhere: through a
+    // traced lobe by the photons, through a gathered one by that vertex's direct light above.
+    if (all_traced) emitter = EmitterWeight::none();
+    all_traced = all_traced && bs->is_traced();
+    if (bs->is_transmission()) eta_scale *= bs->eta * bs->eta;
+    leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+    ++counters.bounce_rays;
+    if (s.beta.is_black()) break;
+    // Russian roulette on the throughput without the radiance scaling of refraction
+    // (pbrt-v4's etaScale), after the first two bounces.
+    Spectrum rr_beta = s.beta * eta_scale;
+    if (rr_beta.max_component() < 1 && depth > 1) {
+      float q = std::fmax(0.0f, 1 - rr_beta.max_component());
+      if (rng.uniform() < q) break;
+      s.beta /= 1 - q;
+    }
+  }
+  return L;
+}
+
+}  // namespace bpm

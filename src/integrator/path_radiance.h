@@ -1,0 +1,31 @@
+// The path tracer's estimate of the radiance along a ray: next-event estimation with multiple
+// importance sampling (power heuristic) against BSDF sampling, Russian roulette, lights chosen in
+// proportion to power. The path integrator renders with it (path/path_integrator.h); illuminance
+// sensors trace their paths with it (integrator/sensors.h).
+#pragma once
+#include "base/rng.h"
+#include "integrator/counters.h"
+#include "integrator/direct_light.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+struct PathSettings {
+  int max_depth = 5;  // scattering events, as pbrt-v4's maxdepth
+  // Leave out the light that reaches the ray's origin through traced lobes only (materials/
+  // material.h): light from an emitter that meets traced lobes at every vertex between. The photon
+  // methods count it with their caustic photons at an illuminance sensor. At a vertex every one
+  // before which was traced, the gathered lobes take their direct light (next-event estimation
+  // and a BSDF sample of that part, as a photon method's eye path at a diffuse vertex); the path
+  // goes on through whichever lobe it samples.
+  bool caustics_elsewhere = false;
+};
+
+// Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl. `first` weighs the
+// emission of the first surface the ray meets (full for a camera ray; an illuminance sensor
+// weighs it against its own light sample).
+Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings,
+                       const Wavelengths& wl, Rng& rng, PathCounters& counters,
+                       const EmitterWeight& first = EmitterWeight::full());
+
+}  // namespace bpm
