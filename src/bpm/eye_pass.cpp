@@ -242,18 +242,6 @@ int emission_sample_count(const EmissionStats<double>& s, double cost_ratio, int
   return int(std::clamp(std::round(e), 1.0, double(max_samples)));
 }
 
-bool may_have_caustics(const RenderScene& scene) {
-  for (const Object& o : scene.objects) {
-    if (o.material < 0 || size_t(o.material) >= scene.materials.size()) return true;
-    const MaterialDesc& m = scene.materials[size_t(o.material)];
-    if (!std::holds_alternative<DiffuseDesc>(m) &&
-        !std::holds_alternative<DiffuseTransmissionDesc>(m) &&
-        !std::holds_alternative<InterfaceMaterial>(m))
-      return true;
-  }
-  return false;
-}
-
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const CameraSampler& camera,
                   const PixelMasks& masks, const RenderControl& control, int pass, int pass_index,
                   EyePixels* px, EyeThreadData threads) {

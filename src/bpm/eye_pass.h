@@ -46,11 +46,6 @@ struct EyePassParams {
   const NearEdges* near_edges = nullptr;
 };
 
-// Whether some material of the scene's objects may have a traced lobe (materials/material.h),
-// through which light could reach a diffuse surface as a caustic: all but diffuse reflection,
-// diffuse transmission and interfaces (a mix counts as one that may).
-bool may_have_caustics(const RenderScene& scene);
-
 struct EyeCounters {
   PathCounters rays;  // camera, bounce, shadow and probe rays
   uint64_t backward_photons = 0;

@@ -165,6 +165,13 @@ PassResult FpmRender::iteration(int pass, const RenderControl& control) {
   const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
   // One set of wavelengths for every eye and light path of the iteration.
   const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
+  if (!opt_.image && !may_have_caustics(scene_)) {
+    // Sensors alone in a scene without caustics: the photons would add nothing, the paths from
+    // the sensors find everything.
+    sensor_sums_.clear();
+    sensor_sums_.finish(scene_, *sensors_, opt_.max_depth, s_.bias_model, opt_.seed, it, 0);
+    return progress();
+  }
   // 1. Light pass: a forward photon at every diffuse hit (and the sensors' crossings).
   if (!light_pass(wm, pass, it, control)) return PassResult{false, 0, "", ""};
   if (sensors_) {

@@ -83,6 +83,21 @@ struct LightCounters {
   }
 };
 
+// Whether some material of the scene's objects may have a traced lobe (materials/material.h),
+// through which light could reach a diffuse surface as a caustic: all but diffuse reflection,
+// diffuse transmission and interfaces (a mix counts as one that may).
+inline bool may_have_caustics(const RenderScene& scene) {
+  for (const Object& o : scene.objects) {
+    if (o.material < 0 || size_t(o.material) >= scene.materials.size()) return true;
+    const MaterialDesc& m = scene.materials[size_t(o.material)];
+    if (!std::holds_alternative<DiffuseDesc>(m) &&
+        !std::holds_alternative<DiffuseTransmissionDesc>(m) &&
+        !std::holds_alternative<InterfaceMaterial>(m))
+      return true;
+  }
+  return false;
+}
+
 // A photon at a diffuse surface: it arrived at sp along -wi with `flux` (per photon emitted,
 // before dividing by their number) after `bounces` scattering events.
 struct PhotonHit {
