@@ -766,8 +766,8 @@ int main(int argc, char** argv) {
   CLI::App app{"bpm: physically based rendering with backward photon maps; reads pbrt-v4 scenes"};
   app.require_subcommand(1);
   RenderArgs ra;
-  CLI::App* render =
-      app.add_subcommand("render", "Render a pbrt-v4 scene to EXR, PNG, error PNG and JSON");
+  CLI::App* render = app.add_subcommand(
+      "render", "Render a pbrt-v4 scene to EXR, PNGs (image, luminance, error) and JSON");
   add_general_options(render, ra);
   add_budget_options(render, ra);
   add_output_options(render, ra);
