@@ -242,9 +242,6 @@ double BpmRender::reserve_memory() const {
 // Fig. 3: one iteration, an independent estimate of the image.
 PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
-  const float scale = radius_scale(s_, it);
-  // One set of wavelengths for every eye and light path of the iteration.
-  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
   if (!opt_.image && !caustics_) {
     // Sensors alone in a scene without caustics: the photons would add nothing, the paths from
     // the sensors find everything.
@@ -252,6 +249,9 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
     sensor_sums_.finish(scene_, *sensors_, opt_.max_depth, s_.bias_model, opt_.seed, it, 0);
     return progress();
   }
+  const float scale = radius_scale(s_, it);
+  // One set of wavelengths for every eye and light path of the iteration.
+  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
   // 1. Eye pass: backward photons, and the light the eye paths count themselves (no image: none).
   if (opt_.image && !eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
   // 2. Per-object sphere trees over the backward photons.
