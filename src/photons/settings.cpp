@@ -3,15 +3,26 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace bpm {
 
 float radius_scale(const PhotonSettings& s, int iteration) {
   if (s.radius_policy == RadiusPolicy::kFixed) return 1;
-  // r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1), i counted from 1 (Knaus & Zwicker 2011, eq. 20).
-  double r2 = 1;
-  for (int i = 1; i <= iteration; ++i) r2 *= (i + double(s.alpha)) / (i + 1);
-  return float(std::sqrt(r2));
+  // r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1), i counted from 1 (Knaus & Zwicker 2011, eq. 20). The
+  // products so far are kept (per thread, for the last alpha asked), so that a render's iterations
+  // do not each multiply from the first; the same products in the same order.
+  thread_local float alpha = -1;
+  thread_local std::vector<double> r2{1.0};
+  if (s.alpha != alpha) {
+    alpha = s.alpha;
+    r2.assign(1, 1.0);
+  }
+  while (int(r2.size()) <= iteration) {
+    const int i = int(r2.size());
+    r2.push_back(r2.back() * ((i + double(s.alpha)) / (i + 1)));
+  }
+  return float(std::sqrt(r2[size_t(iteration)]));
 }
 
 int photons_for(const PhotonSettings& s, size_t pixels) {
