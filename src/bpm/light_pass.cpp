@@ -153,13 +153,9 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
       hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object, int16_t(h.bounces),
                       h.cls, h.hero_only});
     };
-    if (sensors) {
-      // A sensor adds no eye vertex: photons cross it after up to max_depth bounces.
-      SensorSegments segments{scene, *sensors, g.prm.materials->wl, crossings, g.prm.max_depth};
-      trace_light_path(scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit, segments);
-    } else {
-      trace_light_path(scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit);
-    }
+    trace_light_path(
+        scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit,
+        SensorSegments(scene, sensors, g.prm.materials->wl, crossings, g.prm.max_depth));
     if (g.scored) emitted.push_back({e.cell, e.weight});
   }
   buf->hits[size_t(c)].swap(hits);

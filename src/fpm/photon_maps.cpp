@@ -45,13 +45,8 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
         if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
         ++lc.entries;
       };
-      if (sensors) {
-        // A sensor adds no eye vertex: photons cross it after up to max_depth bounces.
-        SensorSegments segments{scene, *sensors, wm.wl, ch.crossings, max_depth};
-        trace_light_path(scene, wm, max_depth, min_eye_vertices, e, rng, lc, store, segments);
-      } else {
-        trace_light_path(scene, wm, max_depth, min_eye_vertices, e, rng, lc, store);
-      }
+      trace_light_path(scene, wm, max_depth, min_eye_vertices, e, rng, lc, store,
+                       SensorSegments(scene, sensors, wm.wl, ch.crossings, max_depth));
     }
   });
   // The chunks past the kept ones leave the maps.

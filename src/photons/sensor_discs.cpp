@@ -139,7 +139,9 @@ void SensorDiscs::cross(const RenderScene& scene, const Wavelengths& wl, const P
   }
   if (in_air_.empty()) return;
   // Sensors in mid-air whose discs the segment crosses.
-  std::vector<std::pair<uint32_t, float>> found;
+  // The discs found, in a list of the thread's own kept from call to call (one call a segment).
+  thread_local std::vector<std::pair<uint32_t, float>> found;
+  found.clear();
   QueryContext q{{}, &sensors_, &in_air_, seg.ray.d, &found};
   rtcInitIntersectContext(&q.embree);
   RTCRay r{};

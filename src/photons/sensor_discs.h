@@ -77,14 +77,17 @@ class SensorDiscs {
 };
 
 // The segments of trace_light_path that a photon's crossings of the discs are recorded from: every
-// piece after up to `depth` bounces (a sensor adds no vertex: max_depth).
+// piece after up to max_depth bounces (a sensor adds no vertex), none without sensors.
 struct SensorSegments {
   const RenderScene& scene;
-  const SensorDiscs& discs;
+  const SensorDiscs* discs;  // null: no sensors, no segments asked for
   const Wavelengths& wl;
   std::vector<SensorCrossing>& out;
   int depth;
-  void operator()(const PhotonSegment& s) const { discs.cross(scene, wl, s, &out); }
+  SensorSegments(const RenderScene& scene, const SensorDiscs* discs, const Wavelengths& wl,
+                 std::vector<SensorCrossing>& out, int max_depth)
+      : scene(scene), discs(discs), wl(wl), out(out), depth(discs ? max_depth : -1) {}
+  void operator()(const PhotonSegment& s) const { discs->cross(scene, wl, s, &out); }
 };
 
 // The sensors of a render (none: null), with the first iteration's radii (see the top of this
