@@ -155,11 +155,19 @@ TEST_F(Distributed, TimeBudgetAndSigtermEndTheJobWithItsOutputs) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     const std::string cmd = std::string("exec env ") + kMpirun + BPM_BINARY + " " + args +
-                            "--spp 1000000 -o " + path("stopped.exr") + " > /dev/null 2>&1";
+                            "--spp 1000000 --write-every 0.1 -o " + path("stopped.exr") +
+                            " > /dev/null 2>&1";
     execl("/bin/sh", "sh", "-c", cmd.c_str(), nullptr);
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  // The signal goes once the job renders (its first checkpoint is written), not after a fixed
+  // time: on a loaded machine mpirun may take seconds to start its processes, and a signal
+  // before they render ends them with nothing to write.
+  const fs::path checkpoint = dir_ / "stopped.checkpoint";
+  for (int i = 0; i < 12000 && !fs::exists(checkpoint); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  if (fs::exists(checkpoint)) std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_TRUE(fs::exists(checkpoint)) << "the job wrote no checkpoint in a minute";
   kill(pid, SIGTERM);
   int status = 0;
   waitpid(pid, &status, 0);
