@@ -397,10 +397,16 @@ TEST_F(Cli, SigintAndSigtermStillWriteEveryOutput) {
       int devnull = ::open("/dev/null", 1);
       dup2(devnull, 2);
       execl(BPM_BINARY, BPM_BINARY, "render", scene.c_str(), "-q", "--integrator", integrator,
-            "--spp", "10000000", "--photons", "5000", "-o", out.c_str(), nullptr);
+            "--spp", "10000000", "--photons", "5000", "--write-every", "0.1", "-o", out.c_str(),
+            nullptr);
       _exit(127);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    // The signal goes once the render has begun (its first checkpoint is written), however
+    // loaded the machine.
+    const fs::path checkpoint = dir_ / (std::string(integrator) + ".checkpoint");
+    for (int i = 0; i < 12000 && !fs::exists(checkpoint); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_TRUE(fs::exists(checkpoint)) << integrator << ": no checkpoint in a minute";
     kill(pid, std::string(integrator) == "bpm" ? SIGINT : SIGTERM);  // Ctrl-C and SIGTERM alike
     int status = 0;
     waitpid(pid, &status, 0);
@@ -428,8 +434,9 @@ TEST_F(Cli, WriteEveryLeavesIntermediateOutputs) {
           "10000000", "--photons", "5000", "--write-every", "0.2", "-o", out.c_str(), nullptr);
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
-  ASSERT_TRUE(fs::exists(out));
+  for (int i = 0; i < 12000 && !(fs::exists(out) && fs::exists(dir_ / "out.json")); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(fs::exists(out));
   auto mid = nlohmann::json::parse(std::ifstream(dir_ / "out.json"));
   EXPECT_EQ(mid["result"]["stop_reason"], "running");
   EXPECT_EQ(read_exr(out).width, 32);
