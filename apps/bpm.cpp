@@ -63,7 +63,7 @@ struct RenderArgs {
   double accuracy = 0, write_every = 0;
   bool no_adaptive = false;
   float adaptive_floor = 0.1f;
-  int m_images = 4;
+  int m_images = 8;
   std::string memory;   // --memory; empty: default_memory_budget()
   std::string resume;   // --resume: a checkpoint file
   std::string sensors;  // --sensors: illuminance sensors
@@ -667,8 +667,8 @@ void add_output_options(CLI::App* render, RenderArgs& ra) {
       ->group(kOutputs);
   render
       ->add_option("--m-images", ra.m_images,
-                   "Also estimate the error from M intermediate images (pass j to image j mod M; "
-                   "0: off; default 4)")
+                   "Keep M intermediate images (pass j to image j mod M): the photon methods' "
+                   "error estimate (2, 4 or 8), a second one for path (0: off; default 8)")
       ->check(CLI::Range(0, 64))
       ->group(kOutputs);
 }

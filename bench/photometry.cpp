@@ -5,7 +5,8 @@
 // the seeds of value - expected) and their ratio. Then the sensor cases at equal time: each
 // integrator renders the sensors alone (--no-image) for the same seconds, and the RMS errors are
 // compared with path's in the same run. Prints figures; never fails.
-//   photometry [--seeds N] [--passes N] [--seconds S]
+//   photometry [--seeds N] [--passes N] [--seconds S] [--only TEXT]
+// --seconds 0 leaves out the equal-time table; --only keeps the cases whose name holds TEXT.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -28,26 +29,40 @@ struct Reading {
   double value = 0, stated = 0;
 };
 
-// The luminance at the image's central 2 x 2 pixels (a camera looking straight down at a
-// point), and its standard error there (with the bias estimate, for the photon methods).
-Reading centre_luminance(const Film& film) {
+// The luminance of each of the image's central 2 x 2 pixels (a camera looking straight down at a
+// point), and the error stated there (standard error, and for the photon methods the bias
+// estimate). Read one by one, not averaged: the photon methods' pixels share their iterations'
+// wavelengths, so their errors are not independent.
+std::vector<Reading> centre_luminance(const Film& film) {
   const int w = film.width(), h = film.height();
   const std::vector<float> y = film.luminance_image(), total = film.total_rms_luminance();
-  Reading r;
-  double var = 0;
+  std::vector<Reading> r;
   for (int j = h / 2 - 1; j <= h / 2; ++j)
-    for (int i = w / 2 - 1; i <= w / 2; ++i) {
-      r.value += y[size_t(j) * w + i] / 4;
-      var += double(total[size_t(j) * w + i]) * total[size_t(j) * w + i] / 16;
-    }
-  r.stated = std::sqrt(var);
+    for (int i = w / 2 - 1; i <= w / 2; ++i)
+      r.push_back({y[size_t(j) * w + i], total[size_t(j) * w + i]});
   return r;
+}
+
+// The plane cases' camera: 1.5 over the plane, a field of view of 0.5 degrees over 8 pixels. A
+// central pixel covers [0, s] x [0, s] of the plane (one quadrant about the axis), and reads the
+// mean of the luminance over it: for a point source of intensity I at height 1 over a plane of
+// reflectance 1, L = I / (pi (1 + x^2 + y^2)^1.5) (midpoint rule, 64 x 64).
+double point_plane_pixel(double intensity) {
+  const double s = 2 * 1.5 * std::tan(0.25 * kPi / 180) / 8;
+  constexpr int kN = 64;
+  double sum = 0;
+  for (int a = 0; a < kN; ++a)
+    for (int b = 0; b < kN; ++b) {
+      const double x = (a + 0.5) * s / kN, y = (b + 0.5) * s / kN;
+      sum += intensity / (kPi * std::pow(1 + x * x + y * y, 1.5));
+    }
+  return sum / (kN * kN);
 }
 
 struct Case {
   const char* name;
   std::string scene;
-  std::vector<Sensor> sensors;  // empty: the luminance at the image's centre
+  std::vector<Sensor> sensors;  // empty: the luminance of the image's central pixels
   double expected;
 };
 
@@ -135,7 +150,7 @@ Shape "sphere" "float radius" 1
       {"point 1000 lm at 1 m, white plane: L = E / pi",
        plane(point, "1 1 1"),
        {},
-       1000 / (4 * kPi) / kPi},
+       point_plane_pixel(1000 / (4 * kPi))},
       {"distant 1000 lx, plane of 0.5: L = 0.5 E / pi",
        plane(
            R"(LightSource "distant" "point3 from" [0 0 1] "point3 to" [0 0 0] "blackbody L" 3000 "float illuminance" 1000)",
@@ -192,7 +207,7 @@ Summary run_case(const Case& c, const LoadedScene& ls, const std::string& integr
                  int passes, double seconds) {
   double sum = 0, stated2 = 0, error2 = 0;
   for (int s = 0; s < seeds; ++s) {
-    Film film(ls.film.width, ls.film.height, 0, c.sensors.size());
+    Film film(ls.film.width, ls.film.height, Film::kStreams, c.sensors.size());
     RenderOptions opt = quiet_options(ls, integrator, passes, uint64_t(101 + s));
     opt.sensors = c.sensors;
     opt.image = c.sensors.empty();
@@ -202,7 +217,7 @@ Summary run_case(const Case& c, const LoadedScene& ls, const std::string& integr
     }
     render(ls, opt, &film);
     std::vector<Reading> readings;
-    if (c.sensors.empty()) readings.push_back(centre_luminance(film));
+    if (c.sensors.empty()) readings = centre_luminance(film);
     for (size_t i = 0; i < c.sensors.size(); ++i)
       readings.push_back({film.sensor_mean(i), film.sensor_total_error(i)});
     for (const Reading& r : readings) {
@@ -211,7 +226,7 @@ Summary run_case(const Case& c, const LoadedScene& ls, const std::string& integr
       error2 += (r.value - c.expected) * (r.value - c.expected);
     }
   }
-  const double n = double(seeds) * double(std::max<size_t>(c.sensors.size(), 1));
+  const double n = double(seeds) * double(c.sensors.empty() ? 4 : c.sensors.size());
   return {sum / n, std::sqrt(stated2 / n), std::sqrt(error2 / n)};
 }
 
@@ -220,23 +235,28 @@ Summary run_case(const Case& c, const LoadedScene& ls, const std::string& integr
 int main(int argc, char** argv) {
   int seeds = 8, passes = 64;
   double seconds = 2;
+  std::string only;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--seeds")) seeds = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--passes")) passes = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--seconds")) seconds = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
   }
+  std::vector<Case> all = cases(), chosen;
+  for (const Case& c : all)
+    if (std::string(c.name).find(only) != std::string::npos) chosen.push_back(c);
   std::printf(
       "photometry: %d seeds of %d passes each; value and errors in cd/m^2 (luminance) or "
       "lux (sensors)\n\n",
       seeds, passes);
-  std::printf("%-58s %-5s %10s %10s %10s %10s %7s\n", "case", "", "expected", "mean", "stated",
+  std::printf("%-58s %-5s %12s %12s %10s %10s %7s\n", "case", "", "expected", "mean", "stated",
               "measured", "ratio");
   const std::vector<std::string> integrators{"path", "bpm", "fpm"};
-  for (const Case& c : cases()) {
+  for (const Case& c : chosen) {
     const LoadedScene ls = flatten_scene(parse_scene_string(c.scene));
     for (const std::string& integrator : integrators) {
       const Summary m = run_case(c, ls, integrator, seeds, passes, 0);
-      std::printf("%-58s %-5s %10.5g %10.5g %10.3g %10.3g %7.2f\n", c.name, integrator.c_str(),
+      std::printf("%-58s %-5s %12.8g %12.8g %10.3g %10.3g %7.2f\n", c.name, integrator.c_str(),
                   c.expected, m.mean, m.stated, m.measured, m.stated / m.measured);
     }
   }
@@ -244,10 +264,11 @@ int main(int argc, char** argv) {
       "\n(stated: the RMS over seeds of the error each render reports, standard error and bias "
       "estimate; measured: the RMS over seeds of value - expected; ratio: stated / measured, 1 "
       "when the estimate is honest)\n\n");
+  if (seconds <= 0) return 0;
   std::printf("sensors alone at equal time: %d seeds of %g s each\n", seeds, seconds);
   std::printf("%-58s %-5s %10s %10s %10s %12s\n", "case", "", "expected", "mean", "measured",
               "path / this");
-  for (const Case& c : cases()) {
+  for (const Case& c : chosen) {
     if (c.sensors.empty()) continue;
     const LoadedScene ls = flatten_scene(parse_scene_string(c.scene));
     double path_error = 0;

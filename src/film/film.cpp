@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace bpm {
 namespace {
@@ -27,6 +28,35 @@ float standard_error(double sum, double sum2, int passes) {
   return float(std::sqrt(var / n));
 }
 
+// The square of one pixel's or sensor's bias beyond its noise, from the mean b of its bias
+// estimates and that mean's standard error se: b^2 less what noise alone gives b^2 on average
+// (se^2) and one standard deviation of it (sqrt(2) se^2), never below zero. The bias estimate is a
+// difference of photon counts, two to four times noisier than the estimate itself; taking out
+// se^2 alone, the part above zero of pure noise would add 0.48 se^2 on average (2 phi(1)) and make
+// the stated error twice the actual one where there is no bias; this adds 0.2 se^2 there, and
+// counts a bias of several se nearly in full.
+double bias_beyond_noise(double b, double se) {
+  return std::fmax(0.0, b * b - (1 + std::sqrt(2.0)) * se * se);
+}
+
+// The error of the average of m independent estimates value(k) from their spread: the standard
+// deviation between them over sqrt(m). None while some value(k) is none (an image or stream
+// without a pass yet).
+template <class Value>
+std::optional<double> spread_error(int m, Value&& value) {
+  constexpr int kMost = 64;  // --m-images is at most this
+  double v[kMost], mean = 0, var = 0;
+  if (m < 2 || m > kMost) return std::nullopt;
+  for (int k = 0; k < m; ++k) {
+    const std::optional<double> x = value(k);
+    if (!x) return std::nullopt;
+    v[k] = *x;
+    mean += *x / m;
+  }
+  for (int k = 0; k < m; ++k) var += (v[k] - mean) * (v[k] - mean);
+  return std::sqrt(var / (m - 1) / m);
+}
+
 }  // namespace
 
 Film::Film(int width, int height, int m_images, size_t sensors)
@@ -35,7 +65,7 @@ Film::Film(int width, int height, int m_images, size_t sensors)
       pixels_(size_t(width) * height),
       sensors_(sensors),
       m_(m_images > 1 ? m_images : 0) {
-  m_sum_.assign(pixels_.size() * size_t(m_) * 3, 0.0);
+  m_sum_.assign(pixels_.size() * size_t(m_) * kChannels, 0.0f);
   m_count_.assign(pixels_.size() * size_t(m_), 0);
 }
 
@@ -51,7 +81,7 @@ double Film::sensor_total_error(size_t i) const {
   const SensorSums& s = sensors_[i];
   const double se = sensor_standard_error(i), b = sensor_bias(i);
   const double b_se = standard_error(s.bias_sum, s.bias_sum2, s.passes);
-  return std::sqrt(se * se + std::fmax(0.0, b * b - b_se * b_se));
+  return std::sqrt(se * se + bias_beyond_noise(b, b_se));
 }
 
 double Film::sensor_relative_error() const {
@@ -64,7 +94,15 @@ double Film::sensor_relative_error() const {
 }
 
 double Film::sensor_standard_error(size_t i) const {
-  return standard_error(sensors_[i].sum, sensors_[i].sum2, sensors_[i].passes);
+  const SensorSums& s = sensors_[i];
+  if (!independent_) {
+    const std::optional<double> e = spread_error(kStreams, [&](int k) -> std::optional<double> {
+      if (s.stream_passes[k] == 0) return std::nullopt;
+      return s.stream_sum[k] / s.stream_passes[k];
+    });
+    if (e) return *e;
+  }
+  return standard_error(s.sum, s.sum2, s.passes);
 }
 
 Image Film::image(float scale) const {
@@ -80,21 +118,26 @@ Image Film::image(float scale) const {
   return img;
 }
 
+float Film::noise(size_t i, int c) const {
+  if (!independent_) {
+    const std::optional<float> e = image_spread(i, c);
+    if (e) return *e;
+  }
+  const Pixel& p = pixels_[i];
+  return standard_error(p.sum_e[c], p.sum_e2[c], p.passes);
+}
+
 std::vector<float> Film::rms_rgb() const {
   std::vector<float> out(pixels_.size() * 3, 0.0f);
   for_pixels(pixels_.size(), [&](size_t i) {
-    const Pixel& p = pixels_[i];
-    for (int c = 0; c < 3; ++c) out[3 * i + c] = standard_error(p.sum_e[c], p.sum_e2[c], p.passes);
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = noise(i, c);
   });
   return out;
 }
 
 std::vector<float> Film::rms() const {
   std::vector<float> out(pixels_.size(), 0.0f);
-  for_pixels(pixels_.size(), [&](size_t i) {
-    const Pixel& p = pixels_[i];
-    out[i] = standard_error(p.sum_e[kY], p.sum_e2[kY], p.passes);
-  });
+  for_pixels(pixels_.size(), [&](size_t i) { out[i] = noise(i, kY); });
   return out;
 }
 
@@ -123,7 +166,7 @@ std::vector<float> Film::total_rms_luminance() const {
     if (p.bias_passes == 0) return;
     const double b = p.sum_b[kY] / p.bias_passes;
     const double se = standard_error(p.sum_b[kY], p.sum_b2[kY], p.bias_passes);
-    out[i] = float(std::sqrt(double(out[i]) * out[i] + std::fmax(0.0, b * b - se * se)));
+    out[i] = float(std::sqrt(double(out[i]) * out[i] + bias_beyond_noise(b, se)));
   });
   return out;
 }
@@ -201,7 +244,7 @@ std::vector<float> Film::total_rms_rgb() const {
       double b = p.sum_b[c] / p.bias_passes;
       double se = standard_error(p.sum_b[c], p.sum_b2[c], p.bias_passes);
       double rms = out[3 * i + c];
-      out[3 * i + c] = float(std::sqrt(rms * rms + std::fmax(0.0, b * b - se * se)));
+      out[3 * i + c] = float(std::sqrt(rms * rms + bias_beyond_noise(b, se)));
     }
   });
   return out;
@@ -235,45 +278,27 @@ double Film::relative_error_luminance() const {
   return den > 0 ? std::sqrt(num / den) : 0;  // eq. (4)
 }
 
-namespace {
-
-// The error of the average of M images from the spread of their values value(k): the standard
-// deviation between them over sqrt(M). Zero until every image has a pass (count[k] > 0).
-template <class Value>
-float m_images_error(const int* count, int m, Value&& value) {
-  for (int k = 0; k < m; ++k)
-    if (count[k] == 0) return 0;
-  double mean = 0, var = 0;
-  for (int k = 0; k < m; ++k) mean += value(k) / m;
-  for (int k = 0; k < m; ++k) var += (value(k) - mean) * (value(k) - mean);
-  return float(std::sqrt(var / (m - 1) / m));
+std::optional<float> Film::image_spread(size_t i, int c) const {
+  if (m_ == 0) return std::nullopt;
+  const int* count = &m_count_[i * size_t(m_)];
+  const std::optional<double> e = spread_error(m_, [&](int k) -> std::optional<double> {
+    if (count[k] == 0) return std::nullopt;
+    return double(m_sum_[kChannels * (i * m_ + k) + c]) / count[k];
+  });
+  return e ? std::optional<float>(float(*e)) : std::nullopt;
 }
-
-}  // namespace
 
 std::vector<float> Film::rms_m_images_rgb() const {
   std::vector<float> out(pixels_.size() * 3, 0.0f);
-  if (m_ == 0) return out;
   for_pixels(pixels_.size(), [&](size_t i) {
-    const int* count = &m_count_[i * size_t(m_)];
-    for (int c = 0; c < 3; ++c)
-      out[3 * i + c] =
-          m_images_error(count, m_, [&](int k) { return m_sum_[3 * (i * m_ + k) + c] / count[k]; });
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = image_spread(i, c).value_or(0.0f);
   });
   return out;
 }
 
 std::vector<float> Film::rms_m_images() const {
   std::vector<float> out(pixels_.size(), 0.0f);
-  if (m_ == 0) return out;
-  for (size_t i = 0; i < pixels_.size(); ++i) {
-    const int* count = &m_count_[i * size_t(m_)];
-    out[i] = m_images_error(count, m_, [&](int k) {
-      double e[3];
-      for (int c = 0; c < 3; ++c) e[c] = m_sum_[3 * (i * m_ + k) + c] / count[k];
-      return luminance(e);
-    });
-  }
+  for_pixels(pixels_.size(), [&](size_t i) { out[i] = image_spread(i, kY).value_or(0.0f); });
   return out;
 }
 
@@ -330,7 +355,7 @@ void Film::add(const Film& o) {
 void Film::clear() {
   std::fill(pixels_.begin(), pixels_.end(), Pixel{});
   std::fill(sensors_.begin(), sensors_.end(), SensorSums{});
-  std::fill(m_sum_.begin(), m_sum_.end(), 0.0);
+  std::fill(m_sum_.begin(), m_sum_.end(), 0.0f);
   std::fill(m_count_.begin(), m_count_.end(), 0);
 }
 
@@ -354,7 +379,7 @@ void Film::load(ByteReader& r) {
     throw Error(r.what() + " keeps " + std::to_string(m) + " M-images, this render " +
                 std::to_string(m_) + " (--m-images)");
   std::vector<Pixel> pixels = r.get_vector<Pixel>();
-  std::vector<double> m_sum = r.get_vector<double>();
+  std::vector<float> m_sum = r.get_vector<float>();
   std::vector<int> m_count = r.get_vector<int>();
   std::vector<SensorSums> sensors = r.get_vector<SensorSums>();
   if (pixels.size() != pixels_.size() || m_sum.size() != m_sum_.size() ||

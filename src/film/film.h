@@ -6,6 +6,7 @@
 // error estimate of the paper's eq. (5) follows.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "base/bytes.h"
@@ -51,15 +52,27 @@ inline FilmSample film_sample(const Spectrum& L, const Wavelengths& wl, float ma
 
 class Film {
  public:
+  // A render's passes form kStreams streams, pass j in stream j mod kStreams, whose means are
+  // independent estimates even where the passes of one stream are not independent of each other:
+  // the photon methods stratify their iterations' wavelengths within a stream
+  // (photons/light_path.h). The sensors keep each stream's sum.
+  static constexpr int kStreams = 8;
   // m_images > 0 also keeps the paper's M intermediate images (section 4): pass j goes to image
-  // j mod M (begin_pass), and the spread between the M images is a second error estimate.
-  // sensors: illuminance sensors (path/sensors.h) whose per-pass estimates the film keeps too.
+  // j mod M (begin_pass), and the spread between the M images is a second error estimate (with
+  // M a divisor of kStreams, each image holds whole streams). sensors: illuminance sensors
+  // (integrator/sensors.h) whose per-pass estimates the film keeps too.
   Film(int width, int height, int m_images = 0, size_t sensors = 0);
+  // Whether the passes are independent estimates (the default; a path tracer's): the standard
+  // error is then eq. 5 over the passes. Where they are not (the photon methods), it is the
+  // spread between the M images (or, for a sensor, between the streams) once each has a pass,
+  // and eq. 5, an upper bound, until then.
+  void set_independent_passes(bool independent) { independent_ = independent; }
+  bool independent_passes() const { return independent_; }
   int width() const { return width_; }
   int height() const { return height_; }
   // What a film takes per pixel with m_images intermediate images, and what this one takes.
   static size_t bytes_per_pixel(int m_images) {
-    return sizeof(Pixel) + size_t(m_images) * (3 * sizeof(double) + sizeof(int));
+    return sizeof(Pixel) + size_t(m_images) * (kChannels * sizeof(float) + sizeof(int));
   }
   size_t bytes() const {
     return size_t(width_) * size_t(height_) * bytes_per_pixel(m_) +
@@ -108,9 +121,9 @@ class Film {
       }
       if (e[0] != 0 || e[1] != 0 || e[2] != 0) ++p.lit_passes;
       if (m_ > 0) {
-        size_t k = 3 * ((size_t(y) * width_ + x) * size_t(m_) + size_t(pass_index_ % m_));
-        for (int c = 0; c < 3; ++c) m_sum_[k + c] += e[c];
-        ++m_count_[k / 3];
+        const size_t k = (size_t(y) * width_ + x) * size_t(m_) + size_t(pass_index_ % m_);
+        for (int c = 0; c < kChannels; ++c) m_sum_[kChannels * k + c] += float(e[c]);
+        ++m_count_[k];
       }
       ++p.passes;
     }
@@ -119,14 +132,18 @@ class Film {
 
   // One pass's estimate of sensor i and the estimate of its bias (photon methods; each sensor
   // written by one thread at a time), and per sensor the mean of its passes, the standard error of
-  // that mean (eq. 5), the mean of the bias estimates, the total error (as the pixels' total_rms:
-  // the standard error and the part of the bias estimate beyond its own noise) and its passes.
+  // that mean (eq. 5, or the spread between the streams: set_independent_passes), the mean of the
+  // bias estimates, the total error (as the pixels' total_rms: the standard error and the part of
+  // the bias estimate beyond its own noise) and its passes.
   void add_sensor_pass(size_t i, double value, double bias = 0) {
-    sensors_[i].sum += value;
-    sensors_[i].sum2 += value * value;
-    sensors_[i].bias_sum += bias;
-    sensors_[i].bias_sum2 += bias * bias;
-    ++sensors_[i].passes;
+    SensorSums& s = sensors_[i];
+    s.sum += value;
+    s.sum2 += value * value;
+    s.bias_sum += bias;
+    s.bias_sum2 += bias * bias;
+    ++s.passes;
+    s.stream_sum[pass_index_ % kStreams] += value;
+    ++s.stream_passes[pass_index_ % kStreams];
   }
   size_t sensor_count() const { return sensors_.size(); }
   double sensor_mean(size_t i) const;
@@ -138,12 +155,12 @@ class Film {
   int sensor_passes(size_t i) const { return sensors_[i].passes; }
 
   Image image(float scale = 1) const;
-  // Per-pixel standard error (eq. 5) of the mean of each channel, R G B per pixel, and of the
-  // luminance.
+  // Per-pixel standard error of the mean of each channel, R G B per pixel, and of the luminance
+  // (eq. 5, or the M images' spread: set_independent_passes).
   std::vector<float> rms_rgb() const;
   std::vector<float> rms() const;
   // The luminance per pixel (the mean of its samples, as image()); its bias estimate (zero
-  // without one) and its total error, sqrt(rms^2 + bias^2) with the bias's noise taken out.
+  // without one) and its total error, sqrt(rms^2 + bias^2) with bias^2 as total_rms_rgb's.
   std::vector<float> luminance_image() const;
   std::vector<float> bias_luminance() const;
   std::vector<float> total_rms_luminance() const;
@@ -159,8 +176,9 @@ class Film {
   bool has_bias() const;
   std::vector<float> bias_rgb() const;
   std::vector<float> bias_standard_error_rgb() const;  // of bias_rgb(), eq. (5) over its passes
-  // Per pixel and channel the total error, sqrt(RMS^2 + bias^2) with bias^2 estimated as above
-  // (its noise taken out, never below zero); rms_rgb() without a bias estimate.
+  // Per pixel and channel the total error, sqrt(RMS^2 + bias^2), with bias^2 the part of the mean
+  // bias estimate's square beyond what its noise alone gives (film.cpp, bias_beyond_noise; a
+  // single pixel's bias estimate is noisier than its value); rms_rgb() without a bias estimate.
   std::vector<float> total_rms_rgb() const;
   double relative_error_bias() const;
   // The total error: sqrt(delta^2 + delta_bias^2), noise and bias together (what --accuracy
@@ -172,7 +190,8 @@ class Film {
   std::vector<int> lit_pass_counts() const;
   // The M-images estimates: per-pixel standard error of the mean from the spread of the M image
   // means (per channel, and of the luminance), and delta over the channels from them. Zero until
-  // every image of a pixel has a pass.
+  // every image of a pixel has a pass. Their sums are single precision: they give the spread
+  // only, never the image.
   int m_images() const { return m_; }
   std::vector<float> rms_m_images_rgb() const;
   std::vector<float> rms_m_images() const;
@@ -188,7 +207,6 @@ class Film {
   void load(ByteReader& r);
 
  private:
-  static double luminance(const double* c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
   // eq. (4) from per-pixel standard errors of the three channels.
   double delta_rgb(const std::vector<float>& rms_rgb) const;
   static constexpr int kChannels = 4, kY = 3;  // R, G, B and the luminance
@@ -206,14 +224,21 @@ class Film {
   struct SensorSums {
     double sum = 0, sum2 = 0, bias_sum = 0, bias_sum2 = 0;
     int passes = 0;
+    double stream_sum[kStreams] = {};
+    int stream_passes[kStreams] = {};
   };
+  // The standard error of pixel i's channel c (rms_rgb), and the M images' (none until each has
+  // a pass).
+  float noise(size_t i, int c) const;
+  std::optional<float> image_spread(size_t i, int c) const;
   int width_, height_;
   std::vector<Pixel> pixels_;
   std::vector<SensorSums> sensors_;
   int m_ = 0;
   int pass_index_ = 0;
-  std::vector<double> m_sum_;  // [pixel][image][channel]
-  std::vector<int> m_count_;   // [pixel][image]
+  bool independent_ = true;
+  std::vector<float> m_sum_;  // [pixel][image][channel]
+  std::vector<int> m_count_;  // [pixel][image]
 };
 
 }  // namespace bpm

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "base/rng.h"
+#include "film/film.h"
 #include "integrator/counters.h"
 #include "integrator/path_vertex.h"
 #include "photons/emission_guide.h"
@@ -46,20 +47,24 @@ int run_chunks_until(int n, const Stop& stop, const Body& body) {
 
 // The wavelengths of iteration `it` of a photon method, shared by all its eye and light paths.
 // Within an iteration they are stratified (sample_wavelengths): one in each of the kChannels
-// strata, at the same offset v within its stratum, the first (hero) one in stratum k. Across
-// iterations (v, k / kChannels) follows a (0,2)-sequence (van der Corput and the second Sobol
-// dimension) under a random digital shift per seed, so that the first 2^m iterations place the
-// offsets one in each 2^-m of the stratum (the spectrum is covered evenly: the colour converges
-// about as 1 / iterations instead of 1 / sqrt(iterations)), and place the hero one in each 2^-m of
-// the whole range (light that only the hero carries, past dispersive glass, converges as well).
-// For each iteration alone v and the hero are uniform, so every iteration is an unbiased estimate
-// and the hero alone has the full density (hero_wavelength_only relies on it).
+// strata, at the same offset v within its stratum, the first (hero) one in stratum k. Within its
+// stream (it mod Film::kStreams) the t-th iteration (t = it / Film::kStreams) takes
+// (v, k / kChannels) from point t of a (0,2)-sequence (van der Corput and the second Sobol
+// dimension) under a random digital shift of the stream's own, so that a stream's first 2^m
+// iterations place the offsets one in each 2^-m of the stratum (the spectrum is covered evenly: the
+// colour converges about as 1 / iterations instead of 1 / sqrt(iterations)), and place the hero
+// one in each 2^-m of the whole range (light that only the hero carries, past dispersive glass,
+// converges as well). The streams' shifts are independent, so their means are independent
+// estimates, whose spread is the render's error estimate (Film::set_independent_passes). For each
+// iteration alone v and the hero are uniform, so every iteration is an unbiased estimate and the
+// hero alone has the full density (hero_wavelength_only relies on it).
 inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
-  Rng rng(stream_key(seed ^ 0x7761766573ull, 0, 0, 3));
+  const int stream = it % Film::kStreams;
+  const uint32_t t = uint32_t(it / Film::kStreams);
+  Rng rng(stream_key(seed ^ 0x7761766573ull, uint64_t(stream), 0, 3));
   uint32_t shift_v = rng.next_u32(), shift_k = rng.next_u32();
-  double v = double(van_der_corput_bits(uint32_t(it)) ^ shift_v) * 0x1p-32;
-  double k =
-      std::floor(double(sobol2_bits(uint32_t(it)) ^ shift_k) * 0x1p-32 * Spectrum::kChannels);
+  double v = double(van_der_corput_bits(t) ^ shift_v) * 0x1p-32;
+  double k = std::floor(double(sobol2_bits(t) ^ shift_k) * 0x1p-32 * Spectrum::kChannels);
   return sample_wavelengths(float((v + k) / Spectrum::kChannels));
 }
 

@@ -43,6 +43,13 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
                 std::to_string(opt.sensors.size()));
   if (!opt.image && opt.sensors.empty())
     throw Error("a render without an image needs sensors (--sensors)");
+  // The photon methods' iterations are independent only stream by stream (photons/light_path.h).
+  const bool photons = opt.integrator != "path";
+  film->set_independent_passes(!photons);
+  if (photons && film->m_images() > 0 && Film::kStreams % film->m_images() != 0)
+    throw Error("--m-images " + std::to_string(film->m_images()) +
+                ": the photon methods take 2, 4 or 8 images (their iterations form " +
+                std::to_string(Film::kStreams) + " independent streams), or 0");
   if (opt.integrator == "bpm") return render_bpm(ls, opt, opt.bpm, film);
   if (opt.integrator == "fpm") return render_fpm(ls, opt, opt.fpm, film);
   RenderOptions o = opt;
