@@ -85,6 +85,8 @@ class Flattener {
   CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
                        RoughnessTextures* tex);
   MaterialDesc make_material(const SceneEntity& e);
+  Bump make_bump(const SceneEntity& e);
+  int add_material(const SceneEntity& e);
   int medium_id(const std::string& name, const FileLoc& loc);
   int material_id(const MaterialRef& ref);
 

@@ -1,6 +1,7 @@
 // Materials (pbrt-v4's, plus bpm's "phong") with their spectral and float parameters, and the
 // media shapes and lights refer to.
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -9,6 +10,8 @@
 #include "scene/spectra.h"
 
 namespace bpm::flatten_internal {
+
+namespace fs = std::filesystem;
 
 // A spectral material parameter: a constant (a constant texture included) or a texture node.
 std::optional<SpectrumParam> Flattener::spectrum_param(const ParamSet& ps, const std::string& name,
@@ -164,11 +167,52 @@ CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const 
   return c;
 }
 
+// A material's bump ("displacement", a float texture) or normal map ("normalmap", an image read
+// with linear encoding, as pbrt-v4 reads it).
+Bump Flattener::make_bump(const SceneEntity& e) {
+  const ParamSet& ps = e.params;
+  Bump b;
+  if (ps.find_any("displacement")) b.displacement = float_or_texture(ps, "displacement", 0);
+  if (const Param* p = ps.find_any("normalmap")) {
+    const std::string file = ps.get_string("normalmap", "");
+    if (file.empty()) throw Error(p->loc, "\"normalmap\" must name an image file");
+    const fs::path path =
+        fs::path(file).is_absolute() ? fs::path(file) : fs::path(parsed_.base_directory) / file;
+    read_data_file(path.string());
+    TexEncoding linear;
+    linear.kind = TexEncoding::Kind::kLinear;
+    try {
+      b.normal_map = load_texture_image(path.string(), linear);
+    } catch (const Error& err) {
+      throw Error(p->loc, std::string("normalmap: ") + err.what());
+    }
+    if (b.normal_map->channels < 3)
+      throw Error(p->loc, "normalmap \"" + file + "\" has " +
+                              std::to_string(b.normal_map->channels) +
+                              " channel; a normal map needs R, G and B");
+  }
+  return b;
+}
+
+// Adds a material and its bump to the render scene; returns its index.
+int Flattener::add_material(const SceneEntity& e) {
+  Bump bump = make_bump(e);  // first: make_material warns of the parameters nothing read
+  MaterialDesc made = make_material(e);
+  if (auto* mix = std::get_if<MixDesc>(&made))
+    for (int part : mix->materials)
+      if (size_t(part) < scene().bumps.size() && scene().bumps[size_t(part)].active())
+        throw Error(e.loc, "a bump or normal map on a material inside a mix is not supported");
+  scene().materials.push_back(std::move(made));
+  const size_t index = scene().materials.size() - 1;
+  if (bump.active()) {
+    scene().bumps.resize(index + 1);
+    scene().bumps[index] = std::move(bump);
+  }
+  return int(index);
+}
+
 MaterialDesc Flattener::make_material(const SceneEntity& e) {
   const ParamSet& ps = e.params;
-  for (const char* unsupported : {"displacement", "normalmap"})
-    if (auto* p = ps.find_any(unsupported))
-      throw Error(p->loc, std::string(unsupported) + " is not supported");
   MaterialDesc m;
   if (e.name == "diffuse") {
     DiffuseDesc d;
@@ -290,16 +334,14 @@ int Flattener::material_id(const MaterialRef& ref) {
       throw Error(ref.loc, "unknown named material \"" + ref.named + "\"");
     if (!building_materials_.insert(ref.named).second)
       throw Error(ref.loc, "named material \"" + ref.named + "\" contains itself (through mix)");
-    MaterialDesc made = make_material(e->second);
+    const int id = add_material(e->second);
     building_materials_.erase(ref.named);
-    scene().materials.push_back(std::move(made));
-    return named_material_ids_[ref.named] = int(scene().materials.size()) - 1;
+    return named_material_ids_[ref.named] = id;
   }
   if (ref.index < 0) return 0;
   auto it = anonymous_material_ids_.find(ref.index);
   if (it != anonymous_material_ids_.end()) return it->second;
-  scene().materials.push_back(make_material(parsed_.materials[ref.index]));
-  return anonymous_material_ids_[ref.index] = int(scene().materials.size()) - 1;
+  return anonymous_material_ids_[ref.index] = add_material(parsed_.materials[ref.index]);
 }
 
 }  // namespace bpm::flatten_internal

@@ -11,6 +11,7 @@
 #include "base/sampling.h"
 #include "lights/light.h"
 #include "materials/material.h"
+#include "scene/bump.h"
 #include "scene/shapes.h"
 
 namespace bpm {
@@ -47,7 +48,8 @@ class RenderScene {
 
   std::vector<Object> objects;
   std::vector<MaterialDesc> materials;
-  TextureSet textures;  // the nodes textured materials read
+  TextureSet textures;      // the nodes textured materials read
+  std::vector<Bump> bumps;  // per material (or fewer: none past the end)
   std::vector<AbsorbingMedium> media;
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
@@ -86,9 +88,14 @@ class RenderScene {
   // it (a query against the emitters alone, much cheaper than `intersect`). True does not say
   // that the emitter met is the nearest surface.
   bool may_reach_emitter(const Ray& ray) const;
+  // The surface point of a hit, its shading normal bent by its material's bump or normal map.
   SurfacePoint surface(const Ray& ray, const Hit& hit) const {
-    return surface_point(objects[hit.object].shape, hit.primitive, hit.barycentric,
-                         ray.o + ray.d * hit.t);
+    const Object& o = objects[hit.object];
+    SurfacePoint sp = surface_point(o.shape, hit.primitive, hit.barycentric, ray.o + ray.d * hit.t);
+    if (size_t(o.material) < bumps.size() && bumps[size_t(o.material)].active())
+      apply_bump(bumps[size_t(o.material)], textures,
+                 surface_derivatives(o.shape, hit.primitive, sp), &sp);
+    return sp;
   }
   const Shape* light_shape(const Light& l) const {
     auto* a = std::get_if<AreaLight>(&l);
