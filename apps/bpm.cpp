@@ -124,8 +124,7 @@ void set_resolution(const std::string& resolution, FilmSettings* film) {
   if (std::sscanf(resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
       (x != 'x' && x != 'X') || w <= 0 || h <= 0 || w > 65536 || h > 65536)
     throw Error("--resolution must look like 640x480; got \"" + resolution + "\"");
-  film->width = w;
-  film->height = h;
+  film->set_full_resolution(w, h);
 }
 
 // The photon methods' settings on the file's Integrator line, read (and checked) right after
@@ -402,7 +401,9 @@ void resume_from(const RenderArgs& a, const nlohmann::json& identity, bool root,
 // --sensors), each atomically.
 void write_outputs(const LoadedScene& ls, const RenderOptions& opt, const Film& film,
                    const OutputPaths& paths) {
-  if (opt.image) write_images(paths, film, ls.film.imaging_ratio);
+  const Raster r = ls.film.raster_for(film.width(), film.height());
+  const DisplayWindow window{r.x0, r.y0, r.full_width, r.full_height};
+  if (opt.image) write_images(paths, film, ls.film.imaging_ratio, window);
   if (opt.sensors.empty()) return;
   std::vector<std::array<float, 6>> sensors;
   for (const Sensor& s : opt.sensors) sensors.push_back({s.p.x, s.p.y, s.p.z, s.n.x, s.n.y, s.n.z});

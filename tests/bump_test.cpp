@@ -44,11 +44,13 @@ std::string square_scene(const std::string& integrator, const std::string& mater
 Camera "perspective" "float fov" 10
 Film "rgb" "integer xresolution" 8 "integer yresolution" 8
 PixelFilter "box"
-Integrator ")" + integrator +
+Integrator ")" +
+         integrator +
          R"(" "integer maxdepth" 1
 WorldBegin
 LightSource "distant" "point3 from" [0 0 1] "point3 to" [0 0 0] "float illuminance" 1000
-)" + material + R"(
+)" + material +
+         R"(
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
   "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]  "point2 uv" [0 0  1 0  1 1  0 1]
 )";
@@ -98,8 +100,10 @@ TEST(Bump, NormalMapTiltsTheNormal) {
   const std::string map = write_pfm("normal.pfm", 1, 1, [&](int, int) {
     return Vec3(float(0.5 + 0.5 * std::sin(kAlpha)), 0.5f, float(0.5 + 0.5 * std::cos(kAlpha)));
   });
-  const std::string material = "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5] "
-                               "\"string normalmap\" \"" + map + "\"";
+  const std::string material =
+      "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5] "
+      "\"string normalmap\" \"" +
+      map + "\"";
   for (const char* integrator : {"path", "bpm", "fpm"})
     expect_luminance(square_scene(integrator, material), integrator,
                      0.5 * 1000 * std::cos(kAlpha) / kPi);
@@ -118,8 +122,8 @@ TEST(Bump, BadMapsAreLocatedErrors) {
     }
     return std::string();
   };
-  std::string e = error_of("Material \"diffuse\" \"string normalmap\" \"" +
-                           (dir / "text.png").string() + "\"");
+  std::string e =
+      error_of("Material \"diffuse\" \"string normalmap\" \"" + (dir / "text.png").string() + "\"");
   EXPECT_NE(e.find("normalmap"), std::string::npos) << e;
   EXPECT_NE(e.find(":8:"), std::string::npos) << e;
   EXPECT_NE(e.find("text.png"), std::string::npos) << e;

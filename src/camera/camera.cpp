@@ -6,12 +6,15 @@
 
 namespace bpm {
 
-PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, int width, int height)
+PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, const Raster& r)
     : world_from_camera_(s.world_from_camera),
       lens_radius_(s.lens_radius),
       focal_distance_(s.focal_distance),
-      width_(width),
-      height_(height) {
+      width_(r.full_width),
+      height_(r.full_height),
+      crop_x0_(float(r.x0)),
+      crop_y0_(float(r.y0)) {
+  const int width = r.full_width, height = r.full_height;
   float aspect = float(width) / float(height);
   if (s.screen_window[0] == 0 && s.screen_window[1] == 0 && s.screen_window[2] == 0 &&
       s.screen_window[3] == 0) {
@@ -29,7 +32,7 @@ PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, int width, int hei
   pixel_solid_angle_ = px * py;
 }
 
-Ray PerspectiveCamera::generate_ray(Vec2 p, Vec2 u_lens) const {
+Ray PerspectiveCamera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
   float sx = x0_ + (p.x / width_) * (x1_ - x0_);
   float sy = y1_ - (p.y / height_) * (y1_ - y0_);
   Vec3 dir = normalize(Vec3(sx * tan_half_, sy * tan_half_, 1));

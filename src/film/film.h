@@ -15,9 +15,16 @@
 
 namespace bpm {
 
+// Where an image lies in a larger one (a crop of a camera's raster): its top-left pixel (x0, y0)
+// in a width x height display window; width 0: the image is the whole window.
+struct DisplayWindow {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgb;  // width * height * 3, row-major from the top
+  DisplayWindow window;    // OpenEXR's data window within its display window
   Rgb at(int x, int y) const {
     size_t i = 3 * (size_t(y) * width + x);
     return Rgb(rgb[i], rgb[i + 1], rgb[i + 2]);

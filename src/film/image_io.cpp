@@ -78,18 +78,28 @@ void set_exr_threads(int threads) { Imf::setGlobalThreadCount(std::max(threads, 
 void write_exr(const std::string& path, const Image& img, const std::vector<ExtraChannel>& extra) {
   std::string tmp = temporary_path(path);
   try {
-    Imf::Header header(img.width, img.height);
+    // A crop keeps its place in the full image: OpenEXR's data window within the display window.
+    const DisplayWindow& w = img.window;
+    const int x0 = w.width > 0 ? w.x0 : 0, y0 = w.width > 0 ? w.y0 : 0;
+    const Imath::Box2i display(Imath::V2i(0, 0), w.width > 0
+                                                     ? Imath::V2i(w.width - 1, w.height - 1)
+                                                     : Imath::V2i(img.width - 1, img.height - 1));
+    const Imath::Box2i data(Imath::V2i(x0, y0),
+                            Imath::V2i(x0 + img.width - 1, y0 + img.height - 1));
+    Imf::Header header(display, data);
     header.compression() = Imf::ZIP_COMPRESSION;
     header.zipCompressionLevel() = 1;  // the fastest deflate: float noise compresses little more
     const char* names[3] = {"R", "G", "B"};
     for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
     for (const ExtraChannel& e : extra) header.channels().insert(e.name, Imf::Channel(Imf::FLOAT));
     Imf::FrameBuffer fb;
+    // Slices address pixel (x, y) of the data window from (0, 0).
+    const ptrdiff_t origin = ptrdiff_t(x0) + ptrdiff_t(y0) * img.width;
     for (int c = 0; c < 3; ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(img.rgb.data() + c), 3 * sizeof(float),
-                                     3 * sizeof(float) * img.width));
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(img.rgb.data() + c - 3 * origin),
+                                     3 * sizeof(float), 3 * sizeof(float) * img.width));
     for (const ExtraChannel& e : extra)
-      fb.insert(e.name, Imf::Slice(Imf::FLOAT, (char*)e.values->data(), sizeof(float),
+      fb.insert(e.name, Imf::Slice(Imf::FLOAT, (char*)(e.values->data() - origin), sizeof(float),
                                    sizeof(float) * img.width));
     Imf::OutputFile file(tmp.c_str(), header);
     file.setFrameBuffer(fb);
@@ -123,6 +133,10 @@ Image read_exr(const std::string& path) {
     img.width = dw.max.x - dw.min.x + 1;
     img.height = dw.max.y - dw.min.y + 1;
     img.rgb.assign(size_t(img.width) * img.height * 3, 0.0f);
+    const Imath::Box2i display = file.header().displayWindow();
+    if (display != dw)
+      img.window = {dw.min.x - display.min.x, dw.min.y - display.min.y,
+                    display.max.x - display.min.x + 1, display.max.y - display.min.y + 1};
     Imf::FrameBuffer fb;
     const char* names[3] = {"R", "G", "B"};
     char* base = (char*)(img.rgb.data()) -

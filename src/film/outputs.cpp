@@ -123,8 +123,10 @@ void write_sensors_png(const std::string& path, const Film& film,
   write_picture(path, blocks, linear_scale(all, "illuminance, lux, linear scale"));
 }
 
-void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio) {
+void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio,
+                  const DisplayWindow& window) {
   Image img = film.image(imaging_ratio);
+  img.window = window;
   std::vector<float> passes = film.pass_counts();
   // eq. (5) of the luminance and of each channel; the same from the M images.
   std::vector<std::vector<float>> values;

@@ -42,7 +42,9 @@ OutputPaths output_paths(const std::string& exr_path);
 // Writes the EXR and the PNGs (the image; the luminance in false colour; its relative total error
 // and, with a bias estimate, its relative bias, each with a legend), each atomically. The caller
 // writes the JSON record last, so that its presence means the set is complete.
-void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio);
+// window: where the film lies in the camera's full image (a crop), kept in the EXR.
+void write_images(const OutputPaths& paths, const Film& film, float imaging_ratio,
+                  const DisplayWindow& window = {});
 
 // Per pixel, an error (R G B) relative to the pixel's value over the three channels (as eq. 4 per
 // pixel).

@@ -69,17 +69,24 @@ struct CameraSample {
 
 class CameraSampler {
  public:
+  CameraSampler(const CameraSettings& camera, const FilterSettings& filter, const Raster& raster,
+                uint64_t seed)
+      : camera_(camera, raster), filter_(filter), raster_(raster), seed_(seed) {}
   CameraSampler(const CameraSettings& camera, const FilterSettings& filter, int width, int height,
                 uint64_t seed)
-      : camera_(camera, width, height), filter_(filter), width_(width), seed_(seed) {}
-  // `sub` > 0: further samples of the same pixel and pass, each with its own stream.
+      : CameraSampler(camera, filter, Raster{width, height, width, height, 0, 0}, seed) {}
+  // `sub` > 0: further samples of the same pixel and pass, each with its own stream. The stream is
+  // keyed by the pixel's place in the full raster, so that a crop renders its pixels as the
+  // whole image does.
   CameraSample sample(int pass_index, uint32_t pixel, uint32_t sub = 0) const {
-    Rng rng(stream_key(seed_, uint64_t(pass_index), pixel, sub));
-    int x = int(pixel % uint32_t(width_)), y = int(pixel / uint32_t(width_));
+    const int x = int(pixel % uint32_t(raster_.width)) + raster_.x0,
+              y = int(pixel / uint32_t(raster_.width)) + raster_.y0;  // in the full raster
+    Rng rng(stream_key(seed_, uint64_t(pass_index),
+                       uint64_t(y) * uint64_t(raster_.full_width) + uint64_t(x), sub));
     FilterSample fs = filter_.sample({rng.uniform(), rng.uniform()});
     Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
     Vec2 u_lens{rng.uniform(), rng.uniform()};
-    Ray ray = camera_.generate_ray(p_film, u_lens);
+    Ray ray = camera_.generate_ray_full(p_film, u_lens);
     return {rng, ray, fs.weight};
   }
   const PerspectiveCamera& camera() const { return camera_; }
@@ -87,7 +94,7 @@ class CameraSampler {
  private:
   PerspectiveCamera camera_;
   Filter filter_;
-  int width_;
+  Raster raster_;
   uint64_t seed_;
 };
 

@@ -9,7 +9,8 @@
 namespace bpm {
 
 RenderStats render_path(const LoadedScene& ls, const IntegratorOptions& opt, Film* film) {
-  const CameraSampler camera(ls.camera, ls.filter, film->width(), film->height(), opt.seed);
+  const CameraSampler camera(ls.camera, ls.filter,
+                             ls.film.raster_for(film->width(), film->height()), opt.seed);
   const PathSettings settings{opt.max_depth};
   tbb::enumerable_thread_specific<PathCounters> counters;
   RenderStats stats;

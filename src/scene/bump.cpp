@@ -80,7 +80,8 @@ SurfaceDerivatives mesh_derivatives(const TriangleMesh& m, int prim, const Surfa
 SurfaceDerivatives sphere_derivatives(const Sphere& s, Vec3 p_world) {
   const Vec3 p = s.world_from_object.inverse().point(p_world);
   const float r = s.radius, z_radius = std::sqrt(p.x * p.x + p.y * p.y);
-  const float cos_phi = z_radius > 0 ? p.x / z_radius : 1, sin_phi = z_radius > 0 ? p.y / z_radius : 0;
+  const float cos_phi = z_radius > 0 ? p.x / z_radius : 1,
+              sin_phi = z_radius > 0 ? p.y / z_radius : 0;
   const float cos_theta = std::clamp(p.z / r, -1.0f, 1.0f);
   const float sin_theta = std::sqrt(std::fmax(0.0f, 1 - cos_theta * cos_theta));
   const float theta_min = std::acos(std::clamp(std::fmin(s.z_min, s.z_max) / r, -1.0f, 1.0f));

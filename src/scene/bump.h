@@ -26,9 +26,9 @@ struct SurfaceDerivatives {
 SurfaceDerivatives surface_derivatives(const Shape& shape, int prim, const SurfacePoint& sp);
 
 // Bends sp.ns as pbrt-v4's BumpMap or NormalMap does (the normal map first, when a material has
-// both: pbrt-v4 then ignores the displacement), keeping it on the side of sp.ng. The displacement's finite differences step
-// 0.0005 in u and v (pbrt-v4's step without ray differentials; it steps half the pixel footprint
-// in (u, v) where it has them).
+// both: pbrt-v4 then ignores the displacement), keeping it on the side of sp.ng. The displacement's
+// finite differences step 0.0005 in u and v (pbrt-v4's step without ray differentials; it steps
+// half the pixel footprint in (u, v) where it has them).
 void apply_bump(const Bump& bump, const TextureSet& textures, const SurfaceDerivatives& d,
                 SurfacePoint* sp);
 

@@ -1,10 +1,36 @@
 // flatten_scene and the order of its steps; flatten_internal.h lists the files that define them.
 #include "scene/flatten.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "scene/flatten_internal.h"
 #include "scene/spectra.h"
 
 namespace bpm {
+
+void FilmSettings::set_full_resolution(int w, int h) {
+  full_width = w;
+  full_height = h;
+  int b[4];
+  if (has_pixel_bounds) {
+    // The file's pixel bounds, scaled to this resolution when it is another.
+    const int size[4] = {file_width, file_width, file_height, file_height};
+    const int to[4] = {w, w, h, h};
+    for (int k = 0; k < 4; ++k)
+      b[k] = size[k] == to[k] ? pixel_bounds[k]
+                              : int(std::ceil(double(pixel_bounds[k]) * to[k] / size[k] - 1e-9));
+  } else {
+    // pbrt-v4: the pixels from ceil(resolution x crop min) up to ceil(resolution x crop max), in
+    // single precision as pbrt-v4 (120 x 0.2f is 24 there, 24.0000004 in double).
+    for (int k = 0; k < 4; ++k) b[k] = int(std::ceil(float(k < 2 ? w : h) * crop_window[k]));
+  }
+  // Pixel bounds beyond the raster are clamped to it, as pbrt-v4 does.
+  x0 = std::clamp(b[0], 0, w);
+  y0 = std::clamp(b[2], 0, h);
+  width = std::clamp(b[1], 0, w) - x0;
+  height = std::clamp(b[3], 0, h) - y0;
+}
 namespace flatten_internal {
 
 Flattener::Flattener(const ParsedScene& p) : parsed_(p) {

@@ -14,7 +14,34 @@
 namespace bpm {
 
 struct FilmSettings {
+  // The image rendered: width x height pixels, the crop of the camera's full_width x full_height
+  // raster whose top-left pixel is (x0, y0) (pbrt-v4's "cropwindow" or "pixelbounds"; the whole
+  // raster without them).
   int width = 1280, height = 720;
+  int full_width = 1280, full_height = 720, x0 = 0, y0 = 0;
+  // The crop as the file gives it: a window in [0, 1]^2 (x0 x1 y0 y1) or pixel bounds of the
+  // file's resolution; set_full_resolution keeps it for another resolution.
+  float crop_window[4] = {0, 1, 0, 1};
+  int pixel_bounds[4] = {0, 0, 0, 0};
+  bool has_pixel_bounds = false;
+  int file_width = 1280, file_height = 720;
+  // Sets the camera's raster and the image's crop of it.
+  void set_full_resolution(int w, int h);
+  Raster raster() const { return {width, height, full_width, full_height, x0, y0}; }
+  bool has_crop() const {
+    return has_pixel_bounds || crop_window[0] != 0 || crop_window[1] != 1 || crop_window[2] != 0 ||
+           crop_window[3] != 1;
+  }
+  // The raster of a film of w x h pixels: the file's crop when it has one of that size, else a
+  // whole raster of that size (width and height set by hand, or a film of another size).
+  Raster raster_for(int w, int h) const {
+    if (has_crop()) {
+      FilmSettings c = *this;
+      c.set_full_resolution(full_width, full_height);
+      if (c.width == w && c.height == h) return c.raster();
+    }
+    return Raster{w, h, w, h, 0, 0};
+  }
   std::string filename = "pbrt.exr";
   float imaging_ratio = 1;  // exposure time * ISO / 100, as pbrt-v4's sensor
   float max_component_value = kInf;

@@ -1,6 +1,9 @@
 // Camera, film, pixel filter, sampler and integrator settings from the scene file, with
 // pbrt-v4's defaults.
+#include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "scene/flatten_internal.h"
 
@@ -38,6 +41,51 @@ void Flattener::read_camera(LoadedScene* out) {
   c.params.warn_unused("camera");
 }
 
+namespace {
+
+// pbrt-v4's "cropwindow" (x0 x1 y0 y1 in [0, 1], clamped, either order) or "pixelbounds" (x0 x1 y0
+// y1 in pixels of the file's resolution), not both: the image is the crop of the camera's raster.
+void read_crop(const ParamSet& ps, FilmSettings* film) {
+  const Param* cw = ps.find_any("cropwindow");
+  const Param* pb = ps.find_any("pixelbounds");
+  if (cw && pb)
+    throw Error(pb->loc, "both \"cropwindow\" and \"pixelbounds\" were given; only one may be");
+  film->file_width = film->width;
+  film->file_height = film->height;
+  if (cw) {
+    const std::vector<float> c = ps.get_floats("cropwindow");
+    if (c.size() != 4)
+      throw Error(cw->loc,
+                  "cropwindow takes 4 values (x0 x1 y0 y1); got " + std::to_string(c.size()));
+    for (float v : c)
+      if (!std::isfinite(v)) throw Error(cw->loc, "cropwindow values must be finite");
+    film->crop_window[0] = std::clamp(std::min(c[0], c[1]), 0.0f, 1.0f);
+    film->crop_window[1] = std::clamp(std::max(c[0], c[1]), 0.0f, 1.0f);
+    film->crop_window[2] = std::clamp(std::min(c[2], c[3]), 0.0f, 1.0f);
+    film->crop_window[3] = std::clamp(std::max(c[2], c[3]), 0.0f, 1.0f);
+  }
+  if (pb) {
+    const std::vector<int> b = ps.get_ints("pixelbounds");
+    if (b.size() != 4)
+      throw Error(pb->loc,
+                  "pixelbounds takes 4 values (x0 x1 y0 y1); got " + std::to_string(b.size()));
+    if (b[1] <= b[0] || b[3] <= b[2])
+      throw Error(pb->loc, "pixelbounds [" + std::to_string(b[0]) + " " + std::to_string(b[1]) +
+                               " " + std::to_string(b[2]) + " " + std::to_string(b[3]) +
+                               "] is empty");
+    for (int k = 0; k < 4; ++k) film->pixel_bounds[k] = b[size_t(k)];
+    film->has_pixel_bounds = true;
+  }
+  film->set_full_resolution(film->width, film->height);
+  if (film->width <= 0 || film->height <= 0)
+    throw Error((cw ? cw : pb)->loc, std::string(cw ? "cropwindow" : "pixelbounds") +
+                                         " leaves no pixel of the " +
+                                         std::to_string(film->full_width) + "x" +
+                                         std::to_string(film->full_height) + " image");
+}
+
+}  // namespace
+
 void Flattener::read_film(LoadedScene* out) {
   const SceneEntity& f = parsed_.film;
   if (f.name != "rgb") throw Error(f.loc, "film \"" + f.name + "\" is not supported (only rgb)");
@@ -57,10 +105,7 @@ void Flattener::read_film(LoadedScene* out) {
   if (f.params.get_float("whitebalance", 0) != 0)
     throw Error(f.params.find_any("whitebalance")->loc, "white balancing is not supported");
   out->film.max_component_value = f.params.get_float("maxcomponentvalue", kInf);
-  if (auto* cw = f.params.find_any("cropwindow"))
-    throw Error(cw->loc, "cropwindow is not supported");
-  if (auto* pb = f.params.find_any("pixelbounds"))
-    throw Error(pb->loc, "pixelbounds is not supported");
+  read_crop(f.params, &out->film);
   f.params.get_bool("savefp16", true);  // bpm always writes 32-bit float EXR
   f.params.warn_unused("film");
 }

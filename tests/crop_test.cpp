@@ -1,0 +1,102 @@
+// pbrt-v4's "cropwindow" and "pixelbounds": the image is a crop of the camera's raster, rendered
+// as the whole image renders those pixels, and written with its place in the full image.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "base/error.h"
+#include "film/image_io.h"
+#include "test_util.h"
+
+namespace bpm {
+namespace {
+
+std::string scene(const std::string& integrator, const std::string& film_extra) {
+  return R"(LookAt 0 1 -3  0 0.3 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 24 "integer yresolution" 16 )" +
+         film_extra + R"(
+Integrator ")" + integrator +
+         R"(" "integer maxdepth" 4
+WorldBegin
+LightSource "point" "point3 from" [1 2 -1] "rgb I" [5 5 5]
+Material "diffuse" "rgb reflectance" [0.7 0.5 0.3]
+Shape "sphere" "float radius" 0.5
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [-5 -0.5 -5  5 -0.5 -5  5 -0.5 5  -5 -0.5 5]
+)";
+}
+
+Image render_image(const LoadedScene& ls, const std::string& integrator) {
+  Film film(ls.film.width, ls.film.height);
+  RenderOptions opt = quiet_options(ls, integrator, 8, 5);
+  opt.adaptive = false;
+  render(ls, opt, &film);
+  return film.image();
+}
+
+// The crop's pixels are the whole image's, bit for bit (path: each pixel's random stream is keyed
+// by its place in the full raster); pixelbounds naming the same pixels gives the same image.
+TEST(Crop, CropRendersTheWholeImagesPixels) {
+  const LoadedScene full = test::load(scene("path", ""));
+  const LoadedScene crop = test::load(scene("path", "\"float cropwindow\" [0.25 0.75 0.5 0.25]"));
+  ASSERT_EQ(crop.film.width, 12);
+  ASSERT_EQ(crop.film.height, 4);
+  EXPECT_EQ(crop.film.x0, 6);
+  EXPECT_EQ(crop.film.y0, 4);
+  const Image a = render_image(full, "path"), b = render_image(crop, "path");
+  for (int y = 0; y < b.height; ++y)
+    for (int x = 0; x < b.width; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(b.at(x, y)[c], a.at(x + 6, y + 4)[c]) << x << "," << y;
+  const LoadedScene bounds = test::load(scene("path", "\"integer pixelbounds\" [6 18 4 8]"));
+  EXPECT_EQ(render_image(bounds, "path").rgb, b.rgb);
+}
+
+// bpm renders a crop as it renders the whole image: the crop's mean agrees with the same pixels
+// of a full render within their stated errors.
+TEST(Crop, BpmCropAgreesWithTheWholeImage) {
+  const LoadedScene full = test::load(scene("bpm", ""));
+  const LoadedScene crop = test::load(scene("bpm", "\"integer pixelbounds\" [4 20 6 14]"));
+  Film fa(full.film.width, full.film.height, Film::kStreams);
+  Film fb(crop.film.width, crop.film.height, Film::kStreams);
+  render(full, quiet_options(full, "bpm", 32, 5), &fa);
+  render(crop, quiet_options(crop, "bpm", 32, 6), &fb);
+  const Image a = fa.image(), b = fb.image();
+  const std::vector<float> ea = fa.total_rms_rgb(), eb = fb.total_rms_rgb();
+  double mean_a = 0, mean_b = 0, err = 0;
+  for (int y = 0; y < b.height; ++y)
+    for (int x = 0; x < b.width; ++x) {
+      mean_a += a.at(x + 4, y + 6).luminance();
+      mean_b += b.at(x, y).luminance();
+      err += ea[3 * ((y + 6) * a.width + x + 4) + 1] + eb[3 * (y * b.width + x) + 1];
+    }
+  EXPECT_NEAR(mean_b, mean_a, 3 * err / std::sqrt(double(b.width * b.height)) + 1e-3 * mean_a);
+}
+
+// Bad crops are located errors; bounds past the raster are clamped to it.
+TEST(Crop, BadCropsAreLocatedErrors) {
+  auto error_of = [](const std::string& extra) {
+    try {
+      test::load(scene("path", extra));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of("\"float cropwindow\" [0 1 0]").find("4 values"), std::string::npos);
+  EXPECT_NE(error_of("\"integer pixelbounds\" [5 5 0 4]").find("empty"), std::string::npos);
+  EXPECT_NE(error_of("\"float cropwindow\" [0.5 0.5 0 1]").find("leaves no pixel"),
+            std::string::npos);
+  EXPECT_NE(error_of("\"float cropwindow\" [0 1 0 1] \"integer pixelbounds\" [0 4 0 4]")
+                .find("only one"),
+            std::string::npos);
+  EXPECT_NE(error_of("\"float cropwindow\" [0 1 0 1]").find(""), std::string::npos);
+  const LoadedScene clamped = test::load(scene("path", "\"integer pixelbounds\" [-4 100 2 6]"));
+  EXPECT_EQ(clamped.film.width, 24);
+  EXPECT_EQ(clamped.film.x0, 0);
+  EXPECT_EQ(clamped.film.height, 4);
+}
+
+}  // namespace
+}  // namespace bpm
