@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "base/vec.h"
 
@@ -546,6 +547,81 @@ void SpectrumCurve::finish(SpectrumKind kind) {
     for (int c = 0; c < 3; ++c) rgb[c] += v * w[c];
   }
   rgb_ = Rgb(float(rgb[0]), float(rgb[1]), float(rgb[2]));
+}
+
+namespace {
+
+using Mat3 = std::array<double, 9>;
+
+Mat3 mul(const Mat3& a, const Mat3& b) {
+  Mat3 r{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) r[3 * i + j] += a[3 * i + k] * b[3 * k + j];
+  return r;
+}
+
+Mat3 inverse(const Mat3& m) {
+  const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                     m[2] * (m[3] * m[7] - m[4] * m[6]);
+  const Mat3 adj{m[4] * m[8] - m[5] * m[7], m[2] * m[7] - m[1] * m[8], m[1] * m[5] - m[2] * m[4],
+                 m[5] * m[6] - m[3] * m[8], m[0] * m[8] - m[2] * m[6], m[2] * m[3] - m[0] * m[5],
+                 m[3] * m[7] - m[4] * m[6], m[1] * m[6] - m[0] * m[7], m[0] * m[4] - m[1] * m[3]};
+  Mat3 r;
+  for (int i = 0; i < 9; ++i) r[i] = adj[i] / det;
+  return r;
+}
+
+// The chromaticity (x, y) of a spectrum's colour, integrated at 1 nm.
+std::array<double, 2> chromaticity(const std::function<double(double)>& spd) {
+  double X = 0, Y = 0, Z = 0;
+  for (int i = 0; i < kTableSize; ++i) {
+    const double l = kLambdaMin + i, s = spd(l);
+    X += s * cie_x(float(l));
+    Y += s * cie_y(float(l));
+    Z += s * cie_z(float(l));
+  }
+  return {X / (X + Y + Z), Y / (X + Y + Z)};
+}
+
+}  // namespace
+
+std::array<float, 9> white_balance_srgb(float temperature) {
+  // pbrt-v4's Spectra::D: the temperature corrected for the revised second radiation constant.
+  const double cct = double(temperature) * 1.4388 / 1.4380;
+  std::array<double, 2> src;
+  if (cct < 4000) {
+    const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
+    src = chromaticity([&](double l) {
+      const double m = l * 1e-9;
+      return 1 / (std::pow(m, 5) * (std::exp((h * c) / (m * kb * cct)) - 1));
+    });
+  } else {
+    const double x =
+        cct <= 7000
+            ? -4.607e9 / (cct * cct * cct) + 2.9678e6 / (cct * cct) + 0.09911e3 / cct + 0.244063
+            : -2.0064e9 / (cct * cct * cct) + 1.9018e6 / (cct * cct) + 0.24748e3 / cct + 0.23704;
+    src = {x, -3 * x * x + 2.870 * x - 0.275};
+  }
+  const std::array<double, 2> dst = chromaticity([](double l) { return d65_raw(l); });
+  const Mat3 lms_from_xyz{0.8951, 0.2664, -0.1614, -0.7502, 1.7135,
+                          0.0367, 0.0389, -0.0685, 1.0296};
+  const Mat3 srgb_from_xyz{3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108,
+                           0.0415560, 0.0556434,  -0.2040259, 1.0572252};
+  auto lms_of = [&](const std::array<double, 2>& xy) {
+    const double xyz[3] = {xy[0] / xy[1], 1, (1 - xy[0] - xy[1]) / xy[1]};
+    std::array<double, 3> lms{};
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) lms[size_t(i)] += lms_from_xyz[size_t(3 * i + k)] * xyz[k];
+    return lms;
+  };
+  const std::array<double, 3> s = lms_of(src), d = lms_of(dst);
+  const Mat3 scale{d[0] / s[0], 0, 0, 0, d[1] / s[1], 0, 0, 0, d[2] / s[2]};
+  const Mat3 m = mul(mul(mul(mul(srgb_from_xyz, inverse(lms_from_xyz)), scale), lms_from_xyz),
+                     inverse(srgb_from_xyz));
+  std::array<float, 9> out;
+  for (int i = 0; i < 9; ++i) out[size_t(i)] = float(m[size_t(i)]);
+  return out;
 }
 
 }  // namespace bpm

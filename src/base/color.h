@@ -44,6 +44,12 @@ float wavelength_pdf(float lambda);
 // Linear sRGB of the Monte Carlo estimate L at the wavelengths wl (the film's sensor, pbrt-v4's
 // "cie1931").
 Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl);
+// pbrt-v4's film "whitebalance" of temperature T (kelvin) for its cie1931 sensor, as a matrix on
+// linear sRGB (row-major): a Bradford adaptation from the white of the CIE daylight illuminant
+// D(T) (a blackbody below 4000 K, at pbrt-v4's corrected temperature T 1.4388 / 1.4380) to sRGB's
+// D65 white. The daylight chromaticity is the CIE formula's, not that of the integrated spectrum.
+std::array<float, 9> white_balance_srgb(float temperature);
+
 // The photopic luminance of the estimate L: the integral of L times the CIE 1931 ybar over that of
 // ybar, with no white balance. Light stated in pbrt-v4's photometric terms (a light's "power" in
 // lumens, "illuminance" in lux, a spectrum normalised to unit luminance) gives it in cd/m^2.

@@ -5,6 +5,7 @@
 // keeps per pixel and channel the sum and sum of squares of the per-pass estimates, from which the
 // error estimate of the paper's eq. (5) follows.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -74,6 +75,13 @@ class Film {
   // spread between the M images (or, for a sensor, between the streams) once each has a pass,
   // and eq. 5, an upper bound, until then.
   void set_independent_passes(bool independent) { independent_ = independent; }
+  // A 3 x 3 matrix (row-major) every sample's and bias estimate's colour goes through before it
+  // is recorded: the film's white balance (base/color.h); none by default. The luminance is
+  // never changed.
+  void set_colour_matrix(const std::array<float, 9>& m) {
+    colour_matrix_ = m;
+    has_colour_matrix_ = true;
+  }
   bool independent_passes() const { return independent_; }
   int width() const { return width_; }
   int height() const { return height_; }
@@ -88,7 +96,8 @@ class Film {
 
   void add_sample(int x, int y, const FilmSample& s, float weight) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
-    const float v[kChannels] = {s.rgb[0], s.rgb[1], s.rgb[2], s.luminance};
+    const Rgb c = colour(s.rgb);
+    const float v[kChannels] = {c[0], c[1], c[2], s.luminance};
     for (int c = 0; c < kChannels; ++c) {
       p.sum_wl[c] += double(weight) * v[c];
       p.pass_wl[c] += double(weight) * v[c];
@@ -102,7 +111,8 @@ class Film {
   // pass, before end_pass.
   void add_bias(int x, int y, const Rgb& b, float b_luminance) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
-    const float v[kChannels] = {b[0], b[1], b[2], b_luminance};
+    const Rgb c = colour(b);
+    const float v[kChannels] = {c[0], c[1], c[2], b_luminance};
     for (int c = 0; c < kChannels; ++c) {
       p.sum_b[c] += v[c];
       p.sum_b2[c] += double(v[c]) * v[c];
@@ -234,6 +244,12 @@ class Film {
     double stream_sum[kStreams] = {};
     int stream_passes[kStreams] = {};
   };
+  Rgb colour(const Rgb& c) const {
+    if (!has_colour_matrix_) return c;
+    const float* m = colour_matrix_.data();
+    return Rgb(m[0] * c[0] + m[1] * c[1] + m[2] * c[2], m[3] * c[0] + m[4] * c[1] + m[5] * c[2],
+               m[6] * c[0] + m[7] * c[1] + m[8] * c[2]);
+  }
   // The standard error of pixel i's channel c (rms_rgb), and the M images' (none until each has
   // a pass).
   float noise(size_t i, int c) const;
@@ -244,6 +260,8 @@ class Film {
   int m_ = 0;
   int pass_index_ = 0;
   bool independent_ = true;
+  bool has_colour_matrix_ = false;
+  std::array<float, 9> colour_matrix_{};
   std::vector<float> m_sum_;  // [pixel][image][channel]
   std::vector<int> m_count_;  // [pixel][image]
 };

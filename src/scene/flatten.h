@@ -45,6 +45,7 @@ struct FilmSettings {
   std::string filename = "pbrt.exr";
   float imaging_ratio = 1;  // exposure time * ISO / 100, as pbrt-v4's sensor
   float max_component_value = kInf;
+  float white_balance = 0;  // kelvin; 0: none (pbrt-v4's "whitebalance" of the cie1931 sensor)
 };
 
 // What the scene file says about how to render it; the command line may override each field.

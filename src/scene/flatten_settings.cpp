@@ -102,8 +102,11 @@ void Flattener::read_film(LoadedScene* out) {
   if (sensor != "cie1931")
     throw Error(f.params.find_any("sensor")->loc,
                 "sensor \"" + sensor + "\" is not supported (only cie1931)");
-  if (f.params.get_float("whitebalance", 0) != 0)
-    throw Error(f.params.find_any("whitebalance")->loc, "white balancing is not supported");
+  out->film.white_balance = f.params.get_float("whitebalance", 0);
+  if (!(out->film.white_balance >= 0) || !std::isfinite(out->film.white_balance) ||
+      (out->film.white_balance > 0 && out->film.white_balance < 1000))
+    throw Error(f.params.find_any("whitebalance")->loc,
+                "whitebalance must be 0 (none) or a temperature of at least 1000 K");
   out->film.max_component_value = f.params.get_float("maxcomponentvalue", kInf);
   read_crop(f.params, &out->film);
   f.params.get_bool("savefp16", true);  // bpm always writes 32-bit float EXR

@@ -1,5 +1,5 @@
-// pbrt-v4's "cropwindow" and "pixelbounds": the image is a crop of the camera's raster, rendered
-// as the whole image renders those pixels, and written with its place in the full image.
+// The Film's crop ("cropwindow", "pixelbounds": the image is a crop of the camera's raster,
+// rendered as the whole image renders those pixels) and white balance ("whitebalance").
 #include <gtest/gtest.h>
 
 #include <string>
@@ -16,7 +16,8 @@ std::string scene(const std::string& integrator, const std::string& film_extra) 
 Camera "perspective" "float fov" 40
 Film "rgb" "integer xresolution" 24 "integer yresolution" 16 )" +
          film_extra + R"(
-Integrator ")" + integrator +
+Integrator ")" +
+         integrator +
          R"(" "integer maxdepth" 4
 WorldBegin
 LightSource "point" "point3 from" [1 2 -1] "rgb I" [5 5 5]
@@ -88,14 +89,52 @@ TEST(Crop, BadCropsAreLocatedErrors) {
   EXPECT_NE(error_of("\"integer pixelbounds\" [5 5 0 4]").find("empty"), std::string::npos);
   EXPECT_NE(error_of("\"float cropwindow\" [0.5 0.5 0 1]").find("leaves no pixel"),
             std::string::npos);
-  EXPECT_NE(error_of("\"float cropwindow\" [0 1 0 1] \"integer pixelbounds\" [0 4 0 4]")
-                .find("only one"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("\"float cropwindow\" [0 1 0 1] \"integer pixelbounds\" [0 4 0 4]").find("only one"),
+      std::string::npos);
   EXPECT_NE(error_of("\"float cropwindow\" [0 1 0 1]").find(""), std::string::npos);
   const LoadedScene clamped = test::load(scene("path", "\"integer pixelbounds\" [-4 100 2 6]"));
   EXPECT_EQ(clamped.film.width, 24);
   EXPECT_EQ(clamped.film.x0, 0);
   EXPECT_EQ(clamped.film.height, 4);
+}
+
+}  // namespace
+}  // namespace bpm
+
+namespace bpm {
+namespace {
+
+// pbrt-v4's film "whitebalance": a white plane under a 3000 K blackbody renders neutral when the
+// film is balanced for 3000 K (pbrt-v4 takes a blackbody's white below 4000 K), and orange when it
+// is not; a balance for D65's temperature changes nothing.
+TEST(WhiteBalance, BalancedFilmRendersTheLightsWhiteNeutral) {
+  auto mean_colour = [](const std::string& film_extra) {
+    const LoadedScene ls = test::load(R"(LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 20
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8 )" +
+                                      film_extra + R"(
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "distant" "point3 from" [0 0 1] "point3 to" [0 0 0] "blackbody L" 3000
+Material "diffuse" "rgb reflectance" [1 1 1]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-5 -5 0  5 -5 0  5 5 0  -5 5 0]
+)");
+    Film film(ls.film.width, ls.film.height);
+    render(ls, quiet_options(ls, "path", 16, 1), &film);
+    const Image img = film.image();
+    Rgb sum(0, 0, 0);
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) sum += img.at(x, y);
+    return sum;
+  };
+  const Rgb balanced = mean_colour("\"float whitebalance\" 3000");
+  EXPECT_NEAR(balanced[0] / balanced[1], 1, 0.01);
+  EXPECT_NEAR(balanced[2] / balanced[1], 1, 0.01);
+  const Rgb raw = mean_colour("");
+  EXPECT_GT(raw[0] / raw[2], 2);
+  const std::array<float, 9> m = white_balance_srgb(6504);
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(m[size_t(i)], i % 4 == 0 ? 1 : 0, 5e-3) << i;
 }
 
 }  // namespace
