@@ -138,3 +138,39 @@ TEST(Bump, BadMapsAreLocatedErrors) {
 
 }  // namespace
 }  // namespace bpm
+
+namespace bpm {
+namespace {
+
+// A dielectric's roughness from a float texture (a "scale" texture of constant 0.2: a node
+// evaluated per surface point) renders as the constant roughness 0.2 does, in path and bpm.
+TEST(TexturedRoughness, DielectricTextureOfAConstantRendersAsTheConstant) {
+  auto image = [](const std::string& integrator, const std::string& rough) {
+    const LoadedScene ls = test::load(R"(LookAt 0 2 -3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 16 "integer yresolution" 12
+Integrator ")" + integrator + R"(" "integer maxdepth" 6
+WorldBegin
+LightSource "point" "point3 from" [0 3 0] "rgb I" [8 8 8]
+Texture "r" "float" "scale" "float tex" 0.2 "float scale" 1
+Material "dielectric" )" + rough + R"(
+Shape "sphere" "float radius" 0.6
+Material "diffuse"
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-3 -0.6 -3  3 -0.6 -3  3 -0.6 3  -3 -0.6 3]
+)");
+    return test::render_film(ls, 8, 0, 2).image();
+  };
+  for (const char* integrator : {"path", "bpm"}) {
+    const Image a = image(integrator, "\"float roughness\" 0.2");
+    const Image b = image(integrator, "\"texture roughness\" \"r\"");
+    double diff = 0, sum = 0;
+    for (size_t i = 0; i < a.rgb.size(); ++i) {
+      diff += std::fabs(a.rgb[i] - b.rgb[i]);
+      sum += std::fabs(a.rgb[i]);
+    }
+    EXPECT_LT(diff, 1e-4 * sum) << integrator;
+  }
+}
+
+}  // namespace
+}  // namespace bpm

@@ -206,7 +206,7 @@ TEST(CoatedDiffuse, WalkTablePdfIsTheSamplingDensity) {
 
 // The walks' part of f (the coat's own reflection taken out), by the walk's estimator or the table.
 Spectrum walks_f(const CoatedDiffuseMaterial& c, Vec3 wo, Vec3 wi, TransportMode mode) {
-  const DielectricMaterial top{c.layer.eta, c.layer.roughness, nullptr};
+  const DielectricMaterial top{c.layer.eta, c.layer.roughness, nullptr, {}};
   return bsdf_f(c, wo, wi, mode) - dielectric_f(top, wo, wi, mode);
 }
 

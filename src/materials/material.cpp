@@ -41,6 +41,7 @@ struct Resolver {
   Material operator()(const DielectricMaterial& d) const {
     DielectricMaterial r = d;
     if (d.eta_spectrum) r.eta = d.eta_spectrum->value(wl.lambda[0]);
+    r.roughness = rough(d.roughness, d.roughness_tex);
     return r;
   }
   Material operator()(const ThinDielectricMaterial& d) const {
@@ -109,7 +110,7 @@ bool material_is_textured(const MaterialDesc& desc) {
     bool operator()(const CoatedConductorDesc& d) const {
       return (*this)(d.conductor) || d.roughness_tex.any();
     }
-    bool operator()(const DielectricMaterial&) const { return false; }
+    bool operator()(const DielectricMaterial& d) const { return d.roughness_tex.any(); }
     bool operator()(const ThinDielectricMaterial&) const { return false; }
     bool operator()(const InterfaceMaterial&) const { return false; }
     bool operator()(const MixDesc&) const { return true; }

@@ -44,6 +44,15 @@ struct ConductorMaterial {
   Roughness roughness;
 };
 
+// Textured roughness: float textures for u and v (-1: the constant), remapped as pbrt-v4's
+// RoughnessToAlpha when remap is set.
+struct RoughnessTextures {
+  int u = -1, v = -1;
+  bool remap = true;
+  bool any() const { return u >= 0 || v >= 0; }
+  Roughness eval(const Roughness& constant, const TextureSet& ts, const TextureContext& ctx) const;
+};
+
 // A dielectric whose index depends on the wavelength (dispersion) keeps its curve; resolved at a
 // path's wavelengths, eta is the index at the first (hero) wavelength, and the path follows that
 // wavelength alone from there on (pbrt-v4's TerminateSecondary; see PathState).
@@ -52,7 +61,8 @@ using EtaSpectrum = std::shared_ptr<const SpectrumCurve>;
 struct DielectricMaterial {
   float eta = 1.5f;  // inside over outside; the outside is the side the normal points to
   Roughness roughness;
-  EtaSpectrum eta_spectrum;  // null: eta at every wavelength
+  EtaSpectrum eta_spectrum;         // null: eta at every wavelength
+  RoughnessTextures roughness_tex;  // textured roughness, resolved per surface point
 };
 
 struct ThinDielectricMaterial {
@@ -116,15 +126,6 @@ using Material = std::variant<DiffuseMaterial, ConductorMaterial, DielectricMate
 // The scene's description of a material, with its colours as spectral curves or textures.
 // resolve_material evaluates it at a path's wavelengths (and, when textured, at the surface point)
 // into the Material the BSDF functions take. The alternatives are in the same order as Material's.
-
-// Textured roughness: float textures for u and v (-1: the constant), remapped as pbrt-v4's
-// RoughnessToAlpha when remap is set.
-struct RoughnessTextures {
-  int u = -1, v = -1;
-  bool remap = true;
-  bool any() const { return u >= 0 || v >= 0; }
-  Roughness eval(const Roughness& constant, const TextureSet& ts, const TextureContext& ctx) const;
-};
 
 struct DiffuseDesc {
   SpectrumParam reflectance{SpectrumCurve(0.5f)};

@@ -222,10 +222,13 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
     m = conductor_desc(ps, e.loc, "");
   } else if (e.name == "dielectric" || e.name == "thindielectric") {
     DielectricEta eta = dielectric_eta(ps, e.loc);
-    if (e.name == "dielectric")
-      m = DielectricMaterial{eta.eta, roughness(ps, e.loc), eta.spectrum};
-    else
+    if (e.name == "dielectric") {
+      DielectricMaterial d{eta.eta, {}, eta.spectrum, {}};
+      d.roughness = roughness(ps, e.loc, "", &d.roughness_tex);
+      m = d;
+    } else {
       m = ThinDielectricMaterial{eta.eta, eta.spectrum};
+    }
   } else if (e.name == "diffusetransmission") {
     DiffuseTransmissionDesc d;
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) d.reflectance = *r;

@@ -1984,11 +1984,6 @@ TEST(SceneFlattenError, TextureErrorsNameTheDirective) {
                                "Shape \"sphere\"\n"),
                       at(2, col(wrap, "\"string mapping")),
                       "texture mapping \"cubic\" is unknown"));
-  // A textured roughness where bpm takes none.
-  EXPECT_TRUE(
-      IsError(error_of("WorldBegin\nTexture \"r\" \"float\" \"checkerboard\"\n"
-                       "Material \"dielectric\" \"texture roughness\" \"r\"\nShape \"sphere\"\n"),
-              at(3, 1), "textured roughness is not supported"));
 }
 
 TEST(SceneParse, MixMaterialNamesTwoMaterials) {
