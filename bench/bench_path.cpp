@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   // Record one pass worth of rays from the integrator itself (same camera, same BSDF sampling).
   RayLog log;
   {
-    PerspectiveCamera cam(ls.camera, res, res);
+    Camera cam(ls.camera, res, res);
     PathCounters c;
     c.observer = &log;
     for (int y = 0; y < res; ++y)

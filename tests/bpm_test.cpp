@@ -194,7 +194,20 @@ void expect_blocks_agree(const Iterations& a, const Film& ref, int block, double
 }
 
 // Whole-image mean luminance of the iterations and its standard error.
-BlockStats image_mean(const Iterations& it) { return it.blocks(it.images[0].width)[0]; }
+// The image's luminance mean over all iterations, with the variance of that mean.
+BlockStats image_mean(const Iterations& it) {
+  double sum = 0, sum2 = 0;
+  for (const Image& img : it.images) {
+    double m = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) m += img.at(x, y).luminance();
+    m /= double(img.width) * img.height;
+    sum += m;
+    sum2 += m * m;
+  }
+  const double n = double(it.images.size()), mean = sum / n;
+  return {mean, std::fmax(0.0, sum2 / n - mean * mean) / (n - 1)};
+}
 
 // Relative RMS difference of two images over pixels (luminance).
 double relative_difference(const Image& ia, const Film& b) {
@@ -306,7 +319,7 @@ void expect_furnace(const std::string& integrator, const BpmSettings& s, const F
   for (int k = 0; k <= ls.render.max_depth; ++k) expected += std::pow(0.8, k);
   BlockStats m = image_mean(render_iterations(ls, integrator, 40, 11, s, f));
   double sigma = std::sqrt(m.var);
-  float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
+  float pixel_angle = Camera(ls.camera, 16, 16).footprint({8, 8}).spread;
   double r_over_R = s.k1 * pixel_angle * path_radii;
   double bias = expected * r_over_R * r_over_R / 8;
   EXPECT_NEAR(m.mean, expected, 4.5 * sigma + bias)
@@ -323,6 +336,50 @@ TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
       // and needs more photons for the test to have power.
       if (d == 0) s.photons_per_iteration = 32768;
       expect_furnace("bpm", s, {}, 1 + 2 * d, "D=" + std::to_string(d) + " " + to_string(policy));
+    }
+}
+
+// The sphere furnace seen by an orthographic camera (rays from a 2 x 2 square about the centre:
+// every pixel's footprint is 1/16 wide at any distance) and by spherical cameras at the centre
+// (each pixel subtends its solid angle; the equirectangular rows differ): the photon methods'
+// radii come from each camera's footprint, so every pixel reads the exact radiance within the
+// spread over iterations and the tilt bias bound of the sphere furnace, at the first vertex with
+// D = 0, and fpm without final gathering (r = k1 footprints).
+TEST(Cameras, SphereFurnaceSeenByOrthographicAndSphericalCameras) {
+  struct Case {
+    std::string camera;
+    int width, height;
+  };
+  const Case cases[] = {{"\"orthographic\" \"float screenwindow\" [-1 1 -1 1]", 32, 32},
+                        {"\"spherical\"", 32, 32},
+                        {"\"spherical\" \"string mapping\" \"equirectangular\"", 32, 16}};
+  for (const Case& c : cases)
+    for (const char* integrator : {"path", "bpm", "fpm"}) {
+      const std::string what = c.camera + " " + integrator;
+      LoadedScene ls = load("LookAt 0 0 0  0 0 1  0 1 0\nCamera " + c.camera +
+                            "\nFilm \"rgb\" \"integer xresolution\" " + std::to_string(c.width) +
+                            " \"integer yresolution\" " + std::to_string(c.height) +
+                            "\nPixelFilter \"box\"\nIntegrator \"path\" \"integer maxdepth\" 8\n"
+                            "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+                            "Material \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
+                            "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+      double expected = 0;
+      for (int k = 0; k <= ls.render.max_depth; ++k) expected += std::pow(0.8, k);
+      BpmSettings s = small_batches(0);
+      FpmSettings f;
+      f.final_gather = false;
+      BlockStats m = image_mean(render_iterations(ls, integrator, 16, 5, s, f));
+      const double sigma = std::sqrt(m.var);
+      // The widest footprint at the sphere (equirectangular: the equator's rows).
+      const Camera camera(ls.camera, c.width, c.height);
+      const float footprint =
+          std::max(camera.footprint_at(Vec3(0, 0, 2)), camera.footprint_at(Vec3(0, 2, 0)));
+      EXPECT_GT(footprint, 0) << what;
+      const double r_over_R = s.k1 * footprint / 2;
+      const double bias = expected * r_over_R * r_over_R / 8;
+      EXPECT_NEAR(m.mean, expected, 4.5 * sigma + bias)
+          << what << " sigma " << sigma << " bias bound " << bias;
+      EXPECT_LT(sigma, 0.01 * expected) << what;
     }
 }
 
@@ -364,7 +421,7 @@ std::string faceted_furnace() {
 TEST(Bpm, FacetedFurnaceWithShadingNormalsMatchesPath) {
   LoadedScene ls = load(faceted_furnace());
   BlockStats want = image_mean(render_iterations(ls, "path", 80, 5, BpmSettings{}));
-  float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
+  float pixel_angle = Camera(ls.camera, 16, 16).footprint({8, 8}).spread;
   for (const std::string integrator : {"bpm", "fpm"}) {
     BpmSettings s = small_batches(0);
     s.photons_per_iteration = 32768;
@@ -411,7 +468,7 @@ struct CheckerFurnace {
     rho_bar /= n;
     double a = 1;  // A_0 = Le = 1 (unit luminance)
     for (int k = 1; k < kDepth; ++k) a = 1 + rho_bar * a;
-    PerspectiveCamera cam(ls.camera, kRes, kRes);
+    Camera cam(ls.camera, kRes, kRes);
     std::vector<double> out(kRes * kRes, 0.0);
     for (int y = 0; y < kRes; ++y)
       for (int x = 0; x < kRes; ++x)
@@ -453,8 +510,7 @@ TEST(Textures, CheckerboardFurnaceMatchesAnalyticRadianceWithBpm) {
   const int block = CheckerFurnace::kRes / 2;
   std::vector<BlockStats> got = its.blocks(block);
   float pixel_angle =
-      std::sqrt(PerspectiveCamera(f.ls.camera, CheckerFurnace::kRes, CheckerFurnace::kRes)
-                    .pixel_solid_angle());
+      Camera(f.ls.camera, CheckerFurnace::kRes, CheckerFurnace::kRes).footprint({}).spread;
   double r_over_R = s.k1 * pixel_angle * 3;
   ASSERT_EQ(got.size(), 4u);
   for (int b = 0; b < 4; ++b) {
@@ -507,7 +563,8 @@ TEST(Bpm, FirstDiffuseVertexGathersCausticsOverK0AndIndirectOverK1) {
       ObjectPhotonLists lists(ls.scene.objects.size());
       EyeCounters counters;
       CameraSample cs = camera.sample(pass, centre);
-      trace_eye_path(ls.scene, ep, cs.ray, centre, cs.rng, lists, counters);
+      // A footprint of one world unit per unit of length: the radii are r0 and r1 per length.
+      trace_eye_path(ls.scene, ep, cs.ray, PixelFootprint{0, 1}, centre, cs.rng, lists, counters);
       all.clear();
       for (const auto& l : lists) all.insert(all.end(), l.begin(), l.end());
     }
@@ -686,7 +743,7 @@ TEST(Materials, MixFurnaceMatchesAnalyticRadiance) {
 
   BpmSettings s = small_batches(1);
   BlockStats m = image_mean(render_iterations(ls, "bpm", 40, 11, s));
-  float pixel_angle = std::sqrt(PerspectiveCamera(ls.camera, 16, 16).pixel_solid_angle());
+  float pixel_angle = Camera(ls.camera, 16, 16).footprint({8, 8}).spread;
   double r_over_R = s.k1 * pixel_angle * 3, sigma = std::sqrt(m.var);
   EXPECT_NEAR(m.mean, want, 4.5 * sigma + want * r_over_R * r_over_R / 8) << "sigma " << sigma;
   EXPECT_LT(sigma, 0.01 * want);
@@ -946,13 +1003,13 @@ TEST(Bpm, WorldRadiusGivesEveryBackwardPhotonThatRadius) {
   const WavelengthMaterials wm(ls.scene, sample_wavelengths(0.5f));
   EyePassParams ep{&wm, 0, 8, 1e-3f, 3e-3f};
   ep.world_radius = 0.07f;
-  PerspectiveCamera cam(ls.camera, 32, 32);
+  Camera cam(ls.camera, 32, 32);
   ObjectPhotonLists lists(ls.scene.objects.size());
   EyeCounters c;
   for (uint32_t pixel = 0; pixel < 32 * 32; pixel += 7) {
     Rng rng(stream_key(3, 0, pixel));
     Ray r = cam.generate_ray({float(pixel % 32) + 0.5f, float(pixel / 32) + 0.5f}, {0.5f, 0.5f});
-    trace_eye_path(ls.scene, ep, r, pixel, rng, lists, c);
+    trace_eye_path(ls.scene, ep, r, PixelFootprint{0, 1}, pixel, rng, lists, c);
   }
   size_t n = 0;
   for (const auto& l : lists)

@@ -95,7 +95,7 @@ TEST(PathIntegrator, PlaneUnderPointLight) {
   Film film = render_film(ls, 64);
   Image img = film.image();
   std::vector<float> rms = film.rms();
-  PerspectiveCamera cam(ls.camera, 24, 16);
+  Camera cam(ls.camera, 24, 16);
   double sum_ratio = 0, sum_var = 0;
   Vec3 light(0.5f, h, 0.3f);
   int checked = 0;
@@ -151,7 +151,7 @@ TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
   Film film = render_film(ls, 64);
   Image img = film.image();
   std::vector<float> rms = film.rms();
-  PerspectiveCamera cam(ls.camera, 24, 16);
+  Camera cam(ls.camera, 24, 16);
   Vec3 light(0.5f, h, 0.3f);
   auto byte = [](float v) { return std::round(v * 255) / 255; };
   int checked = 0, seen[4] = {0, 0, 0, 0};
@@ -203,7 +203,7 @@ TEST(Integrators, AbsorbingMediumAttenuatesByBeerLambert) {
       Shape "trianglemesh" "point3 P" [-9 -9 3  9 -9 3  9 9 3  -9 9 3] "integer indices" [0 2 1 0 3 2]
     AttributeEnd
   )");
-  PerspectiveCamera cam(ls.camera, 16, 16);
+  Camera cam(ls.camera, 16, 16);
   for (const char* integrator : {"path", "bpm", "fpm"}) {
     Film film(16, 16);
     render(ls, quiet_options(ls, integrator, 64, 1), &film);
@@ -231,7 +231,7 @@ TEST(Integrators, AbsorbingMediumAttenuatesByBeerLambert) {
 
 // The expectation of a pixel under the box filter of radius 1/2: f averaged over the pixel.
 template <class F>
-double pixel_mean(const PerspectiveCamera& cam, int x, int y, F&& f) {
+double pixel_mean(const Camera& cam, int x, int y, F&& f) {
   const int n = 12;
   double sum = 0;
   for (int j = 0; j < n; ++j)
@@ -299,7 +299,7 @@ TEST(Integrators, AlphaMasksLetLightThrough) {
     const char* name;
   };
   for (const Case& c : {Case{&sheet, sheet_value, "sheet"}, Case{&lit, lit_value, "lit"}}) {
-    PerspectiveCamera cam(c.ls->camera, 16, 16);
+    Camera cam(c.ls->camera, 16, 16);
     for (const char* integrator : {"path", "bpm", "fpm"}) {
       Film film(16, 16);
       RenderOptions opt = quiet_options(*c.ls, integrator, 64, 1);
@@ -411,7 +411,7 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
     render(sky, quiet_options(sky, "path", 16, 1), &film);
     Image img = film.image();
     std::vector<float> sky_rms = film.rms();
-    PerspectiveCamera cam(sky.camera, 12, 12);
+    Camera cam(sky.camera, 12, 12);
     for (int y = 0; y < 12; ++y)
       for (int x = 0; x < 12; ++x) {
         Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).d);
@@ -468,7 +468,7 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
     const LoadedScene& ls = is_gonio ? gonio : proj;
     Vec3 light = is_gonio ? Vec3(0.5f, 2, 0.3f) : Vec3(0, 2, 0);
     float I = is_gonio ? 1.5f : 2.0f;
-    PerspectiveCamera cam(ls.camera, 24, 16);
+    Camera cam(ls.camera, 24, 16);
     for (const char* integrator : {"path", "bpm"}) {
       RenderOptions opt = quiet_options(ls, integrator, 16, 1);
       opt.bpm.photons_per_iteration = 20000;
@@ -540,7 +540,7 @@ TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
   render(ls, quiet_options(ls, "path", 16, 1), &film);
   Image img = film.image();
   std::vector<float> rms = film.rms();
-  PerspectiveCamera cam(ls.camera, 16, 16);
+  Camera cam(ls.camera, 16, 16);
   int inside = 0;
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) {

@@ -193,8 +193,9 @@ TEST_P(SensorsBy, EstimatesDoNotDependOnThreadsOrTheImage) {
   render(ls, opt, &alone);
   for (size_t i = 0; i < sensors.size(); ++i) {
     EXPECT_EQ(one.sensor_mean(i), two.sensor_mean(i)) << "sensor " << i;
-    if (std::string(GetParam()) == "path")
+    if (std::string(GetParam()) == "path") {
       EXPECT_EQ(one.sensor_mean(i), alone.sensor_mean(i)) << "sensor " << i;
+    }
   }
 }
 

@@ -142,4 +142,16 @@ Vec2 equal_area_sphere_to_square(Vec3 d) {
   return {(u + 1) / 2, (v + 1) / 2};
 }
 
+Vec2 wrap_equal_area_square(Vec2 p) {
+  if (p.x < 0 || p.x > 1) {
+    p.x = p.x < 0 ? -p.x : 2 - p.x;
+    p.y = 1 - p.y;
+  }
+  if (p.y < 0 || p.y > 1) {
+    p.x = 1 - p.x;
+    p.y = p.y < 0 ? -p.y : 2 - p.y;
+  }
+  return p;
+}
+
 }  // namespace bpm

@@ -171,5 +171,8 @@ class Distribution2D {
 // areas of the square map to equal solid angles: d omega = 4 pi du dv.
 Vec3 equal_area_square_to_sphere(Vec2 p);
 Vec2 equal_area_sphere_to_square(Vec3 d);
+// A point of the square's neighbourhood folded back into it as the sphere continues across each
+// edge (mirrored about the edge's middle), for lookups a little outside the square.
+Vec2 wrap_equal_area_square(Vec2 p);
 
 }  // namespace bpm

@@ -139,7 +139,6 @@ class BpmRender {
   Film* film_;
   const size_t n_pixels_;
   const CameraSampler camera_;
-  const float pixel_angle_;
   PixelMasks masks_;
   EyePixels eye_;
   tbb::enumerable_thread_specific<ObjectPhotonLists> thread_lists_;
@@ -199,7 +198,6 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       film_(film),
       n_pixels_(size_t(film->width()) * size_t(film->height())),
       camera_(ls.camera, ls.filter, ls.film.raster_for(film->width(), film->height()), opt.seed),
-      pixel_angle_(std::sqrt(camera_.camera().pixel_solid_angle())),
       masks_(film->width(), film->height(), tbb::this_task_arena::max_concurrency()),
       eye_(n_pixels_),
       thread_lists_([this] { return ObjectPhotonLists(scene_.objects.size()); }),
@@ -213,8 +211,7 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       caustics_(may_have_caustics(scene_)),
       near_edges_(s_.disc_probes && s_.radius <= 0, scene_, camera_.camera(), ls.film.width,
                   ls.film.height, ls.filter.radius),
-      sensors_(
-          make_sensor_discs(scene_, opt.sensors, camera_.camera().position(), pixel_angle_, s_)),
+      sensors_(make_sensor_discs(scene_, opt.sensors, camera_.camera(), s_)),
       sensor_sums_(opt.sensors.size()) {
   pixel_sums_.places = s_.diffuse_depth + 2;
   LightCounters light_exemplar;
@@ -276,17 +273,9 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
 bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, int it,
                          const RenderControl& control) {
   const auto t = Clock::now();
-  EyePassParams ep{&wm,
-                   s_.diffuse_depth,
-                   opt_.max_depth,
-                   s_.k0 * pixel_angle_ * scale,
-                   s_.k1 * pixel_angle_ * scale,
-                   s_.emission_samples,
-                   s_.radius * scale,
-                   caustics_,
-                   s_.normal_cos,
-                   s_.disc_probes,
-                   &near_edges_};
+  EyePassParams ep{&wm,           s_.diffuse_depth,    opt_.max_depth,    s_.k0 * scale,
+                   s_.k1 * scale, s_.emission_samples, s_.radius * scale, caustics_,
+                   s_.normal_cos, s_.disc_probes,      &near_edges_};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii.
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,

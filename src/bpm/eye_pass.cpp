@@ -19,13 +19,13 @@ namespace {
 // Caustic light at the first diffuse vertex is gathered over the small radius (k0); everything
 // gathered at a later vertex, and indirect light anywhere, over the large one (k1).
 BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const EyePassParams& prm,
-                                  uint32_t pixel, int depth, int diffuse, uint8_t accepts) {
+                                  PixelFootprint footprint, uint32_t pixel, int depth, int diffuse,
+                                  uint8_t accepts) {
   BackwardPhoton bp;
   bp.p = v.sp.p;
   const bool small = diffuse == 1 && accepts == kAcceptsCaustic;
-  bp.radius = prm.world_radius > 0
-                  ? prm.world_radius
-                  : s.length * (small ? prm.radius_per_length0 : prm.radius_per_length1);
+  bp.radius =
+      prm.world_radius > 0 ? prm.world_radius : footprint.at(s.length) * (small ? prm.k0 : prm.k1);
   bp.ng = v.sp.ng;
   bp.ns = v.sp.ns;
   bp.uv = v.sp.uv;
@@ -44,6 +44,7 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
 struct EyePath {
   const RenderScene& scene;
   const EyePassParams& prm;
+  PixelFootprint footprint;
   uint32_t pixel;
   uint8_t near_edge;
   Rng& rng;
@@ -66,7 +67,8 @@ inline bool store_backward_photon(const EyePath& path, const PathVertex& v, cons
                                   int depth, int diffuse, bool seen_directly, uint8_t accepts,
                                   bool whole) {
   const EyePassParams& prm = path.prm;
-  BackwardPhoton bp = backward_photon_at(v, s, prm, path.pixel, depth, diffuse, accepts);
+  BackwardPhoton bp =
+      backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
   if (bp.radius <= 0 || s.beta.is_black()) return false;
   const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
   bool probed_whole = false;
@@ -99,12 +101,11 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
     if (last) store(kAcceptsIndirect, false);
   } else if (!last) {
     store(kAcceptsCaustic, false);
-  } else if (diffuse > 1 || prm.world_radius > 0 ||
-             prm.radius_per_length0 == prm.radius_per_length1) {
+  } else if (diffuse > 1 || prm.world_radius > 0 || prm.k0 == prm.k1) {
     store(kAcceptsCaustic | kAcceptsIndirect, false);
   } else {
     const bool whole = store(kAcceptsIndirect, false);  // r1 > r0: the larger disc first
-    store(kAcceptsCaustic, whole && prm.radius_per_length0 < prm.radius_per_length1);
+    store(kAcceptsCaustic, whole && prm.k0 < prm.k1);
   }
 }
 
@@ -154,10 +155,11 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
 // Out of line: GCC 12 would inline the whole path, its steps included, into the eye pass's pixel
 // loop, which then runs 1.2% more instructions (callgrind, caustic-sphere).
 [[gnu::noinline]] EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& prm,
-                                             Ray ray, uint32_t pixel, Rng& rng,
-                                             ObjectPhotonLists& out, EyeCounters& counters,
-                                             bool emission_only, uint8_t near_edge) {
-  const EyePath path{scene, prm, pixel, near_edge, rng, out, counters};
+                                             Ray ray, PixelFootprint footprint, uint32_t pixel,
+                                             Rng& rng, ObjectPhotonLists& out,
+                                             EyeCounters& counters, bool emission_only,
+                                             uint8_t near_edge) {
+  const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters};
   PathState s{ray};
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
@@ -215,7 +217,8 @@ Spectrum mean_emission(const RenderScene& scene, const EyePassParams& prm,
   const uint64_t rays_before = ec.rays.total();
   for (int k = 1; k < count; ++k) {
     CameraSample cs = camera.sample(pass_index, pixel, uint32_t(k));
-    EyeRadiance e = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, true);
+    EyeRadiance e =
+        trace_eye_path(scene, prm, cs.ray, cs.footprint, pixel, cs.rng, lists, ec, true);
     const Spectrum v = e.emission * (cs.filter_weight / first_weight);
     if (stats) stats->add_emission(v.average());
     sum += v;
@@ -269,8 +272,9 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             }
             ++ec.pixels;
             CameraSample cs = camera.sample(pass_index, pixel);
-            EyeRadiance r = trace_eye_path(scene, prm, cs.ray, pixel, cs.rng, lists, ec, false,
-                                           prm.near_edges ? prm.near_edges->at(pixel) : 3);
+            EyeRadiance r =
+                trace_eye_path(scene, prm, cs.ray, cs.footprint, pixel, cs.rng, lists, ec, false,
+                               prm.near_edges ? prm.near_edges->at(pixel) : 3);
             px->filter_weight[pixel] = cs.filter_weight;
             const Spectrum emission =
                 mean_emission(scene, prm, camera, pass_index, pixel,

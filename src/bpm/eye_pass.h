@@ -26,8 +26,9 @@ struct EyePassParams {
   const WavelengthMaterials* materials = nullptr;  // this iteration's wavelengths
   int diffuse_depth = 1;
   int max_depth = 5;
-  // Radius per unit of eye path length: k * sqrt(pixel solid angle) * radius_scale(iteration).
-  float radius_per_length0 = 0, radius_per_length1 = 0;
+  // Radii in pixel footprints (the camera ray's PixelFootprint at the vertex's path length):
+  // k0 and k1 times radius_scale(iteration).
+  float k0 = 0, k1 = 0;
   // At most this many camera samples per iteration for emission seen before the first diffuse
   // vertex (emitter edges, lights behind glass): cheap paths that end at that vertex, averaged
   // with the full path's share. Each pixel takes EyePixels::emission_samples of them.
@@ -71,11 +72,13 @@ struct EyeRadiance {
 };
 
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
-// appends the path's backward photons to out[object]. With emission_only the path ends at its
-// first diffuse vertex and stores nothing: only `emission` is computed. near_edge: the pixel's
-// mark_near_edges bits, which decide whether a first vertex seen directly probes its discs.
+// appends the path's backward photons to out[object] (radii: k0 or k1 footprints). With
+// emission_only the path ends at its first diffuse vertex and stores nothing: only `emission` is
+// computed. near_edge: the pixel's mark_near_edges bits, which decide whether a first vertex seen
+// directly probes its discs.
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
-                           uint32_t pixel, Rng& rng, ObjectPhotonLists& out, EyeCounters& counters,
+                           PixelFootprint footprint, uint32_t pixel, Rng& rng,
+                           ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only = false, uint8_t near_edge = 3);
 
 // A pixel's samples of emission seen before the first diffuse vertex (per camera sample), and of

@@ -1,13 +1,26 @@
 #include "camera/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "base/sampling.h"
 
 namespace bpm {
+namespace {
 
-PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, const Raster& r)
+// The solid angle of the equirectangular row of pixels about raster y (of `height` rows), per
+// pixel of a `width`-wide row.
+float equirectangular_pixel_solid_angle(float y, int width, int height) {
+  const float row = std::clamp(std::floor(y), 0.0f, float(height - 1));
+  const float t0 = kPi * row / float(height), t1 = kPi * (row + 1) / float(height);
+  return 2 * kPi / float(width) * (std::cos(t0) - std::cos(t1));
+}
+
+}  // namespace
+
+Camera::Camera(const CameraSettings& s, const Raster& r)
     : world_from_camera_(s.world_from_camera),
+      projection_(s.projection),
       lens_radius_(s.lens_radius),
       focal_distance_(s.focal_distance),
       width_(r.full_width),
@@ -15,7 +28,8 @@ PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, const Raster& r)
       crop_x0_(float(r.x0)),
       crop_y0_(float(r.y0)) {
   const int width = r.full_width, height = r.full_height;
-  float aspect = float(width) / float(height);
+  const float aspect =
+      s.frame_aspect_ratio > 0 ? s.frame_aspect_ratio : float(width) / float(height);
   if (s.screen_window[0] == 0 && s.screen_window[1] == 0 && s.screen_window[2] == 0 &&
       s.screen_window[3] == 0) {
     if (aspect > 1) {
@@ -28,23 +42,88 @@ PerspectiveCamera::PerspectiveCamera(const CameraSettings& s, const Raster& r)
     y1_ = s.screen_window[3];
   }
   tan_half_ = std::tan(s.fov_degrees * kPi / 360);
-  float px = (x1_ - x0_) / width * tan_half_, py = (y1_ - y0_) / height * tan_half_;
-  pixel_solid_angle_ = px * py;
+  const float dx = std::fabs(x1_ - x0_) / float(width), dy = std::fabs(y1_ - y0_) / float(height);
+  switch (projection_) {
+    case Projection::kPerspective:
+      pixel_angle_ = std::sqrt(dx * tan_half_ * dy * tan_half_);
+      break;
+    case Projection::kOrthographic:
+      pixel_width_ = std::sqrt(length(world_from_camera_.vector(Vec3(dx, 0, 0))) *
+                               length(world_from_camera_.vector(Vec3(0, dy, 0))));
+      break;
+    case Projection::kSphericalEqualArea:
+      pixel_angle_ = std::sqrt(4 * kPi / (float(width) * float(height)));
+      break;
+    case Projection::kSphericalEquirectangular:
+      break;  // per row
+  }
 }
 
-Ray PerspectiveCamera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
-  float sx = x0_ + (p.x / width_) * (x1_ - x0_);
-  float sy = y1_ - (p.y / height_) * (y1_ - y0_);
-  Vec3 dir = normalize(Vec3(sx * tan_half_, sy * tan_half_, 1));
-  Vec3 origin(0, 0, 0);
+// pbrt-v4's spherical directions, with its y and z swapped: +y up.
+Vec3 Camera::camera_direction(Vec2 p) const {
+  Vec2 uv{p.x / float(width_), p.y / float(height_)};
+  Vec3 d;
+  if (projection_ == Projection::kSphericalEquirectangular) {
+    const float theta = kPi * uv.y, phi = 2 * kPi * uv.x;
+    d = Vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+  } else {
+    d = equal_area_square_to_sphere(wrap_equal_area_square(uv));
+  }
+  return Vec3(d.x, d.z, d.y);
+}
+
+Ray Camera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
+  if (projection_ == Projection::kSphericalEqualArea ||
+      projection_ == Projection::kSphericalEquirectangular)
+    return Ray{world_from_camera_.point(Vec3(0, 0, 0)),
+               normalize(world_from_camera_.vector(camera_direction(p))), kInf};
+  const float sx = x0_ + (p.x / float(width_)) * (x1_ - x0_);
+  const float sy = y1_ - (p.y / float(height_)) * (y1_ - y0_);
+  Vec3 origin(0, 0, 0), dir;
+  if (projection_ == Projection::kOrthographic) {
+    origin = Vec3(sx, sy, 0);
+    dir = Vec3(0, 0, 1);
+  } else {
+    dir = normalize(Vec3(sx * tan_half_, sy * tan_half_, 1));
+  }
   if (lens_radius_ > 0) {
-    Vec2 l = sample_uniform_disk_concentric(u_lens);
-    Vec3 p_lens(l.x * lens_radius_, l.y * lens_radius_, 0);
-    Vec3 p_focus = dir * (focal_distance_ / dir.z);
+    // As pbrt-v4: the lens is about the camera's origin for both projections.
+    const Vec2 l = sample_uniform_disk_concentric(u_lens);
+    const Vec3 p_lens(l.x * lens_radius_, l.y * lens_radius_, 0);
+    const Vec3 p_focus = origin + dir * (focal_distance_ / dir.z);
     origin = p_lens;
     dir = normalize(p_focus - p_lens);
   }
   return Ray{world_from_camera_.point(origin), normalize(world_from_camera_.vector(dir)), kInf};
+}
+
+PixelFootprint Camera::footprint(Vec2 p_full) const {
+  switch (projection_) {
+    case Projection::kOrthographic:
+      return {pixel_width_, 0};
+    case Projection::kSphericalEquirectangular:
+      return {0, std::sqrt(equirectangular_pixel_solid_angle(p_full.y, width_, height_))};
+    default:
+      return {0, pixel_angle_};
+  }
+}
+
+float Camera::footprint_at(Vec3 p) const {
+  const Vec3 o = world_from_camera_.point(Vec3(0, 0, 0));
+  const float distance = length(p - o);
+  switch (projection_) {
+    case Projection::kOrthographic:
+      return pixel_width_;
+    case Projection::kSphericalEquirectangular: {
+      if (!(distance > 0)) return 0;
+      const Vec3 d = world_from_camera_.inverse().vector(p - o);
+      const float theta = std::acos(std::clamp(d.y / length(d), -1.0f, 1.0f));
+      const float y = theta / kPi * float(height_);
+      return std::sqrt(equirectangular_pixel_solid_angle(y, width_, height_)) * distance;
+    }
+    default:
+      return pixel_angle_ * distance;
+  }
 }
 
 }  // namespace bpm

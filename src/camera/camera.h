@@ -1,16 +1,26 @@
-// pbrt-v4's perspective camera: the fov spans the shorter image axis, raster y grows downward,
-// and camera space looks down +z with +x to the right of the image.
+// pbrt-v4's cameras: perspective, orthographic and spherical. Raster y grows downward, and camera
+// space looks down +z with +x to the right of the image (the spherical cameras: +y is up; the
+// equirectangular image's left edge looks down +x, a quarter across down +z).
 #pragma once
 #include "base/ray.h"
 #include "base/transform.h"
 
 namespace bpm {
 
+enum class Projection {
+  kPerspective,
+  kOrthographic,
+  kSphericalEqualArea,       // pbrt-v4's default "spherical" mapping: an octahedral map
+  kSphericalEquirectangular  // latitude (rows) and longitude (columns)
+};
+
 struct CameraSettings {
   Transform world_from_camera;
+  Projection projection = Projection::kPerspective;
   float fov_degrees = 90;
   float lens_radius = 0;
   float focal_distance = 1e6f;
+  float frame_aspect_ratio = 0;           // 0: the raster's
   float screen_window[4] = {0, 0, 0, 0};  // x0 x1 y0 y1; all zero means pbrt-v4's default
 };
 
@@ -20,11 +30,20 @@ struct Raster {
   int width = 0, height = 0, full_width = 0, full_height = 0, x0 = 0, y0 = 0;
 };
 
-class PerspectiveCamera {
+// The footprint of one pixel along its camera ray: `width` across at the camera, growing by
+// `spread` per unit of distance (a pinhole's pixel has no width and spreads by its angle, an
+// orthographic one keeps its width). A flat specular surface keeps the pencil growing the same,
+// so at eye path length l the footprint is width + spread * l (world units).
+struct PixelFootprint {
+  float width = 0, spread = 0;
+  float at(float length) const { return width + spread * length; }
+};
+
+class Camera {
  public:
-  PerspectiveCamera(const CameraSettings& s, const Raster& raster);
-  PerspectiveCamera(const CameraSettings& s, int width, int height)
-      : PerspectiveCamera(s, Raster{width, height, width, height, 0, 0}) {}
+  Camera(const CameraSettings& s, const Raster& raster);
+  Camera(const CameraSettings& s, int width, int height)
+      : Camera(s, Raster{width, height, width, height, 0, 0}) {}
   // p_raster in pixels of the image rendered ((0,0) is the top-left corner of the crop); u_lens in
   // [0,1)^2.
   Ray generate_ray(Vec2 p_raster, Vec2 u_lens) const {
@@ -32,18 +51,24 @@ class PerspectiveCamera {
   }
   // The same with p in pixels of the full raster.
   Ray generate_ray_full(Vec2 p_full, Vec2 u_lens) const;
-  Vec3 position() const { return world_from_camera_.point(Vec3(0, 0, 0)); }
-  // Solid angle one pixel subtends at the image centre (steradians).
-  float pixel_solid_angle() const { return pixel_solid_angle_; }
+  // The footprint of the pixel about p_full (pixels of the full raster). Perspective: the
+  // angle the image centre's pixel subtends, for every pixel (lens ignored).
+  PixelFootprint footprint(Vec2 p_full) const;
+  // The width of a pixel's footprint at world point p seen directly.
+  float footprint_at(Vec3 p) const;
+  Projection projection() const { return projection_; }
 
  private:
+  Vec3 camera_direction(Vec2 p_full) const;  // spherical cameras
   Transform world_from_camera_;
+  Projection projection_;
   float lens_radius_, focal_distance_;
   float x0_, x1_, y0_, y1_;  // screen window
   float tan_half_;
   int width_, height_;  // the full raster
   float crop_x0_, crop_y0_;
-  float pixel_solid_angle_;
+  float pixel_angle_ = 0;  // sqrt of the pixel's solid angle (perspective, equal-area)
+  float pixel_width_ = 0;  // sqrt of the pixel's area in world units (orthographic)
 };
 
 }  // namespace bpm

@@ -66,6 +66,7 @@ struct FpmPath {
   const RenderScene& scene;
   const ForwardMaps& maps;
   const FpmEyeParams& prm;
+  PixelFootprint footprint;
   Rng& rng;
   FpmEyeCounters& c;
   uint8_t near_edge;
@@ -106,7 +107,8 @@ inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, c
     L += s.beta * e.L;
     bias += s.beta * e.bias;
   };
-  float r1 = s.length * prm.radius_per_length1;
+  const float footprint = path.footprint.at(s.length);
+  const float r1 = footprint * prm.k1;
   if (gathering) {
     // x2: everything the global map holds, direct photons included.
     gather(path.maps.global, r1, 1, any_class);
@@ -120,11 +122,11 @@ inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, c
   // the caustic map's is too. The path ends here: its BSDF sample only looks for the light.
   if (!prm.fpm->final_gather) {
     gather(path.maps.global, r1, 1, indirect_class);
-    gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+    gather(path.maps.caustic, footprint * prm.k0, 2, caustic_class);
     L += direct_light_by_bsdf(path.scene, *prm.materials, v, s, choice.part, path.rng, path.c.rays);
     return true;
   }
-  gather(path.maps.caustic, s.length * prm.radius_per_length0, 2, caustic_class);
+  gather(path.maps.caustic, footprint * prm.k0, 2, caustic_class);
   gathering = true;
   return false;
 }
@@ -154,9 +156,9 @@ inline bool scatter(const FpmPath& path, const PathVertex& v, const EyeVertexCho
 }  // namespace
 
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                                const FpmEyeParams& prm, Ray ray, Rng& rng, FpmEyeCounters& c,
-                                uint8_t near_edge) {
-  const FpmPath path{scene, maps, prm, rng, c, near_edge};
+                                const FpmEyeParams& prm, Ray ray, PixelFootprint footprint,
+                                Rng& rng, FpmEyeCounters& c, uint8_t near_edge) {
+  const FpmPath path{scene, maps, prm, footprint, rng, c, near_edge};
   PathState s{ray};
   Spectrum L, bias;
   int depth = 0;

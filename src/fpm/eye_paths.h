@@ -15,8 +15,8 @@ struct FpmEyeParams {
   const WavelengthMaterials* materials;  // this iteration's wavelengths
   const FpmSettings* fpm;
   int max_depth;
-  float radius_per_length0, radius_per_length1;  // per unit of eye path length
-  double emitted;                                // photons emitted, N of eq. (2)
+  float k0, k1;    // radii in pixel footprints (PixelFootprint at the vertex's path length)
+  double emitted;  // photons emitted, N of eq. (2)
 };
 
 struct FpmEyeCounters {
@@ -37,7 +37,7 @@ struct FpmEyeRadiance {
   Spectrum L, bias;
 };
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                                const FpmEyeParams& params, Ray ray, Rng& rng,
-                                FpmEyeCounters& counters, uint8_t near_edge = 3);
+                                const FpmEyeParams& params, Ray ray, PixelFootprint footprint,
+                                Rng& rng, FpmEyeCounters& counters, uint8_t near_edge = 3);
 
 }  // namespace bpm

@@ -94,7 +94,6 @@ class FpmRender {
   FpmSettings s_;  // photons_per_iteration as reserve_memory fitted it
   Film* film_;
   const CameraSampler camera_;
-  const float pixel_angle_;
   const int min_eye_vertices_;
   const uint64_t n_photons_;
   // Disc probes at vertices seen directly near edges only (photons/disc_probes.h).
@@ -127,13 +126,11 @@ FpmRender::FpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       s_(checked_settings(settings, size_t(film->width()) * size_t(film->height()))),
       film_(film),
       camera_(ls.camera, ls.filter, ls.film.raster_for(film->width(), film->height()), opt.seed),
-      pixel_angle_(std::sqrt(camera_.camera().pixel_solid_angle())),
       min_eye_vertices_(s_.final_gather ? 2 : 1),
       n_photons_(reserve_memory(settings)),
       near_edges_(s_.disc_probes, scene_, camera_.camera(), film->width(), film->height(),
                   ls.filter.radius),
-      sensors_(
-          make_sensor_discs(scene_, opt.sensors, camera_.camera().position(), pixel_angle_, s_)),
+      sensors_(make_sensor_discs(scene_, opt.sensors, camera_.camera(), s_)),
       sensor_sums_(opt.sensors.size()) {}
 
 // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
@@ -221,15 +218,10 @@ void FpmRender::eye_pass(const WavelengthMaterials& wm, int pass, int it,
   const auto t = Clock::now();
   float scale = radius_scale(s_, it);
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
-  FpmEyeParams ep{&wm,
-                  &s_,
-                  opt_.max_depth,
-                  s_.k0 * pixel_angle_ * scale,
-                  s_.k1 * pixel_angle_ * scale,
-                  double(emitted_)};
+  FpmEyeParams ep{&wm, &s_, opt_.max_depth, s_.k0 * scale, s_.k1 * scale, double(emitted_)};
   for_each_sampled_pixel(film_->width(), film_->height(), control, pass, [&](uint32_t pixel) {
     CameraSample cs = camera_.sample(it, pixel);
-    const FpmEyeRadiance r = fpm_eye_radiance(scene_, maps_, ep, cs.ray, cs.rng,
+    const FpmEyeRadiance r = fpm_eye_radiance(scene_, maps_, ep, cs.ray, cs.footprint, cs.rng,
                                               eye_counters_.local(), near_edges_.at(pixel));
     record(pixel, r, cs, wm);
   });

@@ -60,11 +60,13 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
                 const PassFunction& pass, RenderStats* stats, const IntegratorState& state = {});
 
 // One pixel sample: its random stream, keyed by (seed, pass index, pixel), which has already
-// drawn the filter offset and the lens position; the camera ray; the filter weight.
+// drawn the filter offset and the lens position; the camera ray and the pixel's footprint along
+// it; the filter weight.
 struct CameraSample {
   Rng rng;
   Ray ray;
   float filter_weight;
+  PixelFootprint footprint;
 };
 
 class CameraSampler {
@@ -87,12 +89,12 @@ class CameraSampler {
     Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
     Vec2 u_lens{rng.uniform(), rng.uniform()};
     Ray ray = camera_.generate_ray_full(p_film, u_lens);
-    return {rng, ray, fs.weight};
+    return {rng, ray, fs.weight, camera_.footprint(p_film)};
   }
-  const PerspectiveCamera& camera() const { return camera_; }
+  const Camera& camera() const { return camera_; }
 
  private:
-  PerspectiveCamera camera_;
+  Camera camera_;
   Filter filter_;
   Raster raster_;
   uint64_t seed_;

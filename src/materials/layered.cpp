@@ -76,7 +76,7 @@ struct Layer {
   // does not split: it is seen whole.
   bool coat = true, walks = true;
   Layer(const CoatLayer& c, Material base_material, BsdfPart part)
-      : top{c.eta, c.roughness, nullptr},
+      : top{c.eta, c.roughness, nullptr, {}},
         base(std::move(base_material)),
         thickness(c.thickness),
         max_depth(c.max_depth),
@@ -456,7 +456,7 @@ std::shared_ptr<const CoatWalkTable> make_coat_walk_table(const CoatLayer& layer
   auto t = std::make_shared<CoatWalkTable>();
   t->layer = layer;
   t->visits = std::max(0, (layer.max_depth + 1) / 2);
-  const DielectricMaterial top{layer.eta, layer.roughness, nullptr};
+  const DielectricMaterial top{layer.eta, layer.roughness, nullptr, {}};
   const bool smooth = top.roughness.effectively_smooth();
   // Radiance transport. In importance transport the way in loses its 1 / eta^2 and the way out
   // gains it: the product, a reflection's f, is the same.

@@ -385,8 +385,8 @@ std::vector<uint8_t> spread(const std::vector<uint8_t>& edge, int w, int h, int 
 
 }  // namespace
 
-std::vector<uint8_t> find_edges(const RenderScene& scene, const PerspectiveCamera& camera,
-                                int width, int height) {
+std::vector<uint8_t> find_edges(const RenderScene& scene, const Camera& camera, int width,
+                                int height) {
   const size_t w = size_t(width), h = size_t(height);
   std::vector<FirstVertex> first(w * h);
   tbb::parallel_for(size_t(0), h, [&](size_t y) {
@@ -422,8 +422,8 @@ void mark_near_edges(const std::vector<uint8_t>& edges, int width, int height, i
   for (size_t p = 0; p < edges.size(); ++p) (*near)[p] = uint8_t(near1[p] | (near0[p] << 1));
 }
 
-NearEdges::NearEdges(bool enabled, const RenderScene& scene, const PerspectiveCamera& camera,
-                     int width, int height, Vec2 filter_radius)
+NearEdges::NearEdges(bool enabled, const RenderScene& scene, const Camera& camera, int width,
+                     int height, Vec2 filter_radius)
     : width_(width),
       height_(height),
       reach_(std::fmax(0.5f, std::fmax(filter_radius.x, filter_radius.y))) {

@@ -76,8 +76,8 @@ inline float disc_share(uint8_t found, uint8_t cut, int nested) {
 // Per pixel, whether the surface seen through its centre meets another there or nearby: a change
 // of object between neighbours, a crease, a step off the plane, or no surface (the sky, an
 // interface-only path), from one camera ray per pixel.
-std::vector<uint8_t> find_edges(const RenderScene& scene, const PerspectiveCamera& camera,
-                                int width, int height);
+std::vector<uint8_t> find_edges(const RenderScene& scene, const Camera& camera, int width,
+                                int height);
 
 // Per pixel, bit 0: some cut of the large disc is possible, bit 1: of the small one; that is, an
 // edge pixel (find_edges) or the image's border lies within radius_px1 or radius_px0 pixels (the
@@ -92,8 +92,8 @@ class NearEdges {
  public:
   // Not enabled (no probes, or radii in world units, whose sizes on screen are unknown): no
   // marks are made, and every disc may be cut. filter_radius: the pixel filter's, in pixels.
-  NearEdges(bool enabled, const RenderScene& scene, const PerspectiveCamera& camera, int width,
-            int height, Vec2 filter_radius);
+  NearEdges(bool enabled, const RenderScene& scene, const Camera& camera, int width, int height,
+            Vec2 filter_radius);
   // Marks the pixels for discs of radius_px0 and radius_px1 pixels (the iteration's k0 and k1
   // times its radius scale); nothing to do when the rounded sizes have not changed.
   void mark(float radius_px0, float radius_px1);

@@ -220,7 +220,7 @@ TEST(DiscProbes, FindsEdgesAndMarksPixelsNearThem) {
       " 5 0 -5]\n"
       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-1.2 0.5 -0.3  -1.2 "
       "0.5 0.3  -0.8 0.5 0.3  -0.8 0.5 -0.3]\n"));
-  const PerspectiveCamera camera(ls.camera, w, h);
+  const Camera camera(ls.camera, w, h);
   const std::vector<uint8_t> edges = find_edges(ls.scene, camera, w, h);
   ASSERT_EQ(edges.size(), size_t(w * h));
   auto edge = [&](int x, int y) { return edges[size_t(y * w + x)]; };

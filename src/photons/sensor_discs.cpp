@@ -161,12 +161,13 @@ void SensorDiscs::cross(const RenderScene& scene, const Wavelengths& wl, const P
 }
 
 std::unique_ptr<SensorDiscs> make_sensor_discs(const RenderScene& scene,
-                                               const std::vector<Sensor>& sensors, Vec3 camera,
-                                               float pixel_angle, const PhotonSettings& settings) {
+                                               const std::vector<Sensor>& sensors,
+                                               const Camera& camera,
+                                               const PhotonSettings& settings) {
   if (sensors.empty()) return nullptr;
   std::vector<float> r(sensors.size());
   for (size_t i = 0; i < sensors.size(); ++i) {
-    float footprint = settings.k1 * pixel_angle * length(sensors[i].p - camera);
+    float footprint = settings.k1 * camera.footprint_at(sensors[i].p);
     if (sensors[i].cell > 0) footprint = std::min(footprint, 0.5f * sensors[i].cell);
     r[i] = std::max(footprint, 1e-6f * scene.bounds_info.radius);
   }

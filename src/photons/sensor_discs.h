@@ -23,6 +23,7 @@
 #include <memory>
 #include <vector>
 
+#include "camera/camera.h"
 #include "film/film.h"
 #include "integrator/sensors.h"
 #include "photons/light_path.h"
@@ -91,11 +92,12 @@ struct SensorSegments {
 };
 
 // The sensors of a render (none: null), with the first iteration's radii (see the top of this
-// file): k1 footprints of angle pixel_angle at the distance from `camera`, at most half a grid
+// file): k1 footprints of a pixel of `camera` seen directly, at most half a grid
 // cell; at least a millionth of the scene's bounding radius.
 std::unique_ptr<SensorDiscs> make_sensor_discs(const RenderScene& scene,
-                                               const std::vector<Sensor>& sensors, Vec3 camera,
-                                               float pixel_angle, const PhotonSettings& settings);
+                                               const std::vector<Sensor>& sensors,
+                                               const Camera& camera,
+                                               const PhotonSettings& settings);
 
 // One iteration of the sensors: the photons' crossings summed per sensor in a fixed order, then
 // with each sensor's direct light added to the film as that iteration's estimate and bias.

@@ -19,21 +19,50 @@ void Flattener::read_camera(LoadedScene* out) {
   if (!c.medium.outside.empty())
     throw Error(c.medium.loc,
                 "a camera inside a medium (\"" + c.medium.outside + "\") is not supported");
-  if (c.name != "perspective")
-    throw Error(c.loc, "camera \"" + c.name + "\" is not supported (only perspective)");
-  out->camera.world_from_camera = c.camera_from_world.inverse();
-  out->camera.fov_degrees = c.params.get_float("fov", 90);
-  if (!(out->camera.fov_degrees > 0 && out->camera.fov_degrees < 180))
-    throw Error(c.loc, "fov must lie in (0, 180) degrees");
-  out->camera.lens_radius = c.params.get_float("lensradius", 0);
-  out->camera.focal_distance = c.params.get_float("focaldistance", 1e6f);
-  if (out->camera.lens_radius < 0) throw Error(c.loc, "lensradius must not be negative");
-  if (!(out->camera.focal_distance > 0)) throw Error(c.loc, "focaldistance must be positive");
+  CameraSettings& cam = out->camera;
+  cam.world_from_camera = c.camera_from_world.inverse();
+  if (c.name == "perspective" || c.name == "orthographic") {
+    cam.projection = c.name == "perspective" ? Projection::kPerspective : Projection::kOrthographic;
+    if (c.name == "perspective") {
+      cam.fov_degrees = c.params.get_float("fov", 90);
+      if (!(cam.fov_degrees > 0 && cam.fov_degrees < 180))
+        throw Error(c.loc, "fov must lie in (0, 180) degrees");
+    }
+    cam.lens_radius = c.params.get_float("lensradius", 0);
+    cam.focal_distance = c.params.get_float("focaldistance", 1e6f);
+    if (!(cam.lens_radius >= 0)) throw Error(c.loc, "lensradius must not be negative");
+    if (!(cam.focal_distance > 0)) throw Error(c.loc, "focaldistance must be positive");
+  } else if (c.name == "spherical") {
+    const std::string mapping = c.params.get_string("mapping", "equalarea");
+    if (mapping == "equalarea")
+      cam.projection = Projection::kSphericalEqualArea;
+    else if (mapping == "equirectangular")
+      cam.projection = Projection::kSphericalEquirectangular;
+    else
+      throw Error(
+          c.params.find_any("mapping")->loc,
+          "spherical camera mapping \"" + mapping + "\" is unknown (equalarea, equirectangular)");
+    // pbrt-v4 reads a lens and focus for every camera; a spherical one has no use for them.
+    c.params.get_float("lensradius", 0);
+    c.params.get_float("focaldistance", 1e30f);
+  } else if (c.name == "realistic") {
+    throw Error(c.loc,
+                "camera \"realistic\" is not supported (perspective, orthographic, "
+                "spherical)");
+  } else {
+    throw Error(c.loc, "camera \"" + c.name +
+                           "\" is unknown (perspective, orthographic, spherical, realistic)");
+  }
+  cam.frame_aspect_ratio = c.params.get_float("frameaspectratio", 0);
+  if (c.params.find_any("frameaspectratio") && !(cam.frame_aspect_ratio > 0))
+    throw Error(c.params.find_any("frameaspectratio")->loc, "frameaspectratio must be positive");
   auto sw = c.params.get_floats("screenwindow");
   if (!sw.empty()) {
     if (sw.size() != 4)
       throw Error(c.params.find_any("screenwindow")->loc, "screenwindow needs 4 values");
-    for (int i = 0; i < 4; ++i) out->camera.screen_window[i] = sw[i];
+    if (!(sw[0] != sw[1] && sw[2] != sw[3]))
+      throw Error(c.params.find_any("screenwindow")->loc, "screenwindow is empty");
+    for (int i = 0; i < 4; ++i) cam.screen_window[i] = sw[size_t(i)];
   }
   float open = c.params.get_float("shutteropen", 0), close = c.params.get_float("shutterclose", 1);
   if (close < open) throw Error(c.loc, "shutterclose is before shutteropen");

@@ -1770,8 +1770,21 @@ TEST(SceneFlattenError, UnsupportedAreaLight) {
 }
 
 TEST(SceneFlattenError, UnknownCameraType) {
-  EXPECT_TRUE(IsError(error_of("Camera \"orthographic\"\nWorldBegin\n"), at(1, 1),
-                      "camera \"orthographic\" is not supported"));
+  EXPECT_TRUE(IsError(error_of("Camera \"fisheye\"\nWorldBegin\n"), at(1, 1),
+                      "camera \"fisheye\" is unknown (perspective, orthographic, spherical, "
+                      "realistic)"));
+}
+
+TEST(SceneFlattenError, BadCameraParameters) {
+  const std::string mapping = R"(Camera "spherical" "string mapping" "cube")";
+  EXPECT_TRUE(IsError(error_of(mapping + "\nWorldBegin\n"), at(1, col(mapping, "\"string")),
+                      "spherical camera mapping \"cube\" is unknown (equalarea, equirectangular)"));
+  const std::string aspect = R"(Camera "orthographic" "float frameaspectratio" -1)";
+  EXPECT_TRUE(IsError(error_of(aspect + "\nWorldBegin\n"), at(1, col(aspect, "\"float")),
+                      "frameaspectratio must be positive"));
+  const std::string window = R"(Camera "orthographic" "float screenwindow" [1 1 -1 1])";
+  EXPECT_TRUE(IsError(error_of(window + "\nWorldBegin\n"), at(1, col(window, "\"float")),
+                      "screenwindow is empty"));
 }
 
 TEST(SceneFlattenError, FovOutOfRange) {
