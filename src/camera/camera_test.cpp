@@ -74,7 +74,8 @@ TEST(Camera, EqualAreaPixelsSubtendEqualSolidAngles) {
     EXPECT_NEAR(bands[b], kN / 4, 5 * 194) << "band " << b;
   }
   for (float t : {3.3f, 17.0f, 31.9f}) {
-    const Vec3 a = camera.generate_ray({-0.01f, t}, {}).d, b = camera.generate_ray({0.01f, t}, {}).d;
+    const Vec3 a = camera.generate_ray({-0.01f, t}, {}).d,
+               b = camera.generate_ray({0.01f, t}, {}).d;
     const Vec3 c = camera.generate_ray({t, kH + 0.01f}, {}).d,
                e = camera.generate_ray({t, kH - 0.01f}, {}).d;
     EXPECT_LT(length(a - b), 0.01f) << t;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "scene/flatten.h"
+#include "scene/ply.h"
 
 namespace bpm::flatten_internal {
 
@@ -98,6 +99,8 @@ class Flattener {
   TriangleMesh mesh_shape(const ShapeEntity& s, bool flip);
   TriangleMesh loopsubdiv_shape(const ShapeEntity& s, bool flip);
   TriangleMesh plymesh_shape(const ShapeEntity& s, bool flip);
+  void displace_ply(const ParamSet& ps, const Param& displacement, float edge_length,
+                    const ShapeEntity& s, PlyMesh* ply);
   static Sphere sphere_shape(const ShapeEntity& s, bool flip);
   static Disk disk_shape(const ShapeEntity& s, bool flip);
   static Cylinder cylinder_shape(const ShapeEntity& s, bool flip);

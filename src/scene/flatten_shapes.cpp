@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "scene/displace.h"
 #include "scene/flatten_internal.h"
 #include "scene/loop_subdivision.h"
 #include "scene/ply.h"
@@ -139,12 +140,33 @@ TriangleMesh Flattener::plymesh_shape(const ShapeEntity& s, bool flip) {
   const ParamSet& ps = s.params;
   std::string file = ps.get_string("filename", "");
   if (file.empty()) throw Error(s.loc, "plymesh has no \"string filename\"");
-  if (auto* d = ps.find_any("displacement")) throw Error(d->loc, "displacement is not supported");
-  ps.get_float("edgelength", 1);
+  const float edge_length = ps.get_float("edgelength", 1);
   fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(s.directory) / file;
   read_data_file(path.string());
   PlyMesh ply = read_ply(path.string(), ps.find_any("filename")->loc);
+  if (const Param* d = ps.find_any("displacement")) displace_ply(ps, *d, edge_length, s, &ply);
   return mesh_from(s.world_from_object, flip, ply.positions, ply.normals, ply.uvs, ply.indices);
+}
+
+// pbrt-v4's displacement of a "plymesh" (scene/displace.h) by a float texture or value.
+void Flattener::displace_ply(const ParamSet& ps, const Param& displacement, float edge_length,
+                             const ShapeEntity& s, PlyMesh* ply) {
+  const Param* e = ps.find_any("edgelength");
+  if (!(edge_length > 0) || !std::isfinite(edge_length))
+    throw Error(e ? e->loc : displacement.loc, "edgelength must be positive");
+  if (ply->uvs.size() != ply->positions.size())
+    throw Error(displacement.loc, "displacement needs the PLY file's per-vertex uv");
+  constexpr size_t kMaxTriangles = size_t(1) << 27;
+  const size_t n = displaced_triangle_count(*ply, s.world_from_object, edge_length);
+  if (n > kMaxTriangles)
+    throw Error(e ? e->loc : displacement.loc, "edgelength would split the mesh into about " +
+                                                   std::to_string(n) + " triangles (at most " +
+                                                   std::to_string(kMaxTriangles) + ")");
+  const FloatParam f = float_or_texture(ps, "displacement", 0);
+  const TextureSet& textures = scene_->textures;
+  displace_mesh(ply, s.world_from_object, edge_length, [&](Vec3 p, Vec2 uv) {
+    return f.textured() ? textures.value(f.texture, TextureContext{p, uv}) : f.value;
+  });
 }
 
 Sphere Flattener::sphere_shape(const ShapeEntity& s, bool flip) {

@@ -1511,6 +1511,40 @@ TEST(SceneFlattenError, PlymeshTruncatedBinary) {
   EXPECT_TRUE(Contains(msg, "cut.ply\""));
 }
 
+// A quad with uv (0..1) in the xy plane: "displacement" lifts it along +z by the value; bad
+// edge lengths and a file without uv get located errors.
+TEST(SceneFlatten, DisplacedPlymesh) {
+  TempDir dir;
+  dir.write("uvquad.ply",
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nproperty float u\nproperty float v\nelement face 1\n"
+            "property list uchar int vertex_indices\nend_header\n"
+            "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n");
+  dir.write("quad.ply", kAsciiQuadPly);
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nTexture \"d\" \"float\" \"scale\" \"float tex\" 0.5 \"float scale\" 0.5\n"
+      "Shape \"plymesh\" \"string filename\" \"uvquad.ply\" \"texture displacement\" \"d\" "
+      "\"float edgelength\" 0.3\n",
+      dir.str()));
+  const TriangleMesh& m = std::get<TriangleMesh>(ls.scene.objects[0].shape);
+  EXPECT_GT(m.triangle_count(), 20);
+  for (const Vec3& p : m.positions) EXPECT_NEAR(p.z, 0.25f, 1e-6f);
+  const std::string zero =
+      R"(Shape "plymesh" "string filename" "uvquad.ply" "float displacement" 1 "float edgelength" 0)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + zero + "\n", dir.str()),
+                      at(2, col(zero, "\"float edgelength")), "edgelength must be positive"));
+  const std::string tiny =
+      R"(Shape "plymesh" "string filename" "uvquad.ply" "float displacement" 1 "float edgelength" 1e-5)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + tiny + "\n", dir.str()),
+                      at(2, col(tiny, "\"float edgelength")),
+                      "edgelength would split the mesh into about"));
+  const std::string no_uv =
+      R"(Shape "plymesh" "string filename" "quad.ply" "float displacement" 1)";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + no_uv + "\n", dir.str()),
+                      at(2, col(no_uv, "\"float displacement")),
+                      "displacement needs the PLY file's per-vertex uv"));
+}
+
 TEST(SceneFlattenError, PlymeshAsciiIndexOutOfRange) {
   TempDir dir;
   dir.write("bad.ply",
