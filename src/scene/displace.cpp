@@ -101,8 +101,8 @@ void displace_mesh(PlyMesh* mesh, const Transform& world_from_object, float edge
     refiner.refine(mesh->indices[i], mesh->indices[i + 1], mesh->indices[i + 2], &refined);
   mesh->indices = std::move(refined);
   for (size_t v = 0; v < mesh->positions.size(); ++v)
-    mesh->positions[v] = mesh->positions[v] +
-                         mesh->normals[v] * displacement(mesh->positions[v], mesh->uvs[v]);
+    mesh->positions[v] =
+        mesh->positions[v] + mesh->normals[v] * displacement(mesh->positions[v], mesh->uvs[v]);
   mesh->normals = vertex_normals(mesh->positions, mesh->indices);
 }
 

@@ -89,11 +89,14 @@ Flattener::DielectricEta Flattener::dielectric_eta(const ParamSet& ps, const Fil
                                                    const std::string& name) {
   DielectricEta out;
   const Param* p = ps.find_any(name);
+  if (p && p->type == "texture")
+    throw Error(p->loc, "\"" + name +
+                            "\" takes a value or a spectrum, not a texture (as in pbrt-v4, whose "
+                            "dielectrics and coats have no textured index)");
   if (p && p->type == "float") {
     out.eta = ps.get_float(name, 1.5f);
   } else if (p) {
     SpectrumParam sp = *spectrum_param(ps, name, SpectrumKind::kUnbounded);
-    if (sp.textured()) throw Error(p->loc, "a textured eta is not supported");
     const SpectrumCurve& s = sp.curve;
     // The index at the d line (587.56 nm) stands for the glass where one index is needed.
     out.eta = s.value(587.56f);

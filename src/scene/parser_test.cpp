@@ -1803,6 +1803,19 @@ TEST(SceneFlattenError, UnsupportedAreaLight) {
                       at(2, 1), "area light \"projection\" is not supported"));
 }
 
+// pbrt-v4 reads a dielectric's or a coat's index as a value or a spectrum only.
+TEST(SceneFlattenError, TexturedEta) {
+  const std::string tex = "Texture \"e\" \"float\" \"constant\" \"float value\" 1.4";
+  for (const std::string& material :
+       {std::string(R"(Material "dielectric" "texture eta" "e")"),
+        std::string(R"(Material "coatedconductor" "texture interface.eta" "e")")}) {
+    EXPECT_TRUE(IsError(error_of("WorldBegin\n" + tex + "\n" + material + "\nShape \"sphere\"\n"),
+                        at(3, col(material, "\"texture")),
+                        "takes a value or a spectrum, not a texture"))
+        << material;
+  }
+}
+
 TEST(SceneFlattenError, UnknownCameraType) {
   EXPECT_TRUE(IsError(error_of("Camera \"fisheye\"\nWorldBegin\n"), at(1, 1),
                       "camera \"fisheye\" is unknown (perspective, orthographic, spherical, "

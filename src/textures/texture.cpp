@@ -175,7 +175,15 @@ Spectrum TextureSet::spectrum(int i, const TextureContext& ctx, const Wavelength
 float TextureSet::value(int i, const TextureContext& ctx) const {
   const TextureNode& n = node(i);
   if (auto* c = std::get_if<ConstantTexture>(&n)) return c->value;
-  if (auto* im = std::get_if<ImageTexture>(&n)) return image_rgb(*im, ctx)[0];
+  if (auto* im = std::get_if<ImageTexture>(&n)) {
+    // pbrt-v4 reads an RGB image as a float texture by the mean of its three channels, scaled,
+    // then inverted.
+    Vec2 st = im->mapping.map(ctx);
+    st.y = 1 - st.y;
+    const Rgb c = im->image->lookup(st, im->filter, im->wrap);
+    const float v = (c[0] + c[1] + c[2]) / 3 * im->scale;
+    return im->invert ? std::max(0.0f, 1 - v) : v;
+  }
   if (auto* c = std::get_if<CheckerboardTexture>(&n))
     return value(checker_first(*c, ctx) ? c->tex1 : c->tex2, ctx);
   if (auto* s = std::get_if<ScaleTexture>(&n)) {

@@ -104,7 +104,7 @@ class TextureSet {
   // A spectrum texture at the wavelengths (image texels read as the image's kind says; albedo
   // texels are clamped to [0, 1]). A float texture gives its value at every wavelength.
   Spectrum spectrum(int node, const TextureContext& ctx, const Wavelengths& wl) const;
-  // A float texture; an image gives its first channel.
+  // A float texture; an image gives the mean of its channels (pbrt-v4's reading).
   float value(int node, const TextureContext& ctx) const;
 
  private:

@@ -143,8 +143,10 @@ TEST(TextureSet, ImageTexelsBecomeTheirColoursSpectrum) {
       EXPECT_NEAR(inv[i], want_inv[i], 0.01f) << wl.lambda[i];
     }
   }
-  // A float texture reads the first channel.
-  EXPECT_FLOAT_EQ(ts.value(plain, ctx), 0.7f);
+  // A float texture reads the mean of the channels (as pbrt-v4 does), scaled, then inverted.
+  EXPECT_FLOAT_EQ(ts.value(plain, ctx), (0.7f + 0.3f + 0.1f) / 3);
+  EXPECT_FLOAT_EQ(ts.value(scaled, ctx), 0.5f * (0.7f + 0.3f + 0.1f) / 3);
+  EXPECT_FLOAT_EQ(ts.value(inverted, ctx), 1 - (0.7f + 0.3f + 0.1f) / 3);
 }
 
 }  // namespace
