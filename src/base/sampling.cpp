@@ -154,4 +154,21 @@ Vec2 wrap_equal_area_square(Vec2 p) {
   return p;
 }
 
+Vec3 sample_henyey_greenstein(Vec3 travel, float g, Vec2 u) {
+  // The inverse of the cosine's distribution, 2 pi HG(cos) on [-1, 1].
+  float cos_theta;
+  if (std::fabs(g) < 1e-3f) {
+    cos_theta = 1 - 2 * u.x;
+  } else {
+    const float k = (1 - g * g) / (1 - g + 2 * g * u.x);
+    cos_theta = (1 + g * g - k * k) / (2 * g);
+  }
+  cos_theta = std::clamp(cos_theta, -1.0f, 1.0f);
+  const float sin_theta = std::sqrt(std::fmax(0.0f, 1 - cos_theta * cos_theta));
+  const float phi = 2 * kPi * u.y;
+  const Frame f = Frame::from_z(travel);
+  return normalize(
+      f.to_world(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta)));
+}
+
 }  // namespace bpm

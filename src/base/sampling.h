@@ -93,6 +93,17 @@ inline uint32_t sobol2_bits(uint32_t i) {
   return r;
 }
 
+// The Henyey-Greenstein phase function of asymmetry g in (-1, 1), per steradian, at the cosine
+// between the directions of travel before and after scattering (g > 0 scatters forward).
+inline float henyey_greenstein(float cos_theta, float g) {
+  const float d = 1 + g * g - 2 * g * cos_theta;
+  return (1 - g * g) / (4 * 3.14159265358979f * d * std::sqrt(std::fmax(d, 1e-12f)));
+}
+
+// A new direction of travel after scattering from `travel` (unit), drawn with density
+// henyey_greenstein(dot(travel, new), g) exactly.
+Vec3 sample_henyey_greenstein(Vec3 travel, float g, Vec2 u);
+
 inline float power_heuristic(float pdf_a, float pdf_b) {
   float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
   if (std::isinf(a)) return 1;

@@ -1,5 +1,6 @@
 // Tests of the equal-area square-sphere map (orientation, inverse, equal solid angles) and of
-// the 2D piecewise-constant distribution (density against its own pdf and cell frequencies).
+// the 2D piecewise-constant distribution (density against its own pdf and cell frequencies), and
+// of Henyey-Greenstein sampling.
 #include "base/sampling.h"
 
 #include <gtest/gtest.h>
@@ -223,4 +224,27 @@ TEST(Sobol2, WithVanDerCorputFormsA02Sequence) {
     }
 }
 
+}  // namespace bpm
+
+namespace bpm {
+namespace {
+
+// Henyey-Greenstein directions follow the phase function (chi-square over the sphere), for
+// forward, backward and isotropic scattering about an oblique direction of travel.
+TEST(HenyeyGreenstein, SamplesFollowThePhaseFunction) {
+  const Vec3 travel = normalize(Vec3(0.3f, -0.5f, 0.8f));
+  chi2::Options o;
+  o.n_tests = 3;
+  o.sub = 32;  // smooth
+  for (float g : {0.7f, -0.4f, 0.0f}) {
+    auto res = chi2::run(
+        [&](Rng& rng) -> std::optional<Vec3> {
+          return sample_henyey_greenstein(travel, g, {rng.uniform(), rng.uniform()});
+        },
+        [&](Vec3 w) { return double(henyey_greenstein(dot(travel, w), g)); }, 41, o);
+    EXPECT_TRUE(res.passed()) << "g " << g << "\n" << res.report;
+  }
+}
+
+}  // namespace
 }  // namespace bpm

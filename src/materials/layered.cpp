@@ -69,6 +69,9 @@ struct Layer {
   Base base;
   float thickness;
   int max_depth, samples;
+  Spectrum albedo;  // of the medium between coat and base (CoatLayer)
+  float g;
+  bool medium;  // whether the medium scatters; else it only attenuates
   // The walks' expectation, for a Lambertian base under the coat it was made for; else null.
   const CoatWalkTable* walk_table = nullptr;
   // Which lobes to see (BsdfPart): the coating's own reflection (`coat`), the walks under it
@@ -80,7 +83,10 @@ struct Layer {
         base(std::move(base_material)),
         thickness(c.thickness),
         max_depth(c.max_depth),
-        samples(c.samples) {
+        samples(c.samples),
+        albedo(c.albedo),
+        g(c.g),
+        medium(!c.albedo.is_black()) {
     const bool splits = c.roughness.traced() && !(base.specular || base_traced());
     if (splits && part == BsdfPart::kGathered) coat = false;
     if (splits && part == BsdfPart::kTraced) walks = false;
@@ -100,6 +106,98 @@ float walks_share(const Layer& L, float cos_o) {
   return std::clamp(lookup(L.walk_table->enter, cos_o), 1e-3f, 0.999f);
 }
 
+// Russian roulette on a walk's weight after its first steps: false ends the walk, else the weight
+// is raised by the survival probability.
+bool survives_roulette(int depth, Rng& rng, Spectrum& beta) {
+  if (depth <= 3 || beta.max_component() >= 0.25f) return true;
+  const float q = std::fmax(0.0f, 1 - beta.max_component());
+  if (rng.uniform() < q) return false;
+  beta /= 1 - q;
+  return true;
+}
+
+// The walk's next event from height z along w (the coat at the thickness, the base at 0): with a
+// scattering medium, where it scatters (a free flight of unit extinction), strictly inside the
+// layer, or else the boundary it reaches; without one, the other boundary, with the layer's
+// attenuation applied to `weight`.
+float next_height(const Layer& L, float z, Vec3 w, Rng& rng, Spectrum& weight) {
+  if (L.medium) {
+    const float dz = -std::log1p(-rng.uniform()) * std::fabs(w.z);
+    const float zp = w.z > 0 ? z + dz : z - dz;
+    if (zp > 0 && zp < L.thickness) return zp;
+    return zp <= 0 ? 0 : L.thickness;
+  }
+  weight *= layer_transmittance(L.thickness, w);
+  return z == L.thickness ? 0 : L.thickness;
+}
+
+// A scattering in the layer's medium at height zp, on the walk of layered_f toward wi (outside)
+// whose way out through the coat was presampled (`out`, drawn from wi): next-event estimation
+// through the coat along it, then the phase function's sample, which may itself leave through a
+// rough coat toward wi; each weighed against the other (power heuristic) where both can find
+// the light. Updates the walk's weight beta and direction w, adds to f; false ends the walk.
+bool scatter_in_layer(const Layer& L, Vec3 wi, const BsdfSample& out, float zp, TransportMode mode,
+                      Rng& rng, Spectrum& beta, Vec3& w, Spectrum& f) {
+  const bool top_smooth = L.top.roughness.effectively_smooth();
+  const Vec3 to_exit = -out.wi;
+  const float up = L.thickness - zp;  // distance to the coat, in height
+  const float phase_nee = henyey_greenstein(dot(w, to_exit), L.g);
+  const float wt = top_smooth ? 1 : power_heuristic(out.pdf_solid_angle, phase_nee);
+  f += beta * L.albedo * out.f *
+       (phase_nee * wt * std::exp(-up / std::fabs(out.wi.z)) / out.pdf_solid_angle);
+  const Vec3 wn = sample_henyey_greenstein(w, L.g, {rng.uniform(), rng.uniform()});
+  if (wn.z == 0) return false;
+  const float phase_sampled = henyey_greenstein(dot(w, wn), L.g);
+  beta *= L.albedo;  // the phase function over its own density
+  w = wn;
+  if (!top_smooth && w.z > 0) {
+    const Spectrum f_exit = dielectric_f(L.top, -w, wi, mode);
+    if (!f_exit.is_black()) {
+      // Both densities over the direction leaving the scattering point (as at the base).
+      const float wt_exit =
+          power_heuristic(phase_sampled, dielectric_pdf(L.top, wi, -w, kTransmission));
+      f += beta * f_exit * (std::exp(-up / std::fabs(w.z)) * wt_exit);
+    }
+  }
+  return true;
+}
+
+// At the base, on the walk of layered_f toward wi: next-event estimation through the coating
+// along the presampled way out (impossible for a mirror base), weighted against reaching it by
+// sampling the base (power heuristic) unless the coating is smooth, where only this strategy can
+// find it; then the base's sample, which may itself leave through a rough coat toward wi. Updates
+// beta and w, adds to f; false ends the walk.
+bool reflect_at_base(const Layer& L, Vec3 wi, const BsdfSample& out, TransportMode mode, Rng& rng,
+                     Spectrum& beta, Vec3& w, Spectrum& f) {
+  const bool top_smooth = L.top.roughness.effectively_smooth();
+  const Vec3 wb = -w, to_exit = -out.wi;
+  if (!L.base.specular) {
+    const float wt =
+        top_smooth ? 1 : power_heuristic(out.pdf_solid_angle, L.base.pdf(wb, to_exit, mode));
+    f += beta * L.base.f(wb, to_exit, mode) *
+         (std::fabs(out.wi.z) * wt * layer_transmittance(L.thickness, out.wi) /
+          out.pdf_solid_angle) *
+         out.f;
+  }
+  auto b = L.base.sample(wb, rng, mode);
+  if (!usable(b)) return false;
+  beta *= b->f * (std::fabs(b->wi.z) / b->pdf_solid_angle);
+  w = b->wi;
+  if (!top_smooth) {
+    const Spectrum f_exit = dielectric_f(L.top, -w, wi, mode);
+    if (!f_exit.is_black()) {
+      // Both strategies' densities over the same variable, the direction leaving the base: the
+      // other strategy would have drawn it by refracting wi into the layer.
+      const float wt_exit =
+          L.base.specular
+              ? 1
+              : power_heuristic(b->pdf_solid_angle, dielectric_pdf(L.top, wi, -w, kTransmission));
+      f += beta * f_exit * (layer_transmittance(L.thickness, w) * wt_exit);
+    }
+  }
+  return true;
+}
+
 Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   // Two-sided: seen from below, the material is the same as from above.
   if (wo.z < 0) {
@@ -109,7 +207,6 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   // The base does not transmit, so light leaves on the side it arrived from.
   if (wo.z == 0 || wi.z <= 0) return {};
   const DielectricMaterial& top = L.top;
-  const bool top_smooth = top.roughness.effectively_smooth();
   // Reflection off the coating itself (zero for a smooth coating: its mirror lobe is a delta).
   if (L.walk_table) {
     Spectrum f = L.coat ? dielectric_f(top, wo, wi, mode) : Spectrum();
@@ -129,17 +226,18 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
                                  adjoint(mode), kTransmission);
     if (!usable(out)) continue;
     Spectrum beta = in->f * (std::fabs(in->wi.z) / in->pdf_solid_angle);
-    Vec3 w = in->wi;  // direction of travel inside the layer
-    bool at_top = true;
+    Vec3 w = in->wi;        // direction of travel inside the layer
+    float z = L.thickness;  // height in the layer: the coat at the thickness, the base at 0
     for (int depth = 0; depth < L.max_depth; ++depth) {
-      if (depth > 3 && beta.max_component() < 0.25f) {
-        float q = std::fmax(0.0f, 1 - beta.max_component());
-        if (rng.uniform() < q) break;
-        beta /= 1 - q;
+      if (!survives_roulette(depth, rng, beta)) break;
+      const float zp = next_height(L, z, w, rng, beta);
+      if (zp > 0 && zp < L.thickness) {
+        if (!scatter_in_layer(L, wi, *out, zp, mode, rng, beta, w, f)) break;
+        z = zp;
+        continue;
       }
-      beta *= layer_transmittance(L.thickness, w);
-      at_top = !at_top;
-      if (at_top) {
+      z = zp;
+      if (z == L.thickness) {
         // Reflected back into the layer by the coating, from inside.
         auto r = dielectric_sample(top, -w, rng.uniform(), {rng.uniform(), rng.uniform()}, mode,
                                    kReflection);
@@ -148,34 +246,7 @@ Spectrum layered_f(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
         w = r->wi;
         continue;
       }
-      // At the base. Next-event estimation through the coating along the presampled way out
-      // (impossible for a mirror base), weighted against reaching it by sampling the base (power
-      // heuristic) unless the coating is smooth, where only this strategy can find it.
-      Vec3 wb = -w, to_exit = -out->wi;
-      if (!L.base.specular) {
-        float wt =
-            top_smooth ? 1 : power_heuristic(out->pdf_solid_angle, L.base.pdf(wb, to_exit, mode));
-        f += beta * L.base.f(wb, to_exit, mode) *
-             (std::fabs(out->wi.z) * wt * layer_transmittance(L.thickness, out->wi) /
-              out->pdf_solid_angle) *
-             out->f;
-      }
-      auto b = L.base.sample(wb, rng, mode);
-      if (!usable(b)) break;
-      beta *= b->f * (std::fabs(b->wi.z) / b->pdf_solid_angle);
-      w = b->wi;
-      if (!top_smooth) {
-        Spectrum f_exit = dielectric_f(top, -w, wi, mode);
-        if (!f_exit.is_black()) {
-          // Both strategies' densities over the same variable, the direction leaving the base:
-          // the other strategy would have drawn it by refracting wi into the layer.
-          float wt_exit =
-              L.base.specular
-                  ? 1
-                  : power_heuristic(b->pdf_solid_angle, dielectric_pdf(top, wi, -w, kTransmission));
-          f += beta * f_exit * (layer_transmittance(L.thickness, w) * wt_exit);
-        }
-      }
+      if (!reflect_at_base(L, wi, *out, mode, rng, beta, w, f)) break;
     }
   }
   return f / float(L.samples);
@@ -226,33 +297,35 @@ float layered_pdf(const Layer& L, Vec3 wo, Vec3 wi, TransportMode mode) {
   return 0.1f / (4 * kPi) + 0.9f * sum / float(L.samples);
 }
 
+// With a walk table (wo above the material; `flip`: the caller's wo was below): a mixture of the
+// two lobes, the walks' (the table's f) with probability q, cosine-distributed, else the coat's
+// reflection, drawn as the coat draws it. Every weight is exact for the table's f.
+std::optional<BsdfSample> table_sample(const Layer& L, Vec3 wo, float uc, Vec2 u,
+                                       TransportMode mode, bool flip) {
+  const float q = walks_share(L, wo.z);
+  if (uc < q) {
+    Vec3 wi = sample_cosine_hemisphere(u);
+    if (wi.z <= 0) return std::nullopt;
+    const Spectrum f = L.walk_table->f(std::get<DiffuseMaterial>(L.base.m).reflectance, wo.z, wi.z);
+    const float pdf = q * cosine_hemisphere_pdf_solid_angle(wi.z);
+    if (flip) wi = -wi;
+    return BsdfSample{f, wi, pdf, kReflection | kGlossy, 1};
+  }
+  if (!L.coat) return std::nullopt;
+  auto bs = dielectric_sample(L.top, wo, (uc - q) / (1 - q), u, mode, kReflection);
+  if (!usable(bs)) return std::nullopt;
+  bs->pdf_solid_angle *= 1 - q;
+  if (flip) bs->wi = -bs->wi;
+  if (L.top.roughness.traced()) bs->flags |= kTraced;
+  return bs;
+}
+
 std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2 u,
                                          TransportMode mode) {
   const bool flip = wo.z < 0;
   if (flip) wo = -wo;
   const DielectricMaterial& top = L.top;
-  if (L.walk_table) {
-    // A mixture of the two lobes: the walks' (the table's f) with probability q, cosine-
-    // distributed; else the coat's reflection, drawn as the coat draws it. Every weight is exact
-    // for the table's f.
-    const float q = walks_share(L, wo.z);
-    if (uc < q) {
-      Vec3 wi = sample_cosine_hemisphere(u);
-      if (wi.z <= 0) return std::nullopt;
-      const Spectrum f =
-          L.walk_table->f(std::get<DiffuseMaterial>(L.base.m).reflectance, wo.z, wi.z);
-      const float pdf = q * cosine_hemisphere_pdf_solid_angle(wi.z);
-      if (flip) wi = -wi;
-      return BsdfSample{f, wi, pdf, kReflection | kGlossy, 1};
-    }
-    if (!L.coat) return std::nullopt;
-    auto bs = dielectric_sample(top, wo, (uc - q) / (1 - q), u, mode, kReflection);
-    if (!usable(bs)) return std::nullopt;
-    bs->pdf_solid_angle *= 1 - q;
-    if (flip) bs->wi = -bs->wi;
-    if (top.roughness.traced()) bs->flags |= kTraced;
-    return bs;
-  }
+  if (L.walk_table) return table_sample(L, wo, uc, u, mode, flip);
   auto bs = dielectric_sample(top, wo, uc, u, mode,
                               L.walks ? kReflection | kTransmission : unsigned(kReflection));
   if (!usable(bs)) return std::nullopt;
@@ -266,7 +339,8 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
   Spectrum f = bs->f * std::fabs(bs->wi.z);
   float pdf = bs->pdf_solid_angle;
   Vec3 w = bs->wi;
-  bool at_top = true, specular_path = bs->is_specular();
+  float z = L.thickness;  // the coat at the thickness, the base at 0
+  bool specular_path = bs->is_specular();
   for (int depth = 0; depth < L.max_depth; ++depth) {
     float rr = f.max_component() / pdf;
     if (depth > 3 && rr < 0.25f) {
@@ -275,10 +349,21 @@ std::optional<BsdfSample> layered_sample(const Layer& L, Vec3 wo, float uc, Vec2
       pdf *= 1 - q;
     }
     if (w.z == 0) return std::nullopt;
-    f *= layer_transmittance(L.thickness, w);
-    at_top = !at_top;
+    const float zp = next_height(L, z, w, rng, f);
+    if (zp > 0 && zp < L.thickness) {
+      // Scattered by the medium: the phase function, drawn exactly.
+      const Vec3 wn = sample_henyey_greenstein(w, L.g, {rng.uniform(), rng.uniform()});
+      if (wn.z == 0) return std::nullopt;
+      const float phase = henyey_greenstein(dot(w, wn), L.g);
+      f *= L.albedo * phase;
+      pdf *= phase;
+      specular_path = false;
+      w = wn, z = zp;
+      continue;
+    }
+    z = zp;
     std::optional<BsdfSample> t;
-    if (!at_top) {
+    if (z == 0) {
       t = L.base.sample(-w, rng, mode);
     } else {
       float uc2 = rng.uniform();

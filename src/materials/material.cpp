@@ -59,6 +59,7 @@ struct Resolver {
   Material operator()(const CoatedConductorDesc& d) const {
     CoatLayer layer = d.layer;
     layer.roughness = rough(d.layer.roughness, d.roughness_tex);
+    layer.albedo = eval(d.albedo);
     return CoatedConductorMaterial{std::get<ConductorMaterial>((*this)(d.conductor)), layer};
   }
   Material operator()(const MixDesc&) const {
@@ -68,6 +69,7 @@ struct Resolver {
   Material operator()(const CoatedDiffuseDesc& d) const {
     CoatLayer layer = d.layer;
     layer.roughness = rough(d.layer.roughness, d.roughness_tex);
+    layer.albedo = eval(d.albedo);
     return CoatedDiffuseMaterial{eval(d.reflectance), layer, d.walk_table.get()};
   }
 };
@@ -105,10 +107,10 @@ bool material_is_textured(const MaterialDesc& desc) {
     }
     bool operator()(const PhongDesc& d) const { return d.reflectance.textured(); }
     bool operator()(const CoatedDiffuseDesc& d) const {
-      return d.reflectance.textured() || d.roughness_tex.any();
+      return d.reflectance.textured() || d.roughness_tex.any() || d.albedo.textured();
     }
     bool operator()(const CoatedConductorDesc& d) const {
-      return (*this)(d.conductor) || d.roughness_tex.any();
+      return (*this)(d.conductor) || d.roughness_tex.any() || d.albedo.textured();
     }
     bool operator()(const DielectricMaterial& d) const { return d.roughness_tex.any(); }
     bool operator()(const ThinDielectricMaterial&) const { return false; }

@@ -89,14 +89,20 @@ struct PhongMaterial {
 };
 
 // The coat of pbrt-v4's layered materials: a dielectric boundary (index eta, GGX roughness) over a
-// base, with a non-scattering layer of the given thickness between them that attenuates as
-// exp(-thickness / |cos|). Light bounces inside the layer; the BSDF is the expected value of those
+// base, with a layer of the given thickness between them that attenuates as exp(-thickness / |cos|)
+// and, with an albedo, scatters (a Henyey-Greenstein medium of unit extinction per unit of
+// thickness). Light bounces inside the layer; the BSDF is the expected value of those
 // random walks (pbrt-v4's stochastic LayeredBxDF, two-sided, at most max_depth bounces, `samples`
 // walks per value): f and pdf are estimates seeded by the directions (materials/layered.h).
 struct CoatLayer {
   Roughness roughness;
   float eta = 1.5f, thickness = 0.01f;
   int max_depth = 10, samples = 1;
+  // The medium between coat and base (pbrt-v4's "albedo" and "g"): unit extinction per unit of
+  // thickness, this single-scattering albedo (black: no scattering, only attenuation) and a
+  // Henyey-Greenstein phase function of asymmetry g.
+  Spectrum albedo{0.0f};
+  float g = 0;
 };
 
 struct CoatWalkTable;  // materials/layered.h
@@ -147,14 +153,16 @@ struct PhongDesc {
 struct CoatedDiffuseDesc {
   SpectrumParam reflectance{SpectrumCurve(0.5f)};
   CoatLayer layer;
-  RoughnessTextures roughness_tex;  // the coat's
+  SpectrumParam albedo{SpectrumCurve(0.0f)};  // the layer's medium (CoatLayer::albedo)
+  RoughnessTextures roughness_tex;            // the coat's
   // For the constant coat (make_coat_walk_table); null when the roughness is textured.
   std::shared_ptr<const CoatWalkTable> walk_table;
 };
 struct CoatedConductorDesc {
   ConductorDesc conductor;
   CoatLayer layer;
-  RoughnessTextures roughness_tex;  // the coat's
+  SpectrumParam albedo{SpectrumCurve(0.0f)};  // the layer's medium (CoatLayer::albedo)
+  RoughnessTextures roughness_tex;            // the coat's
 };
 // pbrt-v4's "mix": at each surface point one of two scene materials (indices into the scene's
 // list), the second with probability `amount`, chosen by a hash of the point so that every path

@@ -84,7 +84,7 @@ class Flattener {
                                const std::string& name = "eta");
   ConductorDesc conductor_desc(const ParamSet& ps, const FileLoc& loc, const std::string& prefix);
   CoatLayer coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
-                       RoughnessTextures* tex);
+                       SpectrumParam* albedo, RoughnessTextures* tex);
   MaterialDesc make_material(const SceneEntity& e);
   Bump make_bump(const SceneEntity& e);
   int add_material(const SceneEntity& e);

@@ -141,7 +141,7 @@ std::shared_ptr<const CoatWalkTable> Flattener::coat_walk_table(const CoatLayer&
 }
 
 CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const std::string& prefix,
-                                RoughnessTextures* tex) {
+                                SpectrumParam* albedo, RoughnessTextures* tex) {
   CoatLayer c;
   c.roughness = roughness(ps, e.loc, prefix, tex);
   DielectricEta eta = dielectric_eta(ps, e.loc, prefix + "eta");
@@ -161,12 +161,10 @@ CoatLayer Flattener::coat_layer(const ParamSet& ps, const SceneEntity& e, const 
   };
   c.max_depth = count("maxdepth", 10);
   c.samples = count("nsamples", 1);
-  if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo);
-      a && (a->textured() || !a->curve.is_black()))
-    throw Error(ps.find_any("albedo")->loc,
-                e.name + " with a scattering layer (albedo > 0) is not supported");
-  if (ps.find_any("g"))
-    float_param(ps, "g", 0);  // that medium's phase function: irrelevant without it
+  // The medium between coat and base: its albedo (a spectrum or texture) and phase asymmetry.
+  if (auto a = spectrum_param(ps, "albedo", SpectrumKind::kAlbedo)) *albedo = *a;
+  c.g = float_param(ps, "g", 0);
+  if (!(std::fabs(c.g) < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
   return c;
 }
 
@@ -251,12 +249,14 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
   } else if (e.name == "coateddiffuse") {
     CoatedDiffuseDesc c;
     if (auto r = spectrum_param(ps, "reflectance", SpectrumKind::kAlbedo)) c.reflectance = *r;
-    c.layer = coat_layer(ps, e, "", &c.roughness_tex);
-    if (!c.roughness_tex.any()) c.walk_table = coat_walk_table(c.layer);
+    c.layer = coat_layer(ps, e, "", &c.albedo, &c.roughness_tex);
+    // The walks' table is for a constant coat over no medium.
+    if (!c.roughness_tex.any() && !c.albedo.textured() && c.albedo.curve.is_black())
+      c.walk_table = coat_walk_table(c.layer);
     m = c;
   } else if (e.name == "coatedconductor") {
     CoatedConductorDesc c;
-    c.layer = coat_layer(ps, e, "interface.", &c.roughness_tex);
+    c.layer = coat_layer(ps, e, "interface.", &c.albedo, &c.roughness_tex);
     c.conductor = conductor_desc(ps, e.loc, "conductor.");
     m = c;
   } else if (e.name == "phong") {

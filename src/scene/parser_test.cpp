@@ -1943,10 +1943,9 @@ TEST(SceneFlattenError, CoatedDiffuseBadValues) {
   const std::string l1 = R"(Material "coateddiffuse" "float thickness" -1)";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l1 + "\nShape \"sphere\"\n"),
                       at(2, col(l1, "\"float thickness")), "thickness must be positive"));
-  const std::string l2 = R"(Material "coateddiffuse" "rgb albedo" [0.5 0.5 0.5])";
+  const std::string l2 = R"(Material "coateddiffuse" "rgb albedo" [0.5 0.5 0.5] "float g" 1)";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l2 + "\nShape \"sphere\"\n"),
-                      at(2, col(l2, "\"rgb albedo")),
-                      "coateddiffuse with a scattering layer (albedo > 0) is not supported"));
+                      at(2, col(l2, "\"float g")), "g must lie in (-1, 1)"));
   const std::string l3 = R"(Material "coateddiffuse" "integer maxdepth" 0)";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + l3 + "\nShape \"sphere\"\n"),
                       at(2, col(l3, "\"integer maxdepth")), "maxdepth must be in [1, 1000]"));
