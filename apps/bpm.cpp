@@ -470,6 +470,7 @@ int run_render(RenderArgs a, Team* team, bool* rendering) {
   const bool keep_checkpoint = opt.write_every_s > 0 || !a.resume.empty();
   check_film_memory(a, ls, opt, keep_checkpoint, team != nullptr);
   Film film(ls.film.width, ls.film.height, a.m_images, opt.sensors.size());
+  film.set_spectral(ls.film.spectral);
   std::vector<std::string> files = scene.parsed.files;
   if (!a.sensors.empty()) files.push_back(a.sensors);  // a checkpoint holds these sensors' sums
   const nlohmann::json identity =

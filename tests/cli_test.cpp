@@ -134,7 +134,7 @@ TEST_F(Cli, StartsWithoutOpenImageIOAndStillReadsImages) {
   // A sphere textured with a white image renders brighter than one with a black image.
   double mean[2];
   for (int white = 0; white < 2; ++white) {
-    Image texture{2, 2, std::vector<float>(12, float(white))};
+    Image texture{2, 2, std::vector<float>(12, float(white)), {}};
     const std::string name = white ? "white" : "black";
     const std::string png = (dir_ / (name + ".png")).string();
     write_png(png, texture);

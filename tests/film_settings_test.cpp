@@ -1,8 +1,19 @@
 // The Film's crop ("cropwindow", "pixelbounds": the image is a crop of the camera's raster,
-// rendered as the whole image renders those pixels) and white balance ("whitebalance").
+// rendered as the whole image renders those pixels), white balance ("whitebalance") and the
+// spectral film.
+#include <ImfChannelList.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfStringAttribute.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "base/error.h"
 #include "film/image_io.h"
@@ -135,6 +146,87 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-5 -5 0  5 -5 0
   EXPECT_GT(raw[0] / raw[2], 2);
   const std::array<float, 9> m = white_balance_srgb(6504);
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(m[size_t(i)], i % 4 == 0 ? 1 : 0, 5e-3) << i;
+}
+
+// A spectral film seeing an infinite light of a constant spectrum (normalised, as pbrt-v4 does, to
+// unit luminance: 1 at every wavelength): every bucket of every pixel reads 1, in every
+// integrator, the colour is that spectrum's (the equal-energy white in sRGB); wavelengths fall
+// in the buckets of their range, the ends clamped.
+TEST(SpectralFilm, ConstantSpectrumFillsEveryBucket) {
+  const SpectralBuckets b{5, 400, 700};
+  EXPECT_EQ(b.bucket(399), 0);
+  EXPECT_EQ(b.bucket(459.9f), 0);
+  EXPECT_EQ(b.bucket(460.1f), 1);
+  EXPECT_EQ(b.bucket(701), 4);
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    LoadedScene ls = test::load(R"(LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" 30
+Film "spectral" "integer xresolution" 4 "integer yresolution" 4 "integer nbuckets" 5
+  "float lambdamin" 400 "float lambdamax" 700
+WorldBegin
+LightSource "infinite" "spectrum L" [300 2  900 2]
+)");
+    ASSERT_EQ(ls.film.spectral, b);
+    Film film(ls.film.width, ls.film.height);
+    render(ls, quiet_options(ls, integrator, 8, 3), &film);
+    for (int k = 0; k < b.count; ++k)
+      for (float v : film.bucket_image(k)) EXPECT_NEAR(v, 1, 1e-5) << integrator << " " << k;
+    const Image img = film.image();
+    // Equal energy in linear sRGB: (1.2, 0.95, 0.91) at unit luminance, within the colour noise
+    // of 8 passes of 4 wavelengths.
+    EXPECT_NEAR(img.at(1, 1)[0], 1.2, 0.06) << integrator;
+    EXPECT_NEAR(img.at(1, 1)[2], 0.91, 0.06) << integrator;
+  }
+}
+
+// The EXR holds pbrt-v4's spectral layout: S0.<centre>nm channels (decimal comma) after R, G, B,
+// and the layout's attributes; bad spectral film parameters get located errors.
+TEST(SpectralFilm, ExrChannelsAndErrors) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("bpm_spectral_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string scene_path = (dir / "s.pbrt").string(), out = (dir / "s.exr").string();
+  {
+    std::FILE* f = std::fopen(scene_path.c_str(), "w");
+    std::fputs(
+        R"(Film "spectral" "integer xresolution" 4 "integer yresolution" 2 "integer nbuckets" 2
+WorldBegin
+LightSource "infinite" "rgb L" [0.5 0.5 0.5]
+)",
+        f);
+    std::fclose(f);
+  }
+  const std::string cmd = std::string(BPM_BINARY) + " render " + scene_path + " -q --spp 2 -o " +
+                          out + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  Imf::InputFile exr(out.c_str());
+  std::vector<std::string> names;
+  for (auto c = exr.header().channels().begin(); c != exr.header().channels().end(); ++c)
+    names.push_back(c.name());
+  EXPECT_NE(std::find(names.begin(), names.end(), "S0.477,500nm"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "S0.712,500nm"), names.end());
+  const auto* version =
+      exr.header().findTypedAttribute<Imf::StringAttribute>("spectralLayoutVersion");
+  ASSERT_TRUE(version);
+  EXPECT_EQ(version->value(), "1.0");
+  std::filesystem::remove_all(dir);
+  auto error = [](const std::string& film) {
+    try {
+      test::load(film + "\nWorldBegin\n");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error(R"(Film "spectral" "integer nbuckets" 0)").find("nbuckets must be in [1, 1000]"),
+            std::string::npos);
+  EXPECT_NE(error(R"(Film "spectral" "float lambdamin" 700 "float lambdamax" 400)")
+                .find("lambdamin and lambdamax must lie in [360, 830] nm"),
+            std::string::npos);
+  EXPECT_NE(error(R"(Film "spectral" "string filename" "a.png")").find("writes EXR only"),
+            std::string::npos);
+  EXPECT_NE(error(R"(Film "gbuffer")").find("film \"gbuffer\" is not supported (rgb, spectral)"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -204,6 +204,17 @@ Wavelengths sample_wavelengths(float u) {
   return wl;
 }
 
+Wavelengths sample_wavelengths_uniform(float u, float lo, float hi) {
+  Wavelengths wl;
+  for (int i = 0; i < Spectrum::kChannels; ++i) {
+    double ui = u + double(i) / Spectrum::kChannels;
+    if (ui >= 1) ui -= 1;
+    wl.lambda[i] = std::clamp(float(lo + ui * (hi - lo)), lo, hi);
+    wl.pdf[i] = 1 / (hi - lo);
+  }
+  return wl;
+}
+
 float wavelength_pdf(float lambda) {
   if (lambda < kLambdaMin || lambda > kLambdaMax) return 0;
   double c = std::cosh(kPdfA * (lambda - kPdfMu));

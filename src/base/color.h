@@ -39,6 +39,8 @@ inline Spectrum hero_wavelength_only(const Spectrum& s) {
 // Spectrum::kChannels wavelengths stratified over [kLambdaMin, kLambdaMax] from one uniform number,
 // each drawn with a density that follows the eye's sensitivity (a sech^2 lobe about 540 nm).
 Wavelengths sample_wavelengths(float u);
+// The same stratification with a uniform density over [lo, hi] (pbrt-v4's spectral film).
+Wavelengths sample_wavelengths_uniform(float u, float lo, float hi);
 float wavelength_pdf(float lambda);
 
 // Linear sRGB of the Monte Carlo estimate L at the wavelengths wl (the film's sensor, pbrt-v4's

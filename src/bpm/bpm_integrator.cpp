@@ -248,7 +248,7 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   }
   const float scale = radius_scale(s_, it);
   // One set of wavelengths for every eye and light path of the iteration.
-  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
+  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it, ls_.film.spectral));
   // 1. Eye pass: backward photons, and the light the eye paths count themselves (no image: none).
   if (opt_.image && !eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
   // 2. Per-object sphere trees over the backward photons.

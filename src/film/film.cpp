@@ -348,6 +348,8 @@ void Film::add(const Film& o) {
     sensors_[i].bias_sum2 += o.sensors_[i].bias_sum2;
     sensors_[i].passes += o.sensors_[i].passes;
   }
+  BPM_CHECK(o.spectral_ == spectral_);
+  for (size_t i = 0; i < bucket_sums_.size(); ++i) bucket_sums_[i] += o.bucket_sums_[i];
   for (size_t i = 0; i < m_sum_.size(); ++i) m_sum_[i] += o.m_sum_[i];
   for (size_t i = 0; i < m_count_.size(); ++i) m_count_[i] += o.m_count_[i];
 }
@@ -355,6 +357,7 @@ void Film::add(const Film& o) {
 void Film::clear() {
   std::fill(pixels_.begin(), pixels_.end(), Pixel{});
   std::fill(sensors_.begin(), sensors_.end(), SensorSums{});
+  std::fill(bucket_sums_.begin(), bucket_sums_.end(), 0.0);
   std::fill(m_sum_.begin(), m_sum_.end(), 0.0f);
   std::fill(m_count_.begin(), m_count_.end(), 0);
 }
@@ -367,6 +370,7 @@ void Film::save(ByteWriter& w) const {
   w.put_vector(m_sum_);
   w.put_vector(m_count_);
   w.put_vector(sensors_);
+  w.put_vector(bucket_sums_);
 }
 
 void Film::load(ByteReader& r) {
@@ -382,6 +386,10 @@ void Film::load(ByteReader& r) {
   std::vector<float> m_sum = r.get_vector<float>();
   std::vector<int> m_count = r.get_vector<int>();
   std::vector<SensorSums> sensors = r.get_vector<SensorSums>();
+  std::vector<double> buckets = r.get_vector<double>();
+  if (buckets.size() != bucket_sums_.size())
+    throw Error(r.what() + " keeps " + std::to_string(buckets.size()) +
+                " spectral sums, this render's film " + std::to_string(bucket_sums_.size()));
   if (pixels.size() != pixels_.size() || m_sum.size() != m_sum_.size() ||
       m_count.size() != m_count_.size())
     throw Error(r.what() + " is truncated or corrupt (film sizes)");
@@ -392,6 +400,17 @@ void Film::load(ByteReader& r) {
   pixels_ = std::move(pixels);
   m_sum_ = std::move(m_sum);
   m_count_ = std::move(m_count);
+  bucket_sums_ = std::move(buckets);
+}
+
+std::vector<float> Film::bucket_image(int b) const {
+  std::vector<float> out(pixels_.size());
+  const size_t n = 2 * size_t(spectral_.count);
+  for_pixels(pixels_.size(), [&](size_t i) {
+    const double w = bucket_sums_[i * n + 2 * size_t(b) + 1];
+    out[i] = w > 0 ? float(bucket_sums_[i * n + 2 * size_t(b)] / w) : 0.0f;
+  });
+  return out;
 }
 
 }  // namespace bpm

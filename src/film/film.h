@@ -58,6 +58,28 @@ inline FilmSample film_sample(const Spectrum& L, const Wavelengths& wl, float ma
   return f;
 }
 
+// pbrt-v4's "spectral" film: besides the colour, `count` buckets evenly over [lambda_min,
+// lambda_max] nm, each the mean over the samples that fell in it of the radiance at their
+// wavelengths (sampled uniformly over the range), in pbrt-v4's units: the spectrum whose ybar-
+// weighted mean is the luminance (cd/m^2 where lights are stated photometrically), i.e. spectral
+// radiance in W m^-2 sr^-1 nm^-1 times 683 lm/W times the integral of ybar (106.857 nm). count 0:
+// no buckets.
+struct SpectralBuckets {
+  int count = 0;
+  float lambda_min = 360, lambda_max = 830;
+  int bucket(float lambda) const {
+    const int b = int(float(count) * (lambda - lambda_min) / (lambda_max - lambda_min));
+    return b < 0 ? 0 : b >= count ? count - 1 : b;
+  }
+  bool operator==(const SpectralBuckets&) const = default;
+  // A sample's wavelengths: uniform over the buckets' range for a spectral film (as pbrt-v4's),
+  // else importance-sampled over the visible range.
+  Wavelengths wavelengths(float u) const {
+    return count > 0 ? sample_wavelengths_uniform(u, lambda_min, lambda_max)
+                     : sample_wavelengths(u);
+  }
+};
+
 class Film {
  public:
   // A render's passes form kStreams streams, pass j in stream j mod kStreams, whose means are
@@ -83,6 +105,27 @@ class Film {
     has_colour_matrix_ = true;
   }
   bool independent_passes() const { return independent_; }
+  // Keeps spectral buckets (none by default); forgets what they held.
+  void set_spectral(const SpectralBuckets& b) {
+    spectral_ = b;
+    bucket_sums_.assign(pixels_.size() * 2 * size_t(b.count), 0.0);
+  }
+  const SpectralBuckets& spectral() const { return spectral_; }
+  // Records a sample's radiance at its wavelengths into the buckets (clamped as film_sample
+  // clamps its colour, by its largest spectral value); no-op without buckets.
+  void add_spectrum(int x, int y, const Spectrum& L, const Wavelengths& wl, float weight,
+                    float max_value) {
+    if (spectral_.count == 0 || !recordable(L)) return;
+    const float m = L.max_component(), k = m > max_value ? max_value / m : 1;
+    double* sums = bucket_sums_.data() + (size_t(y) * width_ + x) * 2 * size_t(spectral_.count);
+    for (int i = 0; i < Spectrum::kChannels; ++i) {
+      const int b = spectral_.bucket(wl.lambda[size_t(i)]);
+      sums[2 * b] += double(weight) * k * L[i];
+      sums[2 * b + 1] += weight;
+    }
+  }
+  // Bucket b's image (width * height), in pbrt-v4's units (SpectralBuckets).
+  std::vector<float> bucket_image(int b) const;
   int width() const { return width_; }
   int height() const { return height_; }
   // What a film takes per pixel with m_images intermediate images, and what this one takes.
@@ -262,8 +305,10 @@ class Film {
   bool independent_ = true;
   bool has_colour_matrix_ = false;
   std::array<float, 9> colour_matrix_{};
-  std::vector<float> m_sum_;  // [pixel][image][channel]
-  std::vector<int> m_count_;  // [pixel][image]
+  SpectralBuckets spectral_;
+  std::vector<double> bucket_sums_;  // [pixel][bucket][radiance sum, weight sum]
+  std::vector<float> m_sum_;         // [pixel][image][channel]
+  std::vector<int> m_count_;         // [pixel][image]
 };
 
 }  // namespace bpm

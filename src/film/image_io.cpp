@@ -5,6 +5,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 #include <png.h>
 #include <unistd.h>
@@ -75,7 +76,8 @@ void write_png_bytes(const std::string& path, int w, int h, const std::vector<ui
 
 void set_exr_threads(int threads) { Imf::setGlobalThreadCount(std::max(threads, 0)); }
 
-void write_exr(const std::string& path, const Image& img, const std::vector<ExtraChannel>& extra) {
+void write_exr(const std::string& path, const Image& img, const std::vector<ExtraChannel>& extra,
+               const std::vector<std::pair<std::string, std::string>>& attributes) {
   std::string tmp = temporary_path(path);
   try {
     // A crop keeps its place in the full image: OpenEXR's data window within the display window.
@@ -89,6 +91,7 @@ void write_exr(const std::string& path, const Image& img, const std::vector<Extr
     Imf::Header header(display, data);
     header.compression() = Imf::ZIP_COMPRESSION;
     header.zipCompressionLevel() = 1;  // the fastest deflate: float noise compresses little more
+    for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
     const char* names[3] = {"R", "G", "B"};
     for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
     for (const ExtraChannel& e : extra) header.channels().insert(e.name, Imf::Channel(Imf::FLOAT));

@@ -2,6 +2,7 @@
 // reader never sees a half-written image.
 #pragma once
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "film/film.h"
@@ -16,9 +17,11 @@ struct ExtraChannel {
 // Threads that compress an OpenEXR file's blocks (OpenEXR's own pool; 0: the calling thread
 // alone, the default). The file's bytes do not depend on them.
 void set_exr_threads(int threads);
-// Linear float OpenEXR with R, G, B and optional extra channels. Throws Error on failure.
+// Linear float OpenEXR with R, G, B, optional extra channels and string attributes (name,
+// value). Throws Error on failure.
 void write_exr(const std::string& path, const Image& img,
-               const std::vector<ExtraChannel>& extra = {});
+               const std::vector<ExtraChannel>& extra = {},
+               const std::vector<std::pair<std::string, std::string>>& attributes = {});
 // 8-bit sRGB PNG of the image times exposure, clamped. Throws Error on failure.
 void write_png(const std::string& path, const Image& img, float exposure = 1);
 // 8-bit PNG of an RGB image already in display values [0,1].

@@ -162,9 +162,24 @@ void write_images(const OutputPaths& paths, const Film& film, float imaging_rati
     for (int c = 0; c < 3; ++c)
       add(std::string("rms_m_images.") + "RGB"[c], channel(m_rgb, c, imaging_ratio));
   }
+  // A spectral film's buckets, named as pbrt-v4 names them (OpenEXR's spectral layout: S0. and
+  // the bucket's centre with a decimal comma), with the layout's attributes.
+  std::vector<std::pair<std::string, std::string>> attributes;
+  const SpectralBuckets& sb = film.spectral();
+  for (int b = 0; b < sb.count; ++b) {
+    char name[64];
+    std::snprintf(
+        name, sizeof name, "%.3fnm",
+        sb.lambda_min + (float(b) + 0.5f) / float(sb.count) * (sb.lambda_max - sb.lambda_min));
+    std::string n = name;
+    std::replace(n.begin(), n.end(), '.', ',');
+    add("S0." + n, film.bucket_image(b));
+  }
+  if (sb.count > 0)
+    attributes = {{"spectralLayoutVersion", "1.0"}, {"emissiveUnits", "W.m^-2.sr^-1"}};
   std::vector<ExtraChannel> extra;
   for (size_t k = 0; k < names.size(); ++k) extra.push_back({names[k], &values[k]});
-  write_exr(paths.exr, img, extra);
+  write_exr(paths.exr, img, extra, attributes);
   write_png(paths.png, img);
   const std::vector<float> luminance = film.luminance_image();
   write_picture(paths.luminance_png, {{&luminance, film.width(), film.height()}},

@@ -161,7 +161,7 @@ uint64_t FpmRender::reserve_memory(const FpmSettings& settings) {
 PassResult FpmRender::iteration(int pass, const RenderControl& control) {
   const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
   // One set of wavelengths for every eye and light path of the iteration.
-  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it));
+  const WavelengthMaterials wm(scene_, iteration_wavelengths(opt_.seed, it, ls_.film.spectral));
   if (!opt_.image && !may_have_caustics(scene_)) {
     // Sensors alone in a scene without caustics: the photons would add nothing, the paths from
     // the sensors find everything.

@@ -107,6 +107,7 @@ inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wav
                         float filter_weight, float max_component_value,
                         bool may_be_negative = false) {
   int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
+  film->add_spectrum(x, y, L, wl, filter_weight, max_component_value);
   if (may_be_negative && L.is_finite()) {
     FilmSample f{spectrum_to_rgb(L, wl), spectrum_to_luminance(L, wl)};
     const float m = std::fmax(f.rgb.max_component(), -f.rgb.min_component());

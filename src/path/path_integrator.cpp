@@ -18,7 +18,7 @@ RenderStats render_path(const LoadedScene& ls, const IntegratorOptions& opt, Fil
     const int index = opt.first_iteration + pass;
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(index, pixel);
-      Wavelengths wl = sample_wavelengths(cs.rng.uniform());
+      Wavelengths wl = ls.film.spectral.wavelengths(cs.rng.uniform());
       Spectrum L = path_radiance(ls.scene, cs.ray, settings, wl, cs.rng, counters.local());
       record_pass(film, pixel, L, wl, cs.filter_weight, ls.film.max_component_value);
     });

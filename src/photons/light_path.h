@@ -58,14 +58,14 @@ int run_chunks_until(int n, const Stop& stop, const Body& body) {
 // estimates, whose spread is the render's error estimate (Film::set_independent_passes). For each
 // iteration alone v and the hero are uniform, so every iteration is an unbiased estimate and the
 // hero alone has the full density (hero_wavelength_only relies on it).
-inline Wavelengths iteration_wavelengths(uint64_t seed, int it) {
+inline Wavelengths iteration_wavelengths(uint64_t seed, int it, const SpectralBuckets& film = {}) {
   const int stream = it % Film::kStreams;
   const uint32_t t = uint32_t(it / Film::kStreams);
   Rng rng(stream_key(seed ^ 0x7761766573ull, uint64_t(stream), 0, 3));
   uint32_t shift_v = rng.next_u32(), shift_k = rng.next_u32();
   double v = double(van_der_corput_bits(t) ^ shift_v) * 0x1p-32;
   double k = std::floor(double(sobol2_bits(t) ^ shift_k) * 0x1p-32 * Spectrum::kChannels);
-  return sample_wavelengths(float((v + k) / Spectrum::kChannels));
+  return film.wavelengths(float((v + k) / Spectrum::kChannels));
 }
 
 // How a photon arrived: straight from the light, through specular vertices only, or after at

@@ -99,6 +99,7 @@ class MpiTeam : public Team {
     }
     // In rank order, so that the sums do not depend on which process answers first.
     Film other(film->width(), film->height(), film->m_images(), film->sensor_count());
+    other.set_spectral(film->spectral());
     for (int r = 1; r < size_; ++r) {
       const std::vector<uint8_t> bytes = recv_bytes(r);
       ByteReader reader(bytes, "the film of process " + std::to_string(r));

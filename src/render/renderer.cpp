@@ -44,6 +44,8 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
   if (!opt.image && opt.sensors.empty())
     throw Error("a render without an image needs sensors (--sensors)");
   if (ls.film.white_balance > 0) film->set_colour_matrix(white_balance_srgb(ls.film.white_balance));
+  // A spectral film's buckets (set before a resumed film was loaded, or here).
+  if (!(film->spectral() == ls.film.spectral)) film->set_spectral(ls.film.spectral);
   // The photon methods' iterations are independent only stream by stream (photons/light_path.h).
   const bool photons = opt.integrator != "path";
   film->set_independent_passes(!photons);

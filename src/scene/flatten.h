@@ -7,6 +7,7 @@
 #include <string>
 
 #include "camera/camera.h"
+#include "film/film.h"
 #include "film/filter.h"
 #include "scene/parsed_scene.h"
 #include "scene/render_scene.h"
@@ -45,7 +46,8 @@ struct FilmSettings {
   std::string filename = "pbrt.exr";
   float imaging_ratio = 1;  // exposure time * ISO / 100, as pbrt-v4's sensor
   float max_component_value = kInf;
-  float white_balance = 0;  // kelvin; 0: none (pbrt-v4's "whitebalance" of the cie1931 sensor)
+  float white_balance = 0;   // kelvin; 0: none (pbrt-v4's "whitebalance" of the cie1931 sensor)
+  SpectralBuckets spectral;  // pbrt-v4's "spectral" film; count 0 for "rgb"
 };
 
 // What the scene file says about how to render it; the command line may override each field.

@@ -115,9 +115,31 @@ void read_crop(const ParamSet& ps, FilmSettings* film) {
 
 }  // namespace
 
+namespace {
+
+// pbrt-v4's spectral film: its buckets, and an EXR file (the only format it writes).
+void read_spectral_film(const SceneEntity& f, SpectralBuckets* b) {
+  b->count = f.params.get_int("nbuckets", 16);
+  if (b->count < 1 || b->count > 1000)
+    throw Error(f.params.find_any("nbuckets")->loc, "nbuckets must be in [1, 1000]");
+  b->lambda_min = f.params.get_float("lambdamin", kLambdaMin);
+  b->lambda_max = f.params.get_float("lambdamax", kLambdaMax);
+  if (!(b->lambda_min >= kLambdaMin && b->lambda_max <= kLambdaMax &&
+        b->lambda_min < b->lambda_max))
+    throw Error(f.loc, "lambdamin and lambdamax must lie in [360, 830] nm, lambdamin below");
+  const std::string name = f.params.get_string("filename", "pbrt.exr");
+  if (!name.ends_with(".exr"))
+    throw Error(f.params.find_any("filename")->loc,
+                "a spectral film writes EXR only; \"" + name + "\" is not an .exr file");
+}
+
+}  // namespace
+
 void Flattener::read_film(LoadedScene* out) {
   const SceneEntity& f = parsed_.film;
-  if (f.name != "rgb") throw Error(f.loc, "film \"" + f.name + "\" is not supported (only rgb)");
+  if (f.name != "rgb" && f.name != "spectral")
+    throw Error(f.loc, "film \"" + f.name + "\" is not supported (rgb, spectral)");
+  if (f.name == "spectral") read_spectral_film(f, &out->film.spectral);
   out->film.width = f.params.get_int("xresolution", 1280);
   out->film.height = f.params.get_int("yresolution", 720);
   if (out->film.width <= 0 || out->film.height <= 0 || out->film.width > 65536 ||
