@@ -16,6 +16,8 @@ struct Vec2 {
   constexpr Vec2() = default;
   constexpr Vec2(float x_, float y_) : x(x_), y(y_) {}
 };
+inline Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
+inline Vec2 operator*(Vec2 a, float s) { return {a.x * s, a.y * s}; }
 
 struct Vec3 {
   float x = 0, y = 0, z = 0;

@@ -60,7 +60,7 @@ class Refiner {
     m_.positions.push_back((m_.positions[i] + m_.positions[j]) * 0.5f);
     const Vec3 n = m_.normals[i] + m_.normals[j];
     m_.normals.push_back(length(n) > 0 ? normalize(n) : m_.normals[i]);
-    m_.uvs.push_back(Vec2((m_.uvs[i].x + m_.uvs[j].x) * 0.5f, (m_.uvs[i].y + m_.uvs[j].y) * 0.5f));
+    m_.uvs.push_back((m_.uvs[i] + m_.uvs[j]) * 0.5f);
     return it->second;
   }
   PlyMesh& m_;

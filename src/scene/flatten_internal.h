@@ -104,8 +104,10 @@ class Flattener {
   static Sphere sphere_shape(const ShapeEntity& s, bool flip);
   static Disk disk_shape(const ShapeEntity& s, bool flip);
   static Cylinder cylinder_shape(const ShapeEntity& s, bool flip);
-  static std::vector<int> bilinear_to_triangles(const std::vector<Vec3>& P,
-                                                const std::vector<int>& idx, const FileLoc& loc);
+  // A bilinear mesh's patches as triangles (indices p00 p10 p01 p11 per patch): two for a planar
+  // patch, else a grid fine enough to follow the patch, whose vertices are appended.
+  static std::vector<int> bilinear_to_triangles(std::vector<Vec3>& P, std::vector<Vec3>& N,
+                                                std::vector<Vec2>& uv, const std::vector<int>& idx);
   void add_area_light(const SceneEntity& a, Object* obj, int id, RenderScene* rs);
 
   // Light sources other than area lights (flatten_lights.cpp). The add_*_light helpers take the

@@ -106,7 +106,7 @@ TriangleMesh Flattener::mesh_shape(const ShapeEntity& s, bool flip) {
     S->used = true;
     warning(S->loc, "per-vertex tangents \"S\" are ignored");
   }
-  if (bilinear) idx = bilinear_to_triangles(P, idx, s.loc);
+  if (bilinear) idx = bilinear_to_triangles(P, N, uv, idx);
   return mesh_from(s.world_from_object, flip, P, N, uv, idx);
 }
 
@@ -213,19 +213,74 @@ Cylinder Flattener::cylinder_shape(const ShapeEntity& s, bool flip) {
   return c;
 }
 
-std::vector<int> Flattener::bilinear_to_triangles(const std::vector<Vec3>& P,
-                                                  const std::vector<int>& idx, const FileLoc& loc) {
+namespace {
+
+// Whether a bilinear patch is planar: its fourth corner within 1e-4 of its size of the plane of
+// the other three.
+bool planar_patch(Vec3 p00, Vec3 p10, Vec3 p01, Vec3 p11) {
+  const Vec3 n = cross(p10 - p00, p01 - p00);
+  const float ln = length(n), size = std::fmax(length(p10 - p00), length(p01 - p00));
+  return !(ln > 0) || std::fabs(dot(p11 - p00, n / ln)) <= 1e-4f * size;
+}
+
+template <class T>
+T bilerp(const T& v00, const T& v10, const T& v01, const T& v11, float u, float v) {
+  return (v00 * (1 - u) + v10 * u) * (1 - v) + (v01 * (1 - u) + v11 * u) * v;
+}
+
+}  // namespace
+
+std::vector<int> Flattener::bilinear_to_triangles(std::vector<Vec3>& P, std::vector<Vec3>& N,
+                                                  std::vector<Vec2>& uv,
+                                                  const std::vector<int>& idx) {
+  bool curved = false;
+  for (size_t i = 0; i < idx.size(); i += 4)
+    curved = curved || !planar_patch(P[size_t(idx[i])], P[size_t(idx[i + 1])],
+                                     P[size_t(idx[i + 2])], P[size_t(idx[i + 3])]);
+  // A curved patch gets vertices of its own with the patch's normals; without normals in the
+  // file, every patch then does, and the file's vertices are dropped.
+  const bool own_normals = curved && N.empty();
+  const size_t file_vertices = P.size();
+  if (own_normals) N.assign(P.size(), Vec3(0, 0, 1));
+  const bool has_uv = !uv.empty();
+  if (curved && !has_uv) uv.assign(P.size(), Vec2(0, 0));
   std::vector<int> tris;
   for (size_t i = 0; i < idx.size(); i += 4) {
-    int a = idx[i], b = idx[i + 1], c = idx[i + 2], d = idx[i + 3];  // p00 p10 p01 p11
-    Vec3 n = cross(P[b] - P[a], P[c] - P[a]);
-    float size = std::fmax(length(P[b] - P[a]), length(P[c] - P[a]));
-    float ln = length(n);
-    if (ln > 0 && std::fabs(dot(P[d] - P[a], n / ln)) > 1e-4f * size)
-      throw Error(loc, "non-planar bilinear patches are not supported (patch " +
-                           std::to_string(i / 4) + ")");
-    int t[6] = {a, b, d, a, d, c};
-    tris.insert(tris.end(), t, t + 6);
+    const size_t a = size_t(idx[i]), b = size_t(idx[i + 1]), c = size_t(idx[i + 2]),
+                 d = size_t(idx[i + 3]);  // p00 p10 p01 p11
+    const Vec3 p00 = P[a], p10 = P[b], p01 = P[c], p11 = P[d];
+    const bool planar = planar_patch(p00, p10, p01, p11);
+    if (planar && !own_normals) {
+      tris.insert(tris.end(), {int(a), int(b), int(d), int(a), int(d), int(c)});
+      continue;
+    }
+    // A grid of k x k cells: each cell's two triangles stray from the patch by a quarter of the
+    // cell's twist, |p11 - p10 - p01 + p00| / (4 k^2), kept below 1e-4 of the patch's size.
+    const float twist = length(p11 - p10 - p01 + p00);
+    const float size = std::fmax(length(p10 - p00), length(p01 - p00));
+    const int k = planar ? 1 : std::clamp(int(std::ceil(std::sqrt(twist / (4e-4f * size)))), 2, 64);
+    const int first = int(P.size());
+    for (int jv = 0; jv <= k; ++jv)
+      for (int iu = 0; iu <= k; ++iu) {
+        const float u = float(iu) / float(k), v = float(jv) / float(k);
+        P.push_back(bilerp(p00, p10, p01, p11, u, v));
+        // The patch's own normal, dp/du x dp/dv (pbrt-v4's), unless the file gives normals.
+        const Vec3 dpdu = (p10 - p00) * (1 - v) + (p11 - p01) * v;
+        const Vec3 dpdv = (p01 - p00) * (1 - u) + (p11 - p10) * u;
+        N.push_back(own_normals ? normalize(cross(dpdu, dpdv))
+                                : normalize(bilerp(N[a], N[b], N[c], N[d], u, v)));
+        uv.push_back(has_uv ? bilerp(uv[a], uv[b], uv[c], uv[d], u, v) : Vec2(u, v));
+      }
+    for (int jv = 0; jv < k; ++jv)
+      for (int iu = 0; iu < k; ++iu) {
+        const int q = first + jv * (k + 1) + iu;
+        tris.insert(tris.end(), {q, q + 1, q + k + 2, q, q + k + 2, q + k + 1});
+      }
+  }
+  if (own_normals) {
+    for (auto* v : {&P, &N}) v->erase(v->begin(), v->begin() + ptrdiff_t(file_vertices));
+    uv.erase(uv.begin(), uv.begin() + ptrdiff_t(file_vertices));
+    for (int& t : tris) t -= int(file_vertices);
   }
   return tris;
 }

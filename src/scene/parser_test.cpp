@@ -1479,10 +1479,39 @@ TEST(SceneFlattenError, UvCountMismatch) {
                       "\"uv\" count differs from the vertex count"));
 }
 
-TEST(SceneFlattenError, NonPlanarBilinearPatch) {
-  EXPECT_TRUE(IsError(
-      error_of("WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 1]\n"),
-      at(2, 1), "non-planar bilinear patches are not supported"));
+// A twisted bilinear patch (p(u, v) = (u, v, u v) over the unit square) becomes a grid of
+// triangles on the patch: every vertex on the surface with the patch's normal, dp/du x dp/dv, and
+// its (u, v); the triangles' area is the patch's to 1e-4.
+TEST(SceneFlatten, NonPlanarBilinearPatchIsTessellated) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 1]\n"));
+  const TriangleMesh& m = std::get<TriangleMesh>(ls.scene.objects[0].shape);
+  EXPECT_GT(m.triangle_count(), 100);
+  double area = 0;
+  for (int t = 0; t < m.triangle_count(); ++t) {
+    const Vec3 a = m.positions[size_t(m.indices[3 * size_t(t)])],
+               b = m.positions[size_t(m.indices[3 * size_t(t) + 1])],
+               c = m.positions[size_t(m.indices[3 * size_t(t) + 2])];
+    area += 0.5 * length(cross(b - a, c - a));
+  }
+  // The area of z = x y over the unit square: the integral of sqrt(1 + x^2 + y^2).
+  double exact = 0;
+  constexpr int kN = 400;
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < kN; ++j) {
+      const double x = (i + 0.5) / kN, y = (j + 0.5) / kN;
+      exact += std::sqrt(1 + x * x + y * y) / (kN * kN);
+    }
+  EXPECT_NEAR(area, exact, 1e-4 * exact);
+  ASSERT_EQ(m.normals.size(), m.positions.size());
+  for (size_t v = 0; v < m.positions.size(); ++v) {
+    const Vec3 p = m.positions[v];
+    EXPECT_NEAR(p.z, p.x * p.y, 1e-5f);
+    const Vec3 n = normalize(Vec3(-p.y, -p.x, 1));  // (1, 0, y) x (0, 1, x)
+    EXPECT_NEAR(dot(m.normals[v], n), 1, 1e-5f) << v;
+    EXPECT_NEAR(m.uvs[v].x, p.x, 1e-5f);
+    EXPECT_NEAR(m.uvs[v].y, p.y, 1e-5f);
+  }
 }
 
 TEST(SceneFlattenError, PlymeshWithoutFilename) {
