@@ -100,6 +100,11 @@ Spectrum image_radiance(const ImageInfiniteLight& l, Vec2 uv, const Wavelengths&
   return illuminant_texel(rgb, l.scale, wl);
 }
 
+// Whether the light reaches the scene along w (toward the light): always without a portal.
+bool through_portal(const ImageInfiniteLight& l, Vec3 w) {
+  return !l.portal_normal || dot(w, *l.portal_normal) > 0;
+}
+
 // The solid angle of texel row y (all texels of a row cover the same one).
 double texel_solid_angle(const ImageInfiniteLight& l, int y) {
   const TexImage& im = *l.image;
@@ -169,6 +174,16 @@ void prepare_image_light(ImageInfiniteLight* l) {
     omega_total += omega * im.width;
     for (int x = 0; x < im.width; ++x) {
       Rgb rgb = im.texel(x, y, TexWrap::kClamp).clamped_zero();
+      // Behind a portal (its corners, edge middles and centre all are): never drawn.
+      if (l->portal_normal) {
+        bool seen = false;
+        for (int j = 0; j <= 2 && !seen; ++j)
+          for (int i = 0; i <= 2 && !seen; ++i)
+            seen = through_portal(
+                *l, image_light_direction(*l, {(float(x) + 0.5f * float(i)) / float(im.width),
+                                               (float(y) + 0.5f * float(j)) / float(im.height)}));
+        if (!seen) rgb = Rgb(0.0f);
+      }
       weights[size_t(y) * im.width + x] = float(rgb.average() * omega);
       for (int c = 0; c < 3; ++c) sum[c] += float(rgb[c] * omega);
     }
@@ -209,6 +224,7 @@ double image_light_illuminance(const ImageInfiniteLight& l) {
 }
 
 Spectrum environment_radiance_of(const ImageInfiniteLight& l, Vec3 w, const Wavelengths& wl) {
+  if (!through_portal(l, w)) return {};
   return image_radiance(l, image_light_uv(l, w), wl);
 }
 
@@ -220,6 +236,7 @@ std::optional<LightLiSample> sample_li_of(const ImageInfiniteLight& l, const Sha
   Vec2 uv = image_light_sample(l, u, &pdf);
   if (!(pdf > 0)) return std::nullopt;
   ls.wi = image_light_direction(l, uv);
+  if (!through_portal(l, ls.wi)) return std::nullopt;
   ls.radiance = image_radiance(l, uv, wl);
   ls.p_light = p_ref + ls.wi * (2 * bounds.radius);
   ls.pdf_solid_angle = pdf;
@@ -240,6 +257,7 @@ std::optional<LightLeSample> sample_le_of(const ImageInfiniteLight& l, const Sha
   Vec2 uv = image_light_sample(l, u_dir, &pdf);
   if (!(pdf > 0)) return std::nullopt;
   s.direction = -image_light_direction(l, uv);
+  if (!through_portal(l, -s.direction)) return std::nullopt;
   s.origin = disk_origin(s.direction, u_pos, bounds);
   s.flux = image_radiance(l, uv, wl) * (disk_area(bounds) / pdf);
   if (s.flux.is_black()) return std::nullopt;

@@ -51,6 +51,9 @@ struct ImageInfiniteLight {
   float scale = 1;
   Distribution2D distribution;  // over the image's (u, v), rows from the top
   Rgb mean_radiance;            // over directions, scale included
+  // pbrt-v4's portal: the light reaches the scene only along directions w (toward the light) with
+  // dot(w, n) > 0, the half of the sphere the portal faces; none: every direction.
+  std::optional<Vec3> portal_normal;
 };
 // Builds the distribution and the mean of an image light whose image, layout, frame and scale
 // are set.

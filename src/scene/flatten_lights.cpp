@@ -227,15 +227,38 @@ void Flattener::add_distant_light(const LightEntity& e, float* scale, RenderScen
   rs->lights.push_back(DistantLight{normalize(xf.vector(from - to)), L.scaled(*scale)});
 }
 
+namespace {
+
+// pbrt-v4's light portal: four points in world space (not moved by the current transform); the
+// light reaches the scene only from the side of cross(p3 - p0, p1 - p0): cross(p1 - p0, p3 - p0)
+// points into the scene.
+Vec3 portal_normal(const std::vector<Vec3>& p, const FileLoc& loc) {
+  if (p.size() != 4) throw Error(loc, "a portal takes 4 points; got " + std::to_string(p.size()));
+  const Vec3 n = cross(p[3] - p[0], p[1] - p[0]);
+  if (!(length(n) > 0) || !std::isfinite(length(n)))
+    throw Error(loc, "the portal's points p0, p1, p3 span no plane");
+  return normalize(n);
+}
+
+}  // namespace
+
 void Flattener::add_infinite_light(const LightEntity& e, float* scale, RenderScene* rs) {
   const ParamSet& ps = e.params;
-  if (auto* p = ps.find_any("portal")) throw Error(p->loc, "light portals are not supported");
+  const Param* portal = ps.find_any("portal");
   if (const Param* f = ps.find_any("filename")) {
     if (const Param* l = ps.find_any("L"))
       throw Error(l->loc, "an infinite light takes \"L\" or \"filename\", not both");
-    rs->lights.push_back(image_light(e, *f, scale));
+    ImageInfiniteLight light = image_light(e, *f, scale);
+    if (portal) {
+      light.portal_normal = portal_normal(ps.get_point3s("portal"), portal->loc);
+      prepare_image_light(&light);  // the texels behind the portal are never drawn
+    }
+    rs->lights.push_back(std::move(light));
     return;  // add_light checks the scale and the unused parameters
   }
+  if (portal)
+    throw Error(portal->loc,
+                "a portal needs an image infinite light (\"filename\"), as in pbrt-v4");
   SpectrumCurve L = light_spectrum(ps, "L");
   float E = ps.get_float("illuminance", -1);
   if (E > 0) *scale *= E / kPi;

@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "base/error.h"
+#include "base/rng.h"
+#include "lights/light.h"
 #include "materials/layered.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
@@ -1740,9 +1742,43 @@ TEST(SceneFlattenError, InfiniteLightImageErrors) {
           dir.str()),
       at(3, 1), "the transform of an environment light must be a rotation"));
   const std::string portal =
-      R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 1 0 0 1 0])";
+      R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 1 0])";
   EXPECT_TRUE(IsError(error_of("WorldBegin\n" + portal + "\n", dir.str()),
-                      at(2, col(portal, "\"point3")), "light portals are not supported"));
+                      at(2, col(portal, "\"point3")), "a portal takes 4 points; got 3"));
+  const std::string flat =
+      R"(LightSource "infinite" "string filename" "sky.pfm" "point3 portal" [0 0 0 1 0 0 1 0 0 2 0 0])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + flat + "\n", dir.str()),
+                      at(2, col(flat, "\"point3")), "span no plane"));
+  const std::string uniform =
+      R"(LightSource "infinite" "rgb L" [1 1 1] "point3 portal" [0 0 0 1 0 0 1 1 0 0 1 0])";
+  EXPECT_TRUE(IsError(error_of("WorldBegin\n" + uniform + "\n", dir.str()),
+                      at(2, col(uniform, "\"point3")), "a portal needs an image infinite light"));
+}
+
+// A portal in the plane z = 0 (p1 - p0 = +y, p3 - p0 = +x: cross(p1 - p0, p3 - p0) = -z points
+// into the scene): the light reaches the scene from directions with z > 0 only, its samples all
+// come from there, and the texels it never shows are never drawn.
+TEST(SceneParse, PortalLightsOnlyTheHalfItFaces) {
+  TempDir dir;
+  dir.write("sky.pfm", constant_pfm(64, 64, Rgb(1, 1, 1)));
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nLightSource \"infinite\" \"string filename\" \"sky.pfm\" \"point3 portal\" "
+      "[0 0 0  0 1 0  1 1 0  1 0 0]\n",
+      dir.str()));
+  ASSERT_EQ(ls.scene.lights.size(), 1u);
+  const Light& light = ls.scene.lights[0];
+  const Wavelengths wl = sample_wavelengths(0.3f);
+  EXPECT_GT(environment_radiance(light, normalize(Vec3(0.2f, 0.1f, 1)), wl).average(), 0);
+  EXPECT_EQ(environment_radiance(light, normalize(Vec3(0.2f, 0.1f, -1)), wl).average(), 0);
+  const auto& image = std::get<ImageInfiniteLight>(light);
+  Rng rng(3);
+  int front = 0;
+  for (int i = 0; i < 2000; ++i) {
+    float pdf = 0;
+    const Vec2 uv = image_light_sample(image, {rng.uniform(), rng.uniform()}, &pdf);
+    front += image_light_direction(image, uv).z > -0.1f;  // a texel the horizon crosses
+  }
+  EXPECT_EQ(front, 2000);
 }
 
 TEST(SceneParse, GoniometricAndProjectionLights) {
