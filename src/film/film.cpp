@@ -347,6 +347,10 @@ void Film::add(const Film& o) {
     sensors_[i].bias_sum += o.sensors_[i].bias_sum;
     sensors_[i].bias_sum2 += o.sensors_[i].bias_sum2;
     sensors_[i].passes += o.sensors_[i].passes;
+    for (int k = 0; k < kStreams; ++k) {
+      sensors_[i].stream_sum[k] += o.sensors_[i].stream_sum[k];
+      sensors_[i].stream_passes[k] += o.sensors_[i].stream_passes[k];
+    }
   }
   BPM_CHECK(o.spectral_ == spectral_);
   for (size_t i = 0; i < bucket_sums_.size(); ++i) bucket_sums_[i] += o.bucket_sums_[i];

@@ -73,5 +73,23 @@ TEST(Film, StreamSpreadAgreesWithEq5ForIndependentPasses) {
   EXPECT_NEAR(early.sensor_standard_error(0), std::sqrt(4.0 / 3 / 4), 1e-5);
 }
 
+// Films that recorded other passes (the processes of a distributed render) add up to the film
+// that recorded them all: the pixels, the M images and the sensors' streams, so that every error
+// estimate is the same.
+TEST(Film, AddedFilmsStateTheErrorOfAllTheirPasses) {
+  Rng rng(11);
+  Film all(1, 1, Film::kStreams, 1), a(1, 1, Film::kStreams, 1), b(1, 1, Film::kStreams, 1);
+  for (Film* f : {&all, &a, &b}) f->set_independent_passes(false);
+  for (int j = 0; j < 4 * Film::kStreams; ++j) {
+    const float v = 1 + float(rng.uniform());
+    record(&all, j, v);
+    record(j % 3 ? &a : &b, j, v);
+  }
+  a.add(b);
+  EXPECT_NEAR(a.sensor_mean(0), all.sensor_mean(0), 1e-9);
+  EXPECT_NEAR(a.sensor_standard_error(0), all.sensor_standard_error(0), 1e-9);
+  EXPECT_NEAR(a.rms()[0], all.rms()[0], 1e-6);
+}
+
 }  // namespace
 }  // namespace bpm
