@@ -376,9 +376,11 @@ void check_film_memory(const RenderArgs& a, const LoadedScene& ls, const RenderO
   const double pixels = double(ls.film.width) * double(ls.film.height);
   check_memory("a " + std::to_string(ls.film.width) + "x" + std::to_string(ls.film.height) +
                    " film with its outputs",
-               pixels * (double(Film::bytes_per_pixel(a.m_images)) *
+               pixels * ((double(Film::bytes_per_pixel(a.m_images)) +
+                          // a spectral film's sums, and its channels in the outputs
+                          double(ls.film.spectral.count) * (2 * sizeof(double))) *
                              (1 + (keep_checkpoint ? 1 : 0) + (team ? 2 : 0)) +
-                         kOutputBytesPerPixel),
+                         kOutputBytesPerPixel + double(ls.film.spectral.count) * sizeof(float)),
                opt.memory_budget, "lower --resolution or --m-images, or raise --memory");
 }
 

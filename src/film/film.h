@@ -134,7 +134,7 @@ class Film {
   }
   size_t bytes() const {
     return size_t(width_) * size_t(height_) * bytes_per_pixel(m_) +
-           sensors_.size() * sizeof(SensorSums);
+           sensors_.size() * sizeof(SensorSums) + bucket_sums_.size() * sizeof(double);
   }
 
   void add_sample(int x, int y, const FilmSample& s, float weight) {
