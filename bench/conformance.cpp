@@ -1,4 +1,4 @@
-// Scene conformance: renders every scene file of ../shared/scenes with the path integrator at a
+// Scene conformance: renders every scene file of ../shared/scenes with path, bpm and fpm at a
 // small resolution and prints, per scene, the mean of each channel and, where ../shared/references
 // holds a pbrt-v4 render of that scene, the ratio of our channel means to pbrt-v4's and the
 // relative MSE (mean over pixels and channels of (a - b)^2 / (b^2 + 0.01)) against it. Then each
@@ -153,12 +153,14 @@ int main(int argc, char** argv) {
         if (f.path().extension() == ".pbrt") files.push_back(f.path());
   std::sort(files.begin(), files.end());
 
-  std::printf("path integrator, %d spp; references: pbrt-v4 renders in %s/references\n\n", spp,
-              shared.c_str());
   std::printf(
-      "| scene file | resolution | seconds | mean R G B | bpm / pbrt-v4 per channel | relMSE to "
-      "pbrt-v4 |\n");
-  std::printf("| --- | --- | --- | --- | --- | --- |\n");
+      "path at %d spp, bpm and fpm at %d iterations; references: pbrt-v4 renders in "
+      "%s/references\n\n",
+      spp, spp, shared.c_str());
+  std::printf(
+      "| scene file | integrator | resolution | seconds | mean R G B | ours / pbrt-v4 per channel "
+      "| relMSE to pbrt-v4 |\n");
+  std::printf("| --- | --- | --- | --- | --- | --- | --- |\n");
   for (const fs::path& file : files) {
     std::string scene = file.parent_path().filename().string();
     std::string label = scene + "/" + file.filename().string();
@@ -175,27 +177,30 @@ int main(int argc, char** argv) {
       }
       ls.film.width = w;
       ls.film.height = h;
-      RenderOptions opt = quiet_options(ls, "path", spp);
-      Film film(w, h);
-      auto t0 = std::chrono::steady_clock::now();
-      render(ls, opt, &film);
-      double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      Image img = film.image(ls.film.imaging_ratio);
-      auto m = channel_means(img);
-      std::printf("| %s | %dx%d | %.1f | %.4f %.4f %.4f |", label.c_str(), w, h, secs, m[0], m[1],
-                  m[2]);
-      if (ref) {
-        ImageComparison c = compare_images(img, read_exr(ref->path.string()));
-        const auto& mr = c.mean_b;
-        std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2],
-                    c.rel_mse);
-      } else {
-        std::printf(" no reference | |\n");
+      for (const char* integrator : {"path", "bpm", "fpm"}) {
+        RenderOptions opt = quiet_options(ls, integrator, spp);
+        Film film(w, h);
+        auto t0 = std::chrono::steady_clock::now();
+        render(ls, opt, &film);
+        double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        Image img = film.image(ls.film.imaging_ratio);
+        auto m = channel_means(img);
+        std::printf("| %s | %s | %dx%d | %.1f | %.4f %.4f %.4f |", label.c_str(), integrator, w, h,
+                    secs, m[0], m[1], m[2]);
+        if (ref) {
+          ImageComparison c = compare_images(img, read_exr(ref->path.string()));
+          const auto& mr = c.mean_b;
+          std::printf(" %.4f %.4f %.4f | %.5f |\n", m[0] / mr[0], m[1] / mr[1], m[2] / mr[2],
+                      c.rel_mse);
+        } else {
+          std::printf(" no reference | |\n");
+        }
+        std::fflush(stdout);
       }
     } catch (const std::exception& e) {
       std::string msg = e.what();
       std::replace(msg.begin(), msg.end(), '|', '/');
-      std::printf("| %s | | | not rendered: %s | | |\n", label.c_str(), msg.c_str());
+      std::printf("| %s | | | | not rendered: %s | | |\n", label.c_str(), msg.c_str());
     }
     std::fflush(stdout);
   }
