@@ -183,7 +183,7 @@ Bump Flattener::make_bump(const SceneEntity& e) {
     TexEncoding linear;
     linear.kind = TexEncoding::Kind::kLinear;
     try {
-      b.normal_map = load_texture_image(path.string(), linear);
+      b.normal_map = load_texture_image(path.string(), linear, false);  // directions, not colours
     } catch (const Error& err) {
       throw Error(p->loc, std::string("normalmap: ") + err.what());
     }

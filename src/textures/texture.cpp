@@ -64,10 +64,10 @@ Rgb TexImage::lookup(Vec2 st, TexFilter filter, TexWrap wrap) const {
 }
 
 std::shared_ptr<const TexImage> load_texture_image(const std::string& path,
-                                                   const TexEncoding& encoding) {
+                                                   const TexEncoding& encoding, bool colours) {
   static std::mutex mutex;
   static std::map<std::string, std::shared_ptr<const TexImage>> cache;
-  prepare_texel_spectra();  // what every texel's colour will need, built before the render
+  if (colours) prepare_texel_spectra();  // what every texel's colour will need, before the render
   std::string key =
       path + "|" + std::to_string(int(encoding.kind)) + "|" + std::to_string(encoding.gamma);
   std::lock_guard<std::mutex> lock(mutex);
