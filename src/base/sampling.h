@@ -182,6 +182,14 @@ class Distribution2D {
 // areas of the square map to equal solid angles: d omega = 4 pi du dv.
 Vec3 equal_area_square_to_sphere(Vec2 p);
 Vec2 equal_area_sphere_to_square(Vec3 d);
+// The solid angle of one cell of row `row` of a width x height latitude-longitude grid (rows of
+// equal polar angle from the pole at row 0, every cell of a row the same).
+inline double latlong_cell_solid_angle(int row, int width, int height) {
+  const double t0 = 3.14159265358979323846 * row / height,
+               t1 = 3.14159265358979323846 * (row + 1) / height;
+  return 2 * 3.14159265358979323846 / width * (std::cos(t0) - std::cos(t1));
+}
+
 // A point of the square's neighbourhood folded back into it as the sphere continues across each
 // edge (mirrored about the edge's middle), for lookups a little outside the square.
 Vec2 wrap_equal_area_square(Vec2 p);

@@ -8,12 +8,10 @@
 namespace bpm {
 namespace {
 
-// The solid angle of the equirectangular row of pixels about raster y (of `height` rows), per
-// pixel of a `width`-wide row.
+// The solid angle of a pixel of the equirectangular row about raster y.
 float equirectangular_pixel_solid_angle(float y, int width, int height) {
-  const float row = std::clamp(std::floor(y), 0.0f, float(height - 1));
-  const float t0 = kPi * row / float(height), t1 = kPi * (row + 1) / float(height);
-  return 2 * kPi / float(width) * (std::cos(t0) - std::cos(t1));
+  const int row = std::clamp(int(std::floor(y)), 0, height - 1);
+  return float(latlong_cell_solid_angle(row, width, height));
 }
 
 }  // namespace

@@ -109,8 +109,7 @@ bool through_portal(const ImageInfiniteLight& l, Vec3 w) {
 double texel_solid_angle(const ImageInfiniteLight& l, int y) {
   const TexImage& im = *l.image;
   if (l.equal_area) return 4 * M_PI / (double(im.width) * im.height);
-  double t0 = M_PI * y / im.height, t1 = M_PI * (y + 1) / im.height;
-  return 2 * M_PI / im.width * (std::cos(t0) - std::cos(t1));
+  return latlong_cell_solid_angle(y, im.width, im.height);
 }
 
 }  // namespace

@@ -130,11 +130,16 @@ Vec2 TexMapping::map(const TextureContext& ctx) const {
 
 namespace {
 
-// The image's value at the point, after scale and invert (pbrt-v4's image textures).
-Rgb image_rgb(const ImageTexture& t, const TextureContext& ctx) {
+// The image's texel value at the point, before scale and invert.
+Rgb image_lookup(const ImageTexture& t, const TextureContext& ctx) {
   Vec2 st = t.mapping.map(ctx);
   st.y = 1 - st.y;  // t runs up the image; rows run down
-  Rgb v = t.image->lookup(st, t.filter, t.wrap) * t.scale;
+  return t.image->lookup(st, t.filter, t.wrap);
+}
+
+// The image's value at the point, after scale and invert (pbrt-v4's image textures).
+Rgb image_rgb(const ImageTexture& t, const TextureContext& ctx) {
+  Rgb v = image_lookup(t, ctx) * t.scale;
   if (t.invert)
     for (int c = 0; c < 3; ++c) v[c] = std::max(0.0f, 1 - v[c]);
   return v;
@@ -178,9 +183,7 @@ float TextureSet::value(int i, const TextureContext& ctx) const {
   if (auto* im = std::get_if<ImageTexture>(&n)) {
     // pbrt-v4 reads an RGB image as a float texture by the mean of its three channels, scaled,
     // then inverted.
-    Vec2 st = im->mapping.map(ctx);
-    st.y = 1 - st.y;
-    const Rgb c = im->image->lookup(st, im->filter, im->wrap);
+    const Rgb c = image_lookup(*im, ctx);
     const float v = (c[0] + c[1] + c[2]) / 3 * im->scale;
     return im->invert ? std::max(0.0f, 1 - v) : v;
   }
