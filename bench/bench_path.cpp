@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
       for (int x = 0; x < res; ++x)
         for (int s = 0; s < 4; ++s) {
           Rng rng(stream_key(99, s, uint64_t(y) * res + x));
-          Ray r = cam.generate_ray({x + rng.uniform(), y + rng.uniform()}, {0.5f, 0.5f});
+          Ray r = cam.generate_ray({x + rng.uniform(), y + rng.uniform()}, {0.5f, 0.5f}).ray;
           path_radiance(ls.scene, r, PathSettings{ls.render.max_depth},
                         sample_wavelengths(rng.uniform()), rng, c);
         }

@@ -18,10 +18,13 @@
 // One percent is added for the smooth part of the radius bias (curvature of the irradiance).
 // With progressive radii the bound shrinks with the iterations.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -383,6 +386,54 @@ TEST(Cameras, SphereFurnaceSeenByOrthographicAndSphericalCameras) {
     }
 }
 
+// The furnace through a realistic camera whose aperture stop is nearest the film (the stop is its
+// own exit pupil): a film point at distance rho from the axis sees the radiance of the furnace
+// times the projected solid angle of the stop's disc (radius a, distance z), pi F with F the
+// view factor 1/2 (1 - (z^2 + rho^2 - a^2) / sqrt((z^2 + rho^2 + a^2)^2 - 4 a^2 rho^2)) (the
+// lens's glass is wide enough to vignette nothing). The image mean is that over the film. The
+// lens's weight carries through every integrator's estimate.
+TEST(Cameras, SphereFurnaceThroughALens) {
+  const std::filesystem::path lens =
+      std::filesystem::temp_directory_path() / ("bpm_lens_" + std::to_string(::getpid()) + ".dat");
+  std::ofstream(lens) << "60 5 1.5168 80\n-60 5 1 80\n0 45 0 10\n";
+  const LoadedScene ls = load(
+      "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"realistic\" \"string lensfile\" \"" + lens.string() +
+      "\" \"float aperturediameter\" 10\nFilm \"rgb\" \"integer xresolution\" "
+      "16 \"integer yresolution\" 16\n"
+      "PixelFilter \"box\"\nIntegrator \"path\" \"integer maxdepth\" 8\n"
+      "WorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n"
+      "Material \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n"
+      "ReverseOrientation\nShape \"sphere\" \"float radius\" 2\n");
+  std::filesystem::remove(lens);
+  double furnace = 0;
+  for (int k = 0; k <= ls.render.max_depth; ++k) furnace += std::pow(0.8, k);
+  // The mean of pi F over the square film of 35 mm diagonal, on a 256 x 256 grid.
+  const double a = 0.005, z = ls.camera.lens->rear_z(), side = 0.035 / std::sqrt(2.0);
+  double sum = 0;
+  const int n = 256;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double x = side * ((i + 0.5) / n - 0.5), y = side * ((j + 0.5) / n - 0.5);
+      const double p2 = x * x + y * y, q = z * z + p2 + a * a;
+      sum += kPi / 2 * (1 - (z * z + p2 - a * a) / std::sqrt(q * q - 4 * a * a * p2));
+    }
+  const double expected = furnace * sum / (n * n);
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    BpmSettings s = small_batches(0);
+    FpmSettings f;
+    f.final_gather = false;
+    BlockStats m = image_mean(render_iterations(ls, integrator, 48, 5, s, f));
+    const double sigma = std::sqrt(m.var);
+    const Camera camera(ls.camera, 16, 16);
+    const double r_over_R = s.k1 * camera.footprint_at(Vec3(0, 0, 2)) / 2;
+    const double bias = expected * r_over_R * r_over_R / 8;
+    EXPECT_NEAR(m.mean, expected, 4.5 * sigma + bias)
+        << integrator << " mean " << m.mean << " expected " << expected << " sigma " << sigma
+        << " bias bound " << bias;
+    EXPECT_LT(sigma, 0.01 * expected) << integrator;
+  }
+}
+
 // The furnace with the sphere made of facets (12 around, 6 from pole to pole: neighbours 30 degrees
 // apart) and smooth shading normals, as a coarse scanned or modelled mesh is. A disc about a
 // backward photon near an edge then holds photons that landed on other facets; each is converted
@@ -473,7 +524,8 @@ struct CheckerFurnace {
     for (int y = 0; y < kRes; ++y)
       for (int x = 0; x < kRes; ++x)
         for (int j = 0; j < 64; ++j) {
-          Ray r = cam.generate_ray({x + (j % 8 + 0.5f) / 8, y + (j / 8 + 0.5f) / 8}, {0.5f, 0.5f});
+          Ray r =
+              cam.generate_ray({x + (j % 8 + 0.5f) / 8, y + (j / 8 + 0.5f) / 8}, {0.5f, 0.5f}).ray;
           Vec3 p = r.o + normalize(r.d) * 2.0f;
           out[size_t(y) * kRes + x] += (1 + rho(p) * a) / 64;
         }
@@ -564,7 +616,8 @@ TEST(Bpm, FirstDiffuseVertexGathersCausticsOverK0AndIndirectOverK1) {
       EyeCounters counters;
       CameraSample cs = camera.sample(pass, centre);
       // A footprint of one world unit per unit of length: the radii are r0 and r1 per length.
-      trace_eye_path(ls.scene, ep, cs.ray, PixelFootprint{0, 1}, centre, cs.rng, lists, counters);
+      trace_eye_path(ls.scene, ep, {cs.ray, cs.weight}, PixelFootprint{0, 1}, centre, cs.rng, lists,
+                     counters);
       all.clear();
       for (const auto& l : lists) all.insert(all.end(), l.begin(), l.end());
     }
@@ -1008,8 +1061,9 @@ TEST(Bpm, WorldRadiusGivesEveryBackwardPhotonThatRadius) {
   EyeCounters c;
   for (uint32_t pixel = 0; pixel < 32 * 32; pixel += 7) {
     Rng rng(stream_key(3, 0, pixel));
-    Ray r = cam.generate_ray({float(pixel % 32) + 0.5f, float(pixel / 32) + 0.5f}, {0.5f, 0.5f});
-    trace_eye_path(ls.scene, ep, r, PixelFootprint{0, 1}, pixel, rng, lists, c);
+    Ray r =
+        cam.generate_ray({float(pixel % 32) + 0.5f, float(pixel / 32) + 0.5f}, {0.5f, 0.5f}).ray;
+    trace_eye_path(ls.scene, ep, CameraRay{r}, PixelFootprint{0, 1}, pixel, rng, lists, c);
   }
   size_t n = 0;
   for (const auto& l : lists)

@@ -101,7 +101,7 @@ TEST(PathIntegrator, PlaneUnderPointLight) {
   int checked = 0;
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 24; ++x) {
-      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
       if (r.d.y >= 0) continue;
       Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
       Vec3 to_light = light - p;
@@ -157,7 +157,7 @@ TEST(PathIntegrator, ImageTexturedPlaneUnderPointLight) {
   int checked = 0, seen[4] = {0, 0, 0, 0};
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 24; ++x) {
-      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
       if (r.d.y >= 0) continue;
       Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
       float fx = 2 * 25 * (p.x + 50) / 100, fy = 2 * (1 - 25 * (p.z + 50) / 100);
@@ -212,7 +212,7 @@ TEST(Integrators, AbsorbingMediumAttenuatesByBeerLambert) {
     int inside = 0;
     for (int y = 0; y < 16; ++y)
       for (int x = 0; x < 16; ++x) {
-        Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+        Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
         Vec3 d = normalize(r.d);
         float b = dot(r.o, d), c = length_squared(r.o) - R * R, disc = b * b - c;
         float chord = disc > 0 ? 2 * std::sqrt(disc) : 0;
@@ -236,7 +236,7 @@ double pixel_mean(const Camera& cam, int x, int y, F&& f) {
   double sum = 0;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i)
-      sum += f(cam.generate_ray({x + (i + 0.5f) / n, y + (j + 0.5f) / n}, {0.5f, 0.5f}));
+      sum += f(cam.generate_ray({x + (i + 0.5f) / n, y + (j + 0.5f) / n}, {0.5f, 0.5f}).ray);
   return sum / (n * n);
 }
 
@@ -414,7 +414,7 @@ TEST(Integrators, DiffusePlaneUnderEnvironmentImage) {
     Camera cam(sky.camera, 12, 12);
     for (int y = 0; y < 12; ++y)
       for (int x = 0; x < 12; ++x) {
-        Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).d);
+        Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray.d);
         Vec2 uv = image_light_uv(light, d);
         // pbrt-v4's image coordinates: (u, v) with v down the image's rows.
         Rgb texel = light.image->texel(
@@ -479,7 +479,7 @@ TEST(Integrators, PlaneUnderGoniometricAndProjectionLights) {
       int lit = 0, dark = 0;
       for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 24; ++x) {
-          Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+          Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
           if (r.d.y >= 0) continue;
           Vec3 p = r.o + r.d * (-r.o.y / r.d.y);
           float expected = 0;
@@ -544,7 +544,7 @@ TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
   int inside = 0;
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x) {
-      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f});
+      Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
       Vec3 p = r.o + r.d * (-r.o.z / r.d.z);
       if (std::fabs(p.x) > 1 || std::fabs(p.y) > 1) continue;
       Vec2 uv((p.x + 1) / 2, (p.y + 1) / 2);

@@ -9,6 +9,14 @@ struct Ray {
   float t_max = kInf;
 };
 
+// A ray from the camera and the factor it carries into the radiance it brings back: 1 but for
+// the realistic camera, whose lens weighs its rays (camera/lens_system.h); 0: no light comes
+// along this ray.
+struct CameraRay {
+  Ray ray;
+  float weight = 1;
+};
+
 // The closest hit of a ray: the scene object (Embree geometry id), its primitive, the barycentric
 // coordinates on it and the distance along the ray in units of |d|.
 struct Hit {

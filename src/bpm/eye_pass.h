@@ -75,8 +75,8 @@ struct EyeRadiance {
 // appends the path's backward photons to out[object] (radii: k0 or k1 footprints). With
 // emission_only the path ends at its first diffuse vertex and stores nothing: only `emission` is
 // computed. near_edge: the pixel's mark_near_edges bits, which decide whether a first vertex seen
-// directly probes its discs.
-EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, Ray ray,
+// directly probes its discs. The ray's weight is the throughput the path starts with.
+EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, CameraRay ray,
                            PixelFootprint footprint, uint32_t pixel, Rng& rng,
                            ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only = false, uint8_t near_edge = 3);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/error.h"
 #include "base/sampling.h"
 
 namespace bpm {
@@ -24,7 +25,8 @@ Camera::Camera(const CameraSettings& s, const Raster& r)
       width_(r.full_width),
       height_(r.full_height),
       crop_x0_(float(r.x0)),
-      crop_y0_(float(r.y0)) {
+      crop_y0_(float(r.y0)),
+      lens_(s.lens) {
   const int width = r.full_width, height = r.full_height;
   const float aspect =
       s.frame_aspect_ratio > 0 ? s.frame_aspect_ratio : float(width) / float(height);
@@ -54,6 +56,10 @@ Camera::Camera(const CameraSettings& s, const Raster& r)
       break;
     case Projection::kSphericalEquirectangular:
       break;  // per row
+    case Projection::kRealistic:
+      BPM_CHECK(lens_);
+      pixel_angle_ = lens_->pixel_spread();
+      break;
   }
 }
 
@@ -70,11 +76,16 @@ Vec3 Camera::camera_direction(Vec2 p) const {
   return Vec3(d.x, d.z, d.y);
 }
 
-Ray Camera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
+CameraRay Camera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
   if (projection_ == Projection::kSphericalEqualArea ||
       projection_ == Projection::kSphericalEquirectangular)
-    return Ray{world_from_camera_.point(Vec3(0, 0, 0)),
-               normalize(world_from_camera_.vector(camera_direction(p))), kInf};
+    return {Ray{world_from_camera_.point(Vec3(0, 0, 0)),
+                normalize(world_from_camera_.vector(camera_direction(p))), kInf}};
+  if (projection_ == Projection::kRealistic) {
+    CameraRay r = lens_->generate({p.x / float(width_), p.y / float(height_)}, u_lens);
+    r.ray = Ray{world_from_camera_.point(r.ray.o), normalize(world_from_camera_.vector(r.ray.d))};
+    return r;
+  }
   const float sx = x0_ + (p.x / float(width_)) * (x1_ - x0_);
   const float sy = y1_ - (p.y / float(height_)) * (y1_ - y0_);
   Vec3 origin(0, 0, 0), dir;
@@ -92,7 +103,7 @@ Ray Camera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
     origin = p_lens;
     dir = normalize(p_focus - p_lens);
   }
-  return Ray{world_from_camera_.point(origin), normalize(world_from_camera_.vector(dir)), kInf};
+  return {Ray{world_from_camera_.point(origin), normalize(world_from_camera_.vector(dir)), kInf}};
 }
 
 PixelFootprint Camera::footprint(Vec2 p_full) const {

@@ -1,17 +1,22 @@
-// pbrt-v4's cameras: perspective, orthographic and spherical. Raster y grows downward, and camera
-// space looks down +z with +x to the right of the image (the spherical cameras: +y is up; the
-// equirectangular image's left edge looks down +x, a quarter across down +z).
+// pbrt-v4's cameras: perspective, orthographic, spherical and realistic (a lens system,
+// camera/lens_system.h). Raster y grows downward, and camera space looks down +z with +x to the
+// right of the image (the spherical cameras: +y is up; the equirectangular image's left edge looks
+// down +x, a quarter across down +z).
 #pragma once
+#include <memory>
+
 #include "base/ray.h"
 #include "base/transform.h"
+#include "camera/lens_system.h"
 
 namespace bpm {
 
 enum class Projection {
   kPerspective,
   kOrthographic,
-  kSphericalEqualArea,       // pbrt-v4's default "spherical" mapping: an octahedral map
-  kSphericalEquirectangular  // latitude (rows) and longitude (columns)
+  kSphericalEqualArea,        // pbrt-v4's default "spherical" mapping: an octahedral map
+  kSphericalEquirectangular,  // latitude (rows) and longitude (columns)
+  kRealistic
 };
 
 struct CameraSettings {
@@ -20,8 +25,9 @@ struct CameraSettings {
   float fov_degrees = 90;
   float lens_radius = 0;
   float focal_distance = 1e6f;
-  float frame_aspect_ratio = 0;           // 0: the raster's
-  float screen_window[4] = {0, 0, 0, 0};  // x0 x1 y0 y1; all zero means pbrt-v4's default
+  float frame_aspect_ratio = 0;            // 0: the raster's
+  float screen_window[4] = {0, 0, 0, 0};   // x0 x1 y0 y1; all zero means pbrt-v4's default
+  std::shared_ptr<const LensSystem> lens;  // realistic: focused for the film's full raster
 };
 
 // The pixels a camera renders: width x height of its full_width x full_height raster, from pixel
@@ -46,13 +52,14 @@ class Camera {
       : Camera(s, Raster{width, height, width, height, 0, 0}) {}
   // p_raster in pixels of the image rendered ((0,0) is the top-left corner of the crop); u_lens in
   // [0,1)^2.
-  Ray generate_ray(Vec2 p_raster, Vec2 u_lens) const {
+  // Every camera but the realistic one gives rays of weight 1.
+  CameraRay generate_ray(Vec2 p_raster, Vec2 u_lens) const {
     return generate_ray_full({p_raster.x + crop_x0_, p_raster.y + crop_y0_}, u_lens);
   }
   // The same with p in pixels of the full raster.
-  Ray generate_ray_full(Vec2 p_full, Vec2 u_lens) const;
-  // The footprint of the pixel about p_full (pixels of the full raster). Perspective: the
-  // angle the image centre's pixel subtends, for every pixel (lens ignored).
+  CameraRay generate_ray_full(Vec2 p_full, Vec2 u_lens) const;
+  // The footprint of the pixel about p_full (pixels of the full raster). Perspective and
+  // realistic: the angle the image centre's pixel subtends, for every pixel (lens ignored).
   PixelFootprint footprint(Vec2 p_full) const;
   // The width of a pixel's footprint at world point p seen directly.
   float footprint_at(Vec3 p) const;
@@ -69,6 +76,7 @@ class Camera {
   float crop_x0_, crop_y0_;
   float pixel_angle_ = 0;  // sqrt of the pixel's solid angle (perspective, equal-area)
   float pixel_width_ = 0;  // sqrt of the pixel's area in world units (orthographic)
+  std::shared_ptr<const LensSystem> lens_;
 };
 
 }  // namespace bpm

@@ -19,9 +19,9 @@ CameraSettings settings(Projection p) {
 // Default screen window of a 40 x 30 raster: x in [-4/3, 4/3], y in [-1, 1]; a pixel is 1/15 wide.
 TEST(Camera, OrthographicRaysAreParallelAndOnePixelApart) {
   const Camera camera(settings(Projection::kOrthographic), 40, 30);
-  const Ray a = camera.generate_ray({0.5f, 0.5f}, {0.5f, 0.5f});
-  const Ray b = camera.generate_ray({1.5f, 0.5f}, {0.5f, 0.5f});
-  const Ray c = camera.generate_ray({0.5f, 1.5f}, {0.5f, 0.5f});
+  const Ray a = camera.generate_ray({0.5f, 0.5f}, {0.5f, 0.5f}).ray;
+  const Ray b = camera.generate_ray({1.5f, 0.5f}, {0.5f, 0.5f}).ray;
+  const Ray c = camera.generate_ray({0.5f, 1.5f}, {0.5f, 0.5f}).ray;
   for (const Ray& r : {a, b, c}) {
     EXPECT_FLOAT_EQ(r.d.z, 1);
     EXPECT_FLOAT_EQ(r.o.z, 0);
@@ -40,7 +40,7 @@ TEST(Camera, OrthographicRaysAreParallelAndOnePixelApart) {
 TEST(Camera, EquirectangularDirectionsAndSolidAngles) {
   constexpr int kW = 64, kH = 32;
   const Camera camera(settings(Projection::kSphericalEquirectangular), kW, kH);
-  auto dir = [&](float x, float y) { return camera.generate_ray({x, y}, {}).d; };
+  auto dir = [&](float x, float y) { return camera.generate_ray({x, y}, {}).ray.d; };
   const Vec3 x = dir(0, kH / 2.0f), z = dir(kW / 4.0f, kH / 2.0f), up = dir(5, 0);
   EXPECT_NEAR(x.x, 1, 1e-5f);
   EXPECT_NEAR(z.z, 1, 1e-5f);
@@ -66,7 +66,7 @@ TEST(Camera, EqualAreaPixelsSubtendEqualSolidAngles) {
   Rng rng(7);
   int bands[4] = {0, 0, 0, 0};
   for (int i = 0; i < kN; ++i) {
-    const Vec3 d = camera.generate_ray({rng.uniform() * kW, rng.uniform() * kH}, {}).d;
+    const Vec3 d = camera.generate_ray({rng.uniform() * kW, rng.uniform() * kH}, {}).ray.d;
     bands[std::min(3, int((d.y + 1) * 2))]++;
   }
   for (int b = 0; b < 4; ++b) {
@@ -74,10 +74,10 @@ TEST(Camera, EqualAreaPixelsSubtendEqualSolidAngles) {
     EXPECT_NEAR(bands[b], kN / 4, 5 * 194) << "band " << b;
   }
   for (float t : {3.3f, 17.0f, 31.9f}) {
-    const Vec3 a = camera.generate_ray({-0.01f, t}, {}).d,
-               b = camera.generate_ray({0.01f, t}, {}).d;
-    const Vec3 c = camera.generate_ray({t, kH + 0.01f}, {}).d,
-               e = camera.generate_ray({t, kH - 0.01f}, {}).d;
+    const Vec3 a = camera.generate_ray({-0.01f, t}, {}).ray.d,
+               b = camera.generate_ray({0.01f, t}, {}).ray.d;
+    const Vec3 c = camera.generate_ray({t, kH + 0.01f}, {}).ray.d,
+               e = camera.generate_ray({t, kH - 0.01f}, {}).ray.d;
     EXPECT_LT(length(a - b), 0.01f) << t;
     EXPECT_LT(length(c - e), 0.01f) << t;
   }

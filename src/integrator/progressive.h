@@ -61,12 +61,14 @@ void run_passes(const IntegratorOptions& opt, Film* film, const char* unit,
 
 // One pixel sample: its random stream, keyed by (seed, pass index, pixel), which has already
 // drawn the filter offset and the lens position; the camera ray and the pixel's footprint along
-// it; the filter weight.
+// it; the filter weight; the camera's weight of the ray, a factor of the radiance it brings (1 but
+// for the realistic camera; 0 where its lens stops the ray: the sample counts as black).
 struct CameraSample {
   Rng rng;
   Ray ray;
   float filter_weight;
   PixelFootprint footprint;
+  float weight = 1;
 };
 
 class CameraSampler {
@@ -88,8 +90,8 @@ class CameraSampler {
     FilterSample fs = filter_.sample({rng.uniform(), rng.uniform()});
     Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
     Vec2 u_lens{rng.uniform(), rng.uniform()};
-    Ray ray = camera_.generate_ray_full(p_film, u_lens);
-    return {rng, ray, fs.weight, camera_.footprint(p_film)};
+    const CameraRay r = camera_.generate_ray_full(p_film, u_lens);
+    return {rng, r.ray, fs.weight, camera_.footprint(p_film), r.weight};
   }
   const Camera& camera() const { return camera_; }
 

@@ -392,7 +392,7 @@ std::vector<uint8_t> find_edges(const RenderScene& scene, const Camera& camera, 
   tbb::parallel_for(size_t(0), h, [&](size_t y) {
     for (size_t x = 0; x < w; ++x)
       first[y * w + x] = first_surface(
-          scene, camera.generate_ray({float(x) + 0.5f, float(y) + 0.5f}, {0.5f, 0.5f}));
+          scene, camera.generate_ray({float(x) + 0.5f, float(y) + 0.5f}, {0.5f, 0.5f}).ray);
   });
   // Whether each pixel breaks with its right neighbour, and with the one below.
   std::vector<uint8_t> right(first.size(), 1), down(first.size(), 1);

@@ -235,7 +235,7 @@ TEST(DiscProbes, FindsEdgesAndMarksPixelsNearThem) {
   EXPECT_GE(marked, 2 * h + 8);
   EXPECT_LE(marked, 2 * h + 24);
   // An open stretch of floor on the block's far side: no edge.
-  const int open_x = camera.generate_ray({0.5f, 6.5f}, {0.5f, 0.5f}).d.x < 0 ? 13 : 2;
+  const int open_x = camera.generate_ray({0.5f, 6.5f}, {0.5f, 0.5f}).ray.d.x < 0 ? 13 : 2;
   EXPECT_EQ(edge(open_x, 6), 0);
 
   std::vector<uint8_t> near;

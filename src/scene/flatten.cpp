@@ -41,6 +41,7 @@ LoadedScene Flattener::run() {
   LoadedScene out;
   read_camera(&out);
   read_film(&out);
+  build_lens(&out);
   read_filter(&out);
   read_sampler_and_integrator(&out);
   // Default material (pbrt-v4: diffuse, reflectance 0.5) is material 0.

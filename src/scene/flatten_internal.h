@@ -1,6 +1,7 @@
 // The class behind flatten_scene (flatten.h), private to the files that define it:
 //   flatten.cpp            the order of the steps
 //   flatten_settings.cpp   camera, film, pixel filter, sampler and integrator settings
+//   flatten_lens.cpp       the realistic camera's lens
 //   flatten_textures.cpp   texture nodes
 //   flatten_materials.cpp  spectral and float parameters, materials, media
 //   flatten_shapes.cpp     shapes and the area lights attached to them
@@ -58,6 +59,12 @@ class Flattener {
   void read_film(LoadedScene* out);
   void read_filter(LoadedScene* out);
   void read_sampler_and_integrator(LoadedScene* out);
+  // The realistic camera's lens (flatten_lens.cpp): read with the camera, built once the film's
+  // resolution is known.
+  void read_lens(const CameraEntity& c);
+  void build_lens(LoadedScene* out);
+  std::optional<LensSettings> lens_;
+  FileLoc lens_loc_;
 
   // Texture nodes (flatten_textures.cpp).
   const TextureEntity& texture_entity(const Param& ref);

@@ -46,9 +46,8 @@ void Flattener::read_camera(LoadedScene* out) {
     c.params.get_float("lensradius", 0);
     c.params.get_float("focaldistance", 1e30f);
   } else if (c.name == "realistic") {
-    throw Error(c.loc,
-                "camera \"realistic\" is not supported (perspective, orthographic, "
-                "spherical)");
+    cam.projection = Projection::kRealistic;
+    read_lens(c);
   } else {
     throw Error(c.loc, "camera \"" + c.name +
                            "\" is unknown (perspective, orthographic, spherical, realistic)");
@@ -146,6 +145,9 @@ void Flattener::read_film(LoadedScene* out) {
       out->film.height > 65536)
     throw Error(f.loc, "film resolution must be between 1 and 65536 pixels per axis");
   out->film.filename = f.params.get_string("filename", "pbrt.exr");
+  // The film's size in mm: only the realistic camera uses it (read with the lens).
+  if (!(f.params.get_float("diagonal", 35) > 0))
+    throw Error(f.params.find_any("diagonal")->loc, "diagonal must be positive");
   float iso = f.params.get_float("iso", 100);
   if (!(iso > 0)) throw Error(f.loc, "iso must be positive");
   out->film.imaging_ratio *= iso / 100;

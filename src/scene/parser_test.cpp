@@ -1899,6 +1899,66 @@ TEST(SceneFlattenError, BadCameraParameters) {
                       "screenwindow is empty"));
 }
 
+// pbrt-v4's realistic camera: a lens file (mm), the stop narrowed to aperturediameter, focused at
+// focusdistance, on a film of the given diagonal; each mistake named where it is.
+TEST(SceneParse, RealisticCamera) {
+  TempDir dir;
+  dir.write("lens.dat",
+            "# r thickness eta diameter\n0 5 0 20\n51.68 6 1.5168 24\n-51.68 45 1 24\n");
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 4 "
+      "\"float focusdistance\" 3\nFilm \"rgb\" \"float diagonal\" 20 \"integer xresolution\" 40 "
+      "\"integer yresolution\" 30\nWorldBegin\n",
+      dir.str()));
+  EXPECT_EQ(ls.camera.projection, Projection::kRealistic);
+  ASSERT_TRUE(ls.camera.lens);
+  EXPECT_NEAR(ls.camera.lens->effective_focal_length(), 0.051f, 0.002f);
+  // A 4:3 film of 20 mm diagonal: pixels 16 mm / 40 wide.
+  EXPECT_NEAR(ls.camera.lens->pixel_spread() * ls.camera.lens->effective_focal_length(),
+              0.016f / 40, 0.03f * 0.016f / 40);
+  EXPECT_EQ(ls.data_files.size(), 1u);
+
+  auto camera = [](const std::string& params) { return "Camera \"realistic\" " + params; };
+  const std::string none = camera("\"float focusdistance\" 3");
+  EXPECT_TRUE(IsError(error_of(none + "\nWorldBegin\n", dir.str()), at(1, 1),
+                      "a realistic camera needs a \"lensfile\""));
+  const std::string missing = camera("\"string lensfile\" \"no.dat\"");
+  EXPECT_TRUE(IsError(error_of(missing + "\nWorldBegin\n", dir.str()),
+                      at(1, col(missing, "\"string")), "lens file \"no.dat\" cannot be read"));
+  dir.write("short.dat", "0 5 0 20\n51.68 6 1.5168\n-51.68 45 1 24\n");
+  EXPECT_TRUE(
+      IsError(error_of(camera("\"string lensfile\" \"short.dat\"") + "\nWorldBegin\n", dir.str()),
+              "short.dat:2:1", "a lens element takes 4 values"));
+  dir.write("text.dat", "0 5 0 20\n51.68 six 1.5168 24\n");
+  EXPECT_TRUE(
+      IsError(error_of(camera("\"string lensfile\" \"text.dat\"") + "\nWorldBegin\n", dir.str()),
+              "text.dat:2:1", "a lens file holds numbers only"));
+  const std::string close = camera("\"string lensfile\" \"lens.dat\" \"float focusdistance\" 0.05");
+  EXPECT_TRUE(
+      IsError(error_of(close + "\nWorldBegin\n", dir.str()), at(1, 1), "the lens cannot focus at"));
+  const std::string shape = camera("\"string lensfile\" \"lens.dat\" \"string aperture\" \"hex\"");
+  EXPECT_TRUE(IsError(error_of(shape + "\nWorldBegin\n", dir.str()),
+                      at(1, col(shape, "\"string aperture")),
+                      "is neither a built-in shape (gaussian, square, pentagon, star)"));
+  const std::string diagonal = "Film \"rgb\" \"float diagonal\" 0";
+  EXPECT_TRUE(IsError(error_of(diagonal + "\nWorldBegin\n", dir.str()),
+                      at(1, col(diagonal, "\"float")), "diagonal must be positive"));
+  // An aperture wider than the stop is the stop's, with a warning (as pbrt-v4).
+  const int warnings = warning_count();
+  EXPECT_EQ(error_of(camera("\"string lensfile\" \"lens.dat\" \"float aperturediameter\" 30") +
+                         "\nWorldBegin\n",
+                     dir.str()),
+            "");
+  EXPECT_EQ(warning_count(), warnings + 1);
+  for (const char* builtin : {"gaussian", "square", "pentagon", "star"})
+    EXPECT_EQ(error_of(camera("\"string lensfile\" \"lens.dat\" \"string aperture\" \"" +
+                              std::string(builtin) + "\"") +
+                           "\nWorldBegin\n",
+                       dir.str()),
+              "")
+        << builtin;
+}
+
 TEST(SceneFlattenError, FovOutOfRange) {
   EXPECT_TRUE(IsError(error_of("Camera \"perspective\" \"float fov\" 180\nWorldBegin\n"), at(1, 1),
                       "fov must lie in (0, 180) degrees"));
