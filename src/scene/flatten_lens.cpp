@@ -22,6 +22,9 @@ std::string number(float v) {
 
 namespace fs = std::filesystem;
 
+// Real lens systems have a few dozen interfaces; each camera ray crosses them all.
+constexpr size_t kMaxInterfaces = 100;
+
 fs::path scene_path(const std::string& dir, const std::string& file) {
   return fs::path(file).is_absolute() ? fs::path(file) : fs::path(dir) / file;
 }
@@ -48,6 +51,10 @@ std::vector<LensInterface> read_lens_file(const std::string& path, const std::st
     if (n != 0 && n != 4 && first_odd_line == 0) first_odd_line = line_number;
   }
   if (values.empty()) throw Error(FileLoc{shown, 1, 1}, "the lens file holds no element");
+  if (values.size() > 4 * kMaxInterfaces)
+    throw Error(FileLoc{shown, 1, 1}, "the lens file holds " + std::to_string(values.size() / 4) +
+                                          " elements; at most " + std::to_string(kMaxInterfaces) +
+                                          " are read");
   if (values.size() % 4 != 0)
     throw Error(FileLoc{shown, first_odd_line, 1},
                 "a lens element takes 4 values (curvature radius, thickness, index of "
