@@ -25,7 +25,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     keep_hero_wavelength_at(v, s);
     if (all_traced) {
       // Light reaching v and leaving it through a gathered lobe, then traced lobes to the origin.
-      if (bsdf_part_has_nondelta(v.m(), BsdfPart::kGathered)) {
+      if (!v.on_curve && bsdf_part_has_nondelta(v.m(), BsdfPart::kGathered)) {
         L += s.beta * sample_direct_light(scene, v.sp, v.object(), s.medium, v.m(), v.frame,
                                           v.wo_local, true, materials, rng, counters,
                                           BsdfPart::kGathered);
@@ -45,7 +45,7 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
     // Past a vertex of the traced-only path the emission found is counted elsewhere: through a
     // traced lobe by the photons, through a gathered one by that vertex's direct light above.
     if (all_traced) emitter = EmitterWeight::none();
-    all_traced = all_traced && bs->is_traced();
+    all_traced = all_traced && (bs->is_traced() || v.on_curve);
     if (bs->is_transmission()) eta_scale *= bs->eta * bs->eta;
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     ++counters.bounce_rays;

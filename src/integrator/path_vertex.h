@@ -33,6 +33,7 @@ struct PathVertex {
   Material storage;          // holds the material when it had to be resolved at sp
   Frame frame;               // shading frame
   Vec3 wo_local;
+  bool on_curve = false;  // the surface is a curve (scene/curves.h)
   PathVertex() = default;
   PathVertex(const PathVertex&) = delete;  // material may point into storage
   PathVertex& operator=(const PathVertex&) = delete;
@@ -66,6 +67,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
     v.sp = scene.surface(s.ray, v.hit);
     on_surface(v.hit, v.sp);
     v.material_index = scene.objects[size_t(v.hit.object)].material;
+    v.on_curve = std::holds_alternative<Curves>(scene.objects[size_t(v.hit.object)].shape);
     v.material = &materials.at(v.material_index, texture_context(v.sp), v.storage);
     if (std::holds_alternative<InterfaceMaterial>(*v.material)) {
       // A boundary that does not scatter: the same ray goes on past it.
@@ -100,6 +102,12 @@ inline std::optional<BsdfSample> sample_bsdf(const PathVertex& v, float uc, Vec2
 // What a photon method's eye path does at a vertex (BsdfPart): gather there (a diffuse vertex:
 // next-event estimation and photon estimates with the gathered lobes), or go on through it as
 // through a specular vertex, with the traced lobes; `part` is what it then samples and evaluates.
+// Whether the photon methods go through v whatever lobe they sample there: every lobe of its
+// material is traced, or v lies on a curve, whose ribbons face each ray that meets them and so
+// offer no surface on which a photon and a gathering point could meet. Light paths then neither
+// leave photons there nor end a caustic there.
+inline bool vertex_all_traced(const PathVertex& v) { return v.on_curve || bsdf_all_traced(v.m()); }
+
 // A material with both parts is traced with probability p (bsdf_traced_part_probability) and
 // gathered otherwise, beta divided by p or 1 - p: each light path through it is counted by one of
 // the two choices, with the lobe that carries it.
@@ -108,7 +116,7 @@ struct EyeVertexChoice {
   BsdfPart part;
 };
 inline EyeVertexChoice choose_eye_vertex(const PathVertex& v, Rng& rng, PathState& s) {
-  if (bsdf_all_traced(v.m())) return {false, BsdfPart::kAll};
+  if (vertex_all_traced(v)) return {false, BsdfPart::kAll};
   const float p = bsdf_traced_part_probability(v.m(), v.wo_local);
   if (p == 0) return {true, BsdfPart::kAll};
   if (rng.uniform() < p) {

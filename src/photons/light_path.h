@@ -202,7 +202,7 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     }
     if (end != StepEnd::kVertex) break;
     // A surface with gathered lobes (BsdfPart): the photon's estimate there sees those alone.
-    if (bounces <= hit_depth && !bsdf_all_traced(v.m())) {
+    if (bounces <= hit_depth && !vertex_all_traced(v)) {
       ++counters.diffuse_hits;
       on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only});
     }
@@ -228,7 +228,7 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     if (s.beta.is_black() || !s.beta.is_finite()) break;
     ++bounces;
     // Through a traced lobe (delta, or glossy and sharp) a caustic stays a caustic.
-    all_specular = all_specular && bs->is_traced();
+    all_specular = all_specular && (bs->is_traced() || v.on_curve);
     leave_vertex(scene, v, wi, s);
     ++counters.light_rays;
   }

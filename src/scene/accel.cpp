@@ -26,7 +26,7 @@ struct UserShape {
 
 bool alpha_rejects(const UserShape* us, int prim, Vec2 bary, Vec3 o, Vec3 d, float t) {
   if (!us->object->has_alpha()) return false;
-  SurfacePoint sp = surface_point(*us->shape, prim, bary, o + d * t);
+  SurfacePoint sp = surface_point(*us->shape, prim, bary, o + d * t, d);
   return alpha_passes(*us->textures, us->object->alpha, sp, o, d);
 }
 
@@ -132,6 +132,14 @@ class Accel {
           rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
           rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
         }
+      } else if (auto* c = std::get_if<Curves>(&obj.shape)) {
+        g = curve_geometry(*c);
+        if (obj.has_alpha()) {
+          user_shapes_.push_back(UserShape{&obj.shape, &obj, &textures_});
+          rtcSetGeometryUserData(g, &user_shapes_.back());
+          rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+          rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+        }
       } else {
         g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
         user_shapes_.push_back(UserShape{&obj.shape, &obj, &textures_});
@@ -223,6 +231,25 @@ class Accel {
       hits[i].barycentric = {rh.hit.u[i], rh.hit.v[i]};
       hits[i].t = rh.ray.tfar[i];
     }
+  }
+
+  // Flat (ray-facing) or normal-oriented cubic Bezier curves, from the shape's own buffers.
+  RTCGeometry curve_geometry(const Curves& c) {
+    const bool ribbon = c.type == Curves::Type::kRibbon;
+    RTCGeometry g = rtcNewGeometry(device_, ribbon ? RTC_GEOMETRY_TYPE_NORMAL_ORIENTED_BEZIER_CURVE
+                                                   : RTC_GEOMETRY_TYPE_FLAT_BEZIER_CURVE);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, c.control.data(), 0,
+                               4 * sizeof(float), c.control.size() / 4);
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, c.first.data(), 0,
+                               sizeof(uint32_t), c.first.size());
+    // Embree cuts flat curves into this many straight pieces per segment (4 by default, which
+    // shows as kinks where pbrt-v4's curves bend smoothly).
+    rtcSetGeometryTessellationRate(g, 32);
+    if (ribbon)
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3,
+                                 c.control_normals.data(), 0, sizeof(Vec3),
+                                 c.control_normals.size());
+    return g;
   }
 
   // Embree's point query: visit for each primitive whose bounds come within `radius` of p.

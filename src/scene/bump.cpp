@@ -120,6 +120,11 @@ SurfaceDerivatives surface_derivatives(const Shape& shape, int prim, const Surfa
   if (auto* m = std::get_if<TriangleMesh>(&shape)) return mesh_derivatives(*m, prim, sp);
   if (auto* s = std::get_if<Sphere>(&shape)) return sphere_derivatives(*s, sp.p);
   if (auto* c = std::get_if<Cylinder>(&shape)) return cylinder_derivatives(*c, sp.p);
+  if (auto* c = std::get_if<Curves>(&shape)) {  // pbrt-v4 gives curves no normal derivatives
+    SurfaceDerivatives d;
+    curve_derivatives(*c, prim, sp, &d.dpdu, &d.dpdv);
+    return d;
+  }
   return disk_derivatives(std::get<Disk>(shape), sp.p);
 }
 

@@ -111,6 +111,7 @@ class Flattener {
   static Sphere sphere_shape(const ShapeEntity& s, bool flip);
   static Disk disk_shape(const ShapeEntity& s, bool flip);
   static Cylinder cylinder_shape(const ShapeEntity& s, bool flip);
+  static Curves curve_shape(const ShapeEntity& s, bool flip);
   // A bilinear mesh's patches as triangles (indices p00 p10 p01 p11 per patch): two for a planar
   // patch, else a grid fine enough to follow the patch, whose vertices are appended.
   static std::vector<int> bilinear_to_triangles(std::vector<Vec3>& P, std::vector<Vec3>& N,

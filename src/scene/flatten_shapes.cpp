@@ -1,5 +1,5 @@
-// Shapes (triangle, bilinear and subdivision meshes, PLY meshes, spheres, disks, cylinders) and
-// the diffuse area lights attached to them.
+// Shapes (triangle, bilinear and subdivision meshes, PLY meshes, spheres, disks, cylinders,
+// curves) and the diffuse area lights attached to them.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -64,6 +64,8 @@ void Flattener::add_shape(const ShapeEntity& s, RenderScene* rs) {
     obj.shape = disk_shape(s, flip);
   } else if (s.name == "cylinder") {
     obj.shape = cylinder_shape(s, flip);
+  } else if (s.name == "curve") {
+    obj.shape = curve_shape(s, flip);
   } else {
     throw Error(s.loc, "shape \"" + s.name + "\" is not supported");
   }
@@ -285,6 +287,103 @@ std::vector<int> Flattener::bilinear_to_triangles(std::vector<Vec3>& P, std::vec
   return tris;
 }
 
+namespace {
+
+// A segment's cubic Bezier control points from the file's, by pbrt-v4's conversions.
+void bezier_segment(const std::vector<Vec3>& P, int seg, int degree, bool bspline, Vec3 out[4]) {
+  if (!bspline) {
+    const Vec3* p = &P[size_t(seg * degree)];
+    if (degree == 2) return elevate_quadratic_bezier(p, out);
+    for (int k = 0; k < 4; ++k) out[k] = p[k];
+    return;
+  }
+  const Vec3* p = &P[size_t(seg)];
+  if (degree == 2) return quadratic_bspline_to_bezier(p, out);
+  cubic_bspline_to_bezier(p, out);
+}
+
+}  // namespace
+
+// pbrt-v4's "curve": P holds Bezier segments (degree + 1 points, then degree more per segment)
+// or a uniform B-spline (a segment per point past the first degree); the width runs linearly
+// from width0 to width1 along the whole curve; ribbons turn with the normals N at the segments'
+// ends. Every segment becomes a cubic Bezier in world space. pbrt-v4's splitdepth is read and
+// has no use here: Embree refines the curve itself.
+Curves Flattener::curve_shape(const ShapeEntity& s, bool flip) {
+  const ParamSet& ps = s.params;
+  auto loc_of = [&](const char* name) {
+    return ps.find_any(name) ? ps.find_any(name)->loc : s.loc;
+  };
+  const float width = ps.get_float("width", 1);
+  const float w0 = ps.get_float("width0", width), w1 = ps.get_float("width1", width);
+  if (!(w0 >= 0 && w1 >= 0 && std::isfinite(w0) && std::isfinite(w1)) || (w0 == 0 && w1 == 0))
+    throw Error(s.loc, "a curve's widths must be finite, not negative and not both zero");
+  const int degree = ps.get_int("degree", 3);
+  if (degree != 2 && degree != 3)
+    throw Error(loc_of("degree"), "curve degree " + std::to_string(degree) + " is not 2 or 3");
+  const std::string basis = ps.get_string("basis", "bezier");
+  if (basis != "bezier" && basis != "bspline")
+    throw Error(loc_of("basis"), "curve basis \"" + basis + "\" is unknown (bezier, bspline)");
+  const std::vector<Vec3> P = ps.get_point3s("P");
+  const bool bspline = basis == "bspline";
+  const int n = int(P.size());
+  if (n < degree + 1 || (!bspline && (n - 1 - degree) % degree != 0))
+    throw Error(loc_of("P"),
+                "a degree " + std::to_string(degree) + " " + basis + " curve takes " +
+                    (bspline ? "at least " + std::to_string(degree + 1)
+                             : std::to_string(degree + 1) + " + k x " + std::to_string(degree)) +
+                    " control points; got " + std::to_string(n));
+  const int segments = bspline ? n - degree : (n - 1) / degree;
+  Curves c;
+  const std::string type = ps.get_string("type", "flat");
+  if (type == "flat")
+    c.type = Curves::Type::kFlat;
+  else if (type == "cylinder")
+    c.type = Curves::Type::kCylinder;
+  else if (type == "ribbon")
+    c.type = Curves::Type::kRibbon;
+  else
+    throw Error(loc_of("type"), "curve type \"" + type + "\" is unknown (flat, cylinder, ribbon)");
+  std::vector<Vec3> N = ps.get_normals("N");
+  if (c.type != Curves::Type::kRibbon && !N.empty()) {
+    warning(loc_of("N"), "curve normals are used by \"ribbon\" curves only");
+    N.clear();
+  }
+  if (c.type == Curves::Type::kRibbon && int(N.size()) != segments + 1)
+    throw Error(N.empty() ? s.loc : loc_of("N"),
+                "a ribbon curve of " + std::to_string(segments) + " segment(s) takes " +
+                    std::to_string(segments + 1) + " normals \"N\", one per segment end; got " +
+                    std::to_string(N.size()));
+  for (Vec3& v : N)
+    if (!(length_squared(v) > 0)) throw Error(loc_of("N"), "a curve normal is zero");
+  ps.get_int("splitdepth", 3);
+  const Transform& xf = s.world_from_object;
+  const float det = std::fabs(
+      dot(xf.vector(Vec3(1, 0, 0)), cross(xf.vector(Vec3(0, 1, 0)), xf.vector(Vec3(0, 0, 1)))));
+  const float scale = std::cbrt(det);
+  for (int seg = 0; seg < segments; ++seg) {
+    Vec3 b[4];
+    bezier_segment(P, seg, degree, bspline, b);
+    const float r0 = 0.5f * scale * (w0 + (w1 - w0) * float(seg) / float(segments)),
+                r1 = 0.5f * scale * (w0 + (w1 - w0) * float(seg + 1) / float(segments));
+    c.first.push_back(uint32_t(c.control.size() / 4));
+    for (int k = 0; k < 4; ++k) {
+      const Vec3 p = xf.point(b[k]);
+      c.control.insert(c.control.end(), {p.x, p.y, p.z, r0 + (r1 - r0) * float(k) / 3});
+    }
+    if (c.type == Curves::Type::kRibbon) {
+      c.end_normals.push_back(normalize(xf.normal(N[size_t(seg)])));
+      c.end_normals.push_back(normalize(xf.normal(N[size_t(seg) + 1])));
+      for (int k = 0; k < 4; ++k) c.control_normals.push_back(c.ribbon_normal(seg, float(k) / 3));
+    }
+  }
+  for (float v : c.control)
+    if (!std::isfinite(v)) throw Error(loc_of("P"), "a curve's control points must be finite");
+  c.control_normals.reserve(c.control_normals.size() + 1);  // Embree reads 16 bytes at a time
+  c.flip_normal = flip;
+  return c;
+}
+
 void Flattener::add_area_light(const SceneEntity& a, Object* obj, int id, RenderScene* rs) {
   if (a.name != "diffuse") throw Error(a.loc, "area light \"" + a.name + "\" is not supported");
   const ParamSet& ps = a.params;
@@ -321,6 +420,8 @@ void Flattener::add_area_light(const SceneEntity& a, Object* obj, int id, Render
     if (!xf.is_similarity() || !full)
       throw Error(a.loc, "emitting spheres and disks must be whole and not non-uniformly scaled");
   }
+  if (std::holds_alternative<Curves>(obj->shape))
+    throw Error(a.loc, "a curve cannot emit (pbrt-v4 cannot sample curves as lights either)");
   if (auto* c = std::get_if<Cylinder>(&obj->shape); c && !c->world_from_object.is_similarity())
     throw Error(a.loc, "emitting cylinders must not be non-uniformly scaled");
   obj->first_light = int(rs->lights.size());

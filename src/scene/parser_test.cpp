@@ -1615,9 +1615,62 @@ TEST(SceneFlattenError, CylinderErrors) {
 }
 
 TEST(SceneFlattenError, UnsupportedShape) {
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nShape \"hyperboloid\"\n"), at(2, 1),
+                      "shape \"hyperboloid\" is not supported"));
+}
+
+// pbrt-v4's curve: Bezier segments of degree + 1 points, then degree more each, or a B-spline's
+// points past the first degree; widths along the whole curve; world space, the width scaled.
+TEST(SceneParse, Curves) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nShape \"curve\" \"float width0\" 0.2 \"float width1\" 0.1\n"
+      "  \"point3 P\" [0 0 0  1 0 0  2 0 0  3 0 0  4 0 0  5 0 0  6 0 0]\n"
+      "Translate 0 5 0\nScale 2 2 2\n"
+      "Shape \"curve\" \"string basis\" \"bspline\" \"integer degree\" 2 \"string type\" "
+      "\"cylinder\"\n  \"point3 P\" [0 0 0  1 1 0  2 0 0  3 1 0]\n"
+      "Shape \"curve\" \"string type\" \"ribbon\" \"point3 P\" [0 0 0  1 0 0  2 0 0  3 0 0]\n"
+      "  \"normal N\" [0 1 0  0 0 1]\n"));
+  ASSERT_EQ(ls.scene.objects.size(), 3u);
+  const Curves& a = std::get<Curves>(ls.scene.objects[0].shape);
+  ASSERT_EQ(a.segment_count(), 2);
+  float r;
+  expect_vec_near(a.point(1, 1, nullptr, &r), Vec3(6, 0, 0));
+  EXPECT_NEAR(r, 0.05f, 1e-6f);  // width1 / 2 at the end
+  a.point(1, 0, nullptr, &r);
+  EXPECT_NEAR(r, 0.075f, 1e-6f);  // half way along the curve
+  const Curves& b = std::get<Curves>(ls.scene.objects[1].shape);
+  EXPECT_EQ(b.type, Curves::Type::kCylinder);
+  ASSERT_EQ(b.segment_count(), 2);
+  expect_vec_near(b.point(0, 0, nullptr, &r), Vec3(1, 6, 0));  // (0 + 1) / 2, scaled and moved
+  EXPECT_NEAR(r, 1.0f, 1e-5f);                                 // the default width 1, scaled by 2
+  const Curves& c = std::get<Curves>(ls.scene.objects[2].shape);
+  expect_vec_near(c.ribbon_normal(0, 0), Vec3(0, 1, 0));
+  expect_vec_near(c.ribbon_normal(0, 0.5f), normalize(Vec3(0, 1, 1)));
+}
+
+TEST(SceneFlattenError, BadCurves) {
+  auto curve = [](const std::string& params) {
+    return "WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0] " + params + "\n";
+  };
   EXPECT_TRUE(
-      IsError(error_of("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0]\n"),
-              at(2, 1), "shape \"curve\" is not supported"));
+      IsError(error_of(curve("\"integer degree\" 4")), at(2, 52), "curve degree 4 is not 2 or 3"));
+  EXPECT_TRUE(IsError(error_of(curve("\"string basis\" \"hermite\"")), at(2, 52),
+                      "curve basis \"hermite\" is unknown (bezier, bspline)"));
+  EXPECT_TRUE(IsError(error_of(curve("\"string type\" \"tube\"")), at(2, 52),
+                      "curve type \"tube\" is unknown (flat, cylinder, ribbon)"));
+  EXPECT_TRUE(IsError(error_of(curve("\"float width\" -1")), at(2, 1),
+                      "a curve's widths must be finite, not negative"));
+  EXPECT_TRUE(IsError(error_of(curve("\"string type\" \"ribbon\"")), at(2, 1),
+                      "a ribbon curve of 1 segment(s) takes 2 normals \"N\""));
+  EXPECT_TRUE(IsError(
+      error_of("WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 0 0 2 0 0 3 0 0 4 0 0]\n"),
+      at(2, 15), "a degree 3 bezier curve takes 4 + k x 3 control points; got 5"));
+  EXPECT_TRUE(IsError(error_of("WorldBegin\nAreaLightSource \"diffuse\"\n" +
+                               curve("").substr(std::string("WorldBegin\n").size())),
+                      at(2, 1), "a curve cannot emit"));
+  const int warnings = warning_count();
+  EXPECT_EQ(error_of(curve("\"normal N\" [0 1 0 0 1 0]")), "");
+  EXPECT_EQ(warning_count(), warnings + 1);  // normals on a flat curve: unused, as pbrt-v4 warns
 }
 
 TEST(SceneParse, AlphaConstantOrTexture) {

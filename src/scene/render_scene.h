@@ -91,7 +91,8 @@ class RenderScene {
   // The surface point of a hit, its shading normal bent by its material's bump or normal map.
   SurfacePoint surface(const Ray& ray, const Hit& hit) const {
     const Object& o = objects[hit.object];
-    SurfacePoint sp = surface_point(o.shape, hit.primitive, hit.barycentric, ray.o + ray.d * hit.t);
+    SurfacePoint sp =
+        surface_point(o.shape, hit.primitive, hit.barycentric, ray.o + ray.d * hit.t, ray.d);
     if (size_t(o.material) < bumps.size() && bumps[size_t(o.material)].active())
       apply_bump(bumps[size_t(o.material)], textures,
                  surface_derivatives(o.shape, hit.primitive, sp), &sp);

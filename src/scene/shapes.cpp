@@ -262,14 +262,16 @@ void TriangleMesh::compute_open_edges() {
   }
 }
 
-SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit) {
+SurfacePoint surface_point(const Shape& shape, int prim, Vec2 bary, Vec3 p_hit, Vec3 d) {
   if (auto* m = std::get_if<TriangleMesh>(&shape)) return mesh_point(*m, prim, bary);
+  if (auto* c = std::get_if<Curves>(&shape)) return curve_point(*c, prim, bary.x, p_hit, d);
   SurfacePoint sp = analytic_point(shape, p_hit);
   // The point is re-projected in object space and transformed back: its error is relative to its
   // world coordinates and to its distance from the object's origin (the shape's size).
   const Vec3 origin = std::visit(
       [](const auto& s) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, TriangleMesh>)
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, TriangleMesh> || std::is_same_v<T, Curves>)
           return Vec3(0, 0, 0);
         else
           return s.world_from_object.point(Vec3(0, 0, 0));
@@ -283,6 +285,17 @@ Bounds3 world_bounds(const Shape& shape, int prim) {
   Bounds3 b;
   if (auto* m = std::get_if<TriangleMesh>(&shape)) {
     for (int j = 0; j < 3; ++j) b.expand(m->positions[m->indices[3 * prim + j]]);
+    return b;
+  }
+  if (auto* c = std::get_if<Curves>(&shape)) {  // the control points' hull, grown by the width
+    float r = 0;
+    for (uint32_t i = c->first[size_t(prim)], k = 0; k < 4; ++k) {
+      const float* q = &c->control[4 * size_t(i + k)];
+      b.expand(Vec3(q[0], q[1], q[2]));
+      r = std::fmax(r, q[3]);
+    }
+    b.lo = b.lo - Vec3(r, r, r);
+    b.hi = b.hi + Vec3(r, r, r);
     return b;
   }
   const Transform* t;
@@ -312,6 +325,7 @@ Bounds3 world_bounds(const Shape& shape, int prim) {
 
 int primitive_count(const Shape& shape) {
   if (auto* m = std::get_if<TriangleMesh>(&shape)) return m->triangle_count();
+  if (auto* c = std::get_if<Curves>(&shape)) return c->segment_count();
   return 1;
 }
 

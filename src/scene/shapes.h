@@ -1,5 +1,6 @@
-// Render-time shapes: triangle meshes in world space, and analytic spheres, disks and cylinders
-// kept in their object space (a tessellated sphere would bend caustics wrongly).
+// Render-time shapes: triangle meshes in world space, analytic spheres, disks and cylinders kept
+// in their object space (a tessellated sphere would bend caustics wrongly), and curves
+// (scene/curves.h).
 #pragma once
 #include <cstdint>
 #include <variant>
@@ -7,6 +8,7 @@
 
 #include "base/transform.h"
 #include "base/vec.h"
+#include "scene/curves.h"
 
 namespace bpm {
 
@@ -58,7 +60,7 @@ struct Cylinder {
   bool flip_normal = false;
 };
 
-using Shape = std::variant<TriangleMesh, Sphere, Disk, Cylinder>;
+using Shape = std::variant<TriangleMesh, Sphere, Disk, Cylinder, Curves>;
 
 // A point on a surface as the integrators see it.
 struct SurfacePoint {
@@ -78,12 +80,13 @@ double intersect_sphere(const Sphere& s, Vec3 o_world, Vec3 d_world, double t_mi
 double intersect_disk(const Disk& d, Vec3 o_world, Vec3 d_world, double t_min, double t_max);
 double intersect_cylinder(const Cylinder& c, Vec3 o_world, Vec3 d_world, double t_min,
                           double t_max);
-// The analytic shapes (all but meshes) in one call.
+// The analytic shapes (spheres, disks, cylinders) in one call.
 double intersect_analytic(const Shape& shape, Vec3 o_world, Vec3 d_world, double t_min,
                           double t_max);
 
-// Surface point of a hit: for meshes from the primitive and Embree's barycentrics (b1, b2).
-SurfacePoint surface_point(const Shape& shape, int prim, Vec2 barycentric, Vec3 p_hit);
+// Surface point of a hit: for meshes from the primitive and Embree's barycentrics (b1, b2); for
+// curves from the segment, Embree's u and the direction d of the ray (a flat curve faces it).
+SurfacePoint surface_point(const Shape& shape, int prim, Vec2 barycentric, Vec3 p_hit, Vec3 d = {});
 Bounds3 world_bounds(const Shape& shape, int prim);
 int primitive_count(const Shape& shape);
 
