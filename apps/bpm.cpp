@@ -276,7 +276,9 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                      {"height", ls.film.height},
                      {"filter", Filter(ls.filter).name()},
                      {"filter_radius", {ls.filter.radius.x, ls.filter.radius.y}},
-                     {"imaging_ratio", ls.film.imaging_ratio}};
+                     {"imaging_ratio", ls.film.imaging_ratio},
+                     {"sensor", ls.film.sensor},
+                     {"white_balance", ls.film.white_balance}};
   if (!st.details.is_null()) rec[opt.integrator] = st.details;
   double mean_samples = 0;
   for (float c : film.pass_counts()) mean_samples += c;

@@ -120,7 +120,7 @@ namespace {
 // film is balanced for 3000 K (pbrt-v4 takes a blackbody's white below 4000 K), and orange when it
 // is not; a balance for D65's temperature changes nothing.
 TEST(WhiteBalance, BalancedFilmRendersTheLightsWhiteNeutral) {
-  auto mean_colour = [](const std::string& film_extra) {
+  auto mean_colour = [](const std::string& film_extra, const char* integrator = "path") {
     const LoadedScene ls = test::load(R"(LookAt 0 0 3  0 0 0  0 1 0
 Camera "perspective" "float fov" 20
 Film "rgb" "integer xresolution" 8 "integer yresolution" 8 )" +
@@ -132,7 +132,7 @@ Material "diffuse" "rgb reflectance" [1 1 1]
 Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-5 -5 0  5 -5 0  5 5 0  -5 5 0]
 )");
     Film film(ls.film.width, ls.film.height);
-    render(ls, quiet_options(ls, "path", 16, 1), &film);
+    render(ls, quiet_options(ls, integrator, 16, 1), &film);
     const Image img = film.image();
     Rgb sum(0, 0, 0);
     for (int y = 0; y < img.height; ++y)
@@ -146,6 +146,18 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-5 -5 0  5 -5 0
   EXPECT_GT(raw[0] / raw[2], 2);
   const std::array<float, 9> m = white_balance_srgb(6504);
   for (int i = 0; i < 9; ++i) EXPECT_NEAR(m[size_t(i)], i % 4 == 0 ? 1 : 0, 5e-3) << i;
+  // A named camera sensor balanced for the light renders it neutral too, through every
+  // integrator; unbalanced (6500 K, a named sensor's default) it renders it orange.
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    const Rgb camera =
+        mean_colour("\"string sensor\" \"nikon_d850\" \"float whitebalance\" 3000", integrator);
+    EXPECT_NEAR(camera[0] / camera[1], 1, 0.03) << integrator;
+    EXPECT_NEAR(camera[2] / camera[1], 1, 0.03) << integrator;
+    EXPECT_NEAR(camera[1] / balanced[1], 1, 0.03) << integrator;  // the same exposure
+  }
+  const Rgb camera_raw = mean_colour("\"string sensor\" \"nikon_d850\"");
+  EXPECT_GT(camera_raw[0] / camera_raw[2], 2);
+  EXPECT_THROW(mean_colour("\"string sensor\" \"leica_m\""), Error);
 }
 
 // A spectral film seeing an infinite light of a constant spectrum (normalised, as pbrt-v4 does, to

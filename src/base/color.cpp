@@ -9,6 +9,24 @@
 #include "base/vec.h"
 
 namespace bpm {
+
+void xyz_to_srgb(const double xyz[3], double rgb[3]) {
+  rgb[0] = 3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2];
+  rgb[1] = -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2];
+  rgb[2] = 0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2];
+}
+
+Mat3 inverse(const Mat3& m) {
+  const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                     m[2] * (m[3] * m[7] - m[4] * m[6]);
+  const Mat3 adj{m[4] * m[8] - m[5] * m[7], m[2] * m[7] - m[1] * m[8], m[1] * m[5] - m[2] * m[4],
+                 m[5] * m[6] - m[3] * m[8], m[0] * m[8] - m[2] * m[6], m[2] * m[3] - m[0] * m[5],
+                 m[3] * m[7] - m[4] * m[6], m[1] * m[6] - m[0] * m[7], m[0] * m[4] - m[1] * m[3]};
+  Mat3 r;
+  for (int i = 0; i < 9; ++i) r[i] = adj[i] / det;
+  return r;
+}
+
 namespace {
 
 constexpr int kTableSize = int(kLambdaMax - kLambdaMin) + 1;  // 1 nm steps, both ends included
@@ -27,18 +45,38 @@ constexpr float kD65[] = {
     80.2146f, 82.2778f, 78.2842f, 69.7213f, 71.6091f, 74.349f,  61.604f,  69.8856f, 75.087f,
     63.5927f, 46.4182f, 66.8054f, 63.3828f, 64.304f,  59.4519f, 51.959f,  57.4406f, 60.3125f};
 
+// The CIE daylight basis S0, S1, S2 (CIE 15), 300 to 830 nm in 10 nm steps.
+constexpr float kDaylightS0[] = {
+    0.04f,  6.0f,   29.6f,  55.3f,  57.3f,  61.8f,  61.5f,  68.8f,  63.4f,  65.8f,  94.8f,
+    104.8f, 105.9f, 96.8f,  113.9f, 125.6f, 125.5f, 121.3f, 121.3f, 113.5f, 113.1f, 110.8f,
+    106.5f, 108.8f, 105.3f, 104.4f, 100.0f, 96.0f,  95.1f,  89.1f,  90.5f,  90.3f,  88.4f,
+    84.0f,  85.1f,  81.9f,  82.6f,  84.9f,  81.3f,  71.9f,  74.3f,  76.4f,  63.3f,  71.7f,
+    77.0f,  65.2f,  47.7f,  68.6f,  65.0f,  66.0f,  61.0f,  53.3f,  58.9f,  61.9f};
+constexpr float kDaylightS1[] = {
+    0.02f,  4.5f,   22.4f,  42.0f,  40.6f,  41.6f,  38.0f,  42.4f,  38.5f,  35.0f,  43.4f,
+    46.3f,  43.9f,  37.1f,  36.7f,  35.9f,  32.6f,  27.9f,  24.3f,  20.1f,  16.2f,  13.2f,
+    8.6f,   6.1f,   4.2f,   1.9f,   -0.0f,  -1.6f,  -3.5f,  -3.5f,  -5.8f,  -7.2f,  -8.6f,
+    -9.5f,  -10.9f, -10.7f, -12.0f, -14.0f, -13.6f, -12.0f, -13.3f, -12.9f, -10.6f, -11.6f,
+    -12.2f, -10.2f, -7.8f,  -11.2f, -10.4f, -10.6f, -9.7f,  -8.3f,  -9.3f,  -9.8f};
+constexpr float kDaylightS2[] = {0.0f,  2.0f,  4.0f,  8.5f,  7.8f,  6.7f,  5.3f,  6.1f,  3.0f,
+                                 1.2f,  -1.1f, -0.5f, -0.7f, -1.2f, -2.6f, -2.9f, -2.8f, -2.6f,
+                                 -2.6f, -1.8f, -1.5f, -1.3f, -1.2f, -1.0f, -0.5f, -0.3f, 0.0f,
+                                 0.2f,  0.5f,  2.1f,  3.2f,  4.1f,  4.7f,  5.1f,  6.7f,  7.3f,
+                                 8.6f,  9.8f,  10.2f, 8.3f,  9.6f,  8.5f,  7.0f,  7.6f,  8.0f,
+                                 6.7f,  5.2f,  7.4f,  6.8f,  7.0f,  6.4f,  5.5f,  6.1f,  6.5f};
+
+double daylight_basis(const float* s, double l) {
+  double x = (l - 300) / 10;
+  int i = std::clamp(int(x), 0, 52);
+  double t = std::clamp(x - i, 0.0, 1.0);
+  return s[i] * (1 - t) + s[i + 1] * t;
+}
+
 double d65_raw(double l) {
   double x = (l - 300) / 10;
   int i = std::clamp(int(x), 0, int(std::size(kD65)) - 2);
   double t = std::clamp(x - i, 0.0, 1.0);
   return kD65[i] * (1 - t) + kD65[i + 1] * t;
-}
-
-// XYZ to linear sRGB (IEC 61966-2-1).
-void xyz_to_srgb(const double xyz[3], double rgb[3]) {
-  rgb[0] = 3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2];
-  rgb[1] = -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2];
-  rgb[2] = 0.0556434 * xyz[0] - 0.2040259 * xyz[1] + 1.0572252 * xyz[2];
 }
 
 // Everything the conversions need, tabulated once at 1 nm.
@@ -562,24 +600,11 @@ void SpectrumCurve::finish(SpectrumKind kind) {
 
 namespace {
 
-using Mat3 = std::array<double, 9>;
-
 Mat3 mul(const Mat3& a, const Mat3& b) {
   Mat3 r{};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k) r[3 * i + j] += a[3 * i + k] * b[3 * k + j];
-  return r;
-}
-
-Mat3 inverse(const Mat3& m) {
-  const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-                     m[2] * (m[3] * m[7] - m[4] * m[6]);
-  const Mat3 adj{m[4] * m[8] - m[5] * m[7], m[2] * m[7] - m[1] * m[8], m[1] * m[5] - m[2] * m[4],
-                 m[5] * m[6] - m[3] * m[8], m[0] * m[8] - m[2] * m[6], m[2] * m[3] - m[0] * m[5],
-                 m[3] * m[7] - m[4] * m[6], m[1] * m[6] - m[0] * m[7], m[0] * m[4] - m[1] * m[3]};
-  Mat3 r;
-  for (int i = 0; i < 9; ++i) r[i] = adj[i] / det;
   return r;
 }
 
@@ -597,23 +622,31 @@ std::array<double, 2> chromaticity(const std::function<double(double)>& spd) {
 
 }  // namespace
 
-std::array<float, 9> white_balance_srgb(float temperature) {
-  // pbrt-v4's Spectra::D: the temperature corrected for the revised second radiation constant.
-  const double cct = double(temperature) * 1.4388 / 1.4380;
-  std::array<double, 2> src;
-  if (cct < 4000) {
-    const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
-    src = chromaticity([&](double l) {
-      const double m = l * 1e-9;
-      return 1 / (std::pow(m, 5) * (std::exp((h * c) / (m * kb * cct)) - 1));
-    });
-  } else {
-    const double x =
-        cct <= 7000
-            ? -4.607e9 / (cct * cct * cct) + 2.9678e6 / (cct * cct) + 0.09911e3 / cct + 0.244063
-            : -2.0064e9 / (cct * cct * cct) + 1.9018e6 / (cct * cct) + 0.24748e3 / cct + 0.23704;
-    src = {x, -3 * x * x + 2.870 * x - 0.275};
+float daylight_spectrum(float temperature, float lambda) {
+  const double cct = double(temperature) * 1.4388 / 1.4380, l = lambda;
+  if (cct < 4000) {  // the CIE daylight is not defined there: a blackbody
+    const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23, m = l * 1e-9;
+    const double peak = 2.8977721e-3 / cct;  // Wien: 1 at the peak
+    auto planck = [&](double w) {
+      return 1 / (std::pow(w, 5) * (std::exp((h * c) / (w * kb * cct)) - 1));
+    };
+    return float(planck(m) / planck(peak));
   }
+  const double x =
+      cct <= 7000
+          ? -4.607e9 / (cct * cct * cct) + 2.9678e6 / (cct * cct) + 0.09911e3 / cct + 0.244063
+          : -2.0064e9 / (cct * cct * cct) + 1.9018e6 / (cct * cct) + 0.24748e3 / cct + 0.23704;
+  const double y = -3 * x * x + 2.870 * x - 0.275;
+  const double M = 0.0241 + 0.2562 * x - 0.7341 * y;
+  const double m1 = (-1.3515 - 1.7703 * x + 5.9114 * y) / M,
+               m2 = (0.0300 - 31.4424 * x + 30.0717 * y) / M;
+  return float(0.01 * (daylight_basis(kDaylightS0, l) + m1 * daylight_basis(kDaylightS1, l) +
+                       m2 * daylight_basis(kDaylightS2, l)));
+}
+
+std::array<float, 9> white_balance_srgb(float temperature) {
+  const std::array<double, 2> src =
+      chromaticity([&](double l) { return daylight_spectrum(temperature, float(l)); });
   const std::array<double, 2> dst = chromaticity([](double l) { return d65_raw(l); });
   const Mat3 lms_from_xyz{0.8951, 0.2664, -0.1614, -0.7502, 1.7135,
                           0.0367, 0.0389, -0.0685, 1.0296};

@@ -46,11 +46,20 @@ float wavelength_pdf(float lambda);
 // Linear sRGB of the Monte Carlo estimate L at the wavelengths wl (the film's sensor, pbrt-v4's
 // "cie1931").
 Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl);
+// The CIE daylight illuminant D(T), as pbrt-v4's Spectra::D has it: at the temperature corrected
+// for the revised second radiation constant (T 1.4388 / 1.4380), the daylight basis S0 + M1 S1 +
+// M2 S2 at the CIE formula's chromaticity; below 4000 K a blackbody (1 at its peak). Relative
+// values, 1 near 560 nm.
+float daylight_spectrum(float temperature, float lambda);
 // pbrt-v4's film "whitebalance" of temperature T (kelvin) for its cie1931 sensor, as a matrix on
-// linear sRGB (row-major): a Bradford adaptation from the white of the CIE daylight illuminant
-// D(T) (a blackbody below 4000 K, at pbrt-v4's corrected temperature T 1.4388 / 1.4380) to sRGB's
-// D65 white. The daylight chromaticity is the CIE formula's, not that of the integrated spectrum.
+// linear sRGB (row-major): a Bradford adaptation from the white of D(T) (daylight_spectrum) to
+// sRGB's D65 white.
 std::array<float, 9> white_balance_srgb(float temperature);
+
+// A 3 x 3 matrix, row-major, and its inverse; XYZ to linear sRGB (IEC 61966-2-1).
+using Mat3 = std::array<double, 9>;
+Mat3 inverse(const Mat3& m);
+void xyz_to_srgb(const double xyz[3], double rgb[3]);
 
 // The photopic luminance of the estimate L: the integral of L times the CIE 1931 ybar over that of
 // ybar, with no white balance. Light stated in pbrt-v4's photometric terms (a light's "power" in

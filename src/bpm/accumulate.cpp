@@ -77,7 +77,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         if (settings.debias)
           L -= bias;
         else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))
-          film->add_bias(x, y, spectrum_to_rgb(bias, wl), spectrum_to_luminance(bias, wl));
+          film->add_bias(x, y, film->rgb_of(bias, wl), spectrum_to_luminance(bias, wl));
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
         if (eye.sees_emission[p] && L.is_finite())
           eye.round_stats[p].add_rest(L.average() - eye.emission_part[p]);

@@ -7,12 +7,14 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "base/bytes.h"
 #include "base/color.h"
 #include "base/spectrum.h"
+#include "film/camera_response.h"
 
 namespace bpm {
 
@@ -43,13 +45,9 @@ struct FilmSample {
   float luminance = 0;
 };
 
-// The sample a film records for radiance L at wavelengths wl: linear sRGB and the luminance, both
-// scaled down when the largest colour channel exceeds max_value (pbrt-v4's maxcomponentvalue);
-// black unless recordable(L). Colours may have negative channels: a single sample's few
-// wavelengths can lie outside the sRGB gamut.
-inline FilmSample film_sample(const Spectrum& L, const Wavelengths& wl, float max_value) {
-  if (!recordable(L)) return {};
-  FilmSample f{spectrum_to_rgb(L, wl), spectrum_to_luminance(L, wl)};
+// Scales a sample down when its largest colour channel exceeds max_value (pbrt-v4's
+// maxcomponentvalue), its luminance with it.
+inline FilmSample clamp_sample(FilmSample f, float max_value) {
   const float m = f.rgb.max_component();
   if (m > max_value) {
     f.rgb *= max_value / m;
@@ -104,6 +102,19 @@ class Film {
     colour_matrix_ = m;
     has_colour_matrix_ = true;
   }
+  // The film's spectral response (a named camera sensor); the CIE matching functions when none.
+  void set_response(std::shared_ptr<const CameraResponse> r) { response_ = std::move(r); }
+  // Linear sRGB of the estimate L at the wavelengths wl, through the film's response.
+  Rgb rgb_of(const Spectrum& L, const Wavelengths& wl) const {
+    return response_ ? response_->to_rgb(L, wl) : spectrum_to_rgb(L, wl);
+  }
+  // The sample the film records for radiance L at wavelengths wl: linear sRGB and the luminance,
+  // clamped to max_value (clamp_sample); black unless recordable(L). Colours may have negative
+  // channels: a single sample's few wavelengths can lie outside the sRGB gamut.
+  FilmSample sample_of(const Spectrum& L, const Wavelengths& wl, float max_value) const {
+    if (!recordable(L)) return {};
+    return clamp_sample({rgb_of(L, wl), spectrum_to_luminance(L, wl)}, max_value);
+  }
   bool independent_passes() const { return independent_; }
   // Keeps spectral buckets (none by default); forgets what they held.
   void set_spectral(const SpectralBuckets& b) {
@@ -111,7 +122,7 @@ class Film {
     bucket_sums_.assign(pixels_.size() * 2 * size_t(b.count), 0.0);
   }
   const SpectralBuckets& spectral() const { return spectral_; }
-  // Records a sample's radiance at its wavelengths into the buckets (clamped as film_sample
+  // Records a sample's radiance at its wavelengths into the buckets (clamped as sample_of
   // clamps its colour, by its largest spectral value); no-op without buckets.
   void add_spectrum(int x, int y, const Spectrum& L, const Wavelengths& wl, float weight,
                     float max_value) {
@@ -304,6 +315,7 @@ class Film {
   int pass_index_ = 0;
   bool independent_ = true;
   bool has_colour_matrix_ = false;
+  std::shared_ptr<const CameraResponse> response_;
   std::array<float, 9> colour_matrix_{};
   SpectralBuckets spectral_;
   std::vector<double> bucket_sums_;  // [pixel][bucket][radiance sum, weight sum]

@@ -242,7 +242,7 @@ void FpmRender::record(uint32_t pixel, const FpmEyeRadiance& r, const CameraSamp
   }
   if (r.bias.is_finite() && cs.filter_weight != 0 && recordable(r.L))
     film_->add_bias(int(pixel % uint32_t(film_->width())), int(pixel / uint32_t(film_->width())),
-                    spectrum_to_rgb(r.bias, wm.wl), spectrum_to_luminance(r.bias, wm.wl));
+                    film_->rgb_of(r.bias, wm.wl), spectrum_to_luminance(r.bias, wm.wl));
   record_pass(film_, pixel, r.L, wm.wl, cs.filter_weight, ls_.film.max_component_value);
 }
 

@@ -111,7 +111,7 @@ inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wav
   int x = int(pixel % uint32_t(film->width())), y = int(pixel / uint32_t(film->width()));
   film->add_spectrum(x, y, L, wl, filter_weight, max_component_value);
   if (may_be_negative && L.is_finite()) {
-    FilmSample f{spectrum_to_rgb(L, wl), spectrum_to_luminance(L, wl)};
+    FilmSample f{film->rgb_of(L, wl), spectrum_to_luminance(L, wl)};
     const float m = std::fmax(f.rgb.max_component(), -f.rgb.min_component());
     if (m > max_component_value) {
       f.rgb *= max_component_value / m;
@@ -120,7 +120,7 @@ inline void record_pass(Film* film, uint32_t pixel, const Spectrum& L, const Wav
     film->add_sample(x, y, f, filter_weight);
   } else {
     if (!recordable(L)) film->drop_sample(x, y);
-    film->add_sample(x, y, film_sample(L, wl, max_component_value), filter_weight);
+    film->add_sample(x, y, film->sample_of(L, wl, max_component_value), filter_weight);
   }
   film->end_pass(x, y);
 }

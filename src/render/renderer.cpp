@@ -43,7 +43,12 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
                 std::to_string(opt.sensors.size()));
   if (!opt.image && opt.sensors.empty())
     throw Error("a render without an image needs sensors (--sensors)");
-  if (ls.film.white_balance > 0) film->set_colour_matrix(white_balance_srgb(ls.film.white_balance));
+  // A named sensor is balanced by its fit (6500 K unless the film says); cie1931 by a matrix.
+  if (ls.film.sensor != "cie1931")
+    film->set_response(std::make_shared<const CameraResponse>(*CameraResponse::named(
+        ls.film.sensor, ls.film.white_balance > 0 ? ls.film.white_balance : 6500)));
+  else if (ls.film.white_balance > 0)
+    film->set_colour_matrix(white_balance_srgb(ls.film.white_balance));
   // A spectral film's buckets (set before a resumed film was loaded, or here).
   if (!(film->spectral() == ls.film.spectral)) film->set_spectral(ls.film.spectral);
   // The photon methods' iterations are independent only stream by stream (photons/light_path.h).

@@ -38,7 +38,8 @@ Vec3 Curves::ribbon_normal(int seg, float u) const {
   const float angle = std::acos(std::clamp(dot(n0, n1), -1.0f, 1.0f));
   if (angle < 1e-4f) return n0;
   const float inv_sin = 1 / std::sin(angle);
-  return normalize(n0 * (std::sin((1 - u) * angle) * inv_sin) + n1 * (std::sin(u * angle) * inv_sin));
+  return normalize(n0 * (std::sin((1 - u) * angle) * inv_sin) +
+                   n1 * (std::sin(u * angle) * inv_sin));
 }
 
 // pbrt-v4's frame at a curve hit: dp/dv spans the width (across the ribbon's normal, or for the
@@ -50,7 +51,8 @@ SurfacePoint curve_point(const Curves& c, int seg, float u, Vec3 p, Vec3 d) {
   float radius;
   const Vec3 centre = c.point(seg, u, &dpdu, &radius);
   const float width = 2 * radius;
-  if (!(length_squared(dpdu) > 0)) dpdu = perpendicular(normalize(d.x || d.y || d.z ? d : Vec3(0, 0, 1)));
+  if (!(length_squared(dpdu) > 0))
+    dpdu = perpendicular(normalize(d.x || d.y || d.z ? d : Vec3(0, 0, 1)));
   const Vec3 t = normalize(dpdu);
   Vec3 across = c.type == Curves::Type::kRibbon ? cross(c.ribbon_normal(seg, u), t) : cross(d, t);
   across = length_squared(across) > 0 ? normalize(across) : perpendicular(t);

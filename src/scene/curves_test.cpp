@@ -100,9 +100,8 @@ TEST(Curves, EmbreeFindsTheCurveWithinItsWidth) {
       const Vec3 d(0, std::sin(a), std::cos(a));  // turning about the curve's axis
       const Vec3 across(0, std::cos(a), -std::sin(a));
       // A ribbon of normal (0, 1, -1)/sqrt 2 spans 0.1 |cos| to either side.
-      const float half = type == Curves::Type::kFlat
-                             ? 0.1f
-                             : 0.1f * std::fabs(dot(d, normalize(Vec3(0, 1, -1))));
+      const float half =
+          type == Curves::Type::kFlat ? 0.1f : 0.1f * std::fabs(dot(d, normalize(Vec3(0, 1, -1))));
       for (float s : {0.0f, 0.9f, 1.1f}) {
         const Vec3 o = across * (s * half) - d * 3.0f + Vec3(0.3f, 0, 0);
         Hit h;

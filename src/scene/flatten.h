@@ -46,8 +46,9 @@ struct FilmSettings {
   std::string filename = "pbrt.exr";
   float imaging_ratio = 1;  // exposure time * ISO / 100, as pbrt-v4's sensor
   float max_component_value = kInf;
-  float white_balance = 0;   // kelvin; 0: none (pbrt-v4's "whitebalance" of the cie1931 sensor)
-  SpectralBuckets spectral;  // pbrt-v4's "spectral" film; count 0 for "rgb"
+  float white_balance = 0;         // kelvin; 0: none (a named sensor's: 6500)
+  std::string sensor = "cie1931";  // pbrt-v4's film "sensor": cie1931 or a camera's name
+  SpectralBuckets spectral;        // pbrt-v4's "spectral" film; count 0 for "rgb"
 };
 
 // What the scene file says about how to render it; the command line may override each field.

@@ -151,10 +151,16 @@ void Flattener::read_film(LoadedScene* out) {
   float iso = f.params.get_float("iso", 100);
   if (!(iso > 0)) throw Error(f.loc, "iso must be positive");
   out->film.imaging_ratio *= iso / 100;
-  std::string sensor = f.params.get_string("sensor", "cie1931");
-  if (sensor != "cie1931")
-    throw Error(f.params.find_any("sensor")->loc,
-                "sensor \"" + sensor + "\" is not supported (only cie1931)");
+  out->film.sensor = f.params.get_string("sensor", "cie1931");
+  if (out->film.sensor != "cie1931") {
+    const std::vector<std::string> names = CameraResponse::names();
+    if (std::find(names.begin(), names.end(), out->film.sensor) == names.end()) {
+      std::string list = "cie1931";
+      for (const std::string& n : names) list += ", " + n;
+      throw Error(f.params.find_any("sensor")->loc,
+                  "sensor \"" + out->film.sensor + "\" is unknown (" + list + ")");
+    }
+  }
   out->film.white_balance = f.params.get_float("whitebalance", 0);
   if (!(out->film.white_balance >= 0) || !std::isfinite(out->film.white_balance) ||
       (out->film.white_balance > 0 && out->film.white_balance < 1000))

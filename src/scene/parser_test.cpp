@@ -1062,6 +1062,18 @@ TEST(SceneParams, NamedSpectrumEta) {
   EXPECT_NEAR(c.eta.curve.value(600), 0.5f * (0.155265f + 0.116723f), 1e-5f);  // linear between
 }
 
+// A camera's sensitivity as a named spectrum (here an unbounded one: a conductor's k), zero
+// beyond its measured range.
+TEST(SceneParams, NamedCameraCurve) {
+  LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nMaterial \"conductor\" \"spectrum k\" \"nikon_d850_g\"\nShape \"sphere\"\n"));
+  const ConductorDesc& c =
+      std::get<ConductorDesc>(ls.scene.materials[ls.scene.objects[0].material]);
+  EXPECT_NEAR(c.k.curve.value(520), 1.0f, 1e-5f);  // the green's peak
+  EXPECT_EQ(c.k.curve.value(370), 0.0f);
+  EXPECT_EQ(c.k.curve.value(800), 0.0f);
+}
+
 TEST(SceneParams, BlackbodyLightHasUnitLuminance) {
   LoadedScene ls =
       flatten_scene(parse_scene_string("WorldBegin\nLightSource \"point\" \"blackbody I\" "

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <vector>
 
+#include "film/camera_response.h"
+
 namespace bpm {
 
 std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKind kind) {
@@ -63,6 +65,19 @@ std::optional<SpectrumCurve> named_spectrum(const std::string& name, SpectrumKin
       values.push_back(float(std::sqrt(n2)));
     }
     return SpectrumCurve::from_table(std::move(values), SpectrumKind::kUnbounded);
+  }
+  // The camera sensors' measured sensitivities (film/camera_response.h), NAME_r, _g and _b,
+  // zero beyond 380 to 720 nm as pbrt-v4 has them.
+  for (int i = 0; i < camera_curves::kCameraCount; ++i) {
+    const camera_curves::CameraCurves& cam = camera_curves::kCameras[i];
+    for (int c = 0; c < 3; ++c) {
+      if (name != std::string(cam.name) + "_" + "rgb"[c]) continue;
+      std::vector<double> pairs{375, 0};
+      for (int k = 0; k < camera_curves::kSamples; ++k)
+        pairs.insert(pairs.end(), {380.0 + 10 * k, double(cam.rgb[c][k])});
+      pairs.insert(pairs.end(), {725, 0});
+      return SpectrumCurve::from_pairs(pairs, kind);
+    }
   }
   if (kind == SpectrumKind::kIlluminant) {
     if (name == "stdillum-D65") return SpectrumCurve::from_rgb(Rgb(1.0f), kind);
