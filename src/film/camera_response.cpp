@@ -16,7 +16,6 @@ double curve(const camera_curves::CameraCurves& cam, int c, double lambda) {
   return v[i] * (1 - t) + v[i + 1] * t;
 }
 
-
 // The training reflectances: sigmoid spectra of the 27 colours with channels 0.05, 0.45, 0.85.
 std::vector<std::array<float, 3>> training_coefficients() {
   std::vector<std::array<float, 3>> out;
@@ -65,7 +64,8 @@ Mat3 fit_xyz_from_camera(const camera_curves::CameraCurves& cam, float white_bal
         xtc[3 * i + j] += xyz[i] * rgb[j];
       }
   }
-  const Mat3 inv = inverse({ctc[0], ctc[1], ctc[2], ctc[3], ctc[4], ctc[5], ctc[6], ctc[7], ctc[8]});
+  const Mat3 inv =
+      inverse({ctc[0], ctc[1], ctc[2], ctc[3], ctc[4], ctc[5], ctc[6], ctc[7], ctc[8]});
   Mat3 m{};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -77,7 +77,8 @@ Mat3 fit_xyz_from_camera(const camera_curves::CameraCurves& cam, float white_bal
 
 std::vector<std::string> CameraResponse::names() {
   std::vector<std::string> out;
-  for (int i = 0; i < camera_curves::kCameraCount; ++i) out.push_back(camera_curves::kCameras[i].name);
+  for (int i = 0; i < camera_curves::kCameraCount; ++i)
+    out.push_back(camera_curves::kCameras[i].name);
   return out;
 }
 
@@ -109,7 +110,8 @@ std::optional<CameraResponse> CameraResponse::named(const std::string& name, flo
                 m[size_t(3 * i + 2)] * cam_rgb[2]) /
                y_integral;
     xyz_to_srgb(xyz, rgb);
-    r.weight_.push_back({float(rgb[0] / white[0]), float(rgb[1] / white[1]), float(rgb[2] / white[2])});
+    r.weight_.push_back(
+        {float(rgb[0] / white[0]), float(rgb[1] / white[1]), float(rgb[2] / white[2])});
   }
   return r;
 }

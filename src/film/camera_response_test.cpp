@@ -16,7 +16,8 @@ Rgb colour_of(F&& spectrum, Conv&& to_rgb) {
   Rgb sum;
   const int n = 4000;
   for (int i = 0; i < n; ++i) {
-    const Wavelengths wl = sample_wavelengths_uniform((float(i) + 0.5f) / n, kLambdaMin, kLambdaMax);
+    const Wavelengths wl =
+        sample_wavelengths_uniform((float(i) + 0.5f) / n, kLambdaMin, kLambdaMax);
     Spectrum L;
     for (int k = 0; k < Spectrum::kChannels; ++k) L[k] = spectrum(wl.lambda[size_t(k)]);
     sum += to_rgb(L, wl);
@@ -40,12 +41,11 @@ TEST(CameraResponse, WhiteUnderTheBalanceIlluminantIsNeutral) {
     for (float kelvin : {3000.0f, 6500.0f}) {
       const CameraResponse r = *CameraResponse::named(name, kelvin);
       auto light = [&](float l) { return daylight_spectrum(kelvin, l); };
-      const Rgb camera = colour_of(light, [&](const Spectrum& L, const Wavelengths& wl) {
-        return r.to_rgb(L, wl);
-      });
+      const Rgb camera = colour_of(
+          light, [&](const Spectrum& L, const Wavelengths& wl) { return r.to_rgb(L, wl); });
       const float y = colour_of(light, [](const Spectrum& L, const Wavelengths& wl) {
-                        return Rgb(spectrum_to_luminance(L, wl), 0, 0);
-                      })[0];
+        return Rgb(spectrum_to_luminance(L, wl), 0, 0);
+      })[0];
       for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(camera[c] / y, 1, 0.03) << name << " " << kelvin << " K channel " << c;
     }
@@ -58,14 +58,12 @@ TEST(CameraResponse, ColoursUnderDaylightAreNearTheObservers) {
   for (Rgb colour : {Rgb(0.7f, 0.3f, 0.2f), Rgb(0.2f, 0.6f, 0.3f), Rgb(0.25f, 0.3f, 0.7f)}) {
     const SpectrumCurve refl = SpectrumCurve::from_rgb(colour, SpectrumKind::kAlbedo);
     auto lit = [&](float l) { return d65.value(l) * refl.value(l); };
-    const Rgb cie = colour_of(lit, [](const Spectrum& L, const Wavelengths& wl) {
-      return spectrum_to_rgb(L, wl);
-    });
+    const Rgb cie = colour_of(
+        lit, [](const Spectrum& L, const Wavelengths& wl) { return spectrum_to_rgb(L, wl); });
     for (const char* name : {"canon_eos_5d_mkiv", "nikon_d850", "sony_ilce_9"}) {
       const CameraResponse r = *CameraResponse::named(name, 6500);
-      const Rgb camera = colour_of(lit, [&](const Spectrum& L, const Wavelengths& wl) {
-        return r.to_rgb(L, wl);
-      });
+      const Rgb camera =
+          colour_of(lit, [&](const Spectrum& L, const Wavelengths& wl) { return r.to_rgb(L, wl); });
       for (int c = 0; c < 3; ++c) EXPECT_NEAR(camera[c], cie[c], 0.05f) << name << " channel " << c;
     }
   }
