@@ -98,7 +98,7 @@ void own_scenes(const std::string& shared, int spp) {
       "spp\n\n",
       spp, spp, fs::exists(pbrt) ? "run here" : "not found", spp);
   std::printf(
-      "| scene file | integrator | seconds | mean R G B | bpm / pbrt-v4 per channel | "
+      "| scene file | integrator | seconds | mean R G B | ours / pbrt-v4 per channel | "
       "relMSE to pbrt-v4 |\n| --- | --- | --- | --- | --- | --- |\n");
   for (const fs::path& file : files) {
     std::optional<Image> ref;
