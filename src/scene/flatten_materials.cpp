@@ -320,9 +320,10 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   float le_scale = ps.get_float("Lescale", 1);
   if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
   ps.get_float("g", 0);
-  auto sigma_a = spectrum_curve(ps, "sigma_a", SpectrumKind::kUnbounded)
-                     .value_or(SpectrumCurve::from_rgb(Rgb(0.0011f, 0.0024f, 0.014f),
-                                                       SpectrumKind::kUnbounded));
+  // pbrt-v4's default: 1 per unit distance (older versions had a default of rgb 0.0011 0.0024
+  // 0.014; the pbrt-v4 build we compare with uses 1).
+  auto sigma_a =
+      spectrum_curve(ps, "sigma_a", SpectrumKind::kUnbounded).value_or(SpectrumCurve(1.0f));
   if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
   ps.warn_unused("medium \"" + name + "\"");
   scene().media.push_back(AbsorbingMedium{name, sigma_a.scaled(scale)});

@@ -1388,6 +1388,16 @@ TEST(SceneParseError, NamedMaterialDefinedTwice) {
                       at(3, 1), "named material \"m\" defined twice"));
 }
 
+// pbrt-v4's default absorption is 1 per unit distance.
+TEST(SceneParse, MediumDefaultAbsorption) {
+  const LoadedScene ls = flatten_scene(parse_scene_string(
+      "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] "
+      "\"float scale\" 0.5\nWorldBegin\nMediumInterface \"m\" \"\"\nShape \"sphere\"\n"));
+  ASSERT_EQ(ls.scene.media.size(), 1u);
+  EXPECT_NEAR(ls.scene.media[0].sigma_a.value(450), 0.5f, 1e-6f);
+  EXPECT_NEAR(ls.scene.media[0].sigma_a.value(650), 0.5f, 1e-6f);
+}
+
 TEST(SceneParseError, MediaThatScatterOrAreUnknownAreErrors) {
   auto scene = [](const std::string& medium_params,
                   const std::string& interface = "MediumInterface \"m\" \"\"") {
