@@ -657,7 +657,7 @@ TEST(Bpm, FirstDiffuseVertexGathersCausticsOverK0AndIndirectOverK1) {
       EyeCounters counters;
       CameraSample cs = camera.sample(pass, centre);
       // A footprint of one world unit per unit of length: the radii are r0 and r1 per length.
-      trace_eye_path(ls.scene, ep, {cs.ray, cs.weight}, PixelFootprint{0, 1}, centre, cs.rng, lists,
+      trace_eye_path(ls.scene, ep, cs.camera_ray(), PixelFootprint{0, 1}, centre, cs.rng, lists,
                      counters);
       all.clear();
       for (const auto& l : lists) all.insert(all.end(), l.begin(), l.end());

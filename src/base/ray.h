@@ -11,10 +11,11 @@ struct Ray {
 
 // A ray from the camera and the factor it carries into the radiance it brings back: 1 but for
 // the realistic camera, whose lens weighs its rays (camera/lens_system.h); 0: no light comes
-// along this ray.
+// along this ray. A camera inside a medium starts its rays in it.
 struct CameraRay {
   Ray ray;
   float weight = 1;
+  int medium = -1;  // the scene medium the ray starts in (-1: none)
 };
 
 // The closest hit of a ray: the scene object (Embree geometry id), its primitive, the barycentric

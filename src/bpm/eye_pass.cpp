@@ -161,7 +161,7 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
                                              uint8_t near_edge) {
   const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters};
   if (ray.weight == 0) return {};
-  PathState s{ray.ray, Spectrum(ray.weight)};
+  PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
   std::optional<Spectrum> emission;
@@ -218,8 +218,8 @@ Spectrum mean_emission(const RenderScene& scene, const EyePassParams& prm,
   const uint64_t rays_before = ec.rays.total();
   for (int k = 1; k < count; ++k) {
     CameraSample cs = camera.sample(pass_index, pixel, uint32_t(k));
-    EyeRadiance e = trace_eye_path(scene, prm, {cs.ray, cs.weight}, cs.footprint, pixel, cs.rng,
-                                   lists, ec, true);
+    EyeRadiance e =
+        trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec, true);
     const Spectrum v = e.emission * (cs.filter_weight / first_weight);
     if (stats) stats->add_emission(v.average());
     sum += v;
@@ -274,8 +274,8 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             ++ec.pixels;
             CameraSample cs = camera.sample(pass_index, pixel);
             EyeRadiance r =
-                trace_eye_path(scene, prm, {cs.ray, cs.weight}, cs.footprint, pixel, cs.rng, lists,
-                               ec, false, prm.near_edges ? prm.near_edges->at(pixel) : 3);
+                trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
+                               false, prm.near_edges ? prm.near_edges->at(pixel) : 3);
             px->filter_weight[pixel] = cs.filter_weight;
             const Spectrum emission =
                 mean_emission(scene, prm, camera, pass_index, pixel,

@@ -26,7 +26,8 @@ Camera::Camera(const CameraSettings& s, const Raster& r)
       height_(r.full_height),
       crop_x0_(float(r.x0)),
       crop_y0_(float(r.y0)),
-      lens_(s.lens) {
+      lens_(s.lens),
+      medium_(s.medium) {
   const int width = r.full_width, height = r.full_height;
   const float aspect =
       s.frame_aspect_ratio > 0 ? s.frame_aspect_ratio : float(width) / float(height);
@@ -80,10 +81,12 @@ CameraRay Camera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
   if (projection_ == Projection::kSphericalEqualArea ||
       projection_ == Projection::kSphericalEquirectangular)
     return {Ray{world_from_camera_.point(Vec3(0, 0, 0)),
-                normalize(world_from_camera_.vector(camera_direction(p))), kInf}};
+                normalize(world_from_camera_.vector(camera_direction(p))), kInf},
+            1, medium_};
   if (projection_ == Projection::kRealistic) {
     CameraRay r = lens_->generate({p.x / float(width_), p.y / float(height_)}, u_lens);
     r.ray = Ray{world_from_camera_.point(r.ray.o), normalize(world_from_camera_.vector(r.ray.d))};
+    r.medium = medium_;
     return r;
   }
   const float sx = x0_ + (p.x / float(width_)) * (x1_ - x0_);
@@ -103,7 +106,8 @@ CameraRay Camera::generate_ray_full(Vec2 p, Vec2 u_lens) const {
     origin = p_lens;
     dir = normalize(p_focus - p_lens);
   }
-  return {Ray{world_from_camera_.point(origin), normalize(world_from_camera_.vector(dir)), kInf}};
+  return {Ray{world_from_camera_.point(origin), normalize(world_from_camera_.vector(dir)), kInf}, 1,
+          medium_};
 }
 
 PixelFootprint Camera::footprint(Vec2 p_full) const {

@@ -28,6 +28,7 @@ struct CameraSettings {
   float frame_aspect_ratio = 0;            // 0: the raster's
   float screen_window[4] = {0, 0, 0, 0};   // x0 x1 y0 y1; all zero means pbrt-v4's default
   std::shared_ptr<const LensSystem> lens;  // realistic: focused for the film's full raster
+  int medium = -1;                         // the scene medium the camera sits in (-1: none)
 };
 
 // The pixels a camera renders: width x height of its full_width x full_height raster, from pixel
@@ -77,6 +78,7 @@ class Camera {
   float pixel_angle_ = 0;  // sqrt of the pixel's solid angle (perspective, equal-area)
   float pixel_width_ = 0;  // sqrt of the pixel's area in world units (orthographic)
   std::shared_ptr<const LensSystem> lens_;
+  int medium_;
 };
 
 }  // namespace bpm

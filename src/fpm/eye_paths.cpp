@@ -156,10 +156,11 @@ inline bool scatter(const FpmPath& path, const PathVertex& v, const EyeVertexCho
 }  // namespace
 
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                                const FpmEyeParams& prm, Ray ray, PixelFootprint footprint,
+                                const FpmEyeParams& prm, CameraRay ray, PixelFootprint footprint,
                                 Rng& rng, FpmEyeCounters& c, uint8_t near_edge) {
+  if (ray.weight == 0) return {};
   const FpmPath path{scene, maps, prm, footprint, rng, c, near_edge};
-  PathState s{ray};
+  PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   Spectrum L, bias;
   int depth = 0;
   // Emission found by the ray that leaves x1 is direct light at x1, shared by MIS with next-event

@@ -37,7 +37,7 @@ struct FpmEyeRadiance {
   Spectrum L, bias;
 };
 FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& maps,
-                                const FpmEyeParams& params, Ray ray, PixelFootprint footprint,
+                                const FpmEyeParams& params, CameraRay ray, PixelFootprint footprint,
                                 Rng& rng, FpmEyeCounters& counters, uint8_t near_edge = 3);
 
 }  // namespace bpm

@@ -221,13 +221,8 @@ void FpmRender::eye_pass(const WavelengthMaterials& wm, int pass, int it,
   FpmEyeParams ep{&wm, &s_, opt_.max_depth, s_.k0 * scale, s_.k1 * scale, double(emitted_)};
   for_each_sampled_pixel(film_->width(), film_->height(), control, pass, [&](uint32_t pixel) {
     CameraSample cs = camera_.sample(it, pixel);
-    FpmEyeRadiance r;
-    if (cs.weight > 0) {
-      r = fpm_eye_radiance(scene_, maps_, ep, cs.ray, cs.footprint, cs.rng, eye_counters_.local(),
-                           near_edges_.at(pixel));
-      r.L *= cs.weight;
-      r.bias *= cs.weight;
-    }
+    const FpmEyeRadiance r = fpm_eye_radiance(scene_, maps_, ep, cs.camera_ray(), cs.footprint,
+                                              cs.rng, eye_counters_.local(), near_edges_.at(pixel));
     record(pixel, r, cs, wm);
   });
   tot_.eye_s += since(t);

@@ -47,6 +47,35 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
 }
 
+Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int medium, Vec3 travel,
+                                       float g, const WavelengthMaterials& wm, Rng& rng,
+                                       PathCounters& counters) {
+  const Wavelengths& wl = wm.wl;
+  if (scene.lights.empty()) return {};
+  float pmf;
+  int li = scene.light_distribution.sample(rng.uniform(), &pmf);
+  const Light& light = scene.lights[size_t(li)];
+  Vec2 u{rng.uniform(), rng.uniform()};
+  auto ls = light_sample_li(light, scene.light_shape(light), p, u, scene.bounds_info, wl,
+                            wm.light_spectrum(li));
+  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
+  const float phase = henyey_greenstein(dot(travel, ls->wi), g);
+  if (!(phase > 0)) return {};
+  ++counters.shadow_rays;
+  const bool has_surface = length_squared(ls->n_light) > 0;
+  const Vec3 target = has_surface
+                          ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
+                          : ls->p_light;
+  if (scene.occluded(p, target)) return {};
+  const Spectrum f =
+      medium_transmittance(scene, medium, ls->is_infinite ? kInf : length(ls->p_light - p), wl) *
+      phase;
+  if (f.is_black()) return {};
+  const float p_light = pmf * ls->pdf_solid_angle;
+  if (ls->is_delta) return ls->radiance * f / p_light;
+  return ls->radiance * f * (power_heuristic(p_light, phase) / p_light);
+}
+
 Spectrum weighted_surface_emission(const RenderScene& scene, const Ray& ray, const Hit& hit,
                                    const SurfacePoint& sp, const Wavelengths& wl,
                                    const Spectrum& beta, const EmitterWeight& w) {

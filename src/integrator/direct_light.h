@@ -19,6 +19,15 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
                              bool use_mis, const WavelengthMaterials& wm, Rng& rng,
                              PathCounters& counters, BsdfPart part = BsdfPart::kAll);
 
+// Direct light at a point p inside `medium` that scatters by a Henyey-Greenstein phase function of
+// asymmetry g, reached by a path travelling along `travel`: one light chosen by power, attenuated
+// by the medium up to it, by the power heuristic against phase sampling. Shadow rays stop at any
+// surface, interfaces included: light that reaches p through an interface is found by phase
+// sampling alone and counted in full there (next_eye_vertex).
+Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int medium, Vec3 travel,
+                                       float g, const WavelengthMaterials& wm, Rng& rng,
+                                       PathCounters& counters);
+
 // How emission found by the next ray of a path counts: in full (seen from the camera or through
 // specular vertices only), by the power heuristic against next-event estimation at the previous
 // vertex p_prev whose BSDF sample had density pdf_bsdf, or not at all (counted elsewhere).

@@ -1,7 +1,7 @@
 // The path tracer's estimate of the radiance along a ray: next-event estimation with multiple
 // importance sampling (power heuristic) against BSDF sampling, Russian roulette, lights chosen in
-// proportion to power. The path integrator renders with it (path/path_integrator.h); illuminance
-// sensors trace their paths with it (integrator/sensors.h).
+// proportion to power; scattering in media. The path integrator renders with it
+// (path/path_integrator.h); illuminance sensors trace their paths with it (integrator/sensors.h).
 #pragma once
 #include "base/rng.h"
 #include "integrator/counters.h"
@@ -23,9 +23,12 @@ struct PathSettings {
 
 // Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl. `first` weighs the
 // emission of the first surface the ray meets (full for a camera ray; an illuminance sensor
-// weighs it against its own light sample).
+// weighs it against its own light sample); the ray starts in `medium` (-1: none). In scattering
+// media the path scatters too (a volumetric path tracer, as pbrt-v4's volpath): free-flight
+// distances (sample_medium_distance), next-event estimation through the phase function and
+// phase sampling, by the power heuristic; a scattering event counts toward max_depth.
 Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& settings,
                        const Wavelengths& wl, Rng& rng, PathCounters& counters,
-                       const EmitterWeight& first = EmitterWeight::full());
+                       const EmitterWeight& first = EmitterWeight::full(), int medium = -1);
 
 }  // namespace bpm

@@ -3,10 +3,12 @@
 // attenuating the throughput in absorbing media and crossing interface surfaces on the way; then,
 // after the integrator has done its work at the vertex, sample the BSDF and leave.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <variant>
 
+#include "base/error.h"
 #include "base/rng.h"
 #include "integrator/counters.h"
 #include "scene/render_scene.h"
@@ -21,6 +23,7 @@ struct PathState {
   float length = 0;        // world distance travelled, interfaces included
   bool hero_only = false;  // only the first wavelength goes on (hero_wavelength_only)
   int interfaces = 0;      // interface surfaces crossed since the last vertex (next_vertex)
+  Rng* rng = nullptr;      // draws where the ray scatters in a medium (next_vertex)
 };
 
 // A surface where the path scatters.
@@ -34,6 +37,9 @@ struct PathVertex {
   Frame frame;               // shading frame
   Vec3 wo_local;
   bool on_curve = false;  // the surface is a curve (scene/curves.h)
+  // A point inside a scattering medium (StepEnd::kMedium): sp.p is the point, wo the way back,
+  // `medium` the medium; no surface, material or frame.
+  int medium = -1;
   PathVertex() = default;
   PathVertex(const PathVertex&) = delete;  // material may point into storage
   PathVertex& operator=(const PathVertex&) = delete;
@@ -41,7 +47,38 @@ struct PathVertex {
   const Material& m() const { return *material; }
 };
 
-enum class StepEnd { kVertex, kEscaped, kAbsorbed };
+enum class StepEnd { kVertex, kMedium, kEscaped, kAbsorbed };
+
+// Where a ray in a homogeneous scattering medium next scatters, before `distance` (kInf: none
+// ahead). The distance follows one wavelength's free flight, the wavelength drawn uniformly, and
+// the throughput is weighted by the mixture of all wavelengths' densities (one-sample MIS, the
+// balance heuristic: chromatic media stay unbiased at every wavelength): at a scattering point
+// beta *= sigma_s T(t) / p(t), past it beta *= T(distance) / P(t > distance). Returns the
+// scattering distance, or a negative value when the ray gets past.
+inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sigma_s,
+                                    float distance, Rng& rng, Spectrum& beta) {
+  constexpr int n = Spectrum::kChannels;
+  const int j = std::min(int(rng.uniform() * n), n - 1);
+  const float u = rng.uniform();
+  const float t = sigma_t[j] > 0 ? -std::log1p(-u) / sigma_t[j] : kInf;
+  if (t < distance) {
+    double p = 0;
+    for (int k = 0; k < n; ++k) p += sigma_t[k] * std::exp(-double(sigma_t[k]) * t);
+    p /= n;
+    for (int k = 0; k < n; ++k)
+      beta[k] *= float(sigma_s[k] * std::exp(-double(sigma_t[k]) * t) / p);
+    return t;
+  }
+  double P = 0;
+  Spectrum T;
+  for (int k = 0; k < n; ++k) {
+    T[k] = sigma_t[k] > 0 ? float(std::exp(-double(sigma_t[k]) * distance)) : 1.0f;
+    P += T[k];
+  }
+  P /= n;
+  for (int k = 0; k < n; ++k) beta[k] *= float(T[k] / P);
+  return -1;
+}
 
 // Follows s.ray to the next scattering surface and fills v. on_surface(hit, sp) is called at every
 // surface reached, interfaces included, with s.beta already attenuated up to it and s.interfaces
@@ -57,13 +94,31 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
   for (int guard = 0; guard < 10000; ++guard) {
     if (observer) observer->closest_hit(s.ray);
     v.hit = Hit();
-    if (!scene.intersect(s.ray, &v.hit)) {
-      cross_medium(scene, s.medium, kInf, wl, s.beta);
-      return StepEnd::kEscaped;
+    const bool hit = scene.intersect(s.ray, &v.hit);
+    const float distance = hit ? v.hit.t * length(s.ray.d) : kInf;
+    if (s.medium >= 0 && scene.media[size_t(s.medium)].scatters()) {
+      BPM_CHECK(s.rng);  // only the path integrator renders scattering media
+      const HomogeneousMedium& m = scene.media[size_t(s.medium)];
+      const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
+      const float t = sample_medium_distance(sigma_t, sigma_s, distance, *s.rng, s.beta);
+      if (t >= 0) {
+        s.length += t;
+        v.medium = s.medium;
+        v.sp = SurfacePoint{};
+        v.sp.p = s.ray.o + normalize(s.ray.d) * t;
+        v.wo = -normalize(s.ray.d);
+        return s.beta.is_black() ? StepEnd::kAbsorbed : StepEnd::kMedium;
+      }
+      if (s.beta.is_black()) return StepEnd::kAbsorbed;
+      if (!hit) return StepEnd::kEscaped;
+    } else {
+      if (!hit) {
+        cross_medium(scene, s.medium, kInf, wl, s.beta);
+        return StepEnd::kEscaped;
+      }
+      if (!cross_medium(scene, s.medium, distance, wl, s.beta)) return StepEnd::kAbsorbed;
     }
-    float distance = v.hit.t * length(s.ray.d);
     s.length += distance;
-    if (!cross_medium(scene, s.medium, distance, wl, s.beta)) return StepEnd::kAbsorbed;
     v.sp = scene.surface(s.ray, v.hit);
     on_surface(v.hit, v.sp);
     v.material_index = scene.objects[size_t(v.hit.object)].material;
@@ -77,6 +132,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       ++continuation_rays;
       continue;
     }
+    v.medium = -1;
     v.wo = -s.ray.d;
     v.frame = Frame::from_z(v.sp.ns);
     v.wo_local = v.frame.to_local(v.wo);

@@ -69,6 +69,8 @@ struct CameraSample {
   float filter_weight;
   PixelFootprint footprint;
   float weight = 1;
+  int medium = -1;  // the medium the ray starts in (the camera's)
+  CameraRay camera_ray() const { return {ray, weight, medium}; }
 };
 
 class CameraSampler {
@@ -91,7 +93,7 @@ class CameraSampler {
     Vec2 p_film{x + 0.5f + fs.offset.x, y + 0.5f + fs.offset.y};
     Vec2 u_lens{rng.uniform(), rng.uniform()};
     const CameraRay r = camera_.generate_ray_full(p_film, u_lens);
-    return {rng, r.ray, fs.weight, camera_.footprint(p_film), r.weight};
+    return {rng, r.ray, fs.weight, camera_.footprint(p_film), r.weight, r.medium};
   }
   const Camera& camera() const { return camera_; }
 

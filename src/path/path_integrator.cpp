@@ -19,10 +19,11 @@ RenderStats render_path(const LoadedScene& ls, const IntegratorOptions& opt, Fil
     for_each_sampled_pixel(film->width(), film->height(), control, pass, [&](uint32_t pixel) {
       CameraSample cs = camera.sample(index, pixel);
       Wavelengths wl = ls.film.spectral.wavelengths(cs.rng.uniform());
-      const Spectrum L =
-          cs.weight > 0
-              ? path_radiance(ls.scene, cs.ray, settings, wl, cs.rng, counters.local()) * cs.weight
-              : Spectrum();
+      const Spectrum L = cs.weight > 0
+                             ? path_radiance(ls.scene, cs.ray, settings, wl, cs.rng,
+                                             counters.local(), EmitterWeight::full(), cs.medium) *
+                                   cs.weight
+                             : Spectrum();
       record_pass(film, pixel, L, wl, cs.filter_weight, ls.film.max_component_value);
     });
     PassResult r;

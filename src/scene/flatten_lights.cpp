@@ -89,9 +89,10 @@ ImageInfiniteLight Flattener::image_light(const LightEntity& e, const Param& fil
 // "illuminance" has been applied to it.
 void Flattener::add_light(const LightEntity& e, RenderScene* rs) {
   const ParamSet& ps = e.params;
+  // The path tracer needs no light's medium (next-event estimation attenuates by the medium of
+  // the point lit); the photon methods' light paths would start in it, which they do not yet.
   if (!e.medium.outside.empty() && medium_id(e.medium.outside, e.medium.loc) >= 0)
-    throw Error(e.loc, "light \"" + e.name + "\" inside a medium (\"" + e.medium.outside +
-                           "\") is not supported");
+    rs->light_in_medium = e.loc.str();
   float scale = ps.get_float("scale", 1);
   if (e.name == "point") {
     add_point_light(e, &scale, rs);

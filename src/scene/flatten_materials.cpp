@@ -290,8 +290,9 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
   return m;
 }
 
-// The index of a named medium, -1 for "" (vacuum). Only media that absorb without scattering
-// or emitting are supported (pbrt-v4 "homogeneous" with sigma_s = 0 and no Le).
+// The index of a named medium, -1 for "" (vacuum): pbrt-v4's "homogeneous" medium, absorbing
+// and scattering, with its defaults (sigma_a and sigma_s 1 per unit distance, times scale; g 0).
+// Other types, presets and emission are refused.
 int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   if (name.empty()) return -1;
   if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
@@ -300,33 +301,31 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   const SceneEntity& m = e->second;
   const ParamSet& ps = m.params;
   auto unsupported = [&](const std::string& why) {
-    return Error(loc, "participating media are not supported (medium \"" + name + "\" defined at " +
-                          m.loc.str() + ": " + why +
-                          "); only absorbing homogeneous media (sigma_s = 0) are");
+    return Error(loc, "medium \"" + name + "\" (defined at " + m.loc.str() +
+                          ") is not supported: " + why + "; homogeneous media are");
   };
   if (m.name != "homogeneous") throw unsupported("type \"" + m.name + "\"");
   if (const Param* p = ps.find_any("preset")) {
     p->used = true;
     throw unsupported("preset \"" + (p->strings.empty() ? std::string() : p->strings[0]) +
-                      "\" scatters");
+                      "\" (give sigma_a and sigma_s instead)");
   }
   float scale = ps.get_float("scale", 1);
   if (!(scale >= 0) || !std::isfinite(scale))
     throw Error(m.loc, "medium scale must be a non-negative number");
-  // pbrt-v4's defaults scatter: sigma_s must be stated, and zero.
-  auto sigma_s = spectrum_curve(ps, "sigma_s", SpectrumKind::kUnbounded);
-  if (!sigma_s || sigma_s->max_value() * scale > 0) throw unsupported("it scatters (sigma_s > 0)");
   auto Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
   float le_scale = ps.get_float("Lescale", 1);
   if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
-  ps.get_float("g", 0);
-  // pbrt-v4's default: 1 per unit distance (older versions had a default of rgb 0.0011 0.0024
-  // 0.014; the pbrt-v4 build we compare with uses 1).
+  const float g = ps.get_float("g", 0);
+  if (!(g > -1 && g < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
   auto sigma_a =
       spectrum_curve(ps, "sigma_a", SpectrumKind::kUnbounded).value_or(SpectrumCurve(1.0f));
+  auto sigma_s =
+      spectrum_curve(ps, "sigma_s", SpectrumKind::kUnbounded).value_or(SpectrumCurve(1.0f));
   if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
+  if (!(sigma_s.min_value() >= 0)) throw Error(m.loc, "sigma_s must not be negative");
   ps.warn_unused("medium \"" + name + "\"");
-  scene().media.push_back(AbsorbingMedium{name, sigma_a.scaled(scale)});
+  scene().media.push_back(HomogeneousMedium{name, sigma_a.scaled(scale), sigma_s.scaled(scale), g});
   return medium_ids_[name] = int(scene().media.size()) - 1;
 }
 

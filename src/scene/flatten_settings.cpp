@@ -16,10 +16,9 @@ void Flattener::read_camera(LoadedScene* out) {
     return;
   }
   const CameraEntity& c = *parsed_.camera;
-  if (!c.medium.outside.empty())
-    throw Error(c.medium.loc,
-                "a camera inside a medium (\"" + c.medium.outside + "\") is not supported");
   CameraSettings& cam = out->camera;
+  // pbrt-v4: the camera sits in the "outside" medium of the MediumInterface in effect.
+  cam.medium = medium_id(c.medium.outside, c.medium.loc);
   cam.world_from_camera = c.camera_from_world.inverse();
   if (c.name == "perspective" || c.name == "orthographic") {
     cam.projection = c.name == "perspective" ? Projection::kPerspective : Projection::kOrthographic;

@@ -1398,7 +1398,7 @@ TEST(SceneParse, MediumDefaultAbsorption) {
   EXPECT_NEAR(ls.scene.media[0].sigma_a.value(650), 0.5f, 1e-6f);
 }
 
-TEST(SceneParseError, MediaThatScatterOrAreUnknownAreErrors) {
+TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
   auto scene = [](const std::string& medium_params,
                   const std::string& interface = "MediumInterface \"m\" \"\"") {
     return "MakeNamedMedium \"m\" " + medium_params + "\nWorldBegin\n" + interface +
@@ -1407,28 +1407,35 @@ TEST(SceneParseError, MediaThatScatterOrAreUnknownAreErrors) {
   EXPECT_TRUE(
       IsError(error_of(scene("\"string type\" \"homogeneous\"", "MediumInterface \"nope\" \"\"")),
               at(3, 1), "unknown medium \"nope\""));
-  // pbrt-v4's default sigma_s scatters; so does a stated one.
-  EXPECT_TRUE(IsError(
-      error_of(scene("\"string type\" \"homogeneous\"")), at(3, 1),
-      "participating media are not supported (medium \"m\" defined at <string>:1:1: it scatters"));
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0.1 0]")),
-                      at(3, 1), "it scatters (sigma_s > 0)"));
+  // A scattering homogeneous medium, pbrt-v4's defaults included, is read.
+  EXPECT_EQ(error_of(scene("\"string type\" \"homogeneous\"")), "");
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"rgb sigma_s\" [0 0 0]")),
                       at(3, 1), "type \"uniformgrid\""));
   EXPECT_TRUE(IsError(
       error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] \"rgb Le\" [1 1 1]")),
       at(3, 1), "it emits (Le)"));
+  EXPECT_TRUE(
+      IsError(error_of(scene("\"string type\" \"homogeneous\" \"string preset\" \"Apple\"")),
+              at(3, 1), "preset \"Apple\""));
+  const std::string bad_g = "\"string type\" \"homogeneous\" \"float g\" 1";
+  EXPECT_TRUE(IsError(error_of(scene(bad_g)), at(1, 20 + col(bad_g, "\"float g")),
+                      "g must lie in (-1, 1)"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [-1 0 0]")),
+                      at(1, 49), "sigma_s"));
   EXPECT_TRUE(IsError(error_of("MakeNamedMedium \"m\" \"float scale\" 1\nWorldBegin\n"), at(1, 1),
                       "medium \"m\" has no \"string type\""));
-  // The camera or a light inside a medium.
+  // The camera inside a medium sits in it; a light inside one is noted (path renders it).
   const std::string absorbing =
       "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0]\n";
-  EXPECT_TRUE(IsError(
-      error_of(absorbing + "MediumInterface \"\" \"m\"\nCamera \"perspective\"\nWorldBegin\n"),
-      at(2, 1), "a camera inside a medium (\"m\") is not supported"));
-  EXPECT_TRUE(
-      IsError(error_of(absorbing + "WorldBegin\nMediumInterface \"m\"\nLightSource \"point\"\n"),
-              at(4, 1), "light \"point\" inside a medium (\"m\") is not supported"));
+  EXPECT_EQ(flatten_scene(parse_scene_string(absorbing + "MediumInterface \"\" \"m\"\n"
+                                                         "Camera \"perspective\"\nWorldBegin\n"))
+                .camera.medium,
+            0);
+  EXPECT_EQ(
+      flatten_scene(parse_scene_string(
+                        absorbing + "WorldBegin\nMediumInterface \"m\"\nLightSource \"point\"\n"))
+          .scene.light_in_medium,
+      "<string>:4:1");
 }
 
 TEST(SceneParseError, ColorSpaceOtherThanSrgb) {

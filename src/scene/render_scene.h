@@ -18,9 +18,13 @@ namespace bpm {
 
 // A homogeneous medium that absorbs and does not scatter or emit (pbrt-v4 "homogeneous" with
 // sigma_s = 0): light crossing a distance d in it keeps exp(-sigma_a d), wavelength by wavelength.
-struct AbsorbingMedium {
+// pbrt-v4's "homogeneous" medium: absorption and scattering coefficients (per unit distance,
+// the medium's "scale" applied) and the asymmetry g of its Henyey-Greenstein phase function.
+struct HomogeneousMedium {
   std::string name;
-  SpectrumCurve sigma_a;  // per unit distance
+  SpectrumCurve sigma_a, sigma_s;
+  float g = 0;
+  bool scatters() const { return !sigma_s.is_black(); }
 };
 
 struct Object {
@@ -50,7 +54,16 @@ class RenderScene {
   std::vector<MaterialDesc> materials;
   TextureSet textures;      // the nodes textured materials read
   std::vector<Bump> bumps;  // per material (or fewer: none past the end)
-  std::vector<AbsorbingMedium> media;
+  std::vector<HomogeneousMedium> media;
+  // Where a light source other than an area light sits inside a medium ("" if none): only the
+  // path integrator renders such scenes so far.
+  std::string light_in_medium;
+  // Whether any medium scatters (only the path integrator renders such scenes so far).
+  bool has_scattering_media() const {
+    for (const HomogeneousMedium& m : media)
+      if (m.scatters()) return true;
+    return false;
+  }
   std::vector<Light> lights;
   std::vector<int> infinite_lights;  // lights a ray that escapes the scene sees
   // Some light has an area or lies at infinity: one that a BSDF sample can find (not only points
@@ -125,12 +138,14 @@ inline int medium_toward(const RenderScene& scene, int object, Vec3 ng, Vec3 w, 
   return dot(w, ng) > 0 ? o.medium_outside : o.medium_inside;
 }
 
-// The fraction of light that crosses `distance` in `medium` (-1: vacuum) at each wavelength.
+// The fraction of light that crosses `distance` in `medium` (-1: vacuum) at each wavelength
+// without being absorbed or scattered away: exp(-sigma_t distance).
 inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float distance,
                                      const Wavelengths& wl) {
   Spectrum t(1.0f);
   if (medium < 0) return t;
-  Spectrum sigma = scene.media[size_t(medium)].sigma_a.sample(wl);
+  const HomogeneousMedium& m = scene.media[size_t(medium)];
+  Spectrum sigma = m.sigma_a.sample(wl) + m.sigma_s.sample(wl);
   for (int i = 0; i < Spectrum::kChannels; ++i)
     if (sigma[i] > 0) t[i] = std::exp(-sigma[i] * distance);
   return t;

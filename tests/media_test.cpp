@@ -1,0 +1,176 @@
+// Scattering media in the path integrator against closed forms: transmittance at depth 0 (the
+// free-flight sampling's weights, chromatic media included), single scattering of a point light
+// seen from inside a medium (next-event estimation through the phase function), and the
+// albedo-1 furnace (no light lost or counted twice by the MIS of phase and light sampling).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "base/sampling.h"
+#include "camera/camera.h"
+#include "test_util.h"
+
+namespace bpm {
+namespace {
+
+using test::load;
+
+Film render_path(const LoadedScene& ls, int spp, uint64_t seed = 1) {
+  Film film(ls.film.width, ls.film.height);
+  render(ls, quiet_options(ls, "path", spp, seed), &film);
+  return film;
+}
+
+std::string slab_scene(const std::string& medium, int max_depth) {
+  return R"(LookAt 0 0 -4  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 12 "integer yresolution" 12
+PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+Integrator "path" "integer maxdepth" )" +
+         std::to_string(max_depth) + "\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" " +
+         medium + R"(
+WorldBegin
+AttributeBegin
+  MediumInterface "m" ""
+  Material "interface"
+  Shape "sphere" "float radius" 1
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [1 1 1]
+  Material "diffuse" "rgb reflectance" [0 0 0]
+  Shape "trianglemesh" "point3 P" [-9 -9 3  9 -9 3  9 9 3  -9 9 3] "integer indices" [0 2 1 0 3 2]
+AttributeEnd
+)";
+}
+
+// At depth 0 only light that crosses the medium unscattered counts: exp(-sigma_t c) through a
+// chord c of the sphere, whatever part of sigma_t scatters. A chromatic medium renders as the
+// absorbing one with the same sigma_t, channel by channel (the one-sample MIS over wavelengths).
+TEST(Media, UnscatteredLightIsBeerLambertOfSigmaT) {
+  const LoadedScene grey =
+      load(slab_scene("\"rgb sigma_a\" [0.3 0.3 0.3] \"rgb sigma_s\" [0.5 0.5 0.5]", 0));
+  const Film f = render_path(grey, 64);
+  const Image img = f.image();
+  const std::vector<float> rms = f.rms();
+  const Camera cam(grey.camera, 12, 12);
+  int inside = 0;
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 12; ++x) {
+      const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
+      const Vec3 d = normalize(r.d);
+      const float b = dot(r.o, d), c = length_squared(r.o) - 1, disc = b * b - c;
+      if (disc > 0 && disc < 0.05f) continue;  // grazing
+      const float chord = disc > 0 ? 2 * std::sqrt(disc) : 0;
+      inside += chord > 0;
+      EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-0.8f * chord),
+                  5 * rms[size_t(y) * 12 + x] + 1e-3f)
+          << x << "," << y;
+    }
+  EXPECT_GT(inside, 20);
+  const Image chromatic =
+      render_path(load(slab_scene("\"rgb sigma_a\" [0 0 0] \"rgb sigma_s\" [0.9 0.2 0.4]", 0)), 256)
+          .image();
+  const Image absorbing =
+      render_path(load(slab_scene("\"rgb sigma_a\" [0.9 0.2 0.4] \"rgb sigma_s\" [0 0 0]", 0)), 256)
+          .image();
+  for (int c = 0; c < 3; ++c) {
+    double a = 0, b = 0;
+    for (int y = 0; y < 12; ++y)
+      for (int x = 0; x < 12; ++x) a += chromatic.at(x, y)[c], b += absorbing.at(x, y)[c];
+    EXPECT_NEAR(a / b, 1, 0.01) << "channel " << c;
+  }
+}
+
+// A point light of intensity 1 inside a medium of sigma_s = 0.5, sigma_a = 0.1 and g = 0.4 that
+// fills a sphere of radius 3 around the camera; at depth 1 a pixel sees the light scattered once
+// along its ray: the integral over t of sigma_s exp(-sigma_t t) HG(cos) exp(-sigma_t r) / r^2,
+// r the distance from the ray's point to the light (quadrature at 1e-4 of the sphere's radius).
+TEST(Media, SingleScatteringOfAPointLight) {
+  const float sigma_s = 0.5f, sigma_t = 0.6f, g = 0.4f, R = 3;
+  const Vec3 light(0.4f, 0.3f, 1.2f);
+  const LoadedScene ls = load(R"(LookAt 0 0 0  0 0 1  0 1 0
+MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0.1 0.1 0.1]
+  "rgb sigma_s" [0.5 0.5 0.5] "float g" 0.4
+MediumInterface "" "fog"
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "point" "point3 from" [0.4 0.3 1.2] "rgb I" [1 1 1]
+AttributeBegin
+  MediumInterface "fog" ""
+  Material "interface"
+  Shape "sphere" "float radius" 3
+AttributeEnd
+)");
+  const Film film = render_path(ls, 4096);
+  const Image img = film.image();
+  const std::vector<float> rms = film.rms();
+  const Camera cam(ls.camera, 8, 8);
+  for (int y = 0; y < 8; y += 3)
+    for (int x = 0; x < 8; x += 3) {
+      const Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray.d);
+      double sum = 0;
+      const int n = 30000;
+      for (int i = 0; i < n; ++i) {
+        const double t = R * (i + 0.5) / n;
+        const Vec3 to = light - d * float(t);
+        const double r = length(to);
+        sum += sigma_s * std::exp(-sigma_t * t) * henyey_greenstein(dot(d, to) / float(r), g) *
+               std::exp(-sigma_t * r) / (r * r);
+      }
+      const double expected = sum * R / n;
+      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 8 + x] + 1e-3 * expected)
+          << x << "," << y;
+      EXPECT_LT(rms[size_t(y) * 8 + x], 0.03 * expected);
+    }
+}
+
+// A closed sphere whose wall emits radiance 1 and reflects nothing, filled with a medium that
+// scatters without absorbing (albedo 1, g = 0.6): the radiance inside is 1 everywhere and in every
+// direction, however often light scatters.
+TEST(Media, AlbedoOneFurnace) {
+  const LoadedScene ls = load(R"(LookAt 0 0 0  0 0 1  0 1 0
+MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
+  "rgb sigma_s" [1 1 1] "float g" 0.6
+MediumInterface "" "fog"
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+PixelFilter "box"
+Integrator "path" "integer maxdepth" 100
+WorldBegin
+MediumInterface "fog" ""
+AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
+Material "diffuse" "rgb reflectance" [0 0 0]
+Shape "sphere" "float radius" 1.5
+)");
+  const Film film = render_path(ls, 256);
+  const Image img = film.image();
+  double mean = 0, var = 0;
+  const std::vector<float> rms = film.rms();
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      mean += img.at(x, y).luminance() / 64;
+      var += double(rms[size_t(y) * 8 + x]) * rms[size_t(y) * 8 + x] / (64.0 * 64.0);
+    }
+  EXPECT_NEAR(mean, 1, 5 * std::sqrt(var) + 1e-3);
+  EXPECT_LT(std::sqrt(var), 0.01);
+}
+
+TEST(Media, PhotonMethodsAndSensorsRefuseScatteringMedia) {
+  LoadedScene ls = load(slab_scene("\"rgb sigma_s\" [0.5 0.5 0.5]", 3));
+  for (const char* integrator : {"bpm", "fpm"}) {
+    Film film(ls.film.width, ls.film.height);
+    EXPECT_THROW(render(ls, quiet_options(ls, integrator, 1, 1), &film), Error) << integrator;
+  }
+  // A file's integrator that maps to a photon method renders with path, with a note.
+  std::string bdpt = slab_scene("\"rgb sigma_s\" [0.5 0.5 0.5]", 3);
+  bdpt.replace(bdpt.find("Integrator \"path\""), 17, "Integrator \"bdpt\"");
+  const LoadedScene mapped = load(bdpt);
+  EXPECT_EQ(mapped.render.integrator, "path");
+  EXPECT_NE(mapped.render.integrator_note.find("media scatter"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace bpm
