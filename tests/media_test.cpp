@@ -174,3 +174,46 @@ TEST(Media, PhotonMethodsAndSensorsRefuseScatteringMedia) {
 
 }  // namespace
 }  // namespace bpm
+
+namespace bpm {
+namespace {
+
+// A point light in a vacuum bubble (an interface sphere of radius 0.5) inside an absorbing medium
+// (sigma_a 0.3), 2 units above a diffuse floor (albedo 0.5); the camera in the bubble looks
+// straight down. Shadow rays cross the bubble's surface, as pbrt-v4's do: the floor below the
+// light shows rho / pi I / h^2 exp(-sigma (h - 0.5)), dimmed by the camera ray's own
+// exp(-sigma (h - 0.5)), in every integrator.
+TEST(Media, ShadowRaysCrossInterfaces) {
+  const LoadedScene ls = test::load(R"(LookAt 0 2 0  0 0 0  0 0 1
+Camera "perspective" "float fov" 1
+Film "rgb" "integer xresolution" 2 "integer yresolution" 2
+PixelFilter "box"
+Integrator "path" "integer maxdepth" 1
+MakeNamedMedium "ink" "string type" "homogeneous" "rgb sigma_a" [0.3 0.3 0.3] "rgb sigma_s" [0 0 0]
+WorldBegin
+LightSource "point" "point3 from" [0 2 0] "rgb I" [1 1 1]
+AttributeBegin
+  MediumInterface "" "ink"
+  Material "interface"
+  Translate 0 2 0
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+MediumInterface "ink"
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-9 0 -9  9 0 -9  9 0 9  -9 0 9]
+)");
+  const double t = std::exp(-0.3 * 1.5);
+  const double expected = 0.5 / kPi * 1 / 4.0 * t * t;
+  for (const char* integrator : {"path", "bpm", "fpm"}) {
+    Film film(2, 2);
+    render(ls, quiet_options(ls, integrator, 64, 1), &film);
+    const Image img = film.image();
+    double mean = 0;
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x) mean += img.at(x, y).luminance() / 4;
+    EXPECT_NEAR(mean, expected, 0.01 * expected) << integrator;
+  }
+}
+
+}  // namespace
+}  // namespace bpm

@@ -6,6 +6,37 @@
 
 namespace bpm {
 
+Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
+                              bool infinite, const Wavelengths& wl) {
+  if (!scene.occluded(origin, target))
+    return medium < 0
+               ? Spectrum(1.0f)
+               : medium_transmittance(scene, medium, infinite ? kInf : length(target - origin), wl);
+  if (!scene.has_interfaces) return {};
+  Spectrum T(1.0f);
+  Vec3 o = origin;
+  for (int guard = 0; guard < 64; ++guard) {
+    const Vec3 d = target - o;
+    const float len = length(d);
+    if (!(len > 0)) return {};
+    const Ray r{o, d / len, len * (1 - 1e-4f)};
+    Hit h;
+    if (!scene.intersect(r, &h)) {
+      if (medium >= 0) T *= medium_transmittance(scene, medium, infinite ? kInf : len, wl);
+      return T;
+    }
+    const Object& obj = scene.objects[size_t(h.object)];
+    if (!std::holds_alternative<InterfaceMaterial>(scene.materials[size_t(obj.material)]))
+      return {};
+    const SurfacePoint sp = scene.surface(r, h);
+    if (medium >= 0) T *= medium_transmittance(scene, medium, h.t, wl);
+    if (T.is_black()) return T;
+    medium = medium_toward(scene, h.object, sp.ng, r.d, medium);
+    o = offset_origin(sp.p, sp.ng, r.d, sp.error);
+  }
+  return {};
+}
+
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
                              bool use_mis, const WavelengthMaterials& wm, Rng& rng,
@@ -35,12 +66,10 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
     float len = length(d);
     counters.observer->shadow(Ray{origin, d / len, len * (1 - 1e-4f)});
   }
-  if (scene.occluded(origin, target)) return {};
-  if (int toward = medium_toward(scene, object, sp.ng, ls->wi, medium); toward >= 0) {
-    f *= medium_transmittance(scene, toward, ls->is_infinite ? kInf : length(ls->p_light - sp.p),
-                              wl);
-    if (f.is_black()) return {};
-  }
+  f *= shadow_transmittance(scene, origin, target,
+                            medium_toward(scene, object, sp.ng, ls->wi, medium), ls->is_infinite,
+                            wl);
+  if (f.is_black()) return {};
   float p_light = pmf * ls->pdf_solid_angle;
   if (ls->is_delta || !use_mis) return ls->radiance * f / p_light;
   float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance, part);
@@ -66,10 +95,7 @@ Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int med
   const Vec3 target = has_surface
                           ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
                           : ls->p_light;
-  if (scene.occluded(p, target)) return {};
-  const Spectrum f =
-      medium_transmittance(scene, medium, ls->is_infinite ? kInf : length(ls->p_light - p), wl) *
-      phase;
+  const Spectrum f = shadow_transmittance(scene, p, target, medium, ls->is_infinite, wl) * phase;
   if (f.is_black()) return {};
   const float p_light = pmf * ls->pdf_solid_angle;
   if (ls->is_delta) return ls->radiance * f / p_light;

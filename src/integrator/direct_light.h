@@ -9,10 +9,18 @@
 
 namespace bpm {
 
+// The fraction of light that reaches `target` from `origin` (in `medium`) along the straight
+// segment: 0 when a surface that is not an interface stands between; through interface surfaces,
+// which shadow rays cross as pbrt-v4's cross medium boundaries, the product of each stretch's
+// medium transmittance, the medium changing at each. `infinite`: the target stands for a
+// direction, the last stretch infinitely long.
+Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
+                              bool infinite, const Wavelengths& wl);
+
 // Direct light at a non-specular vertex by sampling one light chosen by power, with the power
 // heuristic against BSDF sampling when use_mis (the caller then weights the emitters its BSDF
 // samples hit by EmitterWeight::mis), else with full weight. sp lies on `object`, reached by a
-// ray in `medium`: the shadow ray's absorption is that of the medium on the light's side.
+// ray in `medium`: the shadow ray crosses interfaces (shadow_transmittance).
 // Only the lobes of `part` reflect it (BsdfPart).
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
                              int medium, const Material& m, const Frame& frame, Vec3 wo_local,
@@ -52,17 +60,13 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
                               const Spectrum& beta, const EmitterWeight& w, Spectrum& L);
 
 // The next vertex of a camera path (next_vertex), adding to L the emission found on the way:
-// surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says;
-// except that emission found past an interface counts in full: next-event estimation's shadow ray
-// along the same line stops at the interface, so BSDF sampling is the only strategy for it.
+// surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says
+// (next-event estimation's shadow rays cross interfaces as these rays do).
 inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
                                PathState& s, PathVertex& v, PathCounters& counters,
                                const EmitterWeight& emitter, Spectrum& L) {
   const Wavelengths& wl = materials.wl;
-  auto weight = [&] {
-    return emitter.kind == EmitterWeight::kMis && s.interfaces > 0 ? EmitterWeight::full()
-                                                                   : emitter;
-  };
+  auto weight = [&] { return emitter; };
   StepEnd end =
       next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
                   [&](const Hit& hit, const SurfacePoint& sp) {

@@ -320,6 +320,11 @@ RenderScene::RenderScene(RenderScene&&) noexcept = default;
 RenderScene& RenderScene::operator=(RenderScene&&) noexcept = default;
 
 void RenderScene::commit() {
+  has_interfaces = false;
+  for (const Object& o : objects)
+    if (size_t(o.material) < materials.size() &&
+        std::holds_alternative<InterfaceMaterial>(materials[size_t(o.material)]))
+      has_interfaces = true;
   for (Object& o : objects)
     if (auto* m = std::get_if<TriangleMesh>(&o.shape)) {
       m->compute_face_normals();

@@ -58,6 +58,8 @@ class RenderScene {
   // Where a light source other than an area light sits inside a medium ("" if none): only the
   // path integrator renders such scenes so far.
   std::string light_in_medium;
+  // Whether a surface has the interface material (commit sets it): shadow rays then cross them.
+  bool has_interfaces = false;
   // Whether any medium scatters (only the path integrator renders such scenes so far).
   bool has_scattering_media() const {
     for (const HomogeneousMedium& m : media)
