@@ -66,6 +66,15 @@ void cardinal_points(const Ray& r_in, const Ray& r_out, float* pz, float* fz) {
   *pz = -(r_out.o.z + tp * r_out.d.z);
 }
 
+// Where the ray (lens space) meets interface e, which lies at z: the stop's plane or the element's
+// sphere (n its normal, facing the ray's origin).
+bool meet_interface(const LensInterface& e, float z, Vec3 o, Vec3 d, float* t, Vec3* n) {
+  if (!e.is_stop())
+    return intersect_element(e.curvature_radius, z + e.curvature_radius, o, d, t, n);
+  *t = (z - o.z) / d.z;
+  return *t >= 0;
+}
+
 }  // namespace
 
 float ApertureMask::at(float u, float v) const {
@@ -123,12 +132,7 @@ float LensSystem::trace_from_film(const Ray& r, Ray* out) const {
     z -= e.thickness;
     float t;
     Vec3 n;
-    if (e.is_stop()) {
-      t = (z - o.z) / d.z;
-      if (!(t >= 0)) return 0;
-    } else if (!intersect_element(e.curvature_radius, z + e.curvature_radius, o, d, &t, &n)) {
-      return 0;
-    }
+    if (!meet_interface(e, z, o, d, &t, &n)) return 0;
     const Vec3 p = o + d * t;
     if (e.is_stop() && !aperture_.empty()) {
       weight = aperture_.at((p.x / e.aperture_radius + 1) / 2, (p.y / e.aperture_radius + 1) / 2);
@@ -154,12 +158,7 @@ float LensSystem::trace_from_scene(const Ray& r, Ray* out) const {
     const LensInterface& e = interfaces_[i];
     float t;
     Vec3 n;
-    if (e.is_stop()) {
-      t = (z - o.z) / d.z;
-      if (!(t >= 0)) return 0;
-    } else if (!intersect_element(e.curvature_radius, z + e.curvature_radius, o, d, &t, &n)) {
-      return 0;
-    }
+    if (!meet_interface(e, z, o, d, &t, &n)) return 0;
     const Vec3 p = o + d * t;
     if (p.x * p.x + p.y * p.y > e.aperture_radius * e.aperture_radius) return 0;
     o = p;

@@ -66,13 +66,12 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
                                PathState& s, PathVertex& v, PathCounters& counters,
                                const EmitterWeight& emitter, Spectrum& L) {
   const Wavelengths& wl = materials.wl;
-  auto weight = [&] { return emitter; };
   StepEnd end =
       next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
                   [&](const Hit& hit, const SurfacePoint& sp) {
-                    L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, weight());
+                    L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
                   });
-  if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, weight(), L);
+  if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
   return end;
 }
 

@@ -22,7 +22,6 @@ struct PathState {
   int medium = -1;         // the medium the ray travels in (-1: vacuum)
   float length = 0;        // world distance travelled, interfaces included
   bool hero_only = false;  // only the first wavelength goes on (hero_wavelength_only)
-  int interfaces = 0;      // interface surfaces crossed since the last vertex (next_vertex)
   Rng* rng = nullptr;      // draws where the ray scatters in a medium (next_vertex)
 };
 
@@ -81,8 +80,8 @@ inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sig
 }
 
 // Follows s.ray to the next scattering surface and fills v. on_surface(hit, sp) is called at every
-// surface reached, interfaces included, with s.beta already attenuated up to it and s.interfaces
-// the interfaces crossed before it (emission is counted there). kEscaped: the ray left the scene
+// surface reached, interfaces included, with s.beta already attenuated up to it (emission is
+// counted there). kEscaped: the ray left the scene
 // (s.ray is the escaping ray, s.beta attenuated by the medium it leaves in); kAbsorbed: nothing is
 // left of the throughput. Each crossing of an interface counts one ray in continuation_rays.
 template <class OnSurface>
@@ -90,7 +89,6 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
                     PathVertex& v, uint64_t& continuation_rays, RayObserver* observer,
                     OnSurface&& on_surface) {
   const Wavelengths& wl = materials.wl;
-  s.interfaces = 0;
   for (int guard = 0; guard < 10000; ++guard) {
     if (observer) observer->closest_hit(s.ray);
     v.hit = Hit();
@@ -128,7 +126,6 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       // A boundary that does not scatter: the same ray goes on past it.
       s.medium = medium_toward(scene, v.hit.object, v.sp.ng, s.ray.d, s.medium);
       s.ray = spawn_ray(v.sp, s.ray.d);
-      ++s.interfaces;
       ++continuation_rays;
       continue;
     }
