@@ -156,6 +156,69 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 5 1 0 4 5  1
   expect_lux(film, 2, through, "in mid-air under the slab");
 }
 
+// A sensor stands in the medium around it: a point light 1 above a box of absorbing medium
+// (sigma_a 0.7, an interface surface around it, the camera outside), sensors inside it facing up.
+// The light reaches each through the box's top, exp(-sigma l) with l the length of its way inside:
+// E = I cos(theta) / d^2 exp(-sigma d (1 - z) / (2 - z)).
+TEST_P(SensorsBy, SensorsInsideAMediumAreAttenuated) {
+  const std::string scene = R"(LookAt 0 -4 3  0 0 0  0 0 1
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+MakeNamedMedium "ink" "string type" "homogeneous" "rgb sigma_a" [0.7 0.7 0.7]
+  "rgb sigma_s" [0 0 0]
+LightSource "point" "point3 from" [0 0 2] "float power" 1000
+AttributeBegin
+  MediumInterface "ink" ""
+  Material "interface"
+  Shape "trianglemesh" "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  1 2 6 1 6 5
+                                          2 3 7 2 7 6  3 0 4 3 4 7]
+    "point3 P" [-2 -2 -1  2 -2 -1  2 2 -1  -2 2 -1  -2 -2 1  2 -2 1  2 2 1  -2 2 1]
+AttributeEnd
+)";
+  const std::vector<Sensor> sensors = parse_sensors("0 0 0 0 0 1\n0.5 0 0.4 0 0 1\n", "s.txt");
+  const Film film = render_sensors(scene, sensors, 32, GetParam());
+  const double intensity = 1000 / (4 * kPi), sigma = 0.7;
+  for (size_t i = 0; i < sensors.size(); ++i) {
+    const Vec3 d = Vec3(0, 0, 2) - sensors[i].p;
+    const double r = length(d), z = sensors[i].p.z;
+    expect_lux(film, i, intensity * (d.z / r) / (r * r) * std::exp(-sigma * r * (1 - z) / (2 - z)),
+               "sensor " + std::to_string(i));
+  }
+}
+
+// The path tracer's sensors in a scattering medium: a closed sphere whose wall emits radiance 1
+// and reflects nothing, filled with a medium that scatters without absorbing (albedo 1, g 0.6),
+// has the radiance 1 everywhere and in every direction, so a sensor anywhere in it reads what it
+// reads in the same sphere empty.
+TEST(Sensors, PathSensorsInAnAlbedoOneFurnace) {
+  auto furnace = [](const std::string& medium) {
+    return R"(LookAt 0 0 0  0 0 1  0 1 0
+MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
+  "rgb sigma_s" [)" +
+           medium + R"(] "float g" 0.6
+MediumInterface "" "fog"
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+Integrator "path" "integer maxdepth" 100
+WorldBegin
+MediumInterface "fog" ""
+AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
+Material "diffuse" "rgb reflectance" [0 0 0]
+Shape "sphere" "float radius" 1.5
+)";
+  };
+  const std::vector<Sensor> sensors = parse_sensors("0 0 0 0 0 1\n0.5 0.3 -0.8 1 0 0\n", "s.txt");
+  const Film empty = render_sensors(furnace("0 0 0"), sensors, 128);
+  const Film fog = render_sensors(furnace("1 1 1"), sensors, 512);
+  for (size_t i = 0; i < sensors.size(); ++i) {
+    const double e = std::hypot(fog.sensor_standard_error(i), empty.sensor_standard_error(i));
+    EXPECT_NEAR(fog.sensor_mean(i), empty.sensor_mean(i), 4 * e) << "sensor " << i;
+    EXPECT_LT(e, 0.01 * empty.sensor_mean(i)) << "sensor " << i;
+  }
+}
+
 // --accuracy bounds the sensors' delta (eq. 4 over them) too: without an image it alone ends the
 // render.
 TEST_P(SensorsBy, AccuracyBoundsTheSensorsError) {

@@ -30,13 +30,15 @@ float standard_error(double sum, double sum2, int passes) {
 
 // The square of one pixel's or sensor's bias beyond its noise, from the mean b of its bias
 // estimates and that mean's standard error se: b^2 less what noise alone gives b^2 on average
-// (se^2) and one standard deviation of it (sqrt(2) se^2), never below zero. The bias estimate is a
-// difference of photon counts, two to four times noisier than the estimate itself; taking out
-// se^2 alone, the part above zero of pure noise would add 0.48 se^2 on average (2 phi(1)) and make
-// the stated error twice the actual one where there is no bias; this adds 0.2 se^2 there, and
-// counts a bias of several se nearly in full.
+// (se^2) and two standard deviations of it (2 sqrt(2) se^2), never below zero. Over an even photon
+// density each photon weighs +-2 in the r^2 bias estimate and 1 in the value, so the estimate is
+// twice as noisy as the value (se = 2 se_value). Pure noise (b / se standard normal) then adds
+// E[max(0, z^2 - k)] se^2 on average: with k = 1 (the noise's mean alone) 0.48 se^2, stating
+// twice the actual error where there is no bias; with k = 1 + sqrt 2 0.20 se^2 (1.34 times it);
+// with k = 1 + 2 sqrt 2 0.088 se^2 (1.16 times it). A bias is counted from 2 se on (where the
+// value's noise is about 4 times smaller), nearly in full from several se.
 double bias_beyond_noise(double b, double se) {
-  return std::fmax(0.0, b * b - (1 + std::sqrt(2.0)) * se * se);
+  return std::fmax(0.0, b * b - (1 + 2 * std::sqrt(2.0)) * se * se);
 }
 
 // The error of the average of m independent estimates value(k) from their spread: the standard

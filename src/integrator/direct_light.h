@@ -29,9 +29,8 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
 
 // Direct light at a point p inside `medium` that scatters by a Henyey-Greenstein phase function of
 // asymmetry g, reached by a path travelling along `travel`: one light chosen by power, attenuated
-// by the medium up to it, by the power heuristic against phase sampling. Shadow rays stop at any
-// surface, interfaces included: light that reaches p through an interface is found by phase
-// sampling alone and counted in full there (next_eye_vertex).
+// by the media up to it (the shadow ray crosses interfaces, shadow_transmittance), by the power
+// heuristic against phase sampling.
 Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int medium, Vec3 travel,
                                        float g, const WavelengthMaterials& wm, Rng& rng,
                                        PathCounters& counters);

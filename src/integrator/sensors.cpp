@@ -91,12 +91,17 @@ Spectrum sensor_light_sample(const RenderScene& scene, const Sensor& s,
   sp.ng = sp.ns = s.n;
   sp.error = sensor_lift(scene);
   const Material white = DiffuseMaterial{Spectrum(1.0f)};
-  return sample_direct_light(scene, sp, -1, -1, white, Frame::from_z(s.n), Vec3(0, 0, 1), true, wm,
-                             rng, counters) *
+  return sample_direct_light(scene, sp, -1, s.medium, white, Frame::from_z(s.n), Vec3(0, 0, 1),
+                             true, wm, rng, counters) *
          kPi;
 }
 
 }  // namespace
+
+void locate_sensor_media(const RenderScene& scene, int outer, std::vector<Sensor>* sensors) {
+  for (Sensor& s : *sensors)
+    s.medium = medium_at(scene, s.p + s.n * sensor_lift(scene), s.n, outer);
+}
 
 Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_depth,
                            const Wavelengths& wl, Rng& rng, PathCounters& counters,
@@ -110,7 +115,7 @@ Spectrum sensor_irradiance(const RenderScene& scene, const Sensor& s, int max_de
   const Vec3 wi = Frame::from_z(s.n).to_world(local);
   const EmitterWeight first = EmitterWeight::mis(local.z * kInvPi, origin);
   E += path_radiance(scene, Ray{origin, wi, kInf}, PathSettings{max_depth, caustics_elsewhere}, wl,
-                     rng, counters, first) *
+                     rng, counters, first, s.medium) *
        kPi;
   return E;
 }

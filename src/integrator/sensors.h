@@ -24,6 +24,8 @@ struct Sensor {
   // For a sensor of a grid: the grid's cell counts and the sensor's index in it, j * nu + i (the
   // sensors of a grid are consecutive); zero counts for a single point.
   uint32_t grid_nu = 0, grid_nv = 0, grid_k = 0;
+  // The medium the sensor stands in (-1: none), found for a render by locate_sensor_media.
+  int medium = -1;
 };
 
 // Reads a sensor file: one point a line, "x y z nx ny nz" (the input of Radiance's rtrace -I), or
@@ -33,6 +35,10 @@ struct Sensor {
 // file, line and column.
 std::vector<Sensor> read_sensors(const std::string& path);
 std::vector<Sensor> parse_sensors(const std::string& text, const std::string& path);
+
+// Sets each sensor's medium: the one on its normal's side (medium_at), `outer` (the camera's)
+// where no surface separating two media lies that way.
+void locate_sensor_media(const RenderScene& scene, int outer, std::vector<Sensor>* sensors);
 
 // Samples per sensor in each pass of the estimators that sample light at the sensor.
 constexpr int kSensorSamplesPerPass = 16;
@@ -45,7 +51,7 @@ inline float sensor_lift(const RenderScene& scene) { return 1e-6f * scene.bounds
 
 // The spectral irradiance at a sensor from one sample (the luminance of it is the illuminance):
 // next-event estimation at a white Lambertian point standing for the sensor (on no object, in the
-// scene's outer medium), weighted by multiple importance sampling against a cosine-distributed
+// sensor's medium), weighted by multiple importance sampling against a cosine-distributed
 // direction whose path then goes on as a camera path does (path_radiance). With
 // caustics_elsewhere, the light that reaches the sensor through traced lobes only is left out:
 // the photon methods count it with photons.

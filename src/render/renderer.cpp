@@ -47,14 +47,10 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
     throw Error(ls.scene.light_in_medium +
                 ": a light inside a medium, which bpm and fpm do not render yet: render the scene "
                 "with --integrator path");
-  if (ls.scene.has_scattering_media()) {
-    if (opt.integrator != "path")
-      throw Error(
-          "the scene's media scatter, which bpm and fpm do not render yet: render it with "
-          "--integrator path");
-    if (!opt.sensors.empty())
-      throw Error("illuminance sensors in a scene whose media scatter are not supported yet");
-  }
+  if (ls.scene.has_scattering_media() && opt.integrator != "path")
+    throw Error(
+        "the scene's media scatter, which bpm and fpm do not render yet: render it with "
+        "--integrator path");
   // A named sensor is balanced by its fit (6500 K unless the film says); cie1931 by a matrix.
   if (ls.film.sensor != "cie1931")
     film->set_response(std::make_shared<const CameraResponse>(*CameraResponse::named(
@@ -70,16 +66,17 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
     throw Error("--m-images " + std::to_string(film->m_images()) +
                 ": the photon methods take 2, 4 or 8 images (their iterations form " +
                 std::to_string(Film::kStreams) + " independent streams), or 0");
-  if (opt.integrator == "bpm") return render_bpm(ls, opt, opt.bpm, film);
-  if (opt.integrator == "fpm") return render_fpm(ls, opt, opt.fpm, film);
   RenderOptions o = opt;
+  locate_sensor_media(ls.scene, ls.camera.medium, &o.sensors);
+  if (opt.integrator == "bpm") return render_bpm(ls, o, o.bpm, film);
+  if (opt.integrator == "fpm") return render_fpm(ls, o, o.fpm, film);
   tbb::enumerable_thread_specific<PathCounters> sensor_counters;
-  if (!opt.sensors.empty())
+  if (!o.sensors.empty())
     o.sensor_pass = [&](int pass_index, Film* f) {
-      sensor_pass(ls.scene, opt.sensors, opt.max_depth, opt.seed, pass_index, f, sensor_counters);
+      sensor_pass(ls.scene, o.sensors, o.max_depth, o.seed, pass_index, f, sensor_counters);
     };
   RenderStats stats =
-      opt.image ? render_path(ls, o, film) : render_path_sensors(o, film, sensor_counters);
+      o.image ? render_path(ls, o, film) : render_path_sensors(o, film, sensor_counters);
   for (const PathCounters& c : sensor_counters) stats.rays.add(c);
   return stats;
 }

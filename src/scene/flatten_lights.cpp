@@ -89,10 +89,10 @@ ImageInfiniteLight Flattener::image_light(const LightEntity& e, const Param& fil
 // "illuminance" has been applied to it.
 void Flattener::add_light(const LightEntity& e, RenderScene* rs) {
   const ParamSet& ps = e.params;
-  // The path tracer needs no light's medium (next-event estimation attenuates by the medium of
-  // the point lit); the photon methods' light paths would start in it, which they do not yet.
-  if (!e.medium.outside.empty() && medium_id(e.medium.outside, e.medium.loc) >= 0)
-    rs->light_in_medium = e.loc.str();
+  // The medium the light sits in, where light paths start (next-event estimation attenuates by
+  // the medium of the point lit and needs none).
+  const int medium = e.medium.outside.empty() ? -1 : medium_id(e.medium.outside, e.medium.loc);
+  if (medium >= 0) rs->light_in_medium = e.loc.str();
   float scale = ps.get_float("scale", 1);
   if (e.name == "point") {
     add_point_light(e, &scale, rs);
@@ -111,6 +111,8 @@ void Flattener::add_light(const LightEntity& e, RenderScene* rs) {
   }
   if (!(scale >= 0) || !std::isfinite(scale))
     throw Error(e.loc, "light scale must be a non-negative number");
+  rs->light_medium.resize(rs->lights.size() - 1, -1);
+  rs->light_medium.push_back(medium);
   ps.warn_unused("light \"" + e.name + "\"");
 }
 

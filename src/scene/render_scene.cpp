@@ -20,6 +20,20 @@ bool alpha_passes(const TextureSet& textures, const FloatParam& alpha, const Sur
   return u >= a;
 }
 
+int medium_at(const RenderScene& scene, Vec3 p, Vec3 d, int outer) {
+  Ray ray{p, d, kInf};
+  for (int guard = 0; guard < 10000; ++guard) {
+    Hit hit;
+    if (!scene.intersect(ray, &hit)) return outer;
+    const SurfacePoint sp = scene.surface(ray, hit);
+    const Object& o = scene.objects[size_t(hit.object)];
+    if (o.medium_inside != o.medium_outside)
+      return dot(d, sp.ng) > 0 ? o.medium_inside : o.medium_outside;
+    ray = spawn_ray(sp, d);
+  }
+  return outer;
+}
+
 int choose_mix(const RenderScene& scene, int material, const TextureContext& ctx) {
   // Nested mixes choose in turn; flatten_materials.cpp rejects cycles, the bound is a safeguard.
   for (int depth = 0; depth < 64; ++depth) {

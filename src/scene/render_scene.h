@@ -58,6 +58,12 @@ class RenderScene {
   // Where a light source other than an area light sits inside a medium ("" if none): only the
   // path integrator renders such scenes so far.
   std::string light_in_medium;
+  // Per light (or fewer: -1 past the end): the medium a light other than an area light sits in,
+  // where its photons start (an area light's leave to the medium on their side of its surface).
+  std::vector<int> light_medium;
+  int medium_of_light(size_t light) const {
+    return light < light_medium.size() ? light_medium[light] : -1;
+  }
   // Whether a surface has the interface material (commit sets it): shadow rays then cross them.
   bool has_interfaces = false;
   // Whether any medium scatters (only the path integrator renders such scenes so far).
@@ -139,6 +145,11 @@ inline int medium_toward(const RenderScene& scene, int object, Vec3 ng, Vec3 w, 
   if (o.medium_inside == o.medium_outside) return current;
   return dot(w, ng) > 0 ? o.medium_outside : o.medium_inside;
 }
+
+// The medium a point p stands in, as found along a ray from p toward d: the side from which the
+// ray reaches the first surface ahead that separates two media, or `outer` (the camera's medium)
+// where none lies ahead.
+int medium_at(const RenderScene& scene, Vec3 p, Vec3 d, int outer);
 
 // The fraction of light that crosses `distance` in `medium` (-1: vacuum) at each wavelength
 // without being absorbed or scattered away: exp(-sigma_t distance).
