@@ -5,8 +5,10 @@
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
 //              [--integrators path,bpm,fpm] [--references-only]
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
-// (references by bpm), lamp-room, room2, the Cornell box (../shared's at 256x256 when present,
-// else ours) and, when ../shared has it, the staircase2 stand-in at 256x256 (references by path).
+// (references by bpm), lamp-room, room2, fog, the Cornell box (../shared's at 256x256 when present,
+// else ours) and, when ../shared has them, the staircase2 stand-in at 256x256 and other shared
+// scenes (references by path), and volumetric-caustic at 256x256 (reference by bpm). In scenes
+// with media pbrt-v4 renders with volpath and bdpt (its path and sppm ignore media).
 // scenes/tools/make_equal_time_scenes.py writes spot-facets, water-box and lamp-room.
 //
 // Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
@@ -62,6 +64,7 @@ std::vector<SceneEntry> default_scenes() {
       {"water-box", ours + "water-box.pbrt", "bpm"},
       {"lamp-room", ours + "lamp-room.pbrt", "path"},
       {"room2", ours + "room2.pbrt", "path"},
+      {"fog", ours + "fog.pbrt", "path"},
   };
   if (fs::exists(shared_cornell))
     s.push_back({"cornell-box", shared_cornell.lexically_normal().string(), "path", "256x256"});
@@ -79,6 +82,9 @@ std::vector<SceneEntry> default_scenes() {
       {"killeroo-simple", (shared / "killeroo-simple" / "killeroo-simple.pbrt").string(), "path",
        "200x200"},
       {"coffee", (shared / "coffee" / "scene-v4.pbrt").string(), "path", "200x250"},
+      // A glass sphere focusing a small light into a box of gas (a volumetric caustic).
+      {"volumetric-caustic", (shared / "volumetric-caustic" / "scene-v4.pbrt").string(), "bpm",
+       "256x256"},
   };
   for (SceneEntry e : more)
     if (fs::exists(e.path)) {
@@ -185,6 +191,12 @@ void pbrt_rows(const std::string& pbrt, const SceneEntry& e, const LoadedScene& 
        "Integrator \"sppm\" \"integer maxdepth\" " + std::to_string(maxdepth) +
            " \"float radius\" " + std::to_string(radius)},
   };
+  // pbrt-v4's path and sppm ignore media: volpath instead, and bdpt.
+  if (ls.scene.has_scattering_media() || !ls.scene.media.empty()) {
+    variants.erase(variants.begin() + 2);
+    variants[0] = {"pbrt-v4 volpath",
+                   "Integrator \"volpath\" \"integer maxdepth\" " + std::to_string(maxdepth)};
+  }
   const std::string film = film_at_resolution(e.path, ls.film.width, ls.film.height);
   for (const Variant& v : variants) {
     std::string copy =
@@ -276,6 +288,10 @@ int main(int argc, char** argv) {
     for (const char* integrator : {"path", "bpm", "fpm"}) {
       if (("," + ours + ",").find(std::string(",") + integrator + ",") == std::string::npos)
         continue;
+      if (std::string(integrator) == "fpm" && ls.scene.has_scattering_media()) {
+        std::printf("  %-28s not rendered: fpm does not render scattering media\n", "bpm fpm");
+        continue;
+      }
       RenderStats st;
       Image img = render_ours(ls, integrator, seconds, 1, &st);
       std::string samples =

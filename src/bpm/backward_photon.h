@@ -27,6 +27,9 @@ struct BackwardPhoton {
   bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
   uint8_t disc_cut = 0;    // the disc probes that found no surface (photons/disc_probes.h)
   uint8_t disc_found = 0;  // and those that found some
+  // A point inside a scattering medium, this one (-1: a surface point): a sphere that gathers
+  // photon beams, with no normals, surface coordinates or material.
+  int16_t medium = -1;
 
   // Sort key that fixes the order of backward photons whatever thread stored them.
   uint64_t key() const { return (uint64_t(pixel) << 4) | (uint64_t(diffuse_index) << 2) | accepts; }

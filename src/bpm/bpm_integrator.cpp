@@ -170,6 +170,9 @@ class BpmRender {
   // Illuminance sensors, when the render has them (photons/sensor_discs.h).
   std::unique_ptr<SensorDiscs> sensors_;
   SensorIteration sensor_sums_;
+  // The backward photons in scattering media as spheres for the photon beams (none without such
+  // media).
+  std::unique_ptr<MediumSpheres> medium_spheres_;
 };
 
 const char* const kMemoryAdvice =
@@ -200,7 +203,8 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       camera_(ls.camera, ls.filter, ls.film.raster_for(film->width(), film->height()), opt.seed),
       masks_(film->width(), film->height(), tbb::this_task_arena::max_concurrency()),
       eye_(n_pixels_),
-      thread_lists_([this] { return ObjectPhotonLists(scene_.objects.size()); }),
+      thread_lists_(
+          [this] { return ObjectPhotonLists(scene_.objects.size() + scene_.media.size()); }),
       eye_counters_(eye_exemplar(opt)),
       guide_(s_.guide_emission ? EmissionGuide(scene_) : EmissionGuide()),
       estimate_sum_(n_pixels_, 0.0),
@@ -212,7 +216,8 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       near_edges_(s_.disc_probes && s_.radius <= 0, scene_, camera_.camera(), ls.film.width,
                   ls.film.height, ls.filter.radius),
       sensors_(make_sensor_discs(scene_, opt.sensors, camera_.camera(), s_)),
-      sensor_sums_(opt.sensors.size()) {
+      sensor_sums_(opt.sensors.size()),
+      medium_spheres_(scene_.has_scattering_media() ? std::make_unique<MediumSpheres>() : nullptr) {
   pixel_sums_.places = s_.diffuse_depth + 2;
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
@@ -290,9 +295,13 @@ bool BpmRender::build_maps(int pass, const RenderControl& control, LightPassPara
   const auto t = Clock::now();
   std::vector<ObjectPhotonLists*> lists;
   for (ObjectPhotonLists& l : thread_lists_) lists.push_back(&l);
-  build_backward_maps(lists, scene_.objects.size(), s_.centre_tree, &maps_);
+  build_backward_maps(lists, scene_.objects.size() + scene_.media.size(), s_.centre_tree, &maps_);
   // The time budget holds inside an iteration: its light pass ends early with the photons
   // traced so far (the iteration is still a complete estimate, only noisier).
+  if (medium_spheres_) {
+    medium_spheres_->build(maps_, scene_.objects.size(), scene_.media.size());
+    lp->medium_spheres = medium_spheres_.get();
+  }
   lp->stop = [&control] { return control.stop_requested(); };
   resolve_photon_materials(maps_, lp);
   if (!guide_.empty() && !pixel_weight_.empty()) lp->pixel_weight = &pixel_weight_;

@@ -32,7 +32,8 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
   bp.wo = v.wo;
   bp.tau = s.beta;
   bp.pixel = pixel;
-  bp.material = uint32_t(v.material_index);
+  bp.material = v.medium >= 0 ? 0 : uint32_t(v.material_index);
+  bp.medium = int16_t(v.medium);
   bp.eye_depth = uint16_t(std::min(depth, 65535));
   bp.accepts = accepts;
   bp.diffuse_index = uint8_t(diffuse - 1);
@@ -70,6 +71,11 @@ inline bool store_backward_photon(const EyePath& path, const PathVertex& v, cons
   BackwardPhoton bp =
       backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
   if (bp.radius <= 0 || s.beta.is_black()) return false;
+  if (v.medium >= 0) {  // after the objects' lists, one per medium
+    path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
+    ++path.counters.backward_photons;
+    return false;
+  }
   const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
   bool probed_whole = false;
   if (prm.disc_probes && !whole && (!seen_directly || (path.near_edge & near_bit)) &&
@@ -128,6 +134,34 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   return false;
 }
 
+// The diffuse-th diffuse vertex, inside a scattering medium: direct light by next-event
+// estimation (shared by MIS with phase sampling), backward photons whose spheres gather photon
+// beams, and a phase-function sample (its weight is 1): the path goes on along it, or at the last
+// vertex it only looks for the light, as direct_light_by_bsdf does at a surface. Returns whether
+// the path ends here.
+inline bool gather_in_medium(const EyePath& path, const PathVertex& v, PathState& s, int depth,
+                             int diffuse, EmitterWeight& emitter, Spectrum& L) {
+  const float g = path.scene.media[size_t(v.medium)].g;
+  L += s.beta * sample_direct_light_in_medium(path.scene, v.sp.p, v.medium, -v.wo, g,
+                                              *path.prm.materials, path.rng, path.counters.rays);
+  const bool last = diffuse == path.prm.diffuse_depth + 1;
+  store_backward_photons(path, v, s, depth, diffuse, last);
+  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
+  const Vec3 wi = sample_henyey_greenstein(-v.wo, g, u);
+  const EmitterWeight w = EmitterWeight::mis(henyey_greenstein(dot(-v.wo, wi), g), v.sp.p);
+  ++path.counters.rays.bounce_rays;
+  if (last) {
+    PathState probe = s;
+    probe.ray = Ray{v.sp.p, wi, kInf};
+    PathVertex next;
+    next_eye_vertex(path.scene, *path.prm.materials, probe, next, path.counters.rays, w, L);
+    return true;
+  }
+  emitter = w;
+  s.ray = Ray{v.sp.p, wi, kInf};
+  return false;
+}
+
 // Samples the BSDF at v and leaves the vertex along the sample; sets the weight of the emission
 // the next vertex sees. Returns false where the path ends (no sample, no throughput left).
 inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexChoice& choice,
@@ -162,6 +196,7 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
   const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
+  s.rng = &rng;
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
   std::optional<Spectrum> emission;
@@ -175,9 +210,17 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    if (next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L) != StepEnd::kVertex)
-      break;
+    const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L);
+    if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == prm.max_depth) break;
+    if (end == StepEnd::kMedium) {  // a diffuse vertex in a medium
+      if (!emission) {
+        emission = L;
+        if (emission_only) break;
+      }
+      if (gather_in_medium(path, v, s, depth, ++diffuse, emitter, L)) break;
+      continue;
+    }
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.

@@ -76,6 +76,7 @@ void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
   prm->photon_materials.resize(maps.photons.size());
   tbb::parallel_for(size_t(0), maps.photons.size(), [&](size_t g) {
     const BackwardPhoton& bp = maps.photons[g];
+    if (bp.medium >= 0) return;  // no material in a medium
     Material storage;
     prm->photon_materials[g] = wm.at(int(bp.material), TextureContext{bp.p, bp.uv}, storage);
   });
@@ -127,6 +128,9 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   const SensorDiscs* sensors = g.prm.sensors;
   std::vector<SensorCrossing>& crossings = buf->crossings[size_t(c)];
   crossings.clear();
+  std::vector<PendingBeam>& beams = buf->beams[size_t(c)];
+  beams.clear();
+  const bool media = g.prm.medium_spheres && !g.prm.medium_spheres->empty();
   const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
   const uint64_t last = std::min(first + kPhotonsPerChunk, g.count);
   auto photon_rng = [&](uint64_t k) {
@@ -146,16 +150,23 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     // A backward photon adds at least one eye vertex; direct photons are never used
     // (next-event estimation counts direct light).
     auto on_hit = [&](const PhotonHit& h) {
-      if (h.cls == PhotonClass::kDirect || !maps.has_photons(h.object)) return;
+      // Photons in media reach the spheres there by their beams (on_beam).
+      if (h.cls == PhotonClass::kDirect || h.medium >= 0 || !maps.has_photons(h.object)) return;
       ++lc.queries;
       const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
       if (bucket == BackwardMaps::kNoBucket) return;
       hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object, int16_t(h.bounces),
                       h.cls, h.hero_only});
     };
+    // Direct beams are never used either (next-event estimation in the medium).
+    auto on_beam = [&](const PhotonBeam& b) {
+      if (!media || b.cls == PhotonClass::kDirect) return;
+      beams.push_back({b.ray, b.t_max, b.flux, photon, int16_t(b.medium), int16_t(b.bounces), b.cls,
+                       b.hero_only});
+    };
     trace_light_path(
         scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit,
-        SensorSegments(scene, sensors, g.prm.materials->wl, crossings, g.prm.max_depth));
+        SensorSegments(scene, sensors, g.prm.materials->wl, crossings, g.prm.max_depth), on_beam);
     if (g.scored) emitted.push_back({e.cell, e.weight});
   }
   buf->hits[size_t(c)].swap(hits);
@@ -230,6 +241,7 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->emitted.resize(size_t(n_chunks));
     buf->chunk_counters.resize(size_t(n_chunks));
     buf->crossings.resize(size_t(n_chunks));
+    buf->beams.resize(size_t(n_chunks));
   }
   const GroupTrace g{
       scene, maps, prm, seed, pass_index, first_photon, count, guide, guide && prm.pixel_weight};
@@ -297,12 +309,12 @@ GatherRound gather_round(const BackwardMaps& maps, const LightPassParams& prm,
 
 // Apply: each slot applies the entries of its own pixels, gather chunk by gather chunk in order.
 // A backward photon's sums start from zero at its first entry (the arrays are not cleared).
-void apply_entries(const LightPassBuffers& buf, int begin, int end, int slots,
-                   LightPassResult* res) {
+void apply_entries(const std::vector<std::vector<std::vector<PhotonEntry>>>& chunks, int begin,
+                   int end, int slots, LightPassResult* res) {
   tbb::parallel_for(tbb::blocked_range<int>(0, slots, 1), [&](const tbb::blocked_range<int>& r) {
     for (int slot = r.begin(); slot < r.end(); ++slot)
       for (int g = begin; g < end; ++g)
-        for (const PhotonEntry& e : buf.chunks[size_t(g)][size_t(slot)]) {
+        for (const PhotonEntry& e : chunks[size_t(g)][size_t(slot)]) {
           const uint32_t b = e.backward_photon();
           if (!res->reached[b]) {
             res->reached[b] = 1;
@@ -381,7 +393,7 @@ void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, cons
     res.peak_entry_bytes = std::max(res.peak_entry_bytes, round.bytes);
     buf->counters.local().entries += entries;
     clock.lap(res.gather_s);
-    apply_entries(*buf, done, done + kept, masks.slots(), &res);
+    apply_entries(buf->chunks, done, done + kept, masks.slots(), &res);
     clock.lap(res.apply_s);
     ++res.batches;
     done += kept;
@@ -392,19 +404,72 @@ void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, cons
   } while (done < n_gather);
 }
 
-// Each photon's score is the sum of its hits', in the order of its path, as if it had been
-// emitted without guidance (weight removed); the guide learns them in photon order.
+// The entries of one beam: at each sphere it reaches, its flux at the point nearest the centre
+// times the phase function toward the sphere's eye path (before 1 / (pi r^2 N), as a hit's).
+// Returns the beam's score, as gather_at_hit's.
+float gather_beam(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+                  const std::vector<uint16_t>& owner, const PendingBeam& b,
+                  std::vector<std::pair<uint32_t, float>>& found,
+                  std::vector<std::vector<PhotonEntry>>& out) {
+  found.clear();
+  prm.medium_spheres->query(b.medium, b.cls, b.ray, b.t_max, &found);
+  const float g_medium = scene.media[size_t(b.medium)].g;
+  float score = 0;
+  for (const auto& [g, t] : found) {
+    const BackwardPhoton& bp = maps.photons[g];
+    if (int(bp.eye_depth) + b.bounces > prm.max_depth) continue;
+    Spectrum value = b.flux * medium_transmittance(scene, b.medium, t, prm.materials->wl) *
+                     (henyey_greenstein(dot(bp.wo, b.ray.d), g_medium) *
+                      hero_join_factor(bp.hero_only, b.hero_only));
+    if (value.is_black()) continue;
+    const float d2 = length_squared(b.ray.o + b.ray.d * t - bp.p), r2 = bp.radius * bp.radius;
+    const uint32_t bits =
+        (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
+    out[owner[bp.pixel]].push_back({g | bits, value});
+    if (prm.pixel_weight)
+      score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
+               (kPi * bp.radius * bp.radius);
+  }
+  return score;
+}
+
+// The beams of the first `chunks` chunks: gathered chunk by chunk in parallel, each into lists of
+// its own, then applied chunk by chunk in order (as the hits' entries).
+void gather_and_apply_beams(const RenderScene& scene, const BackwardMaps& maps,
+                            const LightPassParams& prm, const PixelMasks& masks, int chunks,
+                            LightPassBuffers* buf, LightPassResult& res) {
+  if (!prm.medium_spheres || prm.medium_spheres->empty()) return;
+  if (buf->beam_entries.size() < size_t(chunks)) buf->beam_entries.resize(size_t(chunks));
+  tbb::parallel_for(0, chunks, [&](int c) {
+    std::vector<std::vector<PhotonEntry>>& by_slot = buf->beam_entries[size_t(c)];
+    by_slot.resize(size_t(masks.slots()));
+    for (auto& v : by_slot) v.clear();
+    thread_local std::vector<std::pair<uint32_t, float>> found;
+    for (PendingBeam& b : buf->beams[size_t(c)])
+      b.score = gather_beam(scene, maps, prm, masks.owner(), b, found, by_slot);
+  });
+  size_t entries = 0;
+  for (int c = 0; c < chunks; ++c)
+    for (const auto& v : buf->beam_entries[size_t(c)]) entries += v.size();
+  buf->counters.local().entries += entries;
+  apply_entries(buf->beam_entries, 0, chunks, masks.slots(), &res);
+}
+
+// Each photon's score is the sum of its hits' and beams', in the order of its path, as if it had
+// been emitted without guidance (weight removed); the guide learns them in photon order.
 void learn_scores(int chunks, LightPassBuffers* buf, EmissionGuide& guide) {
   if (buf->scores.size() < size_t(chunks)) buf->scores.resize(size_t(chunks));
   tbb::parallel_for(0, chunks, [&](int c) {
     const std::vector<PendingHit>& hits = buf->hits[size_t(c)];
+    const std::vector<PendingBeam>& beams = buf->beams[size_t(c)];
     const std::vector<EmittedPhoton>& emitted = buf->emitted[size_t(c)];
     std::vector<CellScore>& scores = buf->scores[size_t(c)];
     scores.clear();
-    size_t j = 0;
+    size_t j = 0, k = 0;
     for (uint32_t p = 0; p < uint32_t(emitted.size()); ++p) {
       float score = 0;
       for (; j < hits.size() && hits[j].photon == p; ++j) score += hits[j].score;
+      for (; k < beams.size() && beams[k].photon == p; ++k) score += beams[k].score;
       scores.push_back({emitted[p].cell, emitted[p].weight > 0 ? score / emitted[p].weight : 0});
     }
   });
@@ -464,6 +529,8 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
     gather_and_apply(maps, prm, masks, buf, res, clock);
+    gather_and_apply_beams(scene, maps, prm, masks, tr.chunks, buf, res);
+    clock.lap(res.gather_s);
     if (guide && prm.pixel_weight) learn_scores(tr.chunks, buf, *guide);
     clock.lap(res.apply_s);
     if (res.cut) break;

@@ -18,6 +18,7 @@
 #include "base/rng.h"
 #include "bpm/backward_maps.h"
 #include "bpm/masks.h"
+#include "bpm/medium_spheres.h"
 #include "bpm/settings.h"
 #include "photons/light_path.h"
 #include "photons/sensor_discs.h"
@@ -60,6 +61,8 @@ struct LightPassParams {
   // chunk in order. Null: none.
   const SensorDiscs* sensors = nullptr;
   SensorIteration* sensor_sums = nullptr;
+  // The backward photons in scattering media, which gather the photons' beams. Null: none.
+  const MediumSpheres* medium_spheres = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -78,6 +81,18 @@ struct PendingHit {
   float score = 0;  // set by the gather: the hit's part of its photon's score for the guide
 };
 
+// A beam of a photon through a scattering medium (PhotonBeam), waiting for its gather.
+struct PendingBeam {
+  Ray ray;  // unit direction
+  float t_max;
+  Spectrum flux;
+  uint32_t photon;  // the photon's index in its chunk
+  int16_t medium, bounces;
+  PhotonClass cls;
+  bool hero_only;
+  float score = 0;  // set by the gather, as PendingHit::score
+};
+
 // A photon's emission cell and weight, for its score (EmissionGuide).
 struct EmittedPhoton {
   uint32_t cell;
@@ -88,9 +103,11 @@ struct EmittedPhoton {
 // chunk of a group's photons their hits and emissions, the hits in gather order, per gather chunk
 // the entry lists, per chunk its photons' scores, and the per-thread counters.
 struct LightPassBuffers {
-  std::vector<std::vector<PendingHit>> hits;           // [chunk]
-  std::vector<std::vector<EmittedPhoton>> emitted;     // [chunk]
-  std::vector<std::vector<SensorCrossing>> crossings;  // [chunk], with sensors
+  std::vector<std::vector<PendingHit>> hits;                        // [chunk]
+  std::vector<std::vector<EmittedPhoton>> emitted;                  // [chunk]
+  std::vector<std::vector<SensorCrossing>> crossings;               // [chunk], with sensors
+  std::vector<std::vector<PendingBeam>> beams;                      // [chunk], with medium spheres
+  std::vector<std::vector<std::vector<PhotonEntry>>> beam_entries;  // [chunk][slot]
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]

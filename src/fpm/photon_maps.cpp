@@ -38,7 +38,7 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
       Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
       const EmissionDraw e = unguided_emission(scene, rng);
       auto store = [&](const PhotonHit& hit) {
-        if (hit.bounces + min_eye_vertices > max_depth) return;
+        if (hit.medium >= 0 || hit.bounces + min_eye_vertices > max_depth) return;
         ForwardPhoton ph{hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
                          hit.cls,  hit.hero_only};
         ch.global.push_back(ph);

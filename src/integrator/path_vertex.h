@@ -79,15 +79,23 @@ inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sig
   return -1;
 }
 
-// Follows s.ray to the next scattering surface and fills v. on_surface(hit, sp) is called at every
-// surface reached, interfaces included, with s.beta already attenuated up to it (emission is
-// counted there). kEscaped: the ray left the scene
+// What a path reports of the pieces of its rays that cross a scattering medium: none.
+struct NoMediumPieces {
+  void operator()(const Ray&, float, const Spectrum&) const {}
+};
+
+// Follows s.ray to the next scattering surface or medium point and fills v. on_surface(hit, sp) is
+// called at every surface reached, interfaces included, with s.beta already attenuated up to it
+// (emission is counted there); in_medium(ray, distance, beta) for every piece of the ray inside a
+// scattering medium before the point where it scatters is drawn: the whole piece up to the next
+// surface (distance along the unit direction, kInf where the ray leaves the scene) with the
+// throughput at its start (photon beams, bpm/light_pass.h). kEscaped: the ray left the scene
 // (s.ray is the escaping ray, s.beta attenuated by the medium it leaves in); kAbsorbed: nothing is
 // left of the throughput. Each crossing of an interface counts one ray in continuation_rays.
-template <class OnSurface>
+template <class OnSurface, class InMedium = NoMediumPieces>
 StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materials, PathState& s,
                     PathVertex& v, uint64_t& continuation_rays, RayObserver* observer,
-                    OnSurface&& on_surface) {
+                    OnSurface&& on_surface, InMedium&& in_medium = {}) {
   const Wavelengths& wl = materials.wl;
   for (int guard = 0; guard < 10000; ++guard) {
     if (observer) observer->closest_hit(s.ray);
@@ -95,9 +103,10 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
     const bool hit = scene.intersect(s.ray, &v.hit);
     const float distance = hit ? v.hit.t * length(s.ray.d) : kInf;
     if (s.medium >= 0 && scene.media[size_t(s.medium)].scatters()) {
-      BPM_CHECK(s.rng);  // only the path integrator renders scattering media
+      BPM_CHECK(s.rng);  // set by every path that may meet a scattering medium
       const HomogeneousMedium& m = scene.media[size_t(s.medium)];
       const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
+      in_medium(Ray{s.ray.o, normalize(s.ray.d), kInf}, distance, s.beta);
       const float t = sample_medium_distance(sigma_t, sigma_s, distance, *s.rng, s.beta);
       if (t >= 0) {
         s.length += t;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "base/rng.h"
@@ -112,7 +113,8 @@ struct PhotonHit {
   Spectrum flux;
   PhotonClass cls;
   int bounces;
-  bool hero_only;  // the photon keeps its hero wavelength alone (PathState)
+  bool hero_only;   // the photon keeps its hero wavelength alone (PathState)
+  int medium = -1;  // a point where the photon scatters in this medium (object -1, sp.p only)
 };
 
 // A straight piece of a photon's path, from ray.o along ray.d up to t_max (in units of ray.d; kInf
@@ -129,6 +131,25 @@ struct PhotonSegment {
   PhotonClass cls;
   int bounces;
   bool hero_only;
+};
+
+// A photon's way through a scattering medium (a photon beam): from ray.o along the unit ray.d up
+// to t_max (kInf where it leaves the scene), the whole way to the next surface whether or not the
+// photon scatters before it, with the flux it starts with; at t the flux is flux exp(-sigma_t t)
+// (long beams: Jarosz et al. 2011). bpm gathers beams at the backward photons in media.
+struct PhotonBeam {
+  const Ray& ray;
+  float t_max;
+  const Spectrum& flux;
+  int medium;
+  PhotonClass cls;
+  int bounces;
+  bool hero_only;
+};
+
+// What a photon reports of its beams: nothing.
+struct NoBeams {
+  void operator()(const PhotonBeam&) const {}
 };
 
 // Unguided emission: a light in proportion to power, u_pos and u_dir uniform (five numbers).
@@ -148,33 +169,91 @@ struct NoSegments {
   void operator()(const PhotonSegment&) const {}
 };
 
-// Traces one photon emitted as `e` says (unguided_emission, or an EmissionGuide's draw) at the
-// wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface, where a further
-// bounce could still make a path of at most max_depth scattering events with the
-// `min_eye_vertices` the estimator adds on the camera side, and segments(const PhotonSegment&) for
-// the pieces of its path that segments.depth asks for. The path stops when neither wants more.
-template <class OnHit, class OnSegment = NoSegments>
-void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
-                      int min_eye_vertices, const EmissionDraw& e, Rng& rng,
-                      LightCounters& counters, OnHit&& on_hit, OnSegment&& segments = {}) {
-  ++counters.photons;
-  if (scene.lights.empty() || max_depth < min_eye_vertices || e.light_pmf == 0 || e.weight == 0)
-    return;
+// The photon a light path starts with, emitted as `e` says: its ray, flux and medium. None where
+// the light sends nothing.
+inline std::optional<PathState> emit_photon(const RenderScene& scene, const WavelengthMaterials& wm,
+                                            const EmissionDraw& e, Rng& rng) {
   const Light& light = scene.lights[size_t(e.light)];
   auto le = light_sample_le(light, scene.light_shape(light), e.u_pos, e.u_dir, scene.bounds_info,
                             wm.wl, wm.light_spectrum(e.light));
-  if (!le || le->flux.is_black()) return;
+  if (!le || le->flux.is_black()) return std::nullopt;
   bool has_surface = length_squared(le->n_light) > 0;
   PathState s{
       Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction, le->origin_error)
                       : le->origin,
           le->direction, kInf},
       le->flux * (e.weight / e.light_pmf)};
-  // Only area lights may touch a medium (flatten_lights.cpp): the one on the side the photon leaves
-  // to.
+  // An area light's photons leave to the medium on their side of its surface; another light's
+  // start in the medium it sits in.
   if (const auto* area = std::get_if<AreaLight>(&light))
     s.medium = medium_toward(scene, area->object, le->n_light, le->direction,
                              scene.objects[size_t(area->object)].medium_outside);
+  else
+    s.medium = scene.medium_of_light(size_t(e.light));
+  s.rng = &rng;
+  return s;
+}
+
+// Scatters a photon at the surface vertex v with the adjoint BSDF, Russian roulette on its change
+// of power (pbrt-v4's SPPM photon pass). Returns whether the lobe sampled was traced (a caustic
+// stays a caustic through it), or none where the photon ends.
+inline std::optional<bool> scatter_photon_at_surface(const RenderScene& scene, const PathVertex& v,
+                                                     Rng& rng, PathState& s) {
+  if (v.wo_local.z == 0) return std::nullopt;
+  keep_hero_wavelength_at(v, s);
+  Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
+  float uc = rng.uniform();
+  auto bs = sample_bsdf(v, uc, u, TransportMode::kImportance);
+  if (!bs) return std::nullopt;
+  Vec3 wi = v.frame.to_world(bs->wi);
+  // Adjoint BSDF with shading normals (Veach 1997, 5.3): |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|)
+  // times the usual f |wi.ns| / pdf.
+  float cos_o_g = std::fabs(dot(v.wo, v.sp.ng));
+  if (cos_o_g == 0) return std::nullopt;
+  Spectrum bnew =
+      s.beta * bs->f *
+      (std::fabs(v.wo_local.z) * std::fabs(dot(wi, v.sp.ng)) / (cos_o_g * bs->pdf_solid_angle));
+  float q = std::fmax(0.0f, 1 - bnew.max_component() / s.beta.max_component());
+  if (rng.uniform() < q) return std::nullopt;
+  s.beta = bnew / (1 - q);
+  if (s.beta.is_black() || !s.beta.is_finite()) return std::nullopt;
+  leave_vertex(scene, v, wi, s);
+  return bs->is_traced() || v.on_curve;
+}
+
+// Scatters a photon at the medium point v: a phase-function sample (its weight is 1), Russian
+// roulette on the change of power since the last vertex, beta_before (the medium's albedo).
+// Returns false where the photon ends.
+inline bool scatter_photon_in_medium(const RenderScene& scene, const PathVertex& v,
+                                     const Spectrum& beta_before, Rng& rng, PathState& s) {
+  const float q = std::fmax(0.0f, 1 - s.beta.max_component() / beta_before.max_component());
+  if (rng.uniform() < q) return false;
+  s.beta /= 1 - q;
+  const Vec2 u{rng.uniform(), rng.uniform()};
+  s.ray = Ray{v.sp.p, sample_henyey_greenstein(-v.wo, scene.media[size_t(v.medium)].g, u), kInf};
+  return true;
+}
+
+// Traces one photon emitted as `e` says (unguided_emission, or an EmissionGuide's draw) at the
+// wavelengths of wm; calls on_hit(const PhotonHit&) at each diffuse surface, and at each point
+// where it scatters in a medium (PhotonHit::medium), where a further bounce could still make a path
+// of at most max_depth scattering events with the `min_eye_vertices` the estimator adds on the
+// camera side, and segments(const PhotonSegment&) for the pieces of its path that segments.depth
+// asks for. The path stops when neither wants more. In a scattering medium the photon scatters
+// where its free flight ends (by the phase function, a diffuse event), and on_beam(const
+// PhotonBeam&) is called for each of its ways through the medium after at most the bounces of a hit
+// reported.
+template <class OnHit, class OnSegment = NoSegments, class OnBeam = NoBeams>
+void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
+                      int min_eye_vertices, const EmissionDraw& e, Rng& rng,
+                      LightCounters& counters, OnHit&& on_hit, OnSegment&& segments = {},
+                      OnBeam&& on_beam = {}) {
+  ++counters.photons;
+  if (scene.lights.empty() || max_depth < min_eye_vertices || e.light_pmf == 0 || e.weight == 0)
+    return;
+  std::optional<PathState> emitted = emit_photon(scene, wm, e, rng);
+  if (!emitted) return;
+  PathState& s = *emitted;
   int bounces = 0;
   bool all_specular = true;
   const int hit_depth = max_depth - min_eye_vertices;  // the most bounces of a hit reported
@@ -186,6 +265,11 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
                                 ? PhotonClass::kDirect
                                 : (all_specular ? PhotonClass::kCaustic : PhotonClass::kIndirect);
     StepEnd end;
+    const Spectrum beta_before = s.beta;
+    auto beam = [&](const Ray& ray, float t_max, const Spectrum& flux) {
+      if (bounces <= hit_depth)
+        on_beam(PhotonBeam{ray, t_max, flux, s.medium, cls, bounces, s.hero_only});
+    };
     if (bounces <= segments.depth) {
       // Each piece between the surfaces the photon passes (interfaces) with its flux at the start.
       Spectrum flux = s.beta;
@@ -194,42 +278,35 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
           [&](const Hit& hit, const SurfacePoint& sp) {
             segments(PhotonSegment{s.ray, hit.t, sp.ng, flux, s.medium, cls, bounces, s.hero_only});
             flux = s.beta;
-          });
+          },
+          beam);
       if (end == StepEnd::kEscaped)
         segments(PhotonSegment{s.ray, kInf, Vec3(), flux, s.medium, cls, bounces, s.hero_only});
     } else {
-      end = next_vertex(scene, wm, s, v, counters.light_rays, counters.observer);
+      end = next_vertex(
+          scene, wm, s, v, counters.light_rays, counters.observer,
+          [](const Hit&, const SurfacePoint&) {}, beam);
     }
-    if (end != StepEnd::kVertex) break;
-    // A surface with gathered lobes (BsdfPart): the photon's estimate there sees those alone.
-    if (bounces <= hit_depth && !vertex_all_traced(v)) {
+    if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
+    const bool in_medium = end == StepEnd::kMedium;
+    // A surface with gathered lobes (BsdfPart), or a point in a medium: the photon's estimate
+    // there sees those alone.
+    if (bounces <= hit_depth && (in_medium || !vertex_all_traced(v))) {
       ++counters.diffuse_hits;
-      on_hit(PhotonHit{v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only});
+      on_hit(PhotonHit{in_medium ? -1 : v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only,
+                       in_medium ? v.medium : -1});
     }
     if (bounces + 1 > depth) break;
-    if (v.wo_local.z == 0) break;
-    keep_hero_wavelength_at(v, s);
-    Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
-    float uc = rng.uniform();
-    auto bs = sample_bsdf(v, uc, u, TransportMode::kImportance);
-    if (!bs) break;
-    Vec3 wi = v.frame.to_world(bs->wi);
-    // Adjoint BSDF with shading normals (Veach 1997, 5.3): |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|)
-    // times the usual f |wi.ns| / pdf.
-    float cos_o_g = std::fabs(dot(v.wo, v.sp.ng));
-    if (cos_o_g == 0) break;
-    Spectrum bnew =
-        s.beta * bs->f *
-        (std::fabs(v.wo_local.z) * std::fabs(dot(wi, v.sp.ng)) / (cos_o_g * bs->pdf_solid_angle));
-    // Russian roulette on the change of power (pbrt-v4's SPPM photon pass).
-    float q = std::fmax(0.0f, 1 - bnew.max_component() / s.beta.max_component());
-    if (rng.uniform() < q) break;
-    s.beta = bnew / (1 - q);
-    if (s.beta.is_black() || !s.beta.is_finite()) break;
+    if (in_medium) {
+      if (!scatter_photon_in_medium(scene, v, beta_before, rng, s)) break;
+      all_specular = false;
+    } else {
+      const std::optional<bool> traced = scatter_photon_at_surface(scene, v, rng, s);
+      if (!traced) break;
+      // Through a traced lobe (delta, or glossy and sharp) a caustic stays a caustic.
+      all_specular = all_specular && *traced;
+    }
     ++bounces;
-    // Through a traced lobe (delta, or glossy and sharp) a caustic stays a caustic.
-    all_specular = all_specular && (bs->is_traced() || v.on_curve);
-    leave_vertex(scene, v, wi, s);
     ++counters.light_rays;
   }
 }

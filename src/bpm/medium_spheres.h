@@ -1,0 +1,43 @@
+// The backward photons inside scattering media (bpm/eye_pass.h), as spheres at which photon beams
+// are gathered: per medium and photon class, an Embree scene of sphere points. A beam (a photon's
+// way through a medium to the next surface, photons/light_path.h) reaches a sphere when the point
+// of the beam nearest its centre lies within its radius r: the beam's flux there, blurred over the
+// disc of radius r across the beam (Jarosz et al. 2011, "beam x point" with a 2D kernel), is the
+// light the sphere's point gathers, flux exp(-sigma_t t) p / (pi r^2) per photon emitted. One
+// traversal per beam finds every sphere it reaches.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "base/ray.h"
+#include "bpm/backward_maps.h"
+
+namespace bpm {
+
+class MediumSpheres {
+ public:
+  MediumSpheres();
+  ~MediumSpheres();
+  MediumSpheres(const MediumSpheres&) = delete;
+  MediumSpheres& operator=(const MediumSpheres&) = delete;
+
+  // The spheres of the backward photons of maps past the first object_count objects (whose lists
+  // are the media's, in order), by the classes they accept.
+  void build(const BackwardMaps& maps, size_t object_count, size_t media);
+  bool empty() const { return spheres_ == 0; }
+  // Appends to *found (index of the backward photon in maps, t of the beam's point nearest its
+  // centre) for every sphere of `medium` that accepts `cls` and that the beam from ray.o along
+  // the unit ray.d over [0, t_max] reaches, in index order.
+  void query(int medium, PhotonClass cls, const Ray& ray, float t_max,
+             std::vector<std::pair<uint32_t, float>>* found) const;
+
+ private:
+  struct Scenes;
+  std::unique_ptr<Scenes> scenes_;
+  const BackwardMaps* maps_ = nullptr;
+  size_t spheres_ = 0;
+};
+
+}  // namespace bpm
