@@ -288,10 +288,6 @@ int main(int argc, char** argv) {
     for (const char* integrator : {"path", "bpm", "fpm"}) {
       if (("," + ours + ",").find(std::string(",") + integrator + ",") == std::string::npos)
         continue;
-      if (std::string(integrator) == "fpm" && ls.scene.has_scattering_media()) {
-        std::printf("  %-28s not rendered: fpm does not render scattering media\n", "bpm fpm");
-        continue;
-      }
       RenderStats st;
       Image img = render_ours(ls, integrator, seconds, 1, &st);
       std::string samples =

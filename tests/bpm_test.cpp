@@ -555,12 +555,22 @@ Shape "sphere" "float radius" 1.5
   const double sigma = std::sqrt(m.var), bias = 1.5 * s.radius / 1.5;
   EXPECT_NEAR(m.mean, 1, 4.5 * sigma + bias) << "mean " << m.mean << " sigma " << sigma;
   EXPECT_LT(sigma, 0.01);  // the test has power
+  // fpm from its volume map (its eye paths end at their first point in the medium, with or
+  // without final gathering): a sphere of k1 pixel footprints about the eye path's point, which
+  // lies within R of the camera (the same shell bound with r / R at most k1 pixel angles).
+  BpmSettings sf = s;
+  sf.k1 = 1;
+  const double fpm_bias = 1.5 * sf.k1 * Camera(ls.camera, 16, 16).footprint({8, 8}).spread;
+  const BlockStats fm = image_mean(render_iterations(ls, "fpm", 32, 3, sf));
+  const double fs = std::sqrt(fm.var);
+  EXPECT_NEAR(fm.mean, 1, 4.5 * fs + fpm_bias) << "fpm mean " << fm.mean << " sigma " << fs;
+  EXPECT_LT(fs, 0.03);
 }
 
 // A box of fog (an interface surface around it) over a floor, a small area light above it and a
 // glass sphere in it: light focused into the fog (a volumetric caustic) and onto the floor through
-// the fog, interreflection between fog and floor. bpm's blocks agree with path's within 4.5 sigma
-// plus the edge bias of the radii.
+// the fog, interreflection between fog and floor. bpm's and fpm's blocks agree with path's within
+// 4.5 sigma plus the edge bias of the radii.
 TEST(Bpm, FogWithAGlassSphereMatchesPath) {
   const LoadedScene ls = load(R"(LookAt 0 1 -4  0 1 0  0 1 0
 Camera "perspective" "float fov" 40
@@ -593,7 +603,11 @@ AttributeEnd
   const RenderRun ref = render_with(ls, "path", 2048, 0, 7);
   const BpmSettings s;
   expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, s), ref.film, 6, edge_bias(s, 24, 6),
-                      "fog and glass");
+                      "fog and glass, bpm");
+  FpmSettings f;
+  f.final_gather = false;
+  expect_blocks_agree(render_iterations(ls, "fpm", 24, 3, s, f), ref.film, 6, edge_bias(s, 24, 6),
+                      "fog and glass, fpm");
 }
 
 // A furnace whose albedo is a checkerboard texture over the sphere's (u, v) (0.3 and 0.7, 8 x 4

@@ -159,14 +159,14 @@ Shape "sphere" "float radius" 1.5
   EXPECT_LT(std::sqrt(var), 0.01);
 }
 
-TEST(Media, FpmAndBpmSensorsRefuseScatteringMedia) {
+TEST(Media, PhotonMethodsRefuseSensorsInScatteringMedia) {
   LoadedScene ls = load(slab_scene("\"rgb sigma_s\" [0.5 0.5 0.5]", 3));
-  Film film(ls.film.width, ls.film.height);
-  EXPECT_THROW(render(ls, quiet_options(ls, "fpm", 1, 1), &film), Error);
-  RenderOptions opt = quiet_options(ls, "bpm", 1, 1);
-  opt.sensors = parse_sensors("0 0 0 0 0 1\n", "s.txt");
-  Film with_sensors(ls.film.width, ls.film.height, 0, 1);
-  EXPECT_THROW(render(ls, opt, &with_sensors), Error);
+  for (const char* integrator : {"bpm", "fpm"}) {
+    RenderOptions opt = quiet_options(ls, integrator, 1, 1);
+    opt.sensors = parse_sensors("0 0 0 0 0 1\n", "s.txt");
+    Film with_sensors(ls.film.width, ls.film.height, 0, 1);
+    EXPECT_THROW(render(ls, opt, &with_sensors), Error) << integrator;
+  }
   // A file's integrator that maps to bpm renders with it.
   std::string bdpt = slab_scene("\"rgb sigma_s\" [0.5 0.5 0.5]", 3);
   bdpt.replace(bdpt.find("Integrator \"path\""), 17, "Integrator \"bdpt\"");

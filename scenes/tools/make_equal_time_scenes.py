@@ -3,8 +3,10 @@
 - spot-facets: a spot light through a faceted glass object onto a glossy coated floor;
 - water-box: a wavy water surface over a diffuse floor in a closed box, under a tiny bright light;
 - lamp-room: a room lit only indirectly, by a lamp inside a shade aimed at the ceiling, with a
-  glass egg on a table.
-    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those three scenes/*.pbrt
+  glass egg on a table;
+- spot-lens-fog: a spot light through a glass lens into a foggy room (a volumetric caustic);
+- underwater: a spot light and a dim sky over a wavy water surface, seen from inside murky water.
+    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those five scenes/*.pbrt
 """
 import math
 import os
@@ -132,9 +134,70 @@ def lamp_room():
     return s
 
 
+def spot_lens_fog():
+    s = header('# A spot light shining down through a glass lens (a flattened sphere) into a closed room\n'
+               '# full of thin fog: the lens focuses the cone into a bright waist in the fog and a spot\n'
+               '# on the floor (a volumetric caustic of a point light, which no path from the camera\n'
+               '# finds). The camera stands in the fog.\n'
+               'MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [ 0.01 0.01 0.01 ]\n'
+               '    "rgb sigma_s" [ 0.08 0.08 0.08 ] "float g" [ 0.4 ]\n'
+               'MediumInterface "" "fog"\n',
+               "0 1.5 -3.6   0 1.1 0.5   0 1 0", 55, (256, 192), 8, "spot-lens-fog")
+    s += 'MediumInterface "fog"\n'
+    s += ('LightSource "spot" "point3 from" [ 0 2.9 0.5 ] "point3 to" [ 0 0 0.5 ]\n'
+          '    "float coneangle" [ 18 ] "float conedeltaangle" [ 3 ] "blackbody I" [ 5000 ]\n'
+          '    "float scale" [ 12 ]\n')
+    s += 'LightSource "point" "point3 from" [ -1.5 2.6 -2.5 ] "blackbody I" [ 3000 ] "float scale" [ 0.3 ]\n'
+    s += 'Material "diffuse" "rgb reflectance" [ 0.6 0.6 0.6 ]\n' + box(-2.5, 0, -4, 2.5, 3, 3)
+    s += ('AttributeBegin\n  MediumInterface "" "fog"\n  Material "dielectric" "float eta" [ 1.5 ]\n'
+          '  Translate 0 2.1 0.5\n  Scale 1 0.3 1\n  Shape "sphere" "float radius" [ 0.5 ]\n'
+          'AttributeEnd\n')
+    s += ('AttributeBegin\n  Material "diffuse" "rgb reflectance" [ 0.7 0.3 0.2 ]\n'
+          '  Translate 1.1 0.4 1.2\n  Shape "sphere" "float radius" [ 0.4 ]\nAttributeEnd\n')
+    return s
+
+
+def underwater():
+    s = header('# Inside murky water under a wavy surface: a spot light above the water shines down through\n'
+               '# the waves (caustics on the sand and shafts in the water), a dim sky panel lights the\n'
+               '# rest. The water body is the tank below the surface, an interface between water\n'
+               '# (inside, below) and air; the camera is in the water.\n'
+               'MakeNamedMedium "water" "string type" "homogeneous" "rgb sigma_a" [ 0.25 0.06 0.08 ]\n'
+               '    "rgb sigma_s" [ 0.2 0.25 0.22 ] "float g" [ 0.7 ]\n'
+               'MediumInterface "" "water"\n',
+               "0 0.55 -1.8   0 0.8 0.8   0 1 0", 60, (256, 192), 10, "underwater")
+    s += ('LightSource "spot" "point3 from" [ 0.4 3.5 0.6 ] "point3 to" [ 0 0 0.8 ]\n'
+          '    "float coneangle" [ 14 ] "float conedeltaangle" [ 2 ] "blackbody I" [ 5500 ]\n'
+          '    "float scale" [ 40 ]\n')
+    s += ('AttributeBegin\n  AreaLightSource "diffuse" "rgb L" [ 0.4 0.5 0.7 ]\n'
+          '  Material "diffuse" "rgb reflectance" [ 0 0 0 ]\n  '
+          + quad((-2, 4, -2), (-2, 4, 2), (2, 4, 2), (2, 4, -2)) + "AttributeEnd\n")
+    s += 'Material "diffuse" "rgb reflectance" [ 0.7 0.65 0.5 ]\n'
+    s += quad((-2, 0, -2), (-2, 0, 2), (2, 0, 2), (2, 0, -2))  # sand
+    s += 'Material "diffuse" "rgb reflectance" [ 0.35 0.4 0.4 ]\n'
+    for q in [((-2, 0, 2), (-2, 2, 2), (2, 2, 2), (2, 0, 2)), ((-2, 0, -2), (2, 0, -2), (2, 2, -2), (-2, 2, -2)),
+              ((-2, 0, -2), (-2, 2, -2), (-2, 2, 2), (-2, 0, 2)), ((2, 0, -2), (2, 0, 2), (2, 2, 2), (2, 2, -2))]:
+        s += quad(*q)
+    n = 64
+    pts, tris = [], []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            x, z = -2 + 4 * i / n, -2 + 4 * j / n
+            y = 1.5 + 0.03 * math.sin(5 * x + 2 * z) + 0.02 * math.cos(7 * z - 3 * x) + 0.01 * math.sin(13 * x + 11 * z)
+            pts.append([x, y, z])
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            tris += [(a, a + 1, a + n + 2), (a, a + n + 2, a + n + 1)]
+    s += 'AttributeBegin\n  MediumInterface "water" ""\n  Material "dielectric" "float eta" [ 1.33 ]\n'
+    s += "  " + mesh(pts, outward(pts, tris, None)) + "AttributeEnd\n"
+    return s
+
+
 def main():
     for name, text in [("spot-facets", spot_facets()), ("water-box", water_box()),
-                       ("lamp-room", lamp_room())]:
+                       ("lamp-room", lamp_room()), ("spot-lens-fog", spot_lens_fog()),
+                       ("underwater", underwater())]:
         with open(os.path.join(OUT, name + ".pbrt"), "w") as f:
             f.write(text)
 

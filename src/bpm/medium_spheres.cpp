@@ -86,7 +86,7 @@ void MediumSpheres::build(const BackwardMaps& maps, size_t object_count, size_t 
       spheres_ += ids.size();
       RTCGeometry geom = rtcNewGeometry(s.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
       auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                             RTC_FORMAT_FLOAT4, 16, ids.size()));
+                                                            RTC_FORMAT_FLOAT4, 16, ids.size()));
       for (size_t j = 0; j < ids.size(); ++j) {
         const BackwardPhoton& bp = maps.photons[ids[j]];
         v[4 * j] = bp.p.x;

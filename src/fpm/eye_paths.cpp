@@ -60,6 +60,41 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
 bool any_class(PhotonClass) { return true; }
 bool caustic_class(PhotonClass k) { return k == PhotonClass::kCaustic; }
 bool indirect_class(PhotonClass k) { return k == PhotonClass::kIndirect; }
+bool not_direct_class(PhotonClass k) { return k != PhotonClass::kDirect; }
+
+// The light that the phase function gathers at the medium point v toward v.wo (the integral of p
+// L over directions) from the volume map's photons of its medium and of the accepted classes:
+// sum p(cos) dPhi / (4/3 pi r^3 N sigma_s) (Jensen and Christensen 1998; the photons are stored
+// where they collide, with the weight sigma_s / sigma_t of the free flight, so their density is
+// sigma_s times the fluence's, and the eye path's own weight has its sigma_s), with the
+// Henyey-Greenstein phase function of asymmetry g; and the estimate of its bias from the photons
+// within the radius that holds half the sphere's volume, r 2^(-1/3): for a bias a r^2 it is
+// (L(r) - L(r 2^(-1/3))) / (1 - 2^(-2/3)).
+template <class Accept>
+Estimate volume_estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only, float r,
+                         int eye_depth, const FpmEyeParams& prm, float g, const Spectrum& sigma_s,
+                         Accept&& accept, FpmEyeCounters& c) {
+  ++c.lookups;
+  constexpr float kHalfR2 = 0.62996052f;  // 2^(-2/3)
+  Spectrum all, half;
+  map.tree.query_within(v.sp.p, r, [&](uint32_t i) {
+    const ForwardPhoton& ph = map.photons[i];
+    if (ph.medium != v.medium || !accept(ph.cls) || eye_depth + int(ph.bounces) > prm.max_depth)
+      return;
+    ++c.photons_used;
+    const Spectrum value = ph.flux * (henyey_greenstein(dot(-v.wo, ph.wi), g) *
+                                      hero_join_factor(eye_hero_only, ph.hero_only));
+    all += value;
+    if (length_squared(ph.p - v.sp.p) < kHalfR2 * r * r) half += value;
+  });
+  const float norm = float(1.0 / (4.0 / 3.0 * kPi * double(r) * r * r * prm.emitted));
+  for (int k = 0; k < Spectrum::kChannels; ++k) {
+    const float inv = sigma_s[k] > 0 ? norm / sigma_s[k] : 0.0f;
+    all[k] *= inv;
+    half[k] *= 2 * inv;
+  }
+  return {all, (all - half) * (1 / (1 - kHalfR2))};
+}
 
 // What every vertex of one eye path shares.
 struct FpmPath {
@@ -131,6 +166,35 @@ inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, c
   return false;
 }
 
+// A point where the eye path scatters in a medium, where it ends. At x1: direct light by
+// next-event estimation through the phase function and a phase sample that only looks for the
+// light (by MIS), the rest from the volume map; at x2 of a final gather, everything from it.
+inline void gather_in_medium(const FpmPath& path, const PathVertex& v, const PathState& s,
+                             int depth, bool gathering, Spectrum& L, Spectrum& bias) {
+  const HomogeneousMedium& medium = path.scene.media[size_t(v.medium)];
+  const float g = medium.g;
+  const Spectrum sigma_s = medium.sigma_s.sample(path.prm.materials->wl);
+  const float r = path.footprint.at(s.length) * path.prm.k1;
+  auto gather = [&](auto accept) {
+    const Estimate e = volume_estimate(path.maps.volume, v, s.hero_only, r, depth, path.prm, g,
+                                       sigma_s, accept, path.c);
+    L += s.beta * e.L;
+    bias += s.beta * e.bias;
+  };
+  if (gathering) return gather(any_class);
+  L += s.beta * sample_direct_light_in_medium(path.scene, v.sp.p, v.medium, -v.wo, g,
+                                              *path.prm.materials, path.rng, path.c.rays);
+  gather(not_direct_class);
+  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
+  const Vec3 wi = sample_henyey_greenstein(-v.wo, g, u);
+  PathState probe = s;
+  probe.ray = Ray{v.sp.p, wi, kInf};
+  PathVertex next;
+  next_eye_vertex(path.scene, *path.prm.materials, probe, next, path.c.rays,
+                  EmitterWeight::mis(henyey_greenstein(dot(-v.wo, wi), g), v.sp.p), L);
+  ++path.c.rays.bounce_rays;
+}
+
 // Samples the BSDF at v and leaves the vertex along the sample; sets the weight of the emission
 // the next vertex sees. Returns false where the path ends (no sample, no throughput left).
 inline bool scatter(const FpmPath& path, const PathVertex& v, const EyeVertexChoice& choice,
@@ -161,6 +225,7 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
   if (ray.weight == 0) return {};
   const FpmPath path{scene, maps, prm, footprint, rng, c, near_edge};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
+  s.rng = &rng;
   Spectrum L, bias;
   int depth = 0;
   // Emission found by the ray that leaves x1 is direct light at x1, shared by MIS with next-event
@@ -172,8 +237,13 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
   ++c.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    if (next_eye_vertex(scene, *prm.materials, s, v, c.rays, emitter, L) != StepEnd::kVertex) break;
+    const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, c.rays, emitter, L);
+    if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == prm.max_depth) break;
+    if (end == StepEnd::kMedium) {
+      gather_in_medium(path, v, s, depth, gathering, L, bias);
+      break;
+    }
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.

@@ -31,6 +31,7 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
     ForwardMaps::Chunk& ch = maps->chunks[size_t(c)];
     ch.global.clear();
     ch.caustic.clear();
+    ch.volume.clear();
     ch.crossings.clear();
     uint64_t first = uint64_t(c) * kPhotonsPerChunk,
              last = std::min(first + kPhotonsPerChunk, n_photons);
@@ -38,12 +39,17 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
       Rng rng(stream_key(seed ^ kPhotonStream, uint64_t(pass_index), k, 2));
       const EmissionDraw e = unguided_emission(scene, rng);
       auto store = [&](const PhotonHit& hit) {
-        if (hit.medium >= 0 || hit.bounces + min_eye_vertices > max_depth) return;
-        ForwardPhoton ph{hit.sp.p, hit.wi,       hit.sp.ng, hit.flux, uint16_t(hit.bounces),
-                         hit.cls,  hit.hero_only};
+        if (hit.bounces + min_eye_vertices > max_depth) return;
+        ForwardPhoton ph{
+            hit.sp.p, hit.wi,        hit.sp.ng,          hit.flux, uint16_t(hit.bounces),
+            hit.cls,  hit.hero_only, int16_t(hit.medium)};
+        ++lc.entries;
+        if (hit.medium >= 0) {
+          ch.volume.push_back(ph);
+          return;
+        }
         ch.global.push_back(ph);
         if (hit.cls == PhotonClass::kCaustic) ch.caustic.push_back(ph);
-        ++lc.entries;
       };
       trace_light_path(scene, wm, max_depth, min_eye_vertices, e, rng, lc, store,
                        SensorSegments(scene, sensors, wm.wl, ch.crossings, max_depth));
@@ -57,11 +63,14 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
 void build_forward_maps(ForwardMaps* maps) {
   maps->global.photons.clear();
   maps->caustic.photons.clear();
+  maps->volume.photons.clear();
   for (const ForwardMaps::Chunk& ch : maps->chunks) {
     maps->global.photons.insert(maps->global.photons.end(), ch.global.begin(), ch.global.end());
     maps->caustic.photons.insert(maps->caustic.photons.end(), ch.caustic.begin(), ch.caustic.end());
+    maps->volume.photons.insert(maps->volume.photons.end(), ch.volume.begin(), ch.volume.end());
   }
-  tbb::parallel_invoke([&] { maps->global.build(); }, [&] { maps->caustic.build(); });
+  tbb::parallel_invoke([&] { maps->global.build(); }, [&] { maps->caustic.build(); },
+                       [&] { maps->volume.build(); });
 }
 
 }  // namespace bpm

@@ -1,6 +1,7 @@
 // Forward photon maps (Jensen 1996): the light pass of fpm stores one forward photon at every
 // diffuse surface a photon reaches, in a global map, and also in a caustic map when the path so
-// far was specular only; each map has a kd-tree over the photon centres.
+// far was specular only; and one at every point where it scatters in a medium, in a volume map
+// (Jensen and Christensen 1998); each map has a kd-tree over the photon centres.
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
@@ -18,11 +19,12 @@ namespace bpm {
 struct ForwardPhoton {
   Vec3 p;
   Vec3 wi;  // toward where the photon came from
-  Vec3 ng;
+  Vec3 ng;  // zero in a medium
   Spectrum flux;
   uint16_t bounces;
   PhotonClass cls;
-  bool hero_only;  // the photon keeps its hero wavelength alone (PathState)
+  bool hero_only;       // the photon keeps its hero wavelength alone (PathState)
+  int16_t medium = -1;  // the medium it scatters in (volume map), -1 on a surface
 };
 
 struct PhotonMap {
@@ -33,11 +35,11 @@ struct PhotonMap {
 };
 
 struct ForwardMaps {
-  PhotonMap global, caustic;
+  PhotonMap global, caustic, volume;
   // Per chunk of photons, the photons it stored: joined in chunk order, so that the maps do not
   // depend on the thread count.
   struct Chunk {
-    std::vector<ForwardPhoton> global, caustic;
+    std::vector<ForwardPhoton> global, caustic, volume;
     std::vector<SensorCrossing> crossings;  // of the illuminance sensors' discs, if any
   };
   std::vector<Chunk> chunks;
@@ -56,7 +58,7 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
                                const std::function<bool()>& stop, ForwardMaps* maps,
                                const SensorDiscs* sensors = nullptr);
 
-// Joins the chunks into the two maps and builds their trees.
+// Joins the chunks into the three maps and builds their trees.
 void build_forward_maps(ForwardMaps* maps);
 
 }  // namespace bpm

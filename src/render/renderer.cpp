@@ -43,18 +43,10 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
                 std::to_string(opt.sensors.size()));
   if (!opt.image && opt.sensors.empty())
     throw Error("a render without an image needs sensors (--sensors)");
-  if (!ls.scene.light_in_medium.empty() && opt.integrator == "fpm")
-    throw Error(ls.scene.light_in_medium +
-                ": a light inside a medium, which fpm does not render yet: render the scene "
-                "with --integrator bpm or path");
-  if (ls.scene.has_scattering_media() && opt.integrator == "fpm")
+  if (ls.scene.has_scattering_media() && opt.integrator != "path" && !opt.sensors.empty())
     throw Error(
-        "the scene's media scatter, which fpm does not render yet: render it with "
-        "--integrator bpm or path");
-  if (ls.scene.has_scattering_media() && opt.integrator == "bpm" && !opt.sensors.empty())
-    throw Error(
-        "bpm's illuminance sensors in a scene whose media scatter are not supported yet: render "
-        "them with --integrator path");
+        "the photon methods' illuminance sensors in a scene whose media scatter are not "
+        "supported yet: render them with --integrator path");
   // A named sensor is balanced by its fit (6500 K unless the film says); cie1931 by a matrix.
   if (ls.film.sensor != "cie1931")
     film->set_response(std::make_shared<const CameraResponse>(*CameraResponse::named(

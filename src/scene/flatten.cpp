@@ -49,15 +49,6 @@ LoadedScene Flattener::run() {
   for (const ShapeEntity& s : parsed_.shapes) add_shape(s, &out.scene);
   for (const LightEntity& l : parsed_.lights) add_light(l, &out.scene);
   out.scene.commit();
-  // fpm does not render scattering media or lights in media yet: a file's integrator that maps to
-  // it renders with the path tracer instead.
-  if ((out.scene.has_scattering_media() || !out.scene.light_in_medium.empty()) &&
-      out.render.integrator == "fpm") {
-    out.render.integrator = "path";
-    out.render.integrator_note = "integrator \"" + out.render.integrator_as_written +
-                                 "\" is rendered with bpm's path tracer (\"path\"): the scene's "
-                                 "media scatter or hold a light, which fpm does not render yet";
-  }
   // Distant and infinite lights needed the scene bounds; nothing more to do after commit.
   out.data_files = data_files_;
   return out;

@@ -92,7 +92,6 @@ void Flattener::add_light(const LightEntity& e, RenderScene* rs) {
   // The medium the light sits in, where light paths start (next-event estimation attenuates by
   // the medium of the point lit and needs none).
   const int medium = e.medium.outside.empty() ? -1 : medium_id(e.medium.outside, e.medium.loc);
-  if (medium >= 0) rs->light_in_medium = e.loc.str();
   float scale = ps.get_float("scale", 1);
   if (e.name == "point") {
     add_point_light(e, &scale, rs);

@@ -55,9 +55,6 @@ class RenderScene {
   TextureSet textures;      // the nodes textured materials read
   std::vector<Bump> bumps;  // per material (or fewer: none past the end)
   std::vector<HomogeneousMedium> media;
-  // Where a light source other than an area light sits inside a medium ("" if none): only the
-  // path integrator renders such scenes so far.
-  std::string light_in_medium;
   // Per light (or fewer: -1 past the end): the medium a light other than an area light sits in,
   // where its photons start (an area light's leave to the medium on their side of its surface).
   std::vector<int> light_medium;
@@ -66,7 +63,7 @@ class RenderScene {
   }
   // Whether a surface has the interface material (commit sets it): shadow rays then cross them.
   bool has_interfaces = false;
-  // Whether any medium scatters (only the path integrator renders such scenes so far).
+  // Whether any medium scatters.
   bool has_scattering_media() const {
     for (const HomogeneousMedium& m : media)
       if (m.scatters()) return true;
