@@ -17,6 +17,7 @@
 #include "bpm/statistics.h"
 #include "integrator/progressive.h"
 #include "photons/emission_guide.h"
+#include "photons/medium_radius.h"
 #include "photons/sensor_discs.h"
 
 namespace bpm {
@@ -173,6 +174,7 @@ class BpmRender {
   // The backward photons in scattering media as spheres for the photon beams (none without such
   // media).
   std::unique_ptr<MediumSpheres> medium_spheres_;
+  float medium_min_length_;  // photons/medium_radius.h
 };
 
 const char* const kMemoryAdvice =
@@ -217,7 +219,11 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
                   ls.film.height, ls.filter.radius),
       sensors_(make_sensor_discs(scene_, opt.sensors, camera_.camera(), s_)),
       sensor_sums_(opt.sensors.size()),
-      medium_spheres_(scene_.has_scattering_media() ? std::make_unique<MediumSpheres>() : nullptr) {
+      medium_spheres_(scene_.has_scattering_media() ? std::make_unique<MediumSpheres>() : nullptr),
+      medium_min_length_(
+          scene_.has_scattering_media()
+              ? median_surface_distance(scene_, camera_.camera(), film->width(), film->height())
+              : 0) {
   pixel_sums_.places = s_.diffuse_depth + 2;
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
@@ -279,8 +285,8 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                          const RenderControl& control) {
   const auto t = Clock::now();
   EyePassParams ep{&wm,           s_.diffuse_depth,    opt_.max_depth,    s_.k0 * scale,
-                   s_.k1 * scale, s_.emission_samples, s_.radius * scale, caustics_,
-                   s_.normal_cos, s_.disc_probes,      &near_edges_};
+                   s_.k1 * scale, s_.emission_samples, s_.radius * scale, medium_min_length_,
+                   caustics_,     s_.normal_cos,       s_.disc_probes,    &near_edges_};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii.
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,

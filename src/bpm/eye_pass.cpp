@@ -24,8 +24,9 @@ BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const
   BackwardPhoton bp;
   bp.p = v.sp.p;
   const bool small = diffuse == 1 && accepts == kAcceptsCaustic;
+  const float length = v.medium >= 0 ? std::max(s.length, prm.medium_min_length) : s.length;
   bp.radius =
-      prm.world_radius > 0 ? prm.world_radius : footprint.at(s.length) * (small ? prm.k0 : prm.k1);
+      prm.world_radius > 0 ? prm.world_radius : footprint.at(length) * (small ? prm.k0 : prm.k1);
   bp.ng = v.sp.ng;
   bp.ns = v.sp.ns;
   bp.uv = v.sp.uv;

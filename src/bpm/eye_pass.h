@@ -36,6 +36,9 @@ struct EyePassParams {
   // When positive, every backward photon's radius in world units instead of the per-length radii
   // (BpmSettings::radius, times the iteration's radius scale).
   float world_radius = 0;
+  // In a scattering medium the radii are never those of a shorter path than this
+  // (photons/medium_radius.h).
+  float medium_min_length = 0;
   // False where no light path can be a caustic (no material has a traced lobe,
   // may_have_caustics): then no backward photon accepts caustic photons.
   bool caustics = true;

@@ -174,7 +174,7 @@ inline void gather_in_medium(const FpmPath& path, const PathVertex& v, const Pat
   const HomogeneousMedium& medium = path.scene.media[size_t(v.medium)];
   const float g = medium.g;
   const Spectrum sigma_s = medium.sigma_s.sample(path.prm.materials->wl);
-  const float r = path.footprint.at(s.length) * path.prm.k1;
+  const float r = path.footprint.at(std::max(s.length, path.prm.medium_min_length)) * path.prm.k1;
   auto gather = [&](auto accept) {
     const Estimate e = volume_estimate(path.maps.volume, v, s.hero_only, r, depth, path.prm, g,
                                        sigma_s, accept, path.c);

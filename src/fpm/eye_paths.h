@@ -17,6 +17,9 @@ struct FpmEyeParams {
   int max_depth;
   float k0, k1;    // radii in pixel footprints (PixelFootprint at the vertex's path length)
   double emitted;  // photons emitted, N of eq. (2)
+  // In a scattering medium the radii are never those of a shorter path than this
+  // (photons/medium_radius.h).
+  float medium_min_length = 0;
 };
 
 struct FpmEyeCounters {

@@ -13,6 +13,7 @@
 #include "fpm/photon_maps.h"
 #include "integrator/progressive.h"
 #include "photons/disc_probes.h"
+#include "photons/medium_radius.h"
 
 namespace bpm {
 namespace {
@@ -106,6 +107,7 @@ class FpmRender {
   // Illuminance sensors, when the render has them (photons/sensor_discs.h).
   std::unique_ptr<SensorDiscs> sensors_;
   SensorIteration sensor_sums_;
+  float medium_min_length_;  // photons/medium_radius.h
 };
 
 FpmSettings checked_settings(const FpmSettings& settings, size_t n_pixels) {
@@ -131,7 +133,11 @@ FpmRender::FpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       near_edges_(s_.disc_probes, scene_, camera_.camera(), film->width(), film->height(),
                   ls.filter.radius),
       sensors_(make_sensor_discs(scene_, opt.sensors, camera_.camera(), s_)),
-      sensor_sums_(opt.sensors.size()) {}
+      sensor_sums_(opt.sensors.size()),
+      medium_min_length_(
+          scene_.has_scattering_media()
+              ? median_surface_distance(scene_, camera_.camera(), film->width(), film->height())
+              : 0) {}
 
 // Memory (base/memory.h): a photon is stored at most once per diffuse hit that still leaves room
 // for the eye vertices, plus one caustic copy; each stored photon is in its chunk's list, in the
@@ -218,7 +224,8 @@ void FpmRender::eye_pass(const WavelengthMaterials& wm, int pass, int it,
   const auto t = Clock::now();
   float scale = radius_scale(s_, it);
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
-  FpmEyeParams ep{&wm, &s_, opt_.max_depth, s_.k0 * scale, s_.k1 * scale, double(emitted_)};
+  FpmEyeParams ep{
+      &wm, &s_, opt_.max_depth, s_.k0 * scale, s_.k1 * scale, double(emitted_), medium_min_length_};
   for_each_sampled_pixel(film_->width(), film_->height(), control, pass, [&](uint32_t pixel) {
     CameraSample cs = camera_.sample(it, pixel);
     const FpmEyeRadiance r = fpm_eye_radiance(scene_, maps_, ep, cs.camera_ray(), cs.footprint,
