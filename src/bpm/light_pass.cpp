@@ -20,6 +20,20 @@ namespace {
 // Domain separation of photon streams from pixel streams.
 constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
 
+// Appends backward photon g's entry for a photon (or a beam's nearest point) at squared distance d2
+// from its centre with `value`, to the list of the slot that owns its pixel. Returns the entry's
+// part of the photon's score for the guide (0 when prm.pixel_weight is not set).
+inline float add_entry(const BackwardPhoton& bp, uint32_t g, float d2, const Spectrum& value,
+                       const LightPassParams& prm, const std::vector<uint16_t>& owner,
+                       std::vector<std::vector<PhotonEntry>>& out) {
+  const float r2 = bp.radius * bp.radius;
+  const uint32_t bits =
+      (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
+  out[owner[bp.pixel]].push_back({g | bits, value});
+  if (!prm.pixel_weight) return 0;
+  return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
+}
+
 // Adds the entries of one diffuse hit (its query was counted when it was recorded). Returns the
 // sum of the entries' contributions to their pixels (per unit of 1 / N), each times the pixel's
 // weight, when prm.pixel_weight is set.
@@ -37,13 +51,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, h.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
-    const float d2 = length_squared(h.p - bp.p), r2 = bp.radius * bp.radius;
-    const uint32_t bits =
-        (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
-    out[owner[bp.pixel]].push_back({g | bits, value});
-    if (prm.pixel_weight)
-      score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
-               (kPi * bp.radius * bp.radius);
+    score += add_entry(bp, g, length_squared(h.p - bp.p), value, prm, owner, out);
   };
   // The backward photons found are fetched in groups before any is used: each record is likely a
   // cache miss, and their misses then overlap. They are used in the order the query found them.
@@ -422,13 +430,7 @@ float gather_beam(const RenderScene& scene, const BackwardMaps& maps, const Ligh
                      (henyey_greenstein(dot(bp.wo, b.ray.d), g_medium) *
                       hero_join_factor(bp.hero_only, b.hero_only));
     if (value.is_black()) continue;
-    const float d2 = length_squared(b.ray.o + b.ray.d * t - bp.p), r2 = bp.radius * bp.radius;
-    const uint32_t bits =
-        (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
-    out[owner[bp.pixel]].push_back({g | bits, value});
-    if (prm.pixel_weight)
-      score += (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] /
-               (kPi * bp.radius * bp.radius);
+    score += add_entry(bp, g, length_squared(b.ray.o + b.ray.d * t - bp.p), value, prm, owner, out);
   }
   return score;
 }
