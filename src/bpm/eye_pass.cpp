@@ -147,19 +147,14 @@ inline bool gather_in_medium(const EyePath& path, const PathVertex& v, PathState
                                               *path.prm.materials, path.rng, path.counters.rays);
   const bool last = diffuse == path.prm.diffuse_depth + 1;
   store_backward_photons(path, v, s, depth, diffuse, last);
-  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
-  const Vec3 wi = sample_henyey_greenstein(-v.wo, g, u);
-  const EmitterWeight w = EmitterWeight::mis(henyey_greenstein(dot(-v.wo, wi), g), v.sp.p);
+  const PhaseSample ps = sample_phase(v, g, path.rng);
   ++path.counters.rays.bounce_rays;
   if (last) {
-    PathState probe = s;
-    probe.ray = Ray{v.sp.p, wi, kInf};
-    PathVertex next;
-    next_eye_vertex(path.scene, *path.prm.materials, probe, next, path.counters.rays, w, L);
+    L += emission_by_phase(path.scene, *path.prm.materials, v, s, ps, path.counters.rays);
     return true;
   }
-  emitter = w;
-  s.ray = Ray{v.sp.p, wi, kInf};
+  emitter = ps.emitter;
+  s.ray = Ray{v.sp.p, ps.wi, kInf};
   return false;
 }
 

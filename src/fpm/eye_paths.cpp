@@ -185,13 +185,8 @@ inline void gather_in_medium(const FpmPath& path, const PathVertex& v, const Pat
   L += s.beta * sample_direct_light_in_medium(path.scene, v.sp.p, v.medium, -v.wo, g,
                                               *path.prm.materials, path.rng, path.c.rays);
   gather(not_direct_class);
-  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
-  const Vec3 wi = sample_henyey_greenstein(-v.wo, g, u);
-  PathState probe = s;
-  probe.ray = Ray{v.sp.p, wi, kInf};
-  PathVertex next;
-  next_eye_vertex(path.scene, *path.prm.materials, probe, next, path.c.rays,
-                  EmitterWeight::mis(henyey_greenstein(dot(-v.wo, wi), g), v.sp.p), L);
+  L += emission_by_phase(path.scene, *path.prm.materials, v, s, sample_phase(v, g, path.rng),
+                         path.c.rays);
   ++path.c.rays.bounce_rays;
 }
 

@@ -74,6 +74,31 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
   return end;
 }
 
+// A phase-function sample at the medium point v (its weight is 1), and how the emission its ray
+// finds counts: by the power heuristic against next-event estimation at v.
+struct PhaseSample {
+  Vec3 wi;
+  EmitterWeight emitter;
+};
+inline PhaseSample sample_phase(const PathVertex& v, float g, Rng& rng) {
+  const Vec2 u{rng.uniform(), rng.uniform()};
+  const Vec3 wi = sample_henyey_greenstein(-v.wo, g, u);
+  return {wi, EmitterWeight::mis(henyey_greenstein(dot(-v.wo, wi), g), v.sp.p)};
+}
+
+// The emission that the ray of a phase sample at v finds before it scatters again, weighted as
+// the sample says: at the last vertex in a medium of a photon method's camera path, the sample
+// only looks for the light (as direct_light_by_bsdf at a surface).
+inline Spectrum emission_by_phase(const RenderScene& scene, const WavelengthMaterials& materials,
+                                  const PathVertex& v, PathState s, const PhaseSample& ps,
+                                  PathCounters& counters) {
+  s.ray = Ray{v.sp.p, ps.wi, kInf};
+  PathVertex next;
+  Spectrum L;
+  next_eye_vertex(scene, materials, s, next, counters, ps.emitter, L);
+  return L;
+}
+
 // The direct light that a BSDF sample at the last vertex of a photon method's camera path finds
 // (next-event estimation alone has unbounded variance beside an area light: a lamp against a wall,
 // where the light's density over directions falls to nothing and its contribution does not):

@@ -18,10 +18,9 @@ void scatter_in_medium(const RenderScene& scene, const WavelengthMaterials& mate
   const HomogeneousMedium& m = scene.media[size_t(v.medium)];
   L += s.beta *
        sample_direct_light_in_medium(scene, v.sp.p, v.medium, -v.wo, m.g, materials, rng, counters);
-  const Vec2 u{rng.uniform(), rng.uniform()};
-  const Vec3 wi = sample_henyey_greenstein(-v.wo, m.g, u);
-  emitter = EmitterWeight::mis(henyey_greenstein(dot(-v.wo, wi), m.g), v.sp.p);
-  s.ray = Ray{v.sp.p, wi, kInf};
+  const PhaseSample ps = sample_phase(v, m.g, rng);
+  emitter = ps.emitter;
+  s.ray = Ray{v.sp.p, ps.wi, kInf};
   ++counters.bounce_rays;
 }
 
