@@ -535,20 +535,7 @@ TEST(Bpm, CurvesInAFurnaceMatchPath) {
 // r within r of the wall misses the beams beyond it (at most half its light), and that shell holds
 // at most 3 r / R of the medium's points: a bias within 1.5 r / R.
 TEST(Bpm, AlbedoOneFurnaceInAMedium) {
-  const LoadedScene ls = load(R"(LookAt 0 0 0  0 0 1  0 1 0
-MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
-  "rgb sigma_s" [1 1 1] "float g" 0.6
-MediumInterface "" "fog"
-Camera "perspective" "float fov" 60
-Film "rgb" "integer xresolution" 16 "integer yresolution" 16
-PixelFilter "box"
-Integrator "path" "integer maxdepth" 100
-WorldBegin
-MediumInterface "fog" ""
-AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
-Material "diffuse" "rgb reflectance" [0 0 0]
-Shape "sphere" "float radius" 1.5
-)");
+  const LoadedScene ls = load(test::albedo_one_furnace("1 1 1", 16));
   BpmSettings s;
   s.radius = 0.015f;  // world units
   const BlockStats m = image_mean(render_iterations(ls, "bpm", 64, 3, s));

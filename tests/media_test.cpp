@@ -132,20 +132,7 @@ AttributeEnd
 // scatters without absorbing (albedo 1, g = 0.6): the radiance inside is 1 everywhere and in every
 // direction, however often light scatters.
 TEST(Media, AlbedoOneFurnace) {
-  const LoadedScene ls = load(R"(LookAt 0 0 0  0 0 1  0 1 0
-MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
-  "rgb sigma_s" [1 1 1] "float g" 0.6
-MediumInterface "" "fog"
-Camera "perspective" "float fov" 60
-Film "rgb" "integer xresolution" 8 "integer yresolution" 8
-PixelFilter "box"
-Integrator "path" "integer maxdepth" 100
-WorldBegin
-MediumInterface "fog" ""
-AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
-Material "diffuse" "rgb reflectance" [0 0 0]
-Shape "sphere" "float radius" 1.5
-)");
+  const LoadedScene ls = load(test::albedo_one_furnace("1 1 1", 8));
   const Film film = render_path(ls, 256);
   const Image img = film.image();
   double mean = 0, var = 0;

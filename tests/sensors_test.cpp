@@ -193,25 +193,9 @@ AttributeEnd
 // has the radiance 1 everywhere and in every direction, so a sensor anywhere in it reads what it
 // reads in the same sphere empty.
 TEST(Sensors, PathSensorsInAnAlbedoOneFurnace) {
-  auto furnace = [](const std::string& medium) {
-    return R"(LookAt 0 0 0  0 0 1  0 1 0
-MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
-  "rgb sigma_s" [)" +
-           medium + R"(] "float g" 0.6
-MediumInterface "" "fog"
-Camera "perspective" "float fov" 60
-Film "rgb" "integer xresolution" 8 "integer yresolution" 8
-Integrator "path" "integer maxdepth" 100
-WorldBegin
-MediumInterface "fog" ""
-AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
-Material "diffuse" "rgb reflectance" [0 0 0]
-Shape "sphere" "float radius" 1.5
-)";
-  };
   const std::vector<Sensor> sensors = parse_sensors("0 0 0 0 0 1\n0.5 0.3 -0.8 1 0 0\n", "s.txt");
-  const Film empty = render_sensors(furnace("0 0 0"), sensors, 128);
-  const Film fog = render_sensors(furnace("1 1 1"), sensors, 512);
+  const Film empty = render_sensors(test::albedo_one_furnace("0 0 0", 8), sensors, 128);
+  const Film fog = render_sensors(test::albedo_one_furnace("1 1 1", 8), sensors, 512);
   for (size_t i = 0; i < sensors.size(); ++i) {
     const double e = std::hypot(fog.sensor_standard_error(i), empty.sensor_standard_error(i));
     EXPECT_NEAR(fog.sensor_mean(i), empty.sensor_mean(i), 4 * e) << "sensor " << i;

@@ -15,6 +15,31 @@ namespace bpm::test {
 
 inline LoadedScene load(const std::string& text) { return flatten_scene(parse_scene_string(text)); }
 
+// The albedo-1 furnace filled with a medium: a sphere of radius 1.5 whose wall emits radiance 1
+// (both sides) and reflects nothing, filled with a medium of the given "rgb sigma_s" values that
+// absorbs nothing (g 0.6), the camera at its centre in the medium (fov 60, res x res pixels, box
+// filter, maxdepth 100). With any sigma_s the radiance inside is 1 everywhere and in every
+// direction, however often light scatters.
+inline std::string albedo_one_furnace(const std::string& sigma_s, int res) {
+  const std::string r = std::to_string(res);
+  return R"(LookAt 0 0 0  0 0 1  0 1 0
+MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
+  "rgb sigma_s" [)" +
+         sigma_s + R"(] "float g" 0.6
+MediumInterface "" "fog"
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" )" +
+         r + " \"integer yresolution\" " + r + R"(
+PixelFilter "box"
+Integrator "path" "integer maxdepth" 100
+WorldBegin
+MediumInterface "fog" ""
+AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
+Material "diffuse" "rgb reflectance" [0 0 0]
+Shape "sphere" "float radius" 1.5
+)";
+}
+
 inline Film render_film(const LoadedScene& ls, int spp, int threads = 0, uint64_t seed = 1) {
   Film film(ls.film.width, ls.film.height);
   RenderOptions opt = quiet_options(ls, ls.render.integrator, spp, seed);
