@@ -426,7 +426,7 @@ float gather_beam(const RenderScene& scene, const BackwardMaps& maps, const Ligh
   for (const auto& [g, t] : found) {
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + b.bounces > prm.max_depth) continue;
-    Spectrum value = b.flux * medium_transmittance(scene, b.medium, t, prm.materials->wl) *
+    Spectrum value = b.flux * medium_transmittance(scene, b.medium, b.ray, t, prm.materials->wl) *
                      (henyey_greenstein(dot(bp.wo, b.ray.d), g_medium) *
                       hero_join_factor(bp.hero_only, b.hero_only));
     if (value.is_black()) continue;

@@ -66,7 +66,8 @@ bool not_direct_class(PhotonClass k) { return k != PhotonClass::kDirect; }
 // L over directions) from the volume map's photons of its medium and of the accepted classes:
 // sum p(cos) dPhi / (4/3 pi r^3 N sigma_s) (Jensen and Christensen 1998; the photons are stored
 // where they collide, with the weight sigma_s / sigma_t of the free flight, so their density is
-// sigma_s times the fluence's, and the eye path's own weight has its sigma_s), with the
+// sigma_s times the fluence's, and the eye path's own weight has its sigma_s; in a grid medium
+// each photon's flux is divided by the density where it collided), with the
 // Henyey-Greenstein phase function of asymmetry g; and the estimate of its bias from the photons
 // within the radius that holds half the sphere's volume, r 2^(-1/3): for a bias a r^2 it is
 // (L(r) - L(r 2^(-1/3))) / (1 - 2^(-2/3)).
@@ -171,7 +172,7 @@ inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, c
 // light (by MIS), the rest from the volume map; at x2 of a final gather, everything from it.
 inline void gather_in_medium(const FpmPath& path, const PathVertex& v, const PathState& s,
                              int depth, bool gathering, Spectrum& L, Spectrum& bias) {
-  const HomogeneousMedium& medium = path.scene.media[size_t(v.medium)];
+  const Medium& medium = path.scene.media[size_t(v.medium)];
   const float g = medium.g;
   const Spectrum sigma_s = medium.sigma_s.sample(path.prm.materials->wl);
   const float r = path.footprint.at(std::max(s.length, path.prm.medium_min_length)) * path.prm.k1;

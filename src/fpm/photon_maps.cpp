@@ -45,6 +45,11 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
             hit.cls,  hit.hero_only, int16_t(hit.medium)};
         ++lc.entries;
         if (hit.medium >= 0) {
+          // Collisions are as dense as sigma_s = density sigma_s(unit density) times the fluence:
+          // the density is divided out here, the rest where the map is gathered.
+          const float density = scene.media[size_t(hit.medium)].density(hit.sp.p);
+          if (!(density > 0)) return;
+          ph.flux = ph.flux * (1 / density);
           ch.volume.push_back(ph);
           return;
         }

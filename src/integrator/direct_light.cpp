@@ -8,10 +8,13 @@ namespace bpm {
 
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
                               bool infinite, const Wavelengths& wl) {
-  if (!scene.occluded(origin, target))
-    return medium < 0
-               ? Spectrum(1.0f)
-               : medium_transmittance(scene, medium, infinite ? kInf : length(target - origin), wl);
+  if (!scene.occluded(origin, target)) {
+    if (medium < 0) return Spectrum(1.0f);
+    const Vec3 d = target - origin;
+    const float len = length(d);
+    return medium_transmittance(scene, medium, Ray{origin, d / len, kInf}, infinite ? kInf : len,
+                                wl);
+  }
   if (!scene.has_interfaces) return {};
   Spectrum T(1.0f);
   Vec3 o = origin;
@@ -22,14 +25,14 @@ Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target
     const Ray r{o, d / len, len * (1 - 1e-4f)};
     Hit h;
     if (!scene.intersect(r, &h)) {
-      if (medium >= 0) T *= medium_transmittance(scene, medium, infinite ? kInf : len, wl);
+      if (medium >= 0) T *= medium_transmittance(scene, medium, r, infinite ? kInf : len, wl);
       return T;
     }
     const Object& obj = scene.objects[size_t(h.object)];
     if (!std::holds_alternative<InterfaceMaterial>(scene.materials[size_t(obj.material)]))
       return {};
     const SurfacePoint sp = scene.surface(r, h);
-    if (medium >= 0) T *= medium_transmittance(scene, medium, h.t, wl);
+    if (medium >= 0) T *= medium_transmittance(scene, medium, r, h.t, wl);
     if (T.is_black()) return T;
     medium = medium_toward(scene, h.object, sp.ng, r.d, medium);
     o = offset_origin(sp.p, sp.ng, r.d, sp.error);

@@ -15,7 +15,7 @@ namespace {
 void scatter_in_medium(const RenderScene& scene, const WavelengthMaterials& materials,
                        const PathVertex& v, PathState& s, Rng& rng, PathCounters& counters,
                        EmitterWeight& emitter, Spectrum& L) {
-  const HomogeneousMedium& m = scene.media[size_t(v.medium)];
+  const Medium& m = scene.media[size_t(v.medium)];
   L += s.beta *
        sample_direct_light_in_medium(scene, v.sp.p, v.medium, -v.wo, m.g, materials, rng, counters);
   const PhaseSample ps = sample_phase(v, m.g, rng);

@@ -48,8 +48,9 @@ struct PathVertex {
 
 enum class StepEnd { kVertex, kMedium, kEscaped, kAbsorbed };
 
-// Where a ray in a homogeneous scattering medium next scatters, before `distance` (kInf: none
-// ahead). The distance follows one wavelength's free flight, the wavelength drawn uniformly, and
+// Where a ray in a scattering medium next scatters, before `distance` (kInf: none ahead), all
+// measured in optical depth in density units (scene/medium.h: a homogeneous medium's is the
+// distance). The distance follows one wavelength's free flight, the wavelength drawn uniformly, and
 // the throughput is weighted by the mixture of all wavelengths' densities (one-sample MIS, the
 // balance heuristic: chromatic media stay unbiased at every wavelength): at a scattering point
 // beta *= sigma_s T(t) / p(t), past it beta *= T(distance) / P(t > distance). Returns the
@@ -104,11 +105,15 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
     const float distance = hit ? v.hit.t * length(s.ray.d) : kInf;
     if (s.medium >= 0 && scene.media[size_t(s.medium)].scatters()) {
       BPM_CHECK(s.rng);  // set by every path that may meet a scattering medium
-      const HomogeneousMedium& m = scene.media[size_t(s.medium)];
+      const Medium& m = scene.media[size_t(s.medium)];
       const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
-      in_medium(Ray{s.ray.o, normalize(s.ray.d), kInf}, distance, s.beta);
-      const float t = sample_medium_distance(sigma_t, sigma_s, distance, *s.rng, s.beta);
-      if (t >= 0) {
+      const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
+      in_medium(unit, distance, s.beta);
+      // The free flight in optical depth (density units), then as a distance (scene/medium.h).
+      const float tau =
+          sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance), *s.rng, s.beta);
+      const float t = tau >= 0 ? m.distance_at_depth(unit, tau, distance) : -1.0f;
+      if (tau >= 0 && t >= 0) {
         s.length += t;
         v.medium = s.medium;
         v.sp = SurfacePoint{};
@@ -119,11 +124,12 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       if (s.beta.is_black()) return StepEnd::kAbsorbed;
       if (!hit) return StepEnd::kEscaped;
     } else {
+      const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
       if (!hit) {
-        cross_medium(scene, s.medium, kInf, wl, s.beta);
+        cross_medium(scene, s.medium, unit, kInf, wl, s.beta);
         return StepEnd::kEscaped;
       }
-      if (!cross_medium(scene, s.medium, distance, wl, s.beta)) return StepEnd::kAbsorbed;
+      if (!cross_medium(scene, s.medium, unit, distance, wl, s.beta)) return StepEnd::kAbsorbed;
     }
     s.length += distance;
     v.sp = scene.surface(s.ray, v.hit);

@@ -118,7 +118,11 @@ void SensorDiscs::reach(const RenderScene& scene, const Wavelengths& wl, const P
   const float lift = sensor_lift(scene);
   if (scene.occluded(s.p + s.n * lift, x + s.n * lift)) return;
   Spectrum flux = seg.flux;
-  if (seg.medium >= 0) flux *= medium_transmittance(scene, seg.medium, t * length(seg.ray.d), wl);
+  if (seg.medium >= 0) {
+    const float len = length(seg.ray.d);
+    flux *=
+        medium_transmittance(scene, seg.medium, Ray{seg.ray.o, seg.ray.d / len, kInf}, t * len, wl);
+  }
   const float value = spectrum_to_luminance(flux, wl);
   if (!(value > 0) || !std::isfinite(value)) return;
   const float d2 = length_squared(x - s.p), r2 = radius(i) * radius(i);

@@ -95,8 +95,11 @@ class Flattener {
   MaterialDesc make_material(const SceneEntity& e);
   Bump make_bump(const SceneEntity& e);
   int add_material(const SceneEntity& e);
-  int medium_id(const std::string& name, const FileLoc& loc);
   int material_id(const MaterialRef& ref);
+
+  // The media shapes, lights and the camera refer to (flatten_media.cpp).
+  int medium_id(const std::string& name, const FileLoc& loc);
+  std::shared_ptr<const DensityGrid> density_grid(const MediumEntity& m);
 
   // Shapes and their area lights (flatten_shapes.cpp).
   static void check_indices(const std::vector<int>& idx, size_t n, const FileLoc& loc);

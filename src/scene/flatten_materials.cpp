@@ -1,5 +1,4 @@
-// Materials (pbrt-v4's, plus bpm's "phong") with their spectral and float parameters, and the
-// media shapes and lights refer to.
+// Materials (pbrt-v4's, plus bpm's "phong") with their spectral and float parameters.
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -288,45 +287,6 @@ MaterialDesc Flattener::make_material(const SceneEntity& e) {
   if (const Param* type = ps.find_any("type")) type->used = true;  // MakeNamedMaterial's own
   ps.warn_unused("material \"" + e.name + "\"");
   return m;
-}
-
-// The index of a named medium, -1 for "" (vacuum): pbrt-v4's "homogeneous" medium, absorbing
-// and scattering, with its defaults (sigma_a and sigma_s 1 per unit distance, times scale; g 0).
-// Other types, presets and emission are refused.
-int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
-  if (name.empty()) return -1;
-  if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
-  auto e = parsed_.media.find(name);
-  if (e == parsed_.media.end()) throw Error(loc, "unknown medium \"" + name + "\"");
-  const SceneEntity& m = e->second;
-  const ParamSet& ps = m.params;
-  auto unsupported = [&](const std::string& why) {
-    return Error(loc, "medium \"" + name + "\" (defined at " + m.loc.str() +
-                          ") is not supported: " + why + "; homogeneous media are");
-  };
-  if (m.name != "homogeneous") throw unsupported("type \"" + m.name + "\"");
-  if (const Param* p = ps.find_any("preset")) {
-    p->used = true;
-    throw unsupported("preset \"" + (p->strings.empty() ? std::string() : p->strings[0]) +
-                      "\" (give sigma_a and sigma_s instead)");
-  }
-  float scale = ps.get_float("scale", 1);
-  if (!(scale >= 0) || !std::isfinite(scale))
-    throw Error(m.loc, "medium scale must be a non-negative number");
-  auto Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
-  float le_scale = ps.get_float("Lescale", 1);
-  if (Le && !Le->is_black() && le_scale != 0) throw unsupported("it emits (Le)");
-  const float g = ps.get_float("g", 0);
-  if (!(g > -1 && g < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
-  auto sigma_a =
-      spectrum_curve(ps, "sigma_a", SpectrumKind::kUnbounded).value_or(SpectrumCurve(1.0f));
-  auto sigma_s =
-      spectrum_curve(ps, "sigma_s", SpectrumKind::kUnbounded).value_or(SpectrumCurve(1.0f));
-  if (!(sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
-  if (!(sigma_s.min_value() >= 0)) throw Error(m.loc, "sigma_s must not be negative");
-  ps.warn_unused("medium \"" + name + "\"");
-  scene().media.push_back(HomogeneousMedium{name, sigma_a.scaled(scale), sigma_s.scaled(scale), g});
-  return medium_ids_[name] = int(scene().media.size()) - 1;
 }
 
 // The index of a material in the render scene, made on first use; 0 (the default material) when

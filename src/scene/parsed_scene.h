@@ -46,6 +46,10 @@ struct ShapeEntity : SceneEntity {
   MediumRef medium;
 };
 
+struct MediumEntity : SceneEntity {
+  Transform world_from_medium;  // the transform in effect at MakeNamedMedium (grids' space)
+};
+
 struct LightEntity : SceneEntity {
   Transform world_from_light;
   MediumRef medium;
@@ -67,7 +71,7 @@ struct ParsedScene {
   std::vector<SceneEntity> materials;                  // anonymous Material directives
   std::map<std::string, SceneEntity> named_materials;  // MakeNamedMaterial
   std::vector<TextureEntity> textures;
-  std::map<std::string, SceneEntity> media;  // MakeNamedMedium; name is the "type" parameter
+  std::map<std::string, MediumEntity> media;  // MakeNamedMedium; name is the "type" parameter
   std::vector<ShapeEntity> shapes;
   std::vector<LightEntity> lights;
   std::string base_directory;      // of the main scene file

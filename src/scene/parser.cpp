@@ -365,7 +365,7 @@ class Parser {
       if (!type || type->strings.size() != 1)
         throw Error(d.loc, "medium \"" + name + "\" has no \"string type\"");
       type->used = true;
-      scene_->media[name] = SceneEntity{type->strings[0], std::move(ps), d.loc};
+      scene_->media[name] = MediumEntity{{type->strings[0], std::move(ps), d.loc}, gs_.ctm};
     } else if (k == "MediumInterface") {
       std::string inside = expect_string(d, "a medium name");
       std::string outside = inside;

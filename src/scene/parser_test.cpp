@@ -1398,6 +1398,36 @@ TEST(SceneParse, MediumDefaultAbsorption) {
   EXPECT_NEAR(ls.scene.media[0].sigma_a.value(650), 0.5f, 1e-6f);
 }
 
+// A preset names measured coefficients in mm^-1 (pbrt-v4's table), which "scale" multiplies.
+TEST(SceneParse, MediumPreset) {
+  const LoadedScene ls = flatten_scene(parse_scene_string(
+      "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"string preset\" \"Ketchup\" "
+      "\"float scale\" 2\nWorldBegin\nMediumInterface \"m\" \"\"\nShape \"sphere\"\n"));
+  ASSERT_EQ(ls.scene.media.size(), 1u);
+  const Rgb s = ls.scene.media[0].sigma_s.rgb(), a = ls.scene.media[0].sigma_a.rgb();
+  EXPECT_NEAR(s[0], 0.36f, 0.02f);
+  EXPECT_NEAR(s[2], 0.06f, 0.01f);
+  EXPECT_NEAR(a[1], 1.94f, 0.1f);
+  EXPECT_FALSE(ls.scene.media[0].grid);
+}
+
+// A uniformgrid's density lies on its box in the medium's space, interpolated between voxel
+// centres and zero past the outermost ones.
+TEST(SceneParse, UniformGridMedium) {
+  const LoadedScene ls = flatten_scene(parse_scene_string(
+      "WorldBegin\nTranslate 10 0 0\nMakeNamedMedium \"m\" \"string type\" \"uniformgrid\" "
+      "\"integer nx\" 2 \"float density\" [1 3] \"point3 p0\" [0 0 0] \"point3 p1\" [2 1 1]\n"
+      "MediumInterface \"m\" \"\"\nShape \"sphere\"\n"));
+  ASSERT_EQ(ls.scene.media.size(), 1u);
+  const Medium& m = ls.scene.media[0];
+  ASSERT_TRUE(m.grid);
+  EXPECT_NEAR(m.density({10.5f, 0.5f, 0.5f}), 1, 1e-5f);  // voxel centres
+  EXPECT_NEAR(m.density({11.5f, 0.5f, 0.5f}), 3, 1e-5f);
+  EXPECT_NEAR(m.density({11.0f, 0.5f, 0.5f}), 2, 1e-5f);
+  EXPECT_NEAR(m.density({10.5f, 0.0f, 0.5f}), 0.5f, 1e-5f);  // half way to the zeros beyond
+  EXPECT_EQ(m.density({0.5f, 0.5f, 0.5f}), 0);               // outside the box
+}
+
 TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
   auto scene = [](const std::string& medium_params,
                   const std::string& interface = "MediumInterface \"m\" \"\"") {
@@ -1409,14 +1439,25 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
               at(3, 1), "unknown medium \"nope\""));
   // A scattering homogeneous medium, pbrt-v4's defaults included, is read.
   EXPECT_EQ(error_of(scene("\"string type\" \"homogeneous\"")), "");
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"cloud\"")), at(3, 1), "type \"cloud\""));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"nanovdb\"")), at(3, 1), "NanoVDB"));
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"rgb sigma_s\" [0 0 0]")),
-                      at(3, 1), "type \"uniformgrid\""));
+                      at(1, 1), "uniformgrid medium needs \"float density\""));
+  const std::string short_grid =
+      "\"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [1]";
+  EXPECT_TRUE(IsError(error_of(scene(short_grid)), at(1, 20 + col(short_grid, "\"float density")),
+                      "uniformgrid has 1 density values; nx * ny * nz = 2"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [-1]")),
+                      at(1, 49), "density values must not be negative"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [1] "
+                                     "\"point3 p1\" [1 0 1]")),
+                      at(1, 69), "p1 must exceed p0"));
   EXPECT_TRUE(IsError(
       error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] \"rgb Le\" [1 1 1]")),
       at(3, 1), "it emits (Le)"));
-  EXPECT_TRUE(
-      IsError(error_of(scene("\"string type\" \"homogeneous\" \"string preset\" \"Apple\"")),
-              at(3, 1), "preset \"Apple\""));
+  EXPECT_EQ(error_of(scene("\"string type\" \"homogeneous\" \"string preset\" \"Apple\"")), "");
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"string preset\" \"Pear\"")),
+                      at(1, 49), "unknown medium preset \"Pear\"; known: \"Apple\""));
   const std::string bad_g = "\"string type\" \"homogeneous\" \"float g\" 1";
   EXPECT_TRUE(IsError(error_of(scene(bad_g)), at(1, 20 + col(bad_g, "\"float g")),
                       "g must lie in (-1, 1)"));

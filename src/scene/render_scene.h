@@ -12,20 +12,10 @@
 #include "lights/light.h"
 #include "materials/material.h"
 #include "scene/bump.h"
+#include "scene/medium.h"
 #include "scene/shapes.h"
 
 namespace bpm {
-
-// A homogeneous medium that absorbs and does not scatter or emit (pbrt-v4 "homogeneous" with
-// sigma_s = 0): light crossing a distance d in it keeps exp(-sigma_a d), wavelength by wavelength.
-// pbrt-v4's "homogeneous" medium: absorption and scattering coefficients (per unit distance,
-// the medium's "scale" applied) and the asymmetry g of its Henyey-Greenstein phase function.
-struct HomogeneousMedium {
-  std::string name;
-  SpectrumCurve sigma_a, sigma_s;
-  float g = 0;
-  bool scatters() const { return !sigma_s.is_black(); }
-};
 
 struct Object {
   Shape shape;
@@ -54,7 +44,7 @@ class RenderScene {
   std::vector<MaterialDesc> materials;
   TextureSet textures;      // the nodes textured materials read
   std::vector<Bump> bumps;  // per material (or fewer: none past the end)
-  std::vector<HomogeneousMedium> media;
+  std::vector<Medium> media;
   // Per light (or fewer: -1 past the end): the medium a light other than an area light sits in,
   // where its photons start (an area light's leave to the medium on their side of its surface).
   std::vector<int> light_medium;
@@ -65,7 +55,7 @@ class RenderScene {
   bool has_interfaces = false;
   // Whether any medium scatters.
   bool has_scattering_media() const {
-    for (const HomogeneousMedium& m : media)
+    for (const Medium& m : media)
       if (m.scatters()) return true;
     return false;
   }
@@ -148,25 +138,27 @@ inline int medium_toward(const RenderScene& scene, int object, Vec3 ng, Vec3 w, 
 // where none lies ahead.
 int medium_at(const RenderScene& scene, Vec3 p, Vec3 d, int outer);
 
-// The fraction of light that crosses `distance` in `medium` (-1: vacuum) at each wavelength
-// without being absorbed or scattered away: exp(-sigma_t distance).
-inline Spectrum medium_transmittance(const RenderScene& scene, int medium, float distance,
-                                     const Wavelengths& wl) {
+// The fraction of light that crosses `distance` along the unit ray in `medium` (-1: vacuum) at
+// each wavelength without being absorbed or scattered away: exp(-sigma_t tau), tau the medium's
+// optical depth in density units (scene/medium.h).
+inline Spectrum medium_transmittance(const RenderScene& scene, int medium, const Ray& ray,
+                                     float distance, const Wavelengths& wl) {
   Spectrum t(1.0f);
   if (medium < 0) return t;
-  const HomogeneousMedium& m = scene.media[size_t(medium)];
-  Spectrum sigma = m.sigma_a.sample(wl) + m.sigma_s.sample(wl);
+  const Medium& m = scene.media[size_t(medium)];
+  const Spectrum sigma = m.sigma_a.sample(wl) + m.sigma_s.sample(wl);
+  const float tau = m.depth(ray, 0, distance);
   for (int i = 0; i < Spectrum::kChannels; ++i)
-    if (sigma[i] > 0) t[i] = std::exp(-sigma[i] * distance);
+    if (sigma[i] > 0) t[i] = std::exp(-sigma[i] * tau);
   return t;
 }
 
-// Attenuates a path's throughput over a segment of `distance` in `medium`; false when nothing is
-// left of it.
-inline bool cross_medium(const RenderScene& scene, int medium, float distance,
+// Attenuates a path's throughput over `distance` along the unit ray in `medium`; false when
+// nothing is left of it.
+inline bool cross_medium(const RenderScene& scene, int medium, const Ray& ray, float distance,
                          const Wavelengths& wl, Spectrum& beta) {
   if (medium < 0) return true;
-  beta *= medium_transmittance(scene, medium, distance, wl);
+  beta *= medium_transmittance(scene, medium, ray, distance, wl);
   return !beta.is_black();
 }
 

@@ -1,0 +1,87 @@
+// The media shapes, lights and the camera refer to: pbrt-v4's "homogeneous" (with its named
+// presets) and "uniformgrid" media (scene/medium.h).
+#include <cmath>
+#include <string>
+
+#include "scene/flatten_internal.h"
+
+namespace bpm::flatten_internal {
+
+// pbrt-v4's "uniformgrid" density: nx x ny x nz non-negative values on the box [p0, p1] of the
+// medium's space (media.cpp, GridMedium::Create).
+std::shared_ptr<const DensityGrid> Flattener::density_grid(const MediumEntity& m) {
+  const ParamSet& ps = m.params;
+  const Param* density = ps.find("density", "float");
+  if (!density) throw Error(m.loc, "uniformgrid medium needs \"float density\" values");
+  const int nx = ps.get_int("nx", 1), ny = ps.get_int("ny", 1), nz = ps.get_int("nz", 1);
+  for (const char* n : {"nx", "ny", "nz"})
+    ps.require(n, ps.get_int(n, 1) >= 1, "must be at least 1", m.loc);
+  std::vector<float> values = ps.get_floats("density");
+  const uint64_t expected = uint64_t(nx) * uint64_t(ny) * uint64_t(nz);
+  if (values.size() != expected)
+    throw Error(density->loc, "uniformgrid has " + std::to_string(values.size()) +
+                                  " density values; nx * ny * nz = " + std::to_string(expected));
+  for (float v : values)
+    if (!(v >= 0)) throw Error(density->loc, "density values must not be negative");
+  const Vec3 p0 = ps.get_point3("p0", {0, 0, 0}), p1 = ps.get_point3("p1", {1, 1, 1});
+  ps.require("p1", p1.x > p0.x && p1.y > p0.y && p1.z > p0.z,
+             "must exceed p0 along every axis (the grid's box)", m.loc);
+  return std::make_shared<DensityGrid>(nx, ny, nz, std::move(values), p0, p1,
+                                       m.world_from_medium);
+}
+
+// The index of a named medium, -1 for "" (vacuum). Coefficients default to 1 per unit distance
+// (times "scale"), g to 0; a preset names measured coefficients in mm^-1. Other types and
+// emission are refused.
+int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
+  if (name.empty()) return -1;
+  if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
+  auto e = parsed_.media.find(name);
+  if (e == parsed_.media.end()) throw Error(loc, "unknown medium \"" + name + "\"");
+  const MediumEntity& m = e->second;
+  const ParamSet& ps = m.params;
+  auto unsupported = [&](const std::string& why) {
+    return Error(loc, "medium \"" + name + "\" (defined at " + m.loc.str() +
+                          ") is not supported: " + why +
+                          "; homogeneous and uniformgrid media are");
+  };
+  if (m.name == "nanovdb")
+    throw unsupported("type \"nanovdb\" (no NanoVDB reader is packaged with Debian's OpenVDB)");
+  if (m.name != "homogeneous" && m.name != "uniformgrid")
+    throw unsupported("type \"" + m.name + "\"");
+  const float scale = ps.get_float("scale", 1);
+  if (!(scale >= 0) || !std::isfinite(scale))
+    throw Error(m.loc, "medium scale must be a non-negative number");
+  auto Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
+  if (const Param* p = ps.find_any("Lescale")) p->used = true;
+  if (Le && !Le->is_black()) throw unsupported("it emits (Le)");
+  if (ps.find_any("temperature")) throw unsupported("it emits (temperature)");
+  const float g = ps.get_float("g", 0);
+  if (!(g > -1 && g < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
+  Medium medium{name, SpectrumCurve(1.0f), SpectrumCurve(1.0f), g, nullptr};
+  std::optional<SpectrumCurve> sigma_a, sigma_s;
+  const std::string preset = m.name == "homogeneous" ? ps.get_string("preset", "") : "";
+  if (!preset.empty()) {
+    Rgb s, a;
+    if (!medium_preset(preset, &s, &a))
+      throw Error(ps.find_any("preset")->loc,
+                  "unknown medium preset \"" + preset + "\"; known: " + medium_preset_names());
+    sigma_a = SpectrumCurve::from_rgb(a, SpectrumKind::kUnbounded);
+    sigma_s = SpectrumCurve::from_rgb(s, SpectrumKind::kUnbounded);
+  } else {
+    sigma_a = spectrum_curve(ps, "sigma_a", SpectrumKind::kUnbounded);
+    sigma_s = spectrum_curve(ps, "sigma_s", SpectrumKind::kUnbounded);
+  }
+  if (sigma_a) medium.sigma_a = *sigma_a;
+  if (sigma_s) medium.sigma_s = *sigma_s;
+  if (!(medium.sigma_a.min_value() >= 0)) throw Error(m.loc, "sigma_a must not be negative");
+  if (!(medium.sigma_s.min_value() >= 0)) throw Error(m.loc, "sigma_s must not be negative");
+  medium.sigma_a = medium.sigma_a.scaled(scale);
+  medium.sigma_s = medium.sigma_s.scaled(scale);
+  if (m.name == "uniformgrid") medium.grid = density_grid(m);
+  ps.warn_unused("medium \"" + name + "\"");
+  scene().media.push_back(std::move(medium));
+  return medium_ids_[name] = int(scene().media.size()) - 1;
+}
+
+}  // namespace bpm::flatten_internal

@@ -1,0 +1,76 @@
+// pbrt-v4's participating media as the integrators see them: absorption and scattering
+// coefficients per unit density, a Henyey-Greenstein phase function, and a density that is 1
+// everywhere ("homogeneous") or read from a grid of samples on a box ("uniformgrid").
+//
+// Everything the integrators need from a medium is its optical depth along a ray: light that
+// crosses it keeps exp(-sigma_t tau) with tau the integral of the density along the way, and a
+// free flight is drawn in tau (where the density only stretches distances) and mapped back to a
+// distance. pbrt-v4 interpolates the grid trilinearly between samples at voxel centres, zero
+// beyond the outermost ones (util/containers.h, SampledGrid::Lookup); along a straight line
+// through one cell of that lattice the density is then a cubic, whose integral Simpson's 3/8 rule
+// gives exactly. So depths, transmittances and free flights through a grid are exact (to
+// rounding) and cost no random numbers: the same estimators as in a homogeneous medium, only with
+// distances measured in tau.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "base/color.h"
+#include "base/ray.h"
+#include "base/transform.h"
+
+namespace bpm {
+
+// Density samples at the centres of nx x ny x nz voxels filling the box [p0, p1] of the medium's
+// space, x fastest (pbrt-v4's "uniformgrid" order).
+struct DensityGrid {
+  int nx = 1, ny = 1, nz = 1;
+  std::vector<float> values;
+  // World to lattice coordinates, where sample (i, j, k) sits at (i, j, k): the box spans
+  // [-0.5, n - 0.5] along each axis.
+  Transform lattice_from_world;
+
+  DensityGrid(int nx, int ny, int nz, std::vector<float> values, Vec3 p0, Vec3 p1,
+              const Transform& world_from_medium);
+  // A sample; 0 beyond the grid.
+  float at(int i, int j, int k) const {
+    if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz) return 0;
+    return values[(size_t(k) * size_t(ny) + size_t(j)) * size_t(nx) + size_t(i)];
+  }
+  // The density at a world point (0 outside the box).
+  float density(Vec3 p) const;
+  // The integral of the density along o + d t (d of unit length) over [t0, t1] (t1 may be kInf).
+  float depth(const Ray& ray, float t0, float t1) const;
+  // The distance t in [0, t_max] at which the depth from 0 reaches tau; negative when the depth up
+  // to t_max stays below it.
+  float distance_at_depth(const Ray& ray, float tau, float t_max) const;
+};
+
+struct Medium {
+  std::string name;
+  // Per unit density (pbrt-v4's "scale" applied).
+  SpectrumCurve sigma_a, sigma_s;
+  float g = 0;
+  std::shared_ptr<const DensityGrid> grid;  // none: density 1 everywhere
+
+  bool scatters() const { return !sigma_s.is_black(); }
+  float density(Vec3 p) const { return grid ? grid->density(p) : 1.0f; }
+  // The optical depth in density units along a unit ray over [t0, t1] (see the top of the file).
+  float depth(const Ray& ray, float t0, float t1) const {
+    return grid ? grid->depth(ray, t0, t1) : t1 - t0;
+  }
+  float distance_at_depth(const Ray& ray, float tau, float t_max) const {
+    if (grid) return grid->distance_at_depth(ray, tau, t_max);
+    return tau <= t_max ? tau : -1.0f;
+  }
+};
+
+// pbrt-v4's named scattering media (media.cpp, GetMediumScatteringProperties: Jensen et al. 2001,
+// Narasimhan et al. 2006): sigma_prime_s and sigma_a in mm^-1 as linear sRGB. False for an
+// unknown name.
+bool medium_preset(const std::string& name, Rgb* sigma_s, Rgb* sigma_a);
+// The preset names, comma-separated, for messages.
+std::string medium_preset_names();
+
+}  // namespace bpm

@@ -1,0 +1,75 @@
+#include "scene/medium.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "base/rng.h"
+
+namespace bpm {
+namespace {
+
+// A 3 x 4 x 5 grid of random densities on a rotated, shifted box.
+DensityGrid random_grid(uint64_t seed) {
+  Rng rng(seed);
+  std::vector<float> v(60);
+  for (float& x : v) x = rng.uniform() * 2;
+  const Transform world_from_medium =
+      Transform::translate({0.3f, -0.2f, 0.1f}) * Transform::rotate(30, {1, 2, 3});
+  return DensityGrid(3, 4, 5, std::move(v), {-1, -1, -1}, {1, 2, 1.5f}, world_from_medium);
+}
+
+// The midpoint rule with a million steps: the depth's integral, independently of the lattice.
+double numeric_depth(const DensityGrid& g, const Ray& r, float t0, float t1) {
+  const int n = 1000000;
+  double sum = 0;
+  const double h = double(t1 - t0) / n;
+  for (int i = 0; i < n; ++i) sum += g.density(r.o + r.d * float(t0 + (i + 0.5) * h));
+  return sum * h;
+}
+
+// Along any line the trilinear density is a cubic within each lattice cell, whose integral the
+// lattice walk gives exactly.
+TEST(DensityGrid, DepthIsTheIntegralOfTheDensity) {
+  const DensityGrid g = random_grid(7);
+  Rng rng(11);
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 o{rng.uniform() * 8 - 4, rng.uniform() * 8 - 4, rng.uniform() * 8 - 4};
+    const Vec3 target{rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f};
+    const Ray r{o, normalize(target - o), kInf};
+    const float t1 = length(target - o) + 3 * rng.uniform();
+    const double expected = numeric_depth(g, r, 0, t1);
+    EXPECT_NEAR(g.depth(r, 0, t1), expected, 1e-4 * (1 + expected)) << "ray " << i;
+    // Beyond the box nothing more is added; an infinite ray ends there too.
+    EXPECT_NEAR(g.depth(r, 0, kInf), g.depth(r, 0, 100), 1e-5);
+  }
+}
+
+// distance_at_depth inverts depth: the depth up to the distance found is the depth asked for.
+TEST(DensityGrid, DistanceAtDepthInvertsDepth) {
+  const DensityGrid g = random_grid(3);
+  const Ray r{{-4, 0.4f, 0.2f}, normalize(Vec3{1, 0.05f, -0.02f}), kInf};
+  const float total = g.depth(r, 0, 10);
+  ASSERT_GT(total, 1);
+  for (float f : {0.01f, 0.2f, 0.5f, 0.9f, 0.999f}) {
+    const float t = g.distance_at_depth(r, f * total, 10);
+    ASSERT_GE(t, 0);
+    EXPECT_NEAR(g.depth(r, 0, t), f * total, 1e-4f * total) << f;
+  }
+  EXPECT_LT(g.distance_at_depth(r, 1.01f * total, 10), 0);
+}
+
+// A grid of one value equals a homogeneous medium of that density where the lattice's cells are
+// all inside the outermost samples.
+TEST(DensityGrid, ConstantInsideTheOutermostSamples) {
+  const DensityGrid g(4, 4, 4, std::vector<float>(64, 0.5f), {0, 0, 0}, {4, 4, 4}, Transform());
+  const Ray r{{0.5f, 1, 2}, {1, 0, 0}, kInf};
+  EXPECT_NEAR(g.depth(r, 0.0f, 3.0f), 1.5f, 1e-6f);
+  EXPECT_NEAR(g.distance_at_depth(r, 0.75f, 3), 1.5f, 1e-5f);
+  // From the last sample's centre (x = 3.5, t = 3) to the box (x = 4) the density falls
+  // linearly toward the zero beyond: from 0.5 to 0.25, a mean of 0.375.
+  EXPECT_NEAR(g.depth(r, 3.0f, 3.5f), 0.5f * 0.375f, 1e-6f);
+}
+
+}  // namespace
+}  // namespace bpm
