@@ -597,6 +597,57 @@ AttributeEnd
                       "fog and glass, fpm");
 }
 
+// The same box filled with a uniformgrid medium instead (3 x 4 x 3 densities from 0 to 1.8 on a
+// box placed by the transform, chromatic coefficients) and a diffuse sphere in place of the glass
+// one: bpm's and fpm's free flights, beams and volume photons through a heterogeneous medium agree
+// with path's.
+TEST(Bpm, GridMediumMatchesPath) {
+  const LoadedScene ls = load(R"(LookAt 0 1 -4  0 1 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 24 "integer yresolution" 24
+PixelFilter "box"
+Integrator "path" "integer maxdepth" 6
+WorldBegin
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [20 20 20]
+  Material "diffuse" "rgb reflectance" [0 0 0]
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-0.4 2.95 -0.4  0.4 2.95 -0.4  0.4 2.95 0.4  -0.4 2.95 0.4]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-3 0 -3  3 0 -3  3 0 3  -3 0 3]
+AttributeBegin
+  Translate -1.5 0 -1.5
+  Scale 3 2.5 3
+  MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 3 "integer ny" 4 "integer nz" 3
+    "rgb sigma_a" [0.05 0.1 0.2] "rgb sigma_s" [0.8 0.7 0.6] "float g" 0.3
+    "float density" [0 0.5 1  1.8 0.2 0.7  0.3 0.3 1.2   0.9 0 0.4  1.5 1 0.1  0.6 0.8 0.2
+                     1 1 1  0 1.6 0.5  0.4 0.9 1.3   0.2 0.6 0  1.1 0.5 0.8  0.7 1.4 0.3]
+AttributeEnd
+AttributeBegin
+  MediumInterface "smoke" ""
+  Material "interface"
+  Shape "trianglemesh" "integer indices" [0 1 2 0 2 3  4 6 5 4 7 6  0 5 1 0 4 5  1 6 2 1 5 6  2 7 3 2 6 7  3 4 0 3 7 4]
+    "point3 P" [-1.5 0.01 -1.5  1.5 0.01 -1.5  1.5 0.01 1.5  -1.5 0.01 1.5  -1.5 2.5 -1.5  1.5 2.5 -1.5  1.5 2.5 1.5  -1.5 2.5 1.5]
+AttributeEnd
+AttributeBegin
+  MediumInterface "smoke" "smoke"
+  Material "diffuse" "rgb reflectance" [0.7 0.4 0.3]
+  Translate 0.3 1.2 0
+  Shape "sphere" "float radius" 0.4
+AttributeEnd
+)");
+  ASSERT_EQ(ls.scene.media.size(), 1u);
+  ASSERT_TRUE(ls.scene.media[0].grid);
+  const RenderRun ref = render_with(ls, "path", 2048, 0, 7);
+  const BpmSettings s;
+  expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, s), ref.film, 6, edge_bias(s, 24, 6),
+                      "grid medium, bpm");
+  FpmSettings f;
+  f.final_gather = false;
+  expect_blocks_agree(render_iterations(ls, "fpm", 24, 3, s, f), ref.film, 6, edge_bias(s, 24, 6),
+                      "grid medium, fpm");
+}
+
 // A furnace whose albedo is a checkerboard texture over the sphere's (u, v) (0.3 and 0.7, 8 x 4
 // cells: u follows the azimuth, v runs from the south pole to the north, as pbrt-v4). Inside a
 // sphere every point sees every other with the same form factor, so the radiance after at most D

@@ -146,6 +146,70 @@ TEST(Media, AlbedoOneFurnace) {
   EXPECT_LT(std::sqrt(var), 0.01);
 }
 
+// A grid of densities (a 3 x 3 x 3 pattern, zero included) on a box, rotated, around the
+// camera.
+const char* kGridMedium =
+    "\"string type\" \"uniformgrid\" \"integer nx\" 3 \"integer ny\" 3 \"integer nz\" 3 "
+    "\"point3 p0\" [-1.2 -1.1 -1] \"point3 p1\" [1 1.2 1.1] "
+    "\"float density\" [0 1 2 3 0.5 1 2 0 1  1 1 0.2 0 2 3 1 0.5 0  2 0 1 1 3 0.1 0.4 1 2]";
+
+// In a grid medium unscattered light keeps exp(-sigma_t tau), tau the integral of the density
+// along the pixel's ray (here by the midpoint rule over the medium's own trilinear density, not
+// the lattice walk under test). Chromatic, scattering, depth 0.
+TEST(Media, UnscatteredLightThroughAGridIsExpOfItsDepth) {
+  std::string scene = slab_scene(
+      std::string(kGridMedium) + " \"rgb sigma_a\" [0.3 0.3 0.3] \"rgb sigma_s\" [0.5 0.5 0.5]", 0);
+  const std::string homogeneous = "\"string type\" \"homogeneous\" ";
+  scene.replace(scene.find(homogeneous), homogeneous.size(), "");
+  const LoadedScene ls = load(scene);
+  ASSERT_TRUE(ls.scene.media.at(0).grid);
+  const Film f = render_path(ls, 64);
+  const Image img = f.image();
+  const std::vector<float> rms = f.rms();
+  const Camera cam(ls.camera, 12, 12);
+  int inside = 0;
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 12; ++x) {
+      const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
+      const Vec3 d = normalize(r.d);
+      const float b = dot(r.o, d), c = length_squared(r.o) - 1, disc = b * b - c;
+      if (disc < 0.05f) continue;  // grazing or outside the sphere
+      const float t0 = -b - std::sqrt(disc), t1 = -b + std::sqrt(disc);
+      double tau = 0;
+      const int n = 20000;
+      for (int i = 0; i < n; ++i)
+        tau += ls.scene.media[0].density(r.o + d * (t0 + (t1 - t0) * (float(i) + 0.5f) / n));
+      tau *= double(t1 - t0) / n;
+      EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-0.8 * tau),
+                  5 * rms[size_t(y) * 12 + x] + 1e-3f)
+          << x << "," << y << " tau " << tau;
+      ++inside;
+    }
+  EXPECT_GT(inside, 20);
+}
+
+// The albedo-1 furnace with a grid medium: free flights, shadow rays and phase sampling through
+// a heterogeneous medium keep radiance 1.
+TEST(Media, AlbedoOneFurnaceWithAGridMedium) {
+  const LoadedScene ls = load(test::albedo_one_furnace_of(
+      std::string(kGridMedium) +
+          " \"rgb sigma_a\" [0 0 0] \"rgb sigma_s\" [1.5 1 0.5] \"float g\" 0.6",
+      8));
+  ASSERT_TRUE(ls.scene.media.at(0).grid);
+  const Film film = render_path(ls, 256);
+  const Image img = film.image();
+  const std::vector<float> rms = film.rms();
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0, var = 0;
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        mean += img.at(x, y)[c] / 64;
+        var += double(rms[size_t(y) * 8 + x]) * rms[size_t(y) * 8 + x] / (64.0 * 64.0);
+      }
+    EXPECT_NEAR(mean, 1, 5 * std::sqrt(var) + 2e-3) << "channel " << c;
+  }
+}
+
 TEST(Media, PhotonMethodsRefuseSensorsInScatteringMedia) {
   LoadedScene ls = load(slab_scene("\"rgb sigma_s\" [0.5 0.5 0.5]", 3));
   for (const char* integrator : {"bpm", "fpm"}) {

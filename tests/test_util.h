@@ -19,13 +19,11 @@ inline LoadedScene load(const std::string& text) { return flatten_scene(parse_sc
 // (both sides) and reflects nothing, filled with a medium of the given "rgb sigma_s" values that
 // absorbs nothing (g 0.6), the camera at its centre in the medium (fov 60, res x res pixels, box
 // filter, maxdepth 100). With any sigma_s the radiance inside is 1 everywhere and in every
-// direction, however often light scatters.
-inline std::string albedo_one_furnace(const std::string& sigma_s, int res) {
+// direction, however often light scatters. albedo_one_furnace_of takes the whole medium (its
+// MakeNamedMedium parameters); any medium that absorbs nothing keeps that radiance.
+inline std::string albedo_one_furnace_of(const std::string& medium_params, int res) {
   const std::string r = std::to_string(res);
-  return R"(LookAt 0 0 0  0 0 1  0 1 0
-MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0 0 0]
-  "rgb sigma_s" [)" +
-         sigma_s + R"(] "float g" 0.6
+  return "LookAt 0 0 0  0 0 1  0 1 0\nMakeNamedMedium \"fog\" " + medium_params + R"(
 MediumInterface "" "fog"
 Camera "perspective" "float fov" 60
 Film "rgb" "integer xresolution" )" +
@@ -38,6 +36,13 @@ AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
 Material "diffuse" "rgb reflectance" [0 0 0]
 Shape "sphere" "float radius" 1.5
 )";
+}
+
+inline std::string albedo_one_furnace(const std::string& sigma_s, int res) {
+  return albedo_one_furnace_of(
+      "\"string type\" \"homogeneous\" \"rgb sigma_a\" [0 0 0] \"rgb sigma_s\" [" + sigma_s +
+          "] \"float g\" 0.6",
+      res);
 }
 
 inline Film render_film(const LoadedScene& ls, int spp, int threads = 0, uint64_t seed = 1) {

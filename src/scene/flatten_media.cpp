@@ -26,8 +26,7 @@ std::shared_ptr<const DensityGrid> Flattener::density_grid(const MediumEntity& m
   const Vec3 p0 = ps.get_point3("p0", {0, 0, 0}), p1 = ps.get_point3("p1", {1, 1, 1});
   ps.require("p1", p1.x > p0.x && p1.y > p0.y && p1.z > p0.z,
              "must exceed p0 along every axis (the grid's box)", m.loc);
-  return std::make_shared<DensityGrid>(nx, ny, nz, std::move(values), p0, p1,
-                                       m.world_from_medium);
+  return std::make_shared<DensityGrid>(nx, ny, nz, std::move(values), p0, p1, m.world_from_medium);
 }
 
 // The index of a named medium, -1 for "" (vacuum). Coefficients default to 1 per unit distance
@@ -42,8 +41,7 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   const ParamSet& ps = m.params;
   auto unsupported = [&](const std::string& why) {
     return Error(loc, "medium \"" + name + "\" (defined at " + m.loc.str() +
-                          ") is not supported: " + why +
-                          "; homogeneous and uniformgrid media are");
+                          ") is not supported: " + why + "; homogeneous and uniformgrid media are");
   };
   if (m.name == "nanovdb")
     throw unsupported("type \"nanovdb\" (no NanoVDB reader is packaged with Debian's OpenVDB)");

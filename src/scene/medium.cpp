@@ -14,8 +14,8 @@ DensityGrid::DensityGrid(int nx_, int ny_, int nz_, std::vector<float> values_, 
   BPM_CHECK(size_t(nx) * size_t(ny) * size_t(nz) == values.size());
   // Medium space -> [0, 1]^3 of the box -> lattice: n u - 0.5.
   const Vec3 size = p1 - p0;
-  const Transform unit = Transform::scale({1 / size.x, 1 / size.y, 1 / size.z}) *
-                         Transform::translate(-p0);
+  const Transform unit =
+      Transform::scale({1 / size.x, 1 / size.y, 1 / size.z}) * Transform::translate(-p0);
   lattice_from_world = Transform::translate({-0.5f, -0.5f, -0.5f}) *
                        Transform::scale({float(nx), float(ny), float(nz)}) * unit *
                        world_from_medium.inverse();
@@ -71,8 +71,7 @@ struct Piece {
 // Walks the lattice cells that o + d t crosses for t in [t0, t1], clipped to the box, and adds up
 // the depth piece by piece, up to `target` where that is >= 0. Returns the depth walked and
 // stores in *t_end where the walk ended: where it reached the target, else where it left the box.
-float march(const DensityGrid& g, const Ray& ray, float t0, float t1, float target,
-            float* t_end) {
+float march(const DensityGrid& g, const Ray& ray, float t0, float t1, float target, float* t_end) {
   *t_end = -1;
   const Vec3 go = g.lattice_from_world.point(ray.o), gd = g.lattice_from_world.vector(ray.d);
   const int n[3] = {g.nx, g.ny, g.nz};
@@ -103,8 +102,8 @@ float march(const DensityGrid& g, const Ray& ray, float t0, float t1, float targ
   }
   float depth = 0, t = ta;
   while (t < tb) {
-    const int a = t_next[0] < t_next[1] ? (t_next[0] < t_next[2] ? 0 : 2)
-                                        : (t_next[1] < t_next[2] ? 1 : 2);
+    const int a =
+        t_next[0] < t_next[1] ? (t_next[0] < t_next[2] ? 0 : 2) : (t_next[1] < t_next[2] ? 1 : 2);
     const float te = std::min(t_next[a], tb);
     if (te > t) {
       const Cell cell(g, c[0], c[1], c[2]);
