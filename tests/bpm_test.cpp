@@ -597,11 +597,11 @@ AttributeEnd
                       "fog and glass, fpm");
 }
 
-// The same box filled with a uniformgrid medium instead (3 x 4 x 3 densities from 0 to 1.8 on a
-// box placed by the transform, chromatic coefficients) and a diffuse sphere in place of the glass
-// one: bpm's and fpm's free flights, beams and volume photons through a heterogeneous medium agree
-// with path's.
-TEST(Bpm, GridMediumMatchesPath) {
+// The same box filled with a grid medium instead (3 x 4 x 3 voxels on a box placed by the
+// transform: a uniformgrid of densities from 0 to 1.8 with chromatic coefficients, or an rgbgrid
+// whose colours vary from voxel to voxel) and a diffuse sphere in place of the glass one: bpm's and
+// fpm's free flights, beams and volume photons through a heterogeneous medium agree with path's.
+void expect_grid_medium_matches_path(const std::string& medium, const char* what) {
   const LoadedScene ls = load(R"(LookAt 0 1 -4  0 1 0  0 1 0
 Camera "perspective" "float fov" 40
 Film "rgb" "integer xresolution" 24 "integer yresolution" 24
@@ -618,10 +618,8 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-3 0 -3  3 0 -3
 AttributeBegin
   Translate -1.5 0 -1.5
   Scale 3 2.5 3
-  MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 3 "integer ny" 4 "integer nz" 3
-    "rgb sigma_a" [0.05 0.1 0.2] "rgb sigma_s" [0.8 0.7 0.6] "float g" 0.3
-    "float density" [0 0.5 1  1.8 0.2 0.7  0.3 0.3 1.2   0.9 0 0.4  1.5 1 0.1  0.6 0.8 0.2
-                     1 1 1  0 1.6 0.5  0.4 0.9 1.3   0.2 0.6 0  1.1 0.5 0.8  0.7 1.4 0.3]
+  MakeNamedMedium "smoke" "integer nx" 3 "integer ny" 4 "integer nz" 3 "float g" 0.3
+)" + medium + R"(
 AttributeEnd
 AttributeBegin
   MediumInterface "smoke" ""
@@ -637,15 +635,36 @@ AttributeBegin
 AttributeEnd
 )");
   ASSERT_EQ(ls.scene.media.size(), 1u);
-  ASSERT_TRUE(ls.scene.media[0].grid);
+  ASSERT_TRUE(ls.scene.media[0].grid || ls.scene.media[0].rgb_grid);
   const RenderRun ref = render_with(ls, "path", 2048, 0, 7);
   const BpmSettings s;
   expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, s), ref.film, 6, edge_bias(s, 24, 6),
-                      "grid medium, bpm");
+                      std::string(what) + ", bpm");
   FpmSettings f;
   f.final_gather = false;
   expect_blocks_agree(render_iterations(ls, "fpm", 24, 3, s, f), ref.film, 6, edge_bias(s, 24, 6),
-                      "grid medium, fpm");
+                      std::string(what) + ", fpm");
+}
+
+TEST(Bpm, GridMediumMatchesPath) {
+  expect_grid_medium_matches_path(R"("string type" "uniformgrid"
+    "rgb sigma_a" [0.05 0.1 0.2] "rgb sigma_s" [0.8 0.7 0.6]
+    "float density" [0 0.5 1  1.8 0.2 0.7  0.3 0.3 1.2   0.9 0 0.4  1.5 1 0.1  0.6 0.8 0.2
+                     1 1 1  0 1.6 0.5  0.4 0.9 1.3   0.2 0.6 0  1.1 0.5 0.8  0.7 1.4 0.3])",
+                                  "uniformgrid");
+}
+
+TEST(Bpm, RgbGridMediumMatchesPath) {
+  std::string a, s;
+  for (int i = 0; i < 36; ++i) {
+    const float d = float((i * 7) % 11) / 10;  // 0 to 1, scattered over the voxels
+    a += std::to_string(0.05f * d) + " " + std::to_string(0.1f * (1 - d)) + " 0.15  ";
+    s += std::to_string(1.2f * d) + " " + std::to_string(0.6f) + " " +
+         std::to_string(0.9f * (1 - d)) + "  ";
+  }
+  expect_grid_medium_matches_path(
+      "\"string type\" \"rgbgrid\" \"rgb sigma_a\" [" + a + "]\n  \"rgb sigma_s\" [" + s + "]",
+      "rgbgrid");
 }
 
 // A furnace whose albedo is a checkerboard texture over the sphere's (u, v) (0.3 and 0.7, 8 x 4

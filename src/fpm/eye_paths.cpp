@@ -67,7 +67,8 @@ bool not_direct_class(PhotonClass k) { return k != PhotonClass::kDirect; }
 // sum p(cos) dPhi / (4/3 pi r^3 N sigma_s) (Jensen and Christensen 1998; the photons are stored
 // where they collide, with the weight sigma_s / sigma_t of the free flight, so their density is
 // sigma_s times the fluence's, and the eye path's own weight has its sigma_s; in a grid medium
-// each photon's flux is divided by the density where it collided), with the
+// each photon's flux is divided by the density (or an rgbgrid's sigma_s) where it collided), with
+// the
 // Henyey-Greenstein phase function of asymmetry g; and the estimate of its bias from the photons
 // within the radius that holds half the sphere's volume, r 2^(-1/3): for a bias a r^2 it is
 // (L(r) - L(r 2^(-1/3))) / (1 - 2^(-2/3)).

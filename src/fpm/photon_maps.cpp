@@ -47,9 +47,10 @@ uint64_t trace_forward_photons(const RenderScene& scene, const WavelengthMateria
         if (hit.medium >= 0) {
           // Collisions are as dense as sigma_s = density sigma_s(unit density) times the fluence:
           // the density is divided out here, the rest where the map is gathered.
-          const float density = scene.media[size_t(hit.medium)].density(hit.sp.p);
-          if (!(density > 0)) return;
-          ph.flux = ph.flux * (1 / density);
+          const Spectrum relative =
+              scene.media[size_t(hit.medium)].relative_scattering(hit.sp.p, wm.wl);
+          if (relative.is_black()) return;
+          ph.flux = ph.flux / relative;
           ch.volume.push_back(ph);
           return;
         }

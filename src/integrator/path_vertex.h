@@ -80,6 +80,37 @@ inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sig
   return -1;
 }
 
+// sample_medium_distance in an rgbgrid, whose sigma_t varies with the wavelength from point to
+// point: wavelength j's free flight drawn in its own optical depth, every wavelength weighted by
+// the mixture of their densities sigma_t(x) T(t). Returns the distance, or negative past it.
+inline float sample_rgb_grid_flight(const RgbGrid& g, const Ray& unit, float distance,
+                                    const Wavelengths& wl, Rng& rng, Spectrum& beta) {
+  constexpr int n = Spectrum::kChannels;
+  const int j = std::min(int(rng.uniform() * n), n - 1);
+  const float tau = -std::log1p(-rng.uniform());
+  Spectrum depth;  // up to the point drawn, or the whole way
+  const float t = g.flight(unit, j, tau, distance, wl, &depth);
+  if (t >= 0) {
+    Spectrum a, s;
+    g.coefficients(unit.o + unit.d * t, wl, &a, &s);
+    double p = 0;
+    for (int k = 0; k < n; ++k) p += (a[k] + s[k]) * std::exp(-double(depth[k]));
+    p /= n;
+    for (int k = 0; k < n; ++k)
+      beta[k] = p > 0 ? float(beta[k] * s[k] * std::exp(-double(depth[k])) / p) : 0.0f;
+    return t;
+  }
+  double P = 0;
+  Spectrum T;
+  for (int k = 0; k < n; ++k) {
+    T[k] = float(std::exp(-double(depth[k])));
+    P += T[k];
+  }
+  P /= n;
+  for (int k = 0; k < n; ++k) beta[k] = P > 0 ? float(beta[k] * T[k] / P) : 0.0f;
+  return -1;
+}
+
 // What a path reports of the pieces of its rays that cross a scattering medium: none.
 struct NoMediumPieces {
   void operator()(const Ray&, float, const Spectrum&) const {}
@@ -109,11 +140,16 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
       const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
       in_medium(unit, distance, s.beta);
-      // The free flight in optical depth (density units), then as a distance (scene/medium.h).
-      const float tau =
-          sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance), *s.rng, s.beta);
-      const float t = tau >= 0 ? m.distance_at_depth(unit, tau, distance) : -1.0f;
-      if (tau >= 0 && t >= 0) {
+      float t = -1;
+      if (m.rgb_grid) {
+        t = sample_rgb_grid_flight(*m.rgb_grid, unit, distance, wl, *s.rng, s.beta);
+      } else {
+        // The free flight in optical depth (density units), then as a distance (scene/medium.h).
+        const float tau =
+            sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance), *s.rng, s.beta);
+        if (tau >= 0) t = m.distance_at_depth(unit, tau, distance);
+      }
+      if (t >= 0) {
         s.length += t;
         v.medium = s.medium;
         v.sp = SurfacePoint{};

@@ -100,6 +100,7 @@ class Flattener {
   // The media shapes, lights and the camera refer to (flatten_media.cpp).
   int medium_id(const std::string& name, const FileLoc& loc);
   std::shared_ptr<const DensityGrid> density_grid(const MediumEntity& m);
+  std::shared_ptr<const RgbGrid> rgb_grid(const MediumEntity& m, float scale);
 
   // Shapes and their area lights (flatten_shapes.cpp).
   static void check_indices(const std::vector<int>& idx, size_t n, const FileLoc& loc);

@@ -1,5 +1,5 @@
 // The media shapes, lights and the camera refer to: pbrt-v4's "homogeneous" (with its named
-// presets) and "uniformgrid" media (scene/medium.h).
+// presets), "uniformgrid" and "rgbgrid" media (scene/medium.h).
 #include <cmath>
 #include <string>
 
@@ -29,6 +29,41 @@ std::shared_ptr<const DensityGrid> Flattener::density_grid(const MediumEntity& m
   return std::make_shared<DensityGrid>(nx, ny, nz, std::move(values), p0, p1, m.world_from_medium);
 }
 
+// pbrt-v4's "rgbgrid": per voxel "rgb sigma_a" and "rgb sigma_s" colours (either may be absent:
+// 1 everywhere), nx x ny x nz of each, on the box [p0, p1], times "scale" (media.cpp,
+// RGBGridMedium::Create).
+std::shared_ptr<const RgbGrid> Flattener::rgb_grid(const MediumEntity& m, float scale) {
+  const ParamSet& ps = m.params;
+  const int nx = ps.get_int("nx", 1), ny = ps.get_int("ny", 1), nz = ps.get_int("nz", 1);
+  for (const char* n : {"nx", "ny", "nz"})
+    ps.require(n, ps.get_int(n, 1) >= 1, "must be at least 1", m.loc);
+  const uint64_t expected = uint64_t(nx) * uint64_t(ny) * uint64_t(nz);
+  auto colours = [&](const char* name) {
+    std::vector<Rgb> out;
+    const Param* p = ps.find(name, "rgb");
+    if (!p) return out;
+    p->used = true;
+    if (p->numbers.size() != 3 * expected)
+      throw Error(p->loc, std::string("rgbgrid has ") + std::to_string(p->numbers.size() / 3) +
+                              " " + name + " colours; nx * ny * nz = " + std::to_string(expected));
+    for (size_t i = 0; i < expected; ++i) {
+      const Rgb c(float(p->numbers[3 * i]), float(p->numbers[3 * i + 1]),
+                  float(p->numbers[3 * i + 2]));
+      if (!(c.min_component() >= 0) || !c.is_finite())
+        throw Error(p->loc, std::string(name) + " colours must be finite and not negative");
+      out.push_back(c);
+    }
+    return out;
+  };
+  const std::vector<Rgb> a = colours("sigma_a"), s = colours("sigma_s");
+  if (a.empty() && s.empty())
+    throw Error(m.loc, "rgbgrid medium needs \"rgb sigma_a\" or \"rgb sigma_s\" values");
+  const Vec3 p0 = ps.get_point3("p0", {0, 0, 0}), p1 = ps.get_point3("p1", {1, 1, 1});
+  ps.require("p1", p1.x > p0.x && p1.y > p0.y && p1.z > p0.z,
+             "must exceed p0 along every axis (the grid's box)", m.loc);
+  return std::make_shared<RgbGrid>(nx, ny, nz, a, s, scale, p0, p1, m.world_from_medium);
+}
+
 // The index of a named medium, -1 for "" (vacuum). Coefficients default to 1 per unit distance
 // (times "scale"), g to 0; a preset names measured coefficients in mm^-1. Other types and
 // emission are refused.
@@ -41,22 +76,31 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   const ParamSet& ps = m.params;
   auto unsupported = [&](const std::string& why) {
     return Error(loc, "medium \"" + name + "\" (defined at " + m.loc.str() +
-                          ") is not supported: " + why + "; homogeneous and uniformgrid media are");
+                          ") is not supported: " + why +
+                          "; homogeneous, uniformgrid and rgbgrid media are");
   };
   if (m.name == "nanovdb")
     throw unsupported("type \"nanovdb\" (no NanoVDB reader is packaged with Debian's OpenVDB)");
-  if (m.name != "homogeneous" && m.name != "uniformgrid")
+  if (m.name != "homogeneous" && m.name != "uniformgrid" && m.name != "rgbgrid")
     throw unsupported("type \"" + m.name + "\"");
   const float scale = ps.get_float("scale", 1);
   if (!(scale >= 0) || !std::isfinite(scale))
     throw Error(m.loc, "medium scale must be a non-negative number");
-  auto Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
+  auto Le =
+      m.name == "rgbgrid" ? std::nullopt : spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
+  if (m.name == "rgbgrid" && ps.find_any("Le")) throw unsupported("it emits (Le)");
   if (const Param* p = ps.find_any("Lescale")) p->used = true;
   if (Le && !Le->is_black()) throw unsupported("it emits (Le)");
   if (ps.find_any("temperature")) throw unsupported("it emits (temperature)");
   const float g = ps.get_float("g", 0);
   if (!(g > -1 && g < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
-  Medium medium{name, SpectrumCurve(1.0f), SpectrumCurve(1.0f), g, nullptr};
+  Medium medium{name, SpectrumCurve(1.0f), SpectrumCurve(1.0f), g, nullptr, nullptr};
+  if (m.name == "rgbgrid") {
+    medium.rgb_grid = rgb_grid(m, scale);
+    ps.warn_unused("medium \"" + name + "\"");
+    scene().media.push_back(std::move(medium));
+    return medium_ids_[name] = int(scene().media.size()) - 1;
+  }
   std::optional<SpectrumCurve> sigma_a, sigma_s;
   const std::string preset = m.name == "homogeneous" ? ps.get_string("preset", "") : "";
   if (!preset.empty()) {

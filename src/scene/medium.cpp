@@ -8,78 +8,95 @@
 
 namespace bpm {
 
-DensityGrid::DensityGrid(int nx_, int ny_, int nz_, std::vector<float> values_, Vec3 p0, Vec3 p1,
-                         const Transform& world_from_medium)
-    : nx(nx_), ny(ny_), nz(nz_), values(std::move(values_)) {
-  BPM_CHECK(size_t(nx) * size_t(ny) * size_t(nz) == values.size());
-  // Medium space -> [0, 1]^3 of the box -> lattice: n u - 0.5.
+namespace {
+
+// World to lattice coordinates for nx x ny x nz samples at the voxel centres of the box [p0, p1]
+// of the medium's space: [0, 1]^3 of the box, then n u - 0.5.
+Transform lattice_transform(int nx, int ny, int nz, Vec3 p0, Vec3 p1,
+                            const Transform& world_from_medium) {
   const Vec3 size = p1 - p0;
   const Transform unit =
       Transform::scale({1 / size.x, 1 / size.y, 1 / size.z}) * Transform::translate(-p0);
-  lattice_from_world = Transform::translate({-0.5f, -0.5f, -0.5f}) *
-                       Transform::scale({float(nx), float(ny), float(nz)}) * unit *
-                       world_from_medium.inverse();
+  return Transform::translate({-0.5f, -0.5f, -0.5f}) *
+         Transform::scale({float(nx), float(ny), float(nz)}) * unit * world_from_medium.inverse();
 }
 
-namespace {
+float axis(Vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
 
-// The 8 samples around one cell of the lattice, and the density at a point of it (f: the point's
-// offset from the cell's lowest corner, in [0, 1]^3).
+// The 8 samples around one cell of the lattice (a float or a Spectrum each), and the value at a
+// point of it (f: the point's offset from the cell's lowest corner, in [0, 1]^3).
+template <class T>
 struct Cell {
-  std::array<float, 8> v;  // index: x + 2 y + 4 z
-  Cell(const DensityGrid& g, int i, int j, int k) {
-    for (int c = 0; c < 8; ++c) v[size_t(c)] = g.at(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
+  std::array<T, 8> v;  // index: x + 2 y + 4 z
+  template <class Sample>
+  Cell(int i, int j, int k, Sample&& sample) {
+    for (int c = 0; c < 8; ++c)
+      v[size_t(c)] = sample(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2));
   }
-  float at(Vec3 f) const {
+  T at(Vec3 f) const {
     f = {std::clamp(f.x, 0.0f, 1.0f), std::clamp(f.y, 0.0f, 1.0f), std::clamp(f.z, 0.0f, 1.0f)};
-    auto lerp = [](float t, float a, float b) { return a + t * (b - a); };
-    const float x00 = lerp(f.x, v[0], v[1]), x10 = lerp(f.x, v[2], v[3]);
-    const float x01 = lerp(f.x, v[4], v[5]), x11 = lerp(f.x, v[6], v[7]);
+    auto lerp = [](float t, const T& a, const T& b) { return a + (b - a) * t; };
+    const T x00 = lerp(f.x, v[0], v[1]), x10 = lerp(f.x, v[2], v[3]);
+    const T x01 = lerp(f.x, v[4], v[5]), x11 = lerp(f.x, v[6], v[7]);
     return lerp(f.z, lerp(f.y, x00, x10), lerp(f.y, x01, x11));
   }
 };
 
-float axis(Vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
-
-// The density along a piece of a ray inside one lattice cell, a cubic in s in [0, 1] given by its
-// values at s = 0, 1/3, 2/3, 1; h is the piece's length. Its integral over the piece is Simpson's
-// 3/8 rule; the integral up to s comes from the cubic's coefficients in x = 3 s (Newton's forward
-// differences).
-struct Piece {
-  float h;
-  std::array<float, 4> y;
-  float total() const { return h * (y[0] + 3 * y[1] + 3 * y[2] + y[3]) / 8; }
-  float up_to(float s) const {
-    const float d1 = y[1] - y[0], d2 = y[2] - 2 * y[1] + y[0],
-                d3 = y[3] - 3 * y[2] + 3 * y[1] - y[0];
-    const float c0 = y[0], c1 = d1 - d2 / 2 + d3 / 3, c2 = d2 / 2 - d3 / 2, c3 = d3 / 6;
-    const float x = 3 * s;
-    return h / 3 * x * (c0 + x * (c1 / 2 + x * (c2 / 3 + x * c3 / 4)));
+// A straight piece of a ray inside one lattice cell: the cell, and t from ta to tb.
+struct LatticePiece {
+  int c[3];
+  float ta, tb;
+  Vec3 go, gd;  // the ray in lattice coordinates
+  // The point at a fraction s of the piece, relative to the cell's lowest corner.
+  Vec3 at(float s) const {
+    return go + gd * (ta + (tb - ta) * s) - Vec3{float(c[0]), float(c[1]), float(c[2])};
   }
-  // The s at which up_to(s) reaches `depth` (0 <= depth <= total()): by bisection, since the
-  // integral of a non-negative density never decreases.
-  float solve(float depth) const {
-    float lo = 0, hi = 1;
-    for (int i = 0; i < 30; ++i) {
-      const float mid = 0.5f * (lo + hi);
-      (up_to(mid) < depth ? lo : hi) = mid;
-    }
-    return 0.5f * (lo + hi);
+  // The piece's values at s = 0, 1/3, 2/3, 1 (a cubic along it) and their integral over it,
+  // Simpson's 3/8 rule (exact for a cubic).
+  template <class T>
+  std::array<T, 4> values(const Cell<T>& cell) const {
+    return {cell.at(at(0)), cell.at(at(1.0f / 3)), cell.at(at(2.0f / 3)), cell.at(at(1))};
+  }
+  template <class T>
+  T integral(const std::array<T, 4>& y) const {
+    return (y[0] + (y[1] + y[2]) * 3 + y[3]) * ((tb - ta) / 8);
   }
 };
 
-// Walks the lattice cells that o + d t crosses for t in [t0, t1], clipped to the box, and adds up
-// the depth piece by piece, up to `target` where that is >= 0. Returns the depth walked and
-// stores in *t_end where the walk ended: where it reached the target, else where it left the box.
-float march(const DensityGrid& g, const Ray& ray, float t0, float t1, float target, float* t_end) {
-  *t_end = -1;
-  const Vec3 go = g.lattice_from_world.point(ray.o), gd = g.lattice_from_world.vector(ray.d);
-  const int n[3] = {g.nx, g.ny, g.nz};
+// The integral up to s of a cubic on [0, 1] of length h given by its values at s = 0, 1/3, 2/3, 1
+// (its coefficients in x = 3 s from Newton's forward differences), and the s at which that
+// reaches `depth` (by bisection: the integral of a non-negative function never decreases).
+float cubic_integral_up_to(const std::array<float, 4>& y, float h, float s) {
+  const float d1 = y[1] - y[0], d2 = y[2] - 2 * y[1] + y[0], d3 = y[3] - 3 * y[2] + 3 * y[1] - y[0];
+  const float c0 = y[0], c1 = d1 - d2 / 2 + d3 / 3, c2 = d2 / 2 - d3 / 2, c3 = d3 / 6;
+  const float x = 3 * s;
+  return h / 3 * x * (c0 + x * (c1 / 2 + x * (c2 / 3 + x * c3 / 4)));
+}
+float cubic_solve(const std::array<float, 4>& y, float h, float depth) {
+  float lo = 0, hi = 1;
+  for (int i = 0; i < 30; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (cubic_integral_up_to(y, h, mid) < depth ? lo : hi) = mid;
+  }
+  return 0.5f * (lo + hi);
+}
+
+// Calls visit(const LatticePiece&) for each piece of o + d t, t in [t0, t1] clipped to the box of
+// an n[0] x n[1] x n[2] lattice, that lies in one cell, in order, until visit returns false.
+// Returns where the walk ended: where visit stopped (the piece's start), or where the ray leaves
+// the box; negative when it misses the box.
+template <class Visit>
+float walk_lattice(const Transform& lattice_from_world, const int n[3], const Ray& ray, float t0,
+                   float t1, Visit&& visit) {
+  LatticePiece piece;
+  piece.go = lattice_from_world.point(ray.o);
+  piece.gd = lattice_from_world.vector(ray.d);
+  const Vec3 go = piece.go, gd = piece.gd;
   float ta = std::max(t0, 0.0f), tb = t1;
   for (int a = 0; a < 3; ++a) {
     const float o = axis(go, a), d = axis(gd, a), lo = -0.5f, hi = float(n[a]) - 0.5f;
     if (d == 0) {
-      if (o < lo || o > hi) return 0;
+      if (o < lo || o > hi) return -1;
       continue;
     }
     float e0 = (lo - o) / d, e1 = (hi - o) / d;
@@ -87,10 +104,10 @@ float march(const DensityGrid& g, const Ray& ray, float t0, float t1, float targ
     ta = std::max(ta, e0);
     tb = std::min(tb, e1);
   }
-  if (!(ta < tb)) return 0;
-  int c[3];
+  if (!(ta < tb)) return -1;
   float t_next[3], t_step[3];
   int step[3];
+  int* c = piece.c;
   for (int a = 0; a < 3; ++a) {
     const float o = axis(go, a), d = axis(gd, a), p = o + d * ta;
     c[a] = int(std::floor(p));
@@ -100,57 +117,203 @@ float march(const DensityGrid& g, const Ray& ray, float t0, float t1, float targ
     t_step[a] = d != 0 ? std::fabs(1 / d) : kInf;
     t_next[a] = d > 0 ? (float(c[a] + 1) - o) / d : d < 0 ? (float(c[a]) - o) / d : kInf;
   }
-  float depth = 0, t = ta;
+  float t = ta;
   while (t < tb) {
     const int a =
         t_next[0] < t_next[1] ? (t_next[0] < t_next[2] ? 0 : 2) : (t_next[1] < t_next[2] ? 1 : 2);
     const float te = std::min(t_next[a], tb);
     if (te > t) {
-      const Cell cell(g, c[0], c[1], c[2]);
-      const Vec3 corner{float(c[0]), float(c[1]), float(c[2])};
-      Piece piece{te - t, {}};
-      for (int i = 0; i < 4; ++i)
-        piece.y[size_t(i)] = cell.at(go + gd * (t + piece.h * float(i) / 3) - corner);
-      const float add = piece.total();
-      if (target >= 0 && depth + add >= target) {
-        *t_end = t + piece.h * piece.solve(target - depth);
-        return target;
-      }
-      depth += add;
+      piece.ta = t;
+      piece.tb = te;
+      if (!visit(piece)) return t;
     }
     t = te;
     c[a] += step[a];
     if (c[a] < -1 || c[a] >= n[a]) break;
     t_next[a] += t_step[a];
   }
-  *t_end = tb;
-  return depth;
+  return tb;
+}
+
+// The lattice cell that holds a lattice point, or false outside the box.
+bool cell_of(Vec3 q, const int n[3], int c[3]) {
+  for (int a = 0; a < 3; ++a) {
+    const float x = axis(q, a);
+    if (!(x >= -0.5f && x <= float(n[a]) - 0.5f)) return false;
+    c[a] = std::clamp(int(std::floor(x)), -1, n[a] - 1);
+  }
+  return true;
 }
 
 }  // namespace
+
+DensityGrid::DensityGrid(int nx_, int ny_, int nz_, std::vector<float> values_, Vec3 p0, Vec3 p1,
+                         const Transform& world_from_medium)
+    : nx(nx_),
+      ny(ny_),
+      nz(nz_),
+      values(std::move(values_)),
+      lattice_from_world(lattice_transform(nx_, ny_, nz_, p0, p1, world_from_medium)) {
+  BPM_CHECK(size_t(nx) * size_t(ny) * size_t(nz) == values.size());
+}
 
 float DensityGrid::density(Vec3 p) const {
   const Vec3 q = lattice_from_world.point(p);
   const int n[3] = {nx, ny, nz};
   int c[3];
-  for (int a = 0; a < 3; ++a) {
-    const float x = axis(q, a);
-    if (!(x >= -0.5f && x <= float(n[a]) - 0.5f)) return 0;
-    c[a] = std::clamp(int(std::floor(x)), -1, n[a] - 1);
-  }
-  return Cell(*this, c[0], c[1], c[2]).at(q - Vec3{float(c[0]), float(c[1]), float(c[2])});
+  if (!cell_of(q, n, c)) return 0;
+  const Cell<float> cell(c[0], c[1], c[2], [&](int i, int j, int k) { return at(i, j, k); });
+  return cell.at(q - Vec3{float(c[0]), float(c[1]), float(c[2])});
 }
 
 float DensityGrid::depth(const Ray& ray, float t0, float t1) const {
-  float t_end;
-  return march(*this, ray, t0, t1, -1, &t_end);
+  const int n[3] = {nx, ny, nz};
+  float depth = 0;
+  walk_lattice(lattice_from_world, n, ray, t0, t1, [&](const LatticePiece& p) {
+    const Cell<float> cell(p.c[0], p.c[1], p.c[2],
+                           [&](int i, int j, int k) { return at(i, j, k); });
+    depth += p.integral(p.values(cell));
+    return true;
+  });
+  return depth;
 }
 
 float DensityGrid::distance_at_depth(const Ray& ray, float tau, float t_max) const {
-  float t_end;
-  const float walked = march(*this, ray, 0, t_max, tau, &t_end);
+  const int n[3] = {nx, ny, nz};
+  float depth = 0, t = -1;
+  const float end = walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
+    const Cell<float> cell(p.c[0], p.c[1], p.c[2],
+                           [&](int i, int j, int k) { return at(i, j, k); });
+    const std::array<float, 4> y = p.values(cell);
+    const float add = p.integral(y);
+    if (depth + add >= tau) {
+      t = p.ta + (p.tb - p.ta) * cubic_solve(y, p.tb - p.ta, tau - depth);
+      return false;
+    }
+    depth += add;
+    return true;
+  });
+  if (t >= 0) return t;
   // A depth drawn below the whole way's (as computed before) may miss it by rounding.
-  return walked >= tau * (1 - 1e-5f) ? t_end : -1.0f;
+  return end >= 0 && depth >= tau * (1 - 1e-5f) ? end : -1.0f;
+}
+
+RgbGrid::RgbGrid(int nx_, int ny_, int nz_, const std::vector<Rgb>& a, const std::vector<Rgb>& s,
+                 float scale_, Vec3 p0, Vec3 p1, const Transform& world_from_medium)
+    : nx(nx_),
+      ny(ny_),
+      nz(nz_),
+      scale(scale_),
+      lattice_from_world(lattice_transform(nx_, ny_, nz_, p0, p1, world_from_medium)) {
+  // As SpectrumCurve::from_rgb's unbounded colours: the largest channel scaled to 0.5.
+  auto voxels = [](const std::vector<Rgb>& rgb) {
+    std::vector<Voxel> v(rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i) {
+      const float m = rgb[i].max_component();
+      if (!(m > 0)) continue;
+      v[i].scale = 2 * m;
+      v[i].coeff = sigmoid_coefficients_lookup(rgb[i] / (2 * m));
+    }
+    return v;
+  };
+  sigma_a = voxels(a);
+  sigma_s = voxels(s);
+  scatters = scale > 0 && (s.empty() || std::any_of(s.begin(), s.end(), [](const Rgb& c) {
+                             return c.max_component() > 0;
+                           }));
+}
+
+namespace {
+
+// One voxel's colour at the wavelengths, times `scale`; 1 where the grid gives none, 0 beyond it.
+Spectrum voxel_spectrum(const RgbGrid& g, const std::vector<RgbGrid::Voxel>& voxels, int i, int j,
+                        int k, const Wavelengths& wl) {
+  if (voxels.empty()) return Spectrum(g.scale);
+  if (i < 0 || j < 0 || k < 0 || i >= g.nx || j >= g.ny || k >= g.nz) return {};
+  const RgbGrid::Voxel& v =
+      voxels[(size_t(k) * size_t(g.ny) + size_t(j)) * size_t(g.nx) + size_t(i)];
+  Spectrum s;
+  if (v.scale == 0) return s;
+  for (int c = 0; c < Spectrum::kChannels; ++c)
+    s[c] = g.scale * v.scale * sigmoid_spectrum(v.coeff, wl.lambda[c]);
+  return s;
+}
+
+Cell<Spectrum> sigma_t_cell(const RgbGrid& g, const int c[3], const Wavelengths& wl) {
+  return Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
+    return voxel_spectrum(g, g.sigma_a, i, j, k, wl) + voxel_spectrum(g, g.sigma_s, i, j, k, wl);
+  });
+}
+
+}  // namespace
+
+void RgbGrid::coefficients(Vec3 p, const Wavelengths& wl, Spectrum* a, Spectrum* s) const {
+  const Vec3 q = lattice_from_world.point(p);
+  const int n[3] = {nx, ny, nz};
+  int c[3];
+  *a = *s = Spectrum();
+  if (!cell_of(q, n, c)) return;
+  const Vec3 f = q - Vec3{float(c[0]), float(c[1]), float(c[2])};
+  *a = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
+         return voxel_spectrum(*this, sigma_a, i, j, k, wl);
+       }).at(f);
+  *s = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
+         return voxel_spectrum(*this, sigma_s, i, j, k, wl);
+       }).at(f);
+}
+
+Spectrum RgbGrid::depth(const Ray& ray, float t0, float t1, const Wavelengths& wl) const {
+  const int n[3] = {nx, ny, nz};
+  Spectrum depth;
+  walk_lattice(lattice_from_world, n, ray, t0, t1, [&](const LatticePiece& p) {
+    depth += p.integral(p.values(sigma_t_cell(*this, p.c, wl)));
+    return true;
+  });
+  return depth;
+}
+
+float RgbGrid::flight(const Ray& ray, int channel, float tau, float t_max, const Wavelengths& wl,
+                      Spectrum* depth) const {
+  const int n[3] = {nx, ny, nz};
+  float t = -1;
+  *depth = Spectrum();
+  walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
+    const std::array<Spectrum, 4> ys = p.values(sigma_t_cell(*this, p.c, wl));
+    const Spectrum add = p.integral(ys);
+    if ((*depth)[channel] + add[channel] >= tau) {
+      const float h = p.tb - p.ta;
+      auto channel_values = [&](int k) {
+        return std::array<float, 4>{ys[0][k], ys[1][k], ys[2][k], ys[3][k]};
+      };
+      const float s = cubic_solve(channel_values(channel), h, tau - (*depth)[channel]);
+      t = p.ta + h * s;
+      for (int k = 0; k < Spectrum::kChannels; ++k)
+        (*depth)[k] += cubic_integral_up_to(channel_values(k), h, s);
+      return false;
+    }
+    *depth += add;
+    return true;
+  });
+  return t;
+}
+
+float RgbGrid::distance_at_depth(const Ray& ray, int channel, float tau, float t_max,
+                                 const Wavelengths& wl) const {
+  const int n[3] = {nx, ny, nz};
+  float depth = 0, t = -1;
+  const float end = walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
+    const std::array<Spectrum, 4> ys = p.values(sigma_t_cell(*this, p.c, wl));
+    const std::array<float, 4> y = {ys[0][channel], ys[1][channel], ys[2][channel], ys[3][channel]};
+    const float add = p.integral(y);
+    if (depth + add >= tau) {
+      t = p.ta + (p.tb - p.ta) * cubic_solve(y, p.tb - p.ta, tau - depth);
+      return false;
+    }
+    depth += add;
+    return true;
+  });
+  if (t >= 0) return t;
+  return end >= 0 && depth >= tau * (1 - 1e-5f) ? end : -1.0f;
 }
 
 namespace {

@@ -12,12 +12,14 @@
 // rounding) and cost no random numbers: the same estimators as in a homogeneous medium, only with
 // distances measured in tau.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "base/color.h"
 #include "base/ray.h"
+#include "base/spectrum.h"
 #include "base/transform.h"
 
 namespace bpm {
@@ -47,14 +49,48 @@ struct DensityGrid {
   float distance_at_depth(const Ray& ray, float tau, float t_max) const;
 };
 
+// pbrt-v4's "rgbgrid": per voxel colours of sigma_a and sigma_s (unbounded spectra, as
+// SpectrumCurve::from_rgb makes them), interpolated between voxel centres as the density grid's
+// samples, times `scale`; a colour not given is 1 everywhere in the box. Along a line through one
+// lattice cell each wavelength's sigma_t is again a cubic: depths are exact per wavelength.
+struct RgbGrid {
+  // A colour as a sigmoid spectrum: scale * sigmoid(polynomial(lambda)).
+  struct Voxel {
+    std::array<float, 3> coeff{};
+    float scale = 0;
+  };
+  int nx = 1, ny = 1, nz = 1;
+  std::vector<Voxel> sigma_a, sigma_s;  // empty: 1 (before `scale`) everywhere in the box
+  float scale = 1;
+  bool scatters = true;
+  Transform lattice_from_world;  // as DensityGrid's
+
+  RgbGrid(int nx, int ny, int nz, const std::vector<Rgb>& sigma_a, const std::vector<Rgb>& sigma_s,
+          float scale, Vec3 p0, Vec3 p1, const Transform& world_from_medium);
+  // sigma_a and sigma_s at a world point (0 outside the box).
+  void coefficients(Vec3 p, const Wavelengths& wl, Spectrum* sigma_a, Spectrum* sigma_s) const;
+  // The optical depth of sigma_t along o + d t (d of unit length) over [t0, t1], per wavelength.
+  Spectrum depth(const Ray& ray, float t0, float t1, const Wavelengths& wl) const;
+  // The distance in [0, t_max] at which wavelength `channel`'s depth from 0 reaches tau; negative
+  // when it stays below.
+  float distance_at_depth(const Ray& ray, int channel, float tau, float t_max,
+                          const Wavelengths& wl) const;
+  // Both in one walk: the distance at which wavelength `channel`'s depth reaches tau (negative
+  // when it stays below), and in *depth every wavelength's depth up to there (or up to t_max).
+  float flight(const Ray& ray, int channel, float tau, float t_max, const Wavelengths& wl,
+               Spectrum* depth) const;
+};
+
 struct Medium {
   std::string name;
   // Per unit density (pbrt-v4's "scale" applied).
   SpectrumCurve sigma_a, sigma_s;
   float g = 0;
   std::shared_ptr<const DensityGrid> grid;  // none: density 1 everywhere
+  // An rgbgrid's coefficients, which replace all of the above but g (sigma_a and sigma_s are 1).
+  std::shared_ptr<const RgbGrid> rgb_grid;
 
-  bool scatters() const { return !sigma_s.is_black(); }
+  bool scatters() const { return rgb_grid ? rgb_grid->scatters : !sigma_s.is_black(); }
   float density(Vec3 p) const { return grid ? grid->density(p) : 1.0f; }
   // The optical depth in density units along a unit ray over [t0, t1] (see the top of the file).
   float depth(const Ray& ray, float t0, float t1) const {
@@ -63,6 +99,13 @@ struct Medium {
   float distance_at_depth(const Ray& ray, float tau, float t_max) const {
     if (grid) return grid->distance_at_depth(ray, tau, t_max);
     return tau <= t_max ? tau : -1.0f;
+  }
+  // sigma_s at a point over sigma_s as given: the density, or an rgbgrid's sigma_s there.
+  Spectrum relative_scattering(Vec3 p, const Wavelengths& wl) const {
+    if (!rgb_grid) return Spectrum(density(p));
+    Spectrum a, s;
+    rgb_grid->coefficients(p, wl, &a, &s);
+    return s;
   }
 };
 

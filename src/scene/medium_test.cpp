@@ -71,5 +71,63 @@ TEST(DensityGrid, ConstantInsideTheOutermostSamples) {
   EXPECT_NEAR(g.depth(r, 3.0f, 3.5f), 0.5f * 0.375f, 1e-6f);
 }
 
+// An rgbgrid's depth per wavelength is the integral of its sigma_t there (the midpoint rule over
+// its own trilinear coefficients), and its inverse finds the distance for one wavelength.
+TEST(RgbGrid, DepthPerWavelengthIsTheIntegralOfSigmaT) {
+  Rng rng(5);
+  std::vector<Rgb> a(24), s(24);
+  for (Rgb& c : a) c = Rgb(rng.uniform(), rng.uniform() * 0.3f, rng.uniform() * 2);
+  for (Rgb& c : s) c = Rgb(rng.uniform() * 3, rng.uniform(), 0.1f);
+  const RgbGrid g(2, 3, 4, a, s, 1.5f, {0, 0, 0}, {1, 1.5f, 2}, Transform::rotate(20, {0, 1, 1}));
+  const Wavelengths wl = sample_wavelengths(0.37f);
+  const Ray r{{-2, 0.3f, 0.5f}, normalize(Vec3{1, 0.2f, 0.4f}), kInf};
+  const Spectrum depth = g.depth(r, 0, 6, wl);
+  const int n = 200000;
+  Spectrum sum;
+  for (int i = 0; i < n; ++i) {
+    Spectrum sa, ss;
+    g.coefficients(r.o + r.d * (6.0f * (float(i) + 0.5f) / n), wl, &sa, &ss);
+    sum += sa + ss;
+  }
+  sum = sum * (6.0f / n);
+  for (int k = 0; k < Spectrum::kChannels; ++k) {
+    EXPECT_GT(depth[k], 0.5f);
+    EXPECT_NEAR(depth[k], sum[k], 1e-3f * sum[k]) << k;
+  }
+  for (int k : {0, 5}) {
+    const float t = g.distance_at_depth(r, k, 0.4f * depth[k], 6, wl);
+    ASSERT_GE(t, 0);
+    const Spectrum up_to_t = g.depth(r, 0, t, wl);
+    EXPECT_NEAR(up_to_t[k], 0.4f * depth[k], 1e-4f * depth[k]);
+    // One walk finds the same distance and every wavelength's depth there.
+    Spectrum flown;
+    EXPECT_NEAR(g.flight(r, k, 0.4f * depth[k], 6, wl, &flown), t, 1e-4f);
+    for (int i = 0; i < Spectrum::kChannels; ++i)
+      EXPECT_NEAR(flown[i], up_to_t[i], 1e-3f * up_to_t[i]) << i;
+  }
+  Spectrum whole;
+  EXPECT_LT(g.flight(r, 2, 1.01f * depth[2], 6, wl, &whole), 0);
+  for (int i = 0; i < Spectrum::kChannels; ++i) EXPECT_NEAR(whole[i], depth[i], 1e-4f * depth[i]);
+}
+
+// Grey colours make an rgbgrid the uniformgrid of those values (sigma 1, the same scale).
+TEST(RgbGrid, GreyColoursAreADensityGrid) {
+  Rng rng(9);
+  std::vector<float> d(27);
+  std::vector<Rgb> a(27), s(27);
+  for (size_t i = 0; i < 27; ++i) {
+    d[i] = rng.uniform();
+    a[i] = Rgb(0.25f * d[i]);
+    s[i] = Rgb(0.75f * d[i]);
+  }
+  const RgbGrid rgb(3, 3, 3, a, s, 2, {-1, -1, -1}, {1, 1, 1}, Transform());
+  const DensityGrid grid(3, 3, 3, d, {-1, -1, -1}, {1, 1, 1}, Transform());
+  const Wavelengths wl = sample_wavelengths(0.8f);
+  const Ray r{{-3, 0.2f, -0.1f}, normalize(Vec3{1, -0.1f, 0.05f}), kInf};
+  const Spectrum depth = rgb.depth(r, 0, kInf, wl);
+  for (int k = 0; k < Spectrum::kChannels; ++k)
+    EXPECT_NEAR(depth[k], 2 * grid.depth(r, 0, kInf), 1e-3f) << k;
+}
+
 }  // namespace
 }  // namespace bpm

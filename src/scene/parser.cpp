@@ -212,7 +212,8 @@ class Parser {
           if (x != std::floor(x) || std::fabs(x) > 2147483647.0)
             throw Error(p->loc, "parameter \"" + p->name + "\" expects integers");
       } else if (ty == "rgb") {
-        if (n != 3)
+        // One colour; an rgbgrid medium's lists of them are checked where they are read.
+        if (n == 0 || n % 3 != 0)
           throw Error(p->loc, "parameter \"" + p->name + "\" of type rgb needs 3 values; got " +
                                   std::to_string(n));
       } else if (ty == "blackbody") {

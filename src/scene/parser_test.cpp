@@ -1440,6 +1440,23 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
   // A scattering homogeneous medium, pbrt-v4's defaults included, is read.
   EXPECT_EQ(error_of(scene("\"string type\" \"homogeneous\"")), "");
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"cloud\"")), at(3, 1), "type \"cloud\""));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\"")), at(1, 1),
+                      "rgbgrid medium needs \"rgb sigma_a\" or \"rgb sigma_s\" values"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"integer nx\" 2 "
+                                     "\"rgb sigma_s\" [1 1 1]")),
+                      at(1, 60), "rgbgrid has 1 sigma_s colours; nx * ny * nz = 2"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 -1 1]")),
+                      at(1, 45), "sigma_a colours must be finite and not negative"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 1 1] "
+                                     "\"rgb Le\" [1 1 1]")),
+                      at(3, 1), "it emits (Le)"));
+  EXPECT_EQ(error_of(scene("\"string type\" \"rgbgrid\" \"integer nx\" 2 "
+                           "\"rgb sigma_s\" [1 1 1  0 0.5 2]")),
+            "");
+  // A list of colours where one is wanted.
+  EXPECT_TRUE(
+      IsError(error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_a\" [1 1 1 1 1 1]")),
+              at(1, 49), "parameter \"sigma_a\" of type rgb needs 3 values; got 6"));
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"nanovdb\"")), at(3, 1), "NanoVDB"));
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"rgb sigma_s\" [0 0 0]")),
                       at(1, 1), "uniformgrid medium needs \"float density\""));

@@ -146,6 +146,11 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, const
   Spectrum t(1.0f);
   if (medium < 0) return t;
   const Medium& m = scene.media[size_t(medium)];
+  if (m.rgb_grid) {
+    const Spectrum tau = m.rgb_grid->depth(ray, 0, distance, wl);
+    for (int i = 0; i < Spectrum::kChannels; ++i) t[i] = std::exp(-tau[i]);
+    return t;
+  }
   const Spectrum sigma = m.sigma_a.sample(wl) + m.sigma_s.sample(wl);
   const float tau = m.depth(ray, 0, distance);
   for (int i = 0; i < Spectrum::kChannels; ++i)

@@ -101,6 +101,9 @@ std::optional<SpectrumCurve> get_spectrum(const ParamSet& ps, const std::string&
     return kind == SpectrumKind::kIlluminant && y > 0 ? c.scaled(1 / y) : c;
   };
   if (p->type == "rgb") {
+    if (p->numbers.size() != 3)
+      throw Error(p->loc, "parameter \"" + name + "\" of type rgb needs 3 values; got " +
+                              std::to_string(p->numbers.size()));
     Rgb rgb(float(p->numbers[0]), float(p->numbers[1]), float(p->numbers[2]));
     if (!rgb.is_finite() || rgb.has_negative())
       throw Error(p->loc, "parameter \"" + name + "\" has a negative or non-finite value");
