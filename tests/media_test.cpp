@@ -210,6 +210,40 @@ TEST(Media, AlbedoOneFurnaceWithAGridMedium) {
   }
 }
 
+// A sphere of glowing absorbing gas (sigma_a 0.7, Le 2, Lescale 1.5) in front of a black
+// backdrop: a pixel sees Le (1 - exp(-sigma_a c)) along a chord c. The photon methods refuse
+// emitting media.
+TEST(Media, EmittingMediumGlowsAlongItsChords) {
+  std::string scene = slab_scene(
+      "\"rgb sigma_a\" [0.7 0.7 0.7] \"rgb sigma_s\" [0 0 0] \"rgb Le\" [2 2 2] "
+      "\"float Lescale\" 1.5",
+      3);
+  scene.replace(scene.find("\"rgb L\" [1 1 1]"), 15, "\"rgb L\" [0 0 0]");
+  const LoadedScene ls = load(scene);
+  ASSERT_TRUE(ls.scene.has_emissive_media());
+  const Film f = render_path(ls, 16);
+  const Image img = f.image();
+  const std::vector<float> rms = f.rms();
+  const Camera cam(ls.camera, 12, 12);
+  int inside = 0;
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 12; ++x) {
+      const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
+      const Vec3 d = normalize(r.d);
+      const float b = dot(r.o, d), c = length_squared(r.o) - 1, disc = b * b - c;
+      if (disc > 0 && disc < 0.05f) continue;  // grazing
+      const float chord = disc > 0 ? 2 * std::sqrt(disc) : 0;
+      inside += chord > 0;
+      // Grey coefficients: the only noise is the glow's spectrum (D65) at the wavelengths drawn.
+      EXPECT_NEAR(img.at(x, y).luminance(), 3 * (1 - std::exp(-0.7f * chord)),
+                  5 * rms[size_t(y) * 12 + x] + 1e-3f)
+          << x << "," << y;
+    }
+  EXPECT_GT(inside, 20);
+  Film film(12, 12);
+  EXPECT_THROW(render(ls, quiet_options(ls, "bpm", 1, 1), &film), Error);
+}
+
 TEST(Media, PhotonMethodsRefuseSensorsInScatteringMedia) {
   LoadedScene ls = load(slab_scene("\"rgb sigma_s\" [0.5 0.5 0.5]", 3));
   for (const char* integrator : {"bpm", "fpm"}) {

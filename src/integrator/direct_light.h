@@ -60,16 +60,21 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
 
 // The next vertex of a camera path (next_vertex), adding to L the emission found on the way:
 // surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says
-// (next-event estimation's shadow rays cross interfaces as these rays do).
+// (next-event estimation's shadow rays cross interfaces as these rays do), and where
+// `medium_light` says, the emission of the media crossed (in full: no other strategy finds it).
 inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
                                PathState& s, PathVertex& v, PathCounters& counters,
-                               const EmitterWeight& emitter, Spectrum& L) {
+                               const EmitterWeight& emitter, Spectrum& L,
+                               bool medium_light = false) {
   const Wavelengths& wl = materials.wl;
-  StepEnd end =
-      next_vertex(scene, materials, s, v, counters.bounce_rays, counters.observer,
-                  [&](const Hit& hit, const SurfacePoint& sp) {
-                    L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
-                  });
+  StepEnd end = next_vertex(
+      scene, materials, s, v, counters.bounce_rays, counters.observer,
+      [&](const Hit& hit, const SurfacePoint& sp) {
+        L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
+      },
+      [&](const Ray& ray, float distance, const Spectrum& beta) {
+        if (medium_light) L += beta * medium_emission(scene, s.medium, ray, distance, wl);
+      });
   if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
   return end;
 }

@@ -74,7 +74,9 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
   ++counters.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    const StepEnd end = next_eye_vertex(scene, materials, s, v, counters, emitter, L);
+    // Media emit toward the path before its last scattering event (pbrt-v4's volpath).
+    const StepEnd end =
+        next_eye_vertex(scene, materials, s, v, counters, emitter, L, depth < settings.max_depth);
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == settings.max_depth) break;
     if (end == StepEnd::kMedium) {

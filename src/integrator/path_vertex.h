@@ -161,6 +161,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       if (!hit) return StepEnd::kEscaped;
     } else {
       const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
+      if (s.medium >= 0 && scene.media[size_t(s.medium)].emits()) in_medium(unit, distance, s.beta);
       if (!hit) {
         cross_medium(scene, s.medium, unit, kInf, wl, s.beta);
         return StepEnd::kEscaped;

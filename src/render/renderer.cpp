@@ -43,6 +43,10 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
                 std::to_string(opt.sensors.size()));
   if (!opt.image && opt.sensors.empty())
     throw Error("a render without an image needs sensors (--sensors)");
+  if (ls.scene.has_emissive_media() && opt.integrator != "path")
+    throw Error(
+        "the photon methods do not render emitting media (Le) yet: render the scene with "
+        "--integrator path");
   if (ls.scene.has_scattering_media() && opt.integrator != "path" && !opt.sensors.empty())
     throw Error(
         "the photon methods' illuminance sensors in a scene whose media scatter are not "

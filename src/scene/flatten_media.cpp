@@ -65,8 +65,8 @@ std::shared_ptr<const RgbGrid> Flattener::rgb_grid(const MediumEntity& m, float 
 }
 
 // The index of a named medium, -1 for "" (vacuum). Coefficients default to 1 per unit distance
-// (times "scale"), g to 0; a preset names measured coefficients in mm^-1. Other types and
-// emission are refused.
+// (times "scale"), g to 0; a preset names measured coefficients in mm^-1; Le (times one Lescale)
+// is emitted where sigma_a absorbs. Other types, grids' and temperature's emission are refused.
 int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   if (name.empty()) return -1;
   if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
@@ -86,12 +86,16 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   const float scale = ps.get_float("scale", 1);
   if (!(scale >= 0) || !std::isfinite(scale))
     throw Error(m.loc, "medium scale must be a non-negative number");
-  auto Le =
-      m.name == "rgbgrid" ? std::nullopt : spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
-  if (m.name == "rgbgrid" && ps.find_any("Le")) throw unsupported("it emits (Le)");
-  if (const Param* p = ps.find_any("Lescale")) p->used = true;
-  if (Le && !Le->is_black()) throw unsupported("it emits (Le)");
+  // pbrt-v4 scales a grid's emission by a grid of its own (Lescale, one voxel when not given,
+  // which then fades toward the box's corners): only homogeneous media emit here.
+  if (m.name != "homogeneous" && ps.find_any("Le")) throw unsupported("it emits (Le)");
   if (ps.find_any("temperature")) throw unsupported("it emits (temperature)");
+  std::optional<SpectrumCurve> Le;
+  if (m.name == "homogeneous") Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
+  const std::vector<float> le_scale = ps.get_floats("Lescale");
+  if (le_scale.size() > 1) throw unsupported("it emits by a grid of Lescale values");
+  if (!le_scale.empty() && !(le_scale[0] >= 0))
+    throw Error(ps.find_any("Lescale")->loc, "Lescale must not be negative");
   const float g = ps.get_float("g", 0);
   if (!(g > -1 && g < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
   Medium medium{name, SpectrumCurve(1.0f), SpectrumCurve(1.0f), g, nullptr, nullptr};
@@ -121,6 +125,7 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   medium.sigma_a = medium.sigma_a.scaled(scale);
   medium.sigma_s = medium.sigma_s.scaled(scale);
   if (m.name == "uniformgrid") medium.grid = density_grid(m);
+  if (Le && !Le->is_black()) medium.Le = Le->scaled(le_scale.empty() ? 1.0f : le_scale[0]);
   ps.warn_unused("medium \"" + name + "\"");
   scene().media.push_back(std::move(medium));
   return medium_ids_[name] = int(scene().media.size()) - 1;

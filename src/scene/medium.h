@@ -89,6 +89,11 @@ struct Medium {
   std::shared_ptr<const DensityGrid> grid;  // none: density 1 everywhere
   // An rgbgrid's coefficients, which replace all of the above but g (sigma_a and sigma_s are 1).
   std::shared_ptr<const RgbGrid> rgb_grid;
+  // The radiance emitted where sigma_a absorbs (pbrt-v4's Le times Lescale, normalised as a
+  // light's spectrum): a point emits sigma_a(x) Le per unit length (not with rgbgrid).
+  SpectrumCurve Le;
+
+  bool emits() const { return !Le.is_black(); }
 
   bool scatters() const { return rgb_grid ? rgb_grid->scatters : !sigma_s.is_black(); }
   float density(Vec3 p) const { return grid ? grid->density(p) : 1.0f; }

@@ -51,6 +51,11 @@ class RenderScene {
   int medium_of_light(size_t light) const {
     return light < light_medium.size() ? light_medium[light] : -1;
   }
+  bool has_emissive_media() const {
+    for (const Medium& m : media)
+      if (m.emits()) return true;
+    return false;
+  }
   // Whether a surface has the interface material (commit sets it): shadow rays then cross them.
   bool has_interfaces = false;
   // Whether any medium scatters.
@@ -156,6 +161,24 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, const
   for (int i = 0; i < Spectrum::kChannels; ++i)
     if (sigma[i] > 0) t[i] = std::exp(-sigma[i] * tau);
   return t;
+}
+
+// The radiance that an emitting medium sends along the unit ray toward its origin from the first
+// `distance` of it, attenuated on the way: the integral of T(t) sigma_a(x) Le dt, which with
+// sigma = density (sigma per unit density) and d tau = density dt is
+// sigma_a Le (1 - exp(-sigma_t tau)) / sigma_t, exactly (scene/medium.h).
+inline Spectrum medium_emission(const RenderScene& scene, int medium, const Ray& ray,
+                                float distance, const Wavelengths& wl) {
+  Spectrum L;
+  if (medium < 0) return L;
+  const Medium& m = scene.media[size_t(medium)];
+  if (!m.emits() || m.rgb_grid) return L;
+  const Spectrum sigma_a = m.sigma_a.sample(wl), sigma_t = sigma_a + m.sigma_s.sample(wl);
+  const Spectrum Le = m.Le.sample(wl);
+  const float tau = m.depth(ray, 0, distance);
+  for (int i = 0; i < Spectrum::kChannels; ++i)
+    if (sigma_t[i] > 0) L[i] = sigma_a[i] * Le[i] * -std::expm1(-sigma_t[i] * tau) / sigma_t[i];
+  return L;
 }
 
 // Attenuates a path's throughput over `distance` along the unit ray in `medium`; false when
