@@ -155,7 +155,7 @@ def spot_lens_fog():
           'AttributeEnd\n')
     s += ('AttributeBegin\n  Material "diffuse" "rgb reflectance" [ 0.7 0.3 0.2 ]\n'
           '  Translate 1.1 0.4 1.2\n  Shape "sphere" "float radius" [ 0.4 ]\nAttributeEnd\n')
-    return s
+    return volpath(s)
 
 
 def underwater():
@@ -192,7 +192,13 @@ def underwater():
             tris += [(a, a + 1, a + n + 2), (a, a + n + 2, a + n + 1)]
     s += 'AttributeBegin\n  MediumInterface "water" ""\n  Material "dielectric" "float eta" [ 1.33 ]\n'
     s += "  " + mesh(pts, outward(pts, tris, None)) + "AttributeEnd\n"
-    return s
+    return volpath(s)
+
+
+def volpath(scene):
+    """pbrt-v4's "path" ignores media (and its shadow rays stop at interface surfaces): scenes
+    with media name "volpath", which bpm renders with its path tracer."""
+    return scene.replace('Integrator "path"', 'Integrator "volpath"')
 
 
 def plume_density(nx, ny, nz):
@@ -218,8 +224,7 @@ def smoke():
                "# down, swirled) inside an interface box, lit by a spot light from the side and a dim\n"
                "# sky panel. The camera stands in clear air.\n",
                "0 1.2 -3.2   0 0.9 0   0 1 0", 45, (192, 192), 8, "smoke")
-    # pbrt-v4's "path" ignores media (and its shadow rays stop at interfaces): "volpath".
-    s = s.replace('Integrator "path"', 'Integrator "volpath"')
+    s = volpath(s)
     s += ('LightSource "spot" "point3 from" [ -2.2 2.4 -0.8 ] "point3 to" [ 0 0.8 0 ]\n'
           '    "float coneangle" [ 20 ] "float conedeltaangle" [ 4 ] "blackbody I" [ 4500 ]\n'
           '    "float scale" [ 25 ]\n')

@@ -49,6 +49,15 @@ LoadedScene Flattener::run() {
   for (const ShapeEntity& s : parsed_.shapes) add_shape(s, &out.scene);
   for (const LightEntity& l : parsed_.lights) add_light(l, &out.scene);
   out.scene.commit();
+  // A glowing medium is path's alone (the photon methods refuse it): a file integrator that maps
+  // to bpm renders such a scene with path, which reaches its light, and says so.
+  if (out.scene.has_emissive_media() && out.render.integrator == "bpm" &&
+      out.render.integrator_as_written != "bpm") {
+    out.render.integrator = "path";
+    out.render.integrator_note = "integrator \"" + out.render.integrator_as_written +
+                                 "\" is rendered with bpm's path tracer (\"path\"): a medium "
+                                 "glows, which the photon methods do not render yet";
+  }
   // Distant and infinite lights needed the scene bounds; nothing more to do after commit.
   out.data_files = data_files_;
   return out;

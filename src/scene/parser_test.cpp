@@ -466,6 +466,16 @@ TEST(SceneParse, BidirectionalAndPhotonIntegratorsAreRenderedWithBpm) {
   }
 }
 
+// ... but a glowing medium is path's alone: such a scene renders with path, and the note says why.
+TEST(SceneParse, GlowingMediaAreRenderedWithPath) {
+  const LoadedScene ls = flatten_scene(
+      parse_scene_string("Integrator \"bdpt\"\nMakeNamedMedium \"m\" \"string type\" "
+                         "\"homogeneous\" \"rgb Le\" [1 1 1]\n"
+                         "WorldBegin\nMediumInterface \"m\" \"\"\nShape \"sphere\"\n"));
+  EXPECT_EQ(ls.render.integrator, "path");
+  EXPECT_NE(ls.render.integrator_note.find("glows"), std::string::npos);
+}
+
 TEST(SceneParse, AcceleratorIsAcceptedAndIgnored) {
   int before = warning_count();
   ParsedScene p =
