@@ -230,7 +230,7 @@ def smoke():
           '    "float scale" [ 25 ]\n')
     s += ('AttributeBegin\n  AreaLightSource "diffuse" "rgb L" [ 0.25 0.3 0.4 ]\n'
           '  Material "diffuse" "rgb reflectance" [ 0 0 0 ]\n'
-          '  ' + quad((-2, 3, -2), (-2, 3, 2), (2, 3, 2), (2, 3, -2)) + 'AttributeEnd\n')
+          '  ' + quad((2, 3, -2), (2, 3, 2), (-2, 3, 2), (-2, 3, -2)) + 'AttributeEnd\n')
     s += 'Material "diffuse" "rgb reflectance" [ 0.6 0.6 0.55 ]\n'
     s += quad((-3, 0, -4), (-3, 0, 3), (3, 0, 3), (3, 0, -4))
     s += quad((-3, 0, 2), (-3, 3, 2), (3, 3, 2), (3, 0, 2))
