@@ -44,6 +44,26 @@ AttributeEnd
 )";
 }
 
+// A pixel's camera ray (unit direction) and where it enters and leaves the unit sphere at the
+// origin (the slab scenes' medium); `grazing` where it passes within a sliver of its edge, whose
+// pixels straddle it, `hits` where it crosses it.
+struct PixelChord {
+  Ray ray;
+  float t0 = 0, t1 = 0;
+  bool grazing = false, hits = false;
+  float length() const { return t1 - t0; }
+};
+PixelChord pixel_chord(const Camera& cam, int x, int y) {
+  PixelChord p;
+  const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
+  p.ray = Ray{r.o, normalize(r.d), kInf};
+  const float b = dot(r.o, p.ray.d), c = length_squared(r.o) - 1, disc = b * b - c;
+  p.grazing = disc > 0 && disc < 0.05f;
+  p.hits = disc >= 0.05f;
+  if (p.hits) p.t0 = -b - std::sqrt(disc), p.t1 = -b + std::sqrt(disc);
+  return p;
+}
+
 // At depth 0 only light that crosses the medium unscattered counts: exp(-sigma_t c) through a
 // chord c of the sphere, whatever part of sigma_t scatters. A chromatic medium renders as the
 // absorbing one with the same sigma_t, channel by channel (the one-sample MIS over wavelengths).
@@ -57,12 +77,10 @@ TEST(Media, UnscatteredLightIsBeerLambertOfSigmaT) {
   int inside = 0;
   for (int y = 0; y < 12; ++y)
     for (int x = 0; x < 12; ++x) {
-      const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
-      const Vec3 d = normalize(r.d);
-      const float b = dot(r.o, d), c = length_squared(r.o) - 1, disc = b * b - c;
-      if (disc > 0 && disc < 0.05f) continue;  // grazing
-      const float chord = disc > 0 ? 2 * std::sqrt(disc) : 0;
-      inside += chord > 0;
+      const PixelChord p = pixel_chord(cam, x, y);
+      if (p.grazing) continue;
+      const float chord = p.length();
+      inside += p.hits;
       EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-0.8f * chord),
                   5 * rms[size_t(y) * 12 + x] + 1e-3f)
           << x << "," << y;
@@ -170,16 +188,14 @@ TEST(Media, UnscatteredLightThroughAGridIsExpOfItsDepth) {
   int inside = 0;
   for (int y = 0; y < 12; ++y)
     for (int x = 0; x < 12; ++x) {
-      const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
-      const Vec3 d = normalize(r.d);
-      const float b = dot(r.o, d), c = length_squared(r.o) - 1, disc = b * b - c;
-      if (disc < 0.05f) continue;  // grazing or outside the sphere
-      const float t0 = -b - std::sqrt(disc), t1 = -b + std::sqrt(disc);
+      const PixelChord p = pixel_chord(cam, x, y);
+      if (!p.hits) continue;
       double tau = 0;
       const int n = 20000;
       for (int i = 0; i < n; ++i)
-        tau += ls.scene.media[0].density(r.o + d * (t0 + (t1 - t0) * (float(i) + 0.5f) / n));
-      tau *= double(t1 - t0) / n;
+        tau += ls.scene.media[0].density(p.ray.o +
+                                         p.ray.d * (p.t0 + p.length() * (float(i) + 0.5f) / n));
+      tau *= double(p.length()) / n;
       EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-0.8 * tau),
                   5 * rms[size_t(y) * 12 + x] + 1e-3f)
           << x << "," << y << " tau " << tau;
@@ -228,12 +244,10 @@ TEST(Media, EmittingMediumGlowsAlongItsChords) {
   int inside = 0;
   for (int y = 0; y < 12; ++y)
     for (int x = 0; x < 12; ++x) {
-      const Ray r = cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray;
-      const Vec3 d = normalize(r.d);
-      const float b = dot(r.o, d), c = length_squared(r.o) - 1, disc = b * b - c;
-      if (disc > 0 && disc < 0.05f) continue;  // grazing
-      const float chord = disc > 0 ? 2 * std::sqrt(disc) : 0;
-      inside += chord > 0;
+      const PixelChord p = pixel_chord(cam, x, y);
+      if (p.grazing) continue;
+      const float chord = p.length();
+      inside += p.hits;
       // Grey coefficients: the only noise is the glow's spectrum (D65) at the wavelengths drawn.
       EXPECT_NEAR(img.at(x, y).luminance(), 3 * (1 - std::exp(-0.7f * chord)),
                   5 * rms[size_t(y) * 12 + x] + 1e-3f)

@@ -277,7 +277,7 @@ float RgbGrid::flight(const Ray& ray, int channel, float tau, float t_max, const
   const int n[3] = {nx, ny, nz};
   float t = -1;
   *depth = Spectrum();
-  walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
+  const float end = walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
     const std::array<Spectrum, 4> ys = p.values(sigma_t_cell(*this, p.c, wl));
     const Spectrum add = p.integral(ys);
     if ((*depth)[channel] + add[channel] >= tau) {
@@ -294,26 +294,15 @@ float RgbGrid::flight(const Ray& ray, int channel, float tau, float t_max, const
     *depth += add;
     return true;
   });
-  return t;
+  if (t >= 0) return t;
+  // A depth drawn below the whole way's (as computed before) may miss it by rounding.
+  return end >= 0 && (*depth)[channel] >= tau * (1 - 1e-5f) ? end : -1.0f;
 }
 
 float RgbGrid::distance_at_depth(const Ray& ray, int channel, float tau, float t_max,
                                  const Wavelengths& wl) const {
-  const int n[3] = {nx, ny, nz};
-  float depth = 0, t = -1;
-  const float end = walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
-    const std::array<Spectrum, 4> ys = p.values(sigma_t_cell(*this, p.c, wl));
-    const std::array<float, 4> y = {ys[0][channel], ys[1][channel], ys[2][channel], ys[3][channel]};
-    const float add = p.integral(y);
-    if (depth + add >= tau) {
-      t = p.ta + (p.tb - p.ta) * cubic_solve(y, p.tb - p.ta, tau - depth);
-      return false;
-    }
-    depth += add;
-    return true;
-  });
-  if (t >= 0) return t;
-  return end >= 0 && depth >= tau * (1 - 1e-5f) ? end : -1.0f;
+  Spectrum depth;
+  return flight(ray, channel, tau, t_max, wl, &depth);
 }
 
 namespace {
