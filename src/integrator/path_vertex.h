@@ -119,9 +119,9 @@ struct NoMediumPieces {
 // Follows s.ray to the next scattering surface or medium point and fills v. on_surface(hit, sp) is
 // called at every surface reached, interfaces included, with s.beta already attenuated up to it
 // (emission is counted there); in_medium(ray, distance, beta) for every piece of the ray inside a
-// scattering medium before the point where it scatters is drawn: the whole piece up to the next
-// surface (distance along the unit direction, kInf where the ray leaves the scene) with the
-// throughput at its start (photon beams, bpm/light_pass.h). kEscaped: the ray left the scene
+// scattering or glowing medium before the point where it scatters is drawn: the whole piece up to
+// the next surface (distance along the unit direction, kInf where the ray leaves the scene) with
+// the throughput at its start (photon beams, bpm/light_pass.h). kEscaped: the ray left the scene
 // (s.ray is the escaping ray, s.beta attenuated by the medium it leaves in); kAbsorbed: nothing is
 // left of the throughput. Each crossing of an interface counts one ray in continuation_rays.
 template <class OnSurface, class InMedium = NoMediumPieces>
@@ -137,7 +137,6 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
     if (s.medium >= 0 && scene.media[size_t(s.medium)].scatters()) {
       BPM_CHECK(s.rng);  // set by every path that may meet a scattering medium
       const Medium& m = scene.media[size_t(s.medium)];
-      const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
       const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
       in_medium(unit, distance, s.beta);
       float t = -1;
@@ -145,6 +144,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
         t = sample_rgb_grid_flight(*m.rgb_grid, unit, distance, wl, *s.rng, s.beta);
       } else {
         // The free flight in optical depth (density units), then as a distance (scene/medium.h).
+        const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
         const float tau =
             sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance), *s.rng, s.beta);
         if (tau >= 0) t = m.distance_at_depth(unit, tau, distance);

@@ -7,26 +7,45 @@
 
 namespace bpm::flatten_internal {
 
+namespace {
+
+// A grid's size and box, shared by "uniformgrid" and "rgbgrid": nx x ny x nz samples (1 each by
+// default) on the box [p0, p1] of the medium's space ((0,0,0) to (1,1,1)).
+struct GridBox {
+  int nx, ny, nz;
+  Vec3 p0, p1;
+  uint64_t count() const { return uint64_t(nx) * uint64_t(ny) * uint64_t(nz); }
+};
+
+GridBox grid_box(const MediumEntity& m) {
+  const ParamSet& ps = m.params;
+  for (const char* n : {"nx", "ny", "nz"})
+    ps.require(n, ps.get_int(n, 1) >= 1, "must be at least 1", m.loc);
+  GridBox b{ps.get_int("nx", 1), ps.get_int("ny", 1), ps.get_int("nz", 1),
+            ps.get_point3("p0", {0, 0, 0}), ps.get_point3("p1", {1, 1, 1})};
+  ps.require("p1", b.p1.x > b.p0.x && b.p1.y > b.p0.y && b.p1.z > b.p0.z,
+             "must exceed p0 along every axis (the grid's box)", m.loc);
+  return b;
+}
+
+}  // namespace
+
 // pbrt-v4's "uniformgrid" density: nx x ny x nz non-negative values on the box [p0, p1] of the
 // medium's space (media.cpp, GridMedium::Create).
 std::shared_ptr<const DensityGrid> Flattener::density_grid(const MediumEntity& m) {
   const ParamSet& ps = m.params;
   const Param* density = ps.find("density", "float");
   if (!density) throw Error(m.loc, "uniformgrid medium needs \"float density\" values");
-  const int nx = ps.get_int("nx", 1), ny = ps.get_int("ny", 1), nz = ps.get_int("nz", 1);
-  for (const char* n : {"nx", "ny", "nz"})
-    ps.require(n, ps.get_int(n, 1) >= 1, "must be at least 1", m.loc);
+  const GridBox box = grid_box(m);
   std::vector<float> values = ps.get_floats("density");
-  const uint64_t expected = uint64_t(nx) * uint64_t(ny) * uint64_t(nz);
+  const uint64_t expected = box.count();
   if (values.size() != expected)
     throw Error(density->loc, "uniformgrid has " + std::to_string(values.size()) +
                                   " density values; nx * ny * nz = " + std::to_string(expected));
   for (float v : values)
     if (!(v >= 0)) throw Error(density->loc, "density values must not be negative");
-  const Vec3 p0 = ps.get_point3("p0", {0, 0, 0}), p1 = ps.get_point3("p1", {1, 1, 1});
-  ps.require("p1", p1.x > p0.x && p1.y > p0.y && p1.z > p0.z,
-             "must exceed p0 along every axis (the grid's box)", m.loc);
-  return std::make_shared<DensityGrid>(nx, ny, nz, std::move(values), p0, p1, m.world_from_medium);
+  return std::make_shared<DensityGrid>(box.nx, box.ny, box.nz, std::move(values), box.p0, box.p1,
+                                       m.world_from_medium);
 }
 
 // pbrt-v4's "rgbgrid": per voxel "rgb sigma_a" and "rgb sigma_s" colours (either may be absent:
@@ -34,10 +53,8 @@ std::shared_ptr<const DensityGrid> Flattener::density_grid(const MediumEntity& m
 // RGBGridMedium::Create).
 std::shared_ptr<const RgbGrid> Flattener::rgb_grid(const MediumEntity& m, float scale) {
   const ParamSet& ps = m.params;
-  const int nx = ps.get_int("nx", 1), ny = ps.get_int("ny", 1), nz = ps.get_int("nz", 1);
-  for (const char* n : {"nx", "ny", "nz"})
-    ps.require(n, ps.get_int(n, 1) >= 1, "must be at least 1", m.loc);
-  const uint64_t expected = uint64_t(nx) * uint64_t(ny) * uint64_t(nz);
+  const GridBox box = grid_box(m);
+  const uint64_t expected = box.count();
   auto colours = [&](const char* name) {
     std::vector<Rgb> out;
     const Param* p = ps.find(name, "rgb");
@@ -58,10 +75,8 @@ std::shared_ptr<const RgbGrid> Flattener::rgb_grid(const MediumEntity& m, float 
   const std::vector<Rgb> a = colours("sigma_a"), s = colours("sigma_s");
   if (a.empty() && s.empty())
     throw Error(m.loc, "rgbgrid medium needs \"rgb sigma_a\" or \"rgb sigma_s\" values");
-  const Vec3 p0 = ps.get_point3("p0", {0, 0, 0}), p1 = ps.get_point3("p1", {1, 1, 1});
-  ps.require("p1", p1.x > p0.x && p1.y > p0.y && p1.z > p0.z,
-             "must exceed p0 along every axis (the grid's box)", m.loc);
-  return std::make_shared<RgbGrid>(nx, ny, nz, a, s, scale, p0, p1, m.world_from_medium);
+  return std::make_shared<RgbGrid>(box.nx, box.ny, box.nz, a, s, scale, box.p0, box.p1,
+                                   m.world_from_medium);
 }
 
 // The index of a named medium, -1 for "" (vacuum). Coefficients default to 1 per unit distance
