@@ -53,6 +53,7 @@ struct RenderArgs {
   std::string radius_policy, tree;
   bool no_guide = false;
   bool no_disc_probes = false;
+  bool no_equiangular = false;
   bool debias = false;
   std::string bias_model;
   int emission_samples = 0;
@@ -147,6 +148,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   opt.seed = a.seed >= 0 ? uint64_t(a.seed) : uint64_t(ls.render.seed);
   opt.max_depth = a.max_depth >= 0 ? a.max_depth : ls.render.max_depth;
   opt.progress = !a.quiet;
+  opt.equiangular = !a.no_equiangular;
   if (a.iterations > 0) opt.spp = a.iterations;  // one eye sample per pixel per iteration
   if (a.time > 0 && a.spp <= 0 && a.iterations <= 0)
     opt.spp = std::numeric_limits<int>::max();  // the time budget decides
@@ -272,6 +274,7 @@ nlohmann::json run_record(const RenderArgs& a, const LoadedScene& ls, const Rend
                      {"threads", threads},
                      {"seed", opt.seed},
                      {"max_depth", opt.max_depth},
+                     {"equiangular", opt.equiangular},
                      {"width", ls.film.width},
                      {"height", ls.film.height},
                      {"filter", Filter(ls.filter).name()},
@@ -602,6 +605,11 @@ void add_general_options(CLI::App* render, RenderArgs& ra) {
       ->add_option("--maxdepth", ra.max_depth,
                    "Maximum scattering events; default: the file's maxdepth (5)")
       ->check(CLI::Range(0, 100000))
+      ->group(kGeneral);
+  render
+      ->add_flag("--no-equiangular", ra.no_equiangular,
+                 "path and bpm: direct light in scattering media from free-flight points only, "
+                 "without equiangular sampling along the camera's rays")
       ->group(kGeneral);
   render->add_flag("-q,--quiet", ra.quiet, "No progress output")->group(kGeneral);
 }

@@ -100,6 +100,31 @@ TEST(Media, UnscatteredLightIsBeerLambertOfSigmaT) {
   }
 }
 
+// The single-scattering test's pixels against the integral along their rays.
+void check_single_scattering(const LoadedScene& ls, const Film& film, Vec3 light, float sigma_s,
+                             float sigma_t, float g, float R) {
+  const Image img = film.image();
+  const std::vector<float> rms = film.rms();
+  const Camera cam(ls.camera, 8, 8);
+  for (int y = 0; y < 8; y += 3)
+    for (int x = 0; x < 8; x += 3) {
+      const Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray.d);
+      double sum = 0;
+      const int n = 30000;
+      for (int i = 0; i < n; ++i) {
+        const double t = R * (i + 0.5) / n;
+        const Vec3 to = light - d * float(t);
+        const double r = length(to);
+        sum += sigma_s * std::exp(-sigma_t * t) * henyey_greenstein(dot(d, to) / float(r), g) *
+               std::exp(-sigma_t * r) / (r * r);
+      }
+      const double expected = sum * R / n;
+      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 8 + x] + 1e-3 * expected)
+          << x << "," << y;
+      EXPECT_LT(rms[size_t(y) * 8 + x], 0.03 * expected);
+    }
+}
+
 // A point light of intensity 1 inside a medium of sigma_s = 0.5, sigma_a = 0.1 and g = 0.4 that
 // fills a sphere of radius 3 around the camera; at depth 1 a pixel sees the light scattered once
 // along its ray: the integral over t of sigma_s exp(-sigma_t t) HG(cos) exp(-sigma_t r) / r^2,
@@ -123,27 +148,21 @@ AttributeBegin
   Shape "sphere" "float radius" 3
 AttributeEnd
 )");
-  const Film film = render_path(ls, 4096);
-  const Image img = film.image();
-  const std::vector<float> rms = film.rms();
-  const Camera cam(ls.camera, 8, 8);
-  for (int y = 0; y < 8; y += 3)
-    for (int x = 0; x < 8; x += 3) {
-      const Vec3 d = normalize(cam.generate_ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}).ray.d);
-      double sum = 0;
-      const int n = 30000;
-      for (int i = 0; i < n; ++i) {
-        const double t = R * (i + 0.5) / n;
-        const Vec3 to = light - d * float(t);
-        const double r = length(to);
-        sum += sigma_s * std::exp(-sigma_t * t) * henyey_greenstein(dot(d, to) / float(r), g) *
-               std::exp(-sigma_t * r) / (r * r);
-      }
-      const double expected = sum * R / n;
-      EXPECT_NEAR(img.at(x, y).luminance(), expected, 5 * rms[size_t(y) * 8 + x] + 1e-3 * expected)
-          << x << "," << y;
-      EXPECT_LT(rms[size_t(y) * 8 + x], 0.03 * expected);
-    }
+  // Equiangular sampling along the camera ray shared with free flights (the default), and free
+  // flights alone: each is exact on its own.
+  // Near the light the first has the lower noise (its density of points falls as the light's
+  // does, 1 / r^2).
+  double rms_sum[2] = {0, 0};
+  for (const bool equiangular : {true, false}) {
+    SCOPED_TRACE(equiangular ? "equiangular" : "free flights");
+    RenderOptions opt = quiet_options(ls, "path", 4096, 1);
+    opt.equiangular = equiangular;
+    Film film(8, 8);
+    render(ls, opt, &film);
+    check_single_scattering(ls, film, light, sigma_s, sigma_t, g, R);
+    for (float r : film.rms()) rms_sum[equiangular ? 0 : 1] += r;
+  }
+  EXPECT_LT(rms_sum[0], 0.8 * rms_sum[1]);
 }
 
 // A closed sphere whose wall emits radiance 1 and reflects nothing, filled with a medium that
@@ -170,6 +189,69 @@ const char* kGridMedium =
     "\"string type\" \"uniformgrid\" \"integer nx\" 3 \"integer ny\" 3 \"integer nz\" 3 "
     "\"point3 p0\" [-1.2 -1.1 -1] \"point3 p1\" [1 1.2 1.1] "
     "\"float density\" [0 1 2 3 0.5 1 2 0 1  1 1 0.2 0 2 3 1 0.5 0  2 0 1 1 3 0.1 0.4 1 2]";
+
+// Direct light is sampled along the camera's rays in media (equiangular sampling, shared with
+// free flights by the balance heuristic) or at free-flight points alone: the same image within
+// their noise, for point, spot, one-sided quad and sphere lights in a grid medium (and a
+// homogeneous one) at depth 2.
+TEST(Media, EquiangularSamplingAgreesWithFreeFlights) {
+  const std::string lights = R"(
+LightSource "point" "point3 from" [0.6 0.3 0.8] "rgb I" [0.3 0.3 0.3]
+LightSource "spot" "point3 from" [-0.5 0.5 0.5] "point3 to" [0 -1 1] "rgb I" [1 0.5 0.2]
+  "float coneangle" 30
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [2 2 2]
+  Material "diffuse" "rgb reflectance" [0 0 0]
+  Shape "trianglemesh" "point3 P" [-0.2 0.9 0.2  0.2 0.9 0.2  0.2 0.9 0.6  -0.2 0.9 0.6]
+    "integer indices" [0 1 2 0 2 3]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [1 2 3]
+  Material "diffuse" "rgb reflectance" [0 0 0]
+  Translate -0.5 -0.4 0.7
+  Shape "sphere" "float radius" 0.1
+AttributeEnd
+)";
+  for (const std::string medium :
+       {std::string(kGridMedium) + " \"rgb sigma_a\" [0.2 0.3 0.1] \"rgb sigma_s\" [1 0.6 0.8]",
+        std::string("\"string type\" \"homogeneous\" \"rgb sigma_a\" [0.05 0.05 0.05] "
+                    "\"rgb sigma_s\" [0.4 0.5 0.6]")}) {
+    SCOPED_TRACE(medium);
+    const LoadedScene ls = load(R"(LookAt 0 0 -0.5  0 0 1  0 1 0
+MakeNamedMedium "m" )" + medium +
+                                R"( "float g" -0.3
+MediumInterface "" "m"
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" 10 "integer yresolution" 10
+PixelFilter "box" "float xradius" 0.0001 "float yradius" 0.0001
+Integrator "path" "integer maxdepth" 2
+WorldBegin
+AttributeBegin
+  MediumInterface "m" ""
+  Material "interface"
+  Shape "sphere" "float radius" 3
+AttributeEnd
+)" + lights);
+    Film films[2] = {Film(10, 10), Film(10, 10)};
+    for (int k = 0; k < 2; ++k) {
+      RenderOptions opt = quiet_options(ls, "path", 2048, 5 + uint64_t(k));
+      opt.equiangular = k == 0;
+      render(ls, opt, &films[k]);
+    }
+    const Image a = films[0].image(), b = films[1].image();
+    const std::vector<float> ra = films[0].rms(), rb = films[1].rms();
+    double diff = 0, var = 0;
+    for (size_t i = 0; i < ra.size(); ++i) {
+      const int x = int(i % 10), y = int(i / 10);
+      const double d = a.at(x, y).luminance() - b.at(x, y).luminance();
+      const double v = double(ra[i]) * ra[i] + double(rb[i]) * rb[i];
+      EXPECT_LT(std::fabs(d), 5 * std::sqrt(v) + 1e-4) << x << "," << y;
+      diff += d;
+      var += v;
+    }
+    EXPECT_LT(std::fabs(diff), 4 * std::sqrt(var));
+  }
+}
 
 // In a grid medium unscattered light keeps exp(-sigma_t tau), tau the integral of the density
 // along the pixel's ray (here by the midpoint rule over the medium's own trilinear density, not

@@ -284,9 +284,19 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
 bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, int it,
                          const RenderControl& control) {
   const auto t = Clock::now();
-  EyePassParams ep{&wm,           s_.diffuse_depth,    opt_.max_depth,    s_.k0 * scale,
-                   s_.k1 * scale, s_.emission_samples, s_.radius * scale, medium_min_length_,
-                   caustics_,     s_.normal_cos,       s_.disc_probes,    &near_edges_};
+  EyePassParams ep{&wm,
+                   s_.diffuse_depth,
+                   opt_.max_depth,
+                   s_.k0 * scale,
+                   s_.k1 * scale,
+                   s_.emission_samples,
+                   s_.radius * scale,
+                   medium_min_length_,
+                   caustics_,
+                   s_.normal_cos,
+                   s_.disc_probes,
+                   &near_edges_,
+                   opt_.equiangular};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii.
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,

@@ -143,8 +143,8 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
 inline bool gather_in_medium(const EyePath& path, const PathVertex& v, PathState& s, int depth,
                              int diffuse, EmitterWeight& emitter, Spectrum& L) {
   const float g = path.scene.media[size_t(v.medium)].g;
-  L += s.beta * sample_direct_light_in_medium(path.scene, v.sp.p, v.medium, -v.wo, g,
-                                              *path.prm.materials, path.rng, path.counters.rays);
+  L += s.beta * sample_direct_light_in_medium(path.scene, v, g, *path.prm.materials, path.rng,
+                                              path.counters.rays);
   const bool last = diffuse == path.prm.diffuse_depth + 1;
   store_backward_photons(path, v, s, depth, diffuse, last);
   const PhaseSample ps = sample_phase(v, g, path.rng);
@@ -203,10 +203,16 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
   // at the vertex, shared with next-event estimation by MIS (at the last vertex,
   // direct_light_by_bsdf does the same).
   EmitterWeight emitter = EmitterWeight::full();
+  // Direct light sampled along the pieces of rays in media that lead to a diffuse vertex that
+  // estimates it (the next one, while it is not past the last): never emission.
+  Spectrum along;
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L);
+    const bool sample_along =
+        prm.equiangular && !emission_only && depth < prm.max_depth && diffuse <= prm.diffuse_depth;
+    const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L,
+                                        false, sample_along ? &along : nullptr);
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == prm.max_depth) break;
     if (end == StepEnd::kMedium) {  // a diffuse vertex in a medium
@@ -238,7 +244,7 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
     if (direct_here) L += direct_light_at(path, v, s, choice.part);
     if (!scatter(path, v, choice, direct_here, diffuse, s, emitter)) break;
   }
-  return {L, emission ? *emission : L};
+  return {L + along, emission ? *emission : L};
 }
 
 namespace {

@@ -48,6 +48,9 @@ struct EyePassParams {
   // at first vertices seen directly only where near_edges marks the pixel (all when null).
   bool disc_probes = true;
   const NearEdges* near_edges = nullptr;
+  // Direct light in media also sampled along the rays that lead to diffuse vertices
+  // (IntegratorOptions::equiangular).
+  bool equiangular = true;
 };
 
 struct EyeCounters {

@@ -184,8 +184,8 @@ inline void gather_in_medium(const FpmPath& path, const PathVertex& v, const Pat
     bias += s.beta * e.bias;
   };
   if (gathering) return gather(any_class);
-  L += s.beta * sample_direct_light_in_medium(path.scene, v.sp.p, v.medium, -v.wo, g,
-                                              *path.prm.materials, path.rng, path.c.rays);
+  L += s.beta *
+       sample_direct_light_in_medium(path.scene, v, g, *path.prm.materials, path.rng, path.c.rays);
   gather(not_direct_class);
   L += emission_by_phase(path.scene, *path.prm.materials, v, s, sample_phase(v, g, path.rng),
                          path.c.rays);

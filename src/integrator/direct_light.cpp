@@ -1,6 +1,8 @@
 #include "integrator/direct_light.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "base/sampling.h"
 
@@ -79,8 +81,77 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
 }
 
-Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int medium, Vec3 travel,
-                                       float g, const WavelengthMaterials& wm, Rng& rng,
+namespace {
+
+// A medium at distance t along a unit ray from where it enters: the transmittance up to there,
+// sigma_s there, and the density per unit length with which next_vertex's free flight draws t
+// (sample_medium_distance, sample_rgb_grid_flight: the mixture over wavelengths).
+struct MediumAtDistance {
+  Spectrum T, sigma_s;
+  float flight_pdf = 0;
+};
+MediumAtDistance medium_at_distance(const RenderScene& scene, int medium, const Ray& unit, float t,
+                                    const Wavelengths& wl) {
+  constexpr int n = Spectrum::kChannels;
+  const Medium& m = scene.media[size_t(medium)];
+  const Vec3 x = unit.o + unit.d * t;
+  MediumAtDistance r;
+  double pdf = 0;
+  if (m.rgb_grid) {
+    const Spectrum depth = m.rgb_grid->depth(unit, 0, t, wl);
+    Spectrum a;
+    m.rgb_grid->coefficients(x, wl, &a, &r.sigma_s);
+    for (int k = 0; k < n; ++k) {
+      r.T[k] = std::exp(-depth[k]);
+      pdf += double(a[k] + r.sigma_s[k]) * r.T[k];
+    }
+  } else {
+    const float density = m.density(x), tau = m.depth(unit, 0, t);
+    const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
+    for (int k = 0; k < n; ++k) {
+      r.T[k] = std::exp(-sigma_t[k] * tau);
+      pdf += double(sigma_t[k]) * density * r.T[k];
+    }
+    r.sigma_s = sigma_s * density;
+  }
+  r.flight_pdf = float(pdf / n);
+  return r;
+}
+
+// Equiangular sampling of the distance t in [0, length] along a unit ray about a point: uniform in
+// the angle under which the point sees the ray, so the density of t is
+// h / ((theta_b - theta_a) (h^2 + (t - delta)^2)), h the point's distance from the line and delta
+// the distance along the ray to its foot.
+struct Equiangular {
+  float delta = 0, h = 0, theta_a = 0, theta_b = 0;
+  float sample(float u) const { return delta + h * std::tan(theta_a + u * (theta_b - theta_a)); }
+  float pdf(float t) const {
+    return h / ((theta_b - theta_a) * (h * h + (t - delta) * (t - delta)));
+  }
+};
+// None where the point lies on the line (no density to speak of: neither strategy counts that).
+std::optional<Equiangular> equiangular_about(const Ray& unit, float length, Vec3 p) {
+  const Vec3 w = p - unit.o;
+  Equiangular e;
+  e.delta = dot(w, unit.d);
+  e.h = ::bpm::length(w - unit.d * e.delta);
+  if (!(e.h > 1e-6f * ::bpm::length(w))) return std::nullopt;
+  e.theta_a = std::atan2(-e.delta, e.h);
+  e.theta_b = std::atan2(length - e.delta, e.h);  // pi / 2 without end
+  if (!(e.theta_b > e.theta_a)) return std::nullopt;
+  return e;
+}
+
+// The area density with which sample_direct_light_along draws a light's point (1 for a point).
+float light_point_pdf(const Light& light) {
+  const auto* area = std::get_if<AreaLight>(&light);
+  return area ? 1 / area->area : 1.0f;
+}
+
+}  // namespace
+
+Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVertex& v, float g,
+                                       const WavelengthMaterials& wm, Rng& rng,
                                        PathCounters& counters) {
   const Wavelengths& wl = wm.wl;
   if (scene.lights.empty()) return {};
@@ -88,21 +159,95 @@ Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int med
   int li = scene.light_distribution.sample(rng.uniform(), &pmf);
   const Light& light = scene.lights[size_t(li)];
   Vec2 u{rng.uniform(), rng.uniform()};
+  const Vec3 p = v.sp.p;
   auto ls = light_sample_li(light, scene.light_shape(light), p, u, scene.bounds_info, wl,
                             wm.light_spectrum(li));
   if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
-  const float phase = henyey_greenstein(dot(travel, ls->wi), g);
+  const float phase = henyey_greenstein(dot(-v.wo, ls->wi), g);
   if (!(phase > 0)) return {};
   ++counters.shadow_rays;
   const bool has_surface = length_squared(ls->n_light) > 0;
   const Vec3 target = has_surface
                           ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
                           : ls->p_light;
-  const Spectrum f = shadow_transmittance(scene, p, target, medium, ls->is_infinite, wl) * phase;
+  const Spectrum f = shadow_transmittance(scene, p, target, v.medium, ls->is_infinite, wl) * phase;
   if (f.is_black()) return {};
   const float p_light = pmf * ls->pdf_solid_angle;
-  if (ls->is_delta) return ls->radiance * f / p_light;
-  return ls->radiance * f * (power_heuristic(p_light, phase) / p_light);
+  float share = ls->is_delta ? 1 : power_heuristic(p_light, phase);
+  // The balance heuristic against sample_direct_light_along's density of the same light path.
+  const std::optional<Equiangular> eq =
+      v.piece.equiangular && !ls->is_infinite
+          ? equiangular_about(v.piece.ray, v.piece.length, ls->p_light)
+          : std::nullopt;
+  if (eq) {
+    float p_area = 1;  // next-event estimation's density of the light's point
+    if (!ls->is_delta)
+      p_area = ls->pdf_solid_angle * absdot(ls->n_light, ls->wi) / length_squared(ls->p_light - p);
+    const float p_flight =
+        medium_at_distance(scene, v.medium, v.piece.ray, v.piece.t, wl).flight_pdf * p_area;
+    const float p_along = eq->pdf(v.piece.t) * light_point_pdf(light);
+    share *= p_flight > 0 ? p_flight / (p_flight + p_along) : 0.0f;
+  }
+  return ls->radiance * f * (share / p_light);
+}
+
+Spectrum sample_direct_light_along(const RenderScene& scene, int medium, const Ray& ray,
+                                   float length, const WavelengthMaterials& wm, Rng& rng,
+                                   PathCounters& counters) {
+  const Wavelengths& wl = wm.wl;
+  if (scene.lights.empty()) return {};
+  float pmf;
+  const int li = scene.light_distribution.sample(rng.uniform(), &pmf);
+  const Light& light = scene.lights[size_t(li)];
+  const Shape* shape = scene.light_shape(light);
+  const Vec2 u{rng.uniform(), rng.uniform()};
+  const float ut = rng.uniform();
+  const std::optional<LightPoint> lp = light_sample_point(light, shape, u);
+  if (!lp) return {};
+  const std::optional<Equiangular> eq = equiangular_about(ray, length, lp->p);
+  if (!eq) return {};
+  const float t = std::clamp(eq->sample(ut), 0.0f, length);
+  const Vec3 x = ray.o + ray.d * t;
+  // The light arriving at x from the point: radiance per unit solid angle at x times G, the
+  // solid angle per unit area of the light; next-event estimation's density of that point.
+  Spectrum radiance;
+  Vec3 wi, target;
+  float G = 1, p_area = 1, p_solid_angle = 0;
+  if (lp->is_delta) {
+    const auto ls = light_sample_li(light, shape, x, u, scene.bounds_info, wl);
+    if (!ls || ls->radiance.is_black()) return {};
+    radiance = ls->radiance;
+    wi = ls->wi;
+    target = ls->p_light;
+  } else {
+    const Vec3 d = lp->p - x;
+    const float d2 = length_squared(d);
+    if (!(d2 > 0)) return {};
+    wi = d / std::sqrt(d2);
+    const float cos_light = absdot(lp->n, wi);
+    if (cos_light == 0) return {};
+    radiance = area_light_radiance(std::get<AreaLight>(light), lp->n, lp->uv, -wi, wl,
+                                   wm.light_spectrum(li));
+    if (radiance.is_black()) return {};
+    G = cos_light / d2;
+    p_solid_angle = light_pdf_li(light, shape, x, wi, lp->p, lp->n);
+    p_area = p_solid_angle * G;
+    target = offset_origin(lp->p, lp->n, -wi, lp->error);
+  }
+  const float g = scene.media[size_t(medium)].g;
+  const float phase = henyey_greenstein(dot(ray.d, wi), g);
+  if (!(phase > 0)) return {};
+  const MediumAtDistance at = medium_at_distance(scene, medium, ray, t, wl);
+  if (at.sigma_s.is_black()) return {};
+  ++counters.shadow_rays;
+  const Spectrum f = shadow_transmittance(scene, x, target, medium, false, wl);
+  if (f.is_black()) return {};
+  // Next-event estimation's share against phase sampling, split between the free flight and this
+  // sample by the balance heuristic (the 1 / p of this sample folded in).
+  const float share = lp->is_delta ? 1 : power_heuristic(pmf * p_solid_angle, phase);
+  const float denominator = pmf * (at.flight_pdf * p_area + eq->pdf(t) * lp->pdf_area);
+  if (!(denominator > 0)) return {};
+  return radiance * f * at.T * at.sigma_s * (phase * G * share / denominator);
 }
 
 Spectrum weighted_surface_emission(const RenderScene& scene, const Ray& ray, const Hit& hit,

@@ -27,13 +27,29 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
                              bool use_mis, const WavelengthMaterials& wm, Rng& rng,
                              PathCounters& counters, BsdfPart part = BsdfPart::kAll);
 
-// Direct light at a point p inside `medium` that scatters by a Henyey-Greenstein phase function of
-// asymmetry g, reached by a path travelling along `travel`: one light chosen by power, attenuated
-// by the media up to it (the shadow ray crosses interfaces, shadow_transmittance), by the power
-// heuristic against phase sampling.
-Spectrum sample_direct_light_in_medium(const RenderScene& scene, Vec3 p, int medium, Vec3 travel,
-                                       float g, const WavelengthMaterials& wm, Rng& rng,
+// Direct light at a medium vertex v (StepEnd::kMedium) that scatters by a Henyey-Greenstein phase
+// function of asymmetry g: one light chosen by power, attenuated by the media up to it (the shadow
+// ray crosses interfaces, shadow_transmittance), by the power heuristic against phase sampling;
+// where the path also sampled direct light along v's piece (v.piece.equiangular), that share is
+// split with sample_direct_light_along by the balance heuristic.
+Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVertex& v, float g,
+                                       const WavelengthMaterials& wm, Rng& rng,
                                        PathCounters& counters);
+
+// Direct light scattered toward the origin of a unit ray from anywhere on its first `length`
+// (kInf: without end) inside `medium`, per unit throughput at the ray's origin: a point drawn on a
+// light chosen by power (light_sample_point), then a distance by equiangular sampling about that
+// point (Kulla and Fajardo 2012, "Importance sampling techniques for path tracing in
+// participating media"), whose density falls as 1 / r^2 from the light as the light itself does:
+// beside a small light in fog, next-event estimation from free-flight points alone has unbounded
+// variance. A light path x_light - x_t - origin that a free flight and next-event estimation at
+// x_t also draw is shared with it by the balance heuristic on the two densities of x_t (the
+// power heuristic against phase sampling as sample_direct_light_in_medium's), so a path that
+// samples along every piece where its next medium vertex would estimate direct light stays
+// unbiased. Distant and environment lights are not sampled so.
+Spectrum sample_direct_light_along(const RenderScene& scene, int medium, const Ray& ray,
+                                   float length, const WavelengthMaterials& wm, Rng& rng,
+                                   PathCounters& counters);
 
 // How emission found by the next ray of a path counts: in full (seen from the camera or through
 // specular vertices only), by the power heuristic against next-event estimation at the previous
@@ -62,10 +78,13 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
 // surfaces reached and, when the ray escapes, environment lights, weighted as `emitter` says
 // (next-event estimation's shadow rays cross interfaces as these rays do), and where
 // `medium_light` says, the emission of the media crossed (in full: no other strategy finds it).
+// Where `along` is given, the direct light scattered along each piece crossed in a scattering
+// medium (sample_direct_light_along) is added to it: the caller passes it exactly where a medium
+// vertex drawn on the way would estimate direct light.
 inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
                                PathState& s, PathVertex& v, PathCounters& counters,
-                               const EmitterWeight& emitter, Spectrum& L,
-                               bool medium_light = false) {
+                               const EmitterWeight& emitter, Spectrum& L, bool medium_light = false,
+                               Spectrum* along = nullptr) {
   const Wavelengths& wl = materials.wl;
   StepEnd end = next_vertex(
       scene, materials, s, v, counters.bounce_rays, counters.observer,
@@ -74,8 +93,12 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
       },
       [&](const Ray& ray, float distance, const Spectrum& beta) {
         if (medium_light) L += beta * medium_emission(scene, s.medium, ray, distance, wl);
+        if (along && scene.media[size_t(s.medium)].scatters())
+          *along += beta * sample_direct_light_along(scene, s.medium, ray, distance, materials,
+                                                     *s.rng, counters);
       });
   if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
+  if (end == StepEnd::kMedium) v.piece.equiangular = along != nullptr;
   return end;
 }
 

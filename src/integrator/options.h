@@ -36,6 +36,9 @@ struct IntegratorOptions {
   int threads = 0;          // 0: all hardware threads
   uint64_t seed = 0;
   int max_depth = 5;
+  // path and bpm: direct light in scattering media also sampled along the camera's rays
+  // (integrator/direct_light.h, sample_direct_light_along).
+  bool equiangular = true;
   bool progress = true;
   double accuracy = 0;          // stop when the image error delta (eq. 4) is at most this; 0: off
   bool adaptive = false;        // adaptive sampling (integrator/control.h)

@@ -16,8 +16,7 @@ void scatter_in_medium(const RenderScene& scene, const WavelengthMaterials& mate
                        const PathVertex& v, PathState& s, Rng& rng, PathCounters& counters,
                        EmitterWeight& emitter, Spectrum& L) {
   const Medium& m = scene.media[size_t(v.medium)];
-  L += s.beta *
-       sample_direct_light_in_medium(scene, v.sp.p, v.medium, -v.wo, m.g, materials, rng, counters);
+  L += s.beta * sample_direct_light_in_medium(scene, v, m.g, materials, rng, counters);
   const PhaseSample ps = sample_phase(v, m.g, rng);
   emitter = ps.emitter;
   s.ray = Ray{v.sp.p, ps.wi, kInf};
@@ -74,9 +73,11 @@ Spectrum path_radiance(const RenderScene& scene, Ray ray, const PathSettings& se
   ++counters.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    // Media emit toward the path before its last scattering event (pbrt-v4's volpath).
-    const StepEnd end =
-        next_eye_vertex(scene, materials, s, v, counters, emitter, L, depth < settings.max_depth);
+    // Media emit toward the path before its last scattering event (pbrt-v4's volpath), and
+    // direct light is sampled along the pieces in media where a vertex would estimate it.
+    const bool more = depth < settings.max_depth;
+    const StepEnd end = next_eye_vertex(scene, materials, s, v, counters, emitter, L, more,
+                                        more && settings.equiangular ? &L : nullptr);
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == settings.max_depth) break;
     if (end == StepEnd::kMedium) {

@@ -19,6 +19,9 @@ struct PathSettings {
   // and a BSDF sample of that part, as a photon method's eye path at a diffuse vertex); the path
   // goes on through whichever lobe it samples.
   bool caustics_elsewhere = false;
+  // Direct light in media also by equiangular sampling along each piece of the path's rays
+  // (sample_direct_light_along), shared with next-event estimation at free-flight points.
+  bool equiangular = true;
 };
 
 // Radiance arriving along -ray.d at the ray's origin, at the wavelengths wl. `first` weighs the

@@ -25,6 +25,16 @@ struct PathState {
   Rng* rng = nullptr;      // draws where the ray scatters in a medium (next_vertex)
 };
 
+// The piece of a ray through a scattering medium on which a medium vertex was drawn: from ray.o
+// along the unit ray.d, `length` long (kInf: without end), the vertex at distance t;
+// `equiangular`: the path also sampled direct light along the piece (direct_light.h).
+struct MediumPiece {
+  Ray ray;
+  float length = 0;
+  float t = 0;
+  bool equiangular = false;
+};
+
 // A surface where the path scatters.
 struct PathVertex {
   Hit hit;
@@ -37,8 +47,9 @@ struct PathVertex {
   Vec3 wo_local;
   bool on_curve = false;  // the surface is a curve (scene/curves.h)
   // A point inside a scattering medium (StepEnd::kMedium): sp.p is the point, wo the way back,
-  // `medium` the medium; no surface, material or frame.
+  // `medium` the medium, `piece` where on its ray it was drawn; no surface, material or frame.
   int medium = -1;
+  MediumPiece piece;
   PathVertex() = default;
   PathVertex(const PathVertex&) = delete;  // material may point into storage
   PathVertex& operator=(const PathVertex&) = delete;
@@ -155,6 +166,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
         v.sp = SurfacePoint{};
         v.sp.p = s.ray.o + normalize(s.ray.d) * t;
         v.wo = -normalize(s.ray.d);
+        v.piece = MediumPiece{unit, distance, t, false};
         return s.beta.is_black() ? StepEnd::kAbsorbed : StepEnd::kMedium;
       }
       if (s.beta.is_black()) return StepEnd::kAbsorbed;

@@ -133,6 +133,11 @@ std::optional<LightLiSample> sample_li_of(const AreaLight& l, const Shape* shape
   return ls;
 }
 
+LightPoint sample_point_of(const AreaLight& l, const Shape& shape, Vec2 u) {
+  const AreaSample as = sample_area(l, shape, u);
+  return {as.p, as.n, as.uv, as.error, as.pdf_area, false};
+}
+
 float pdf_li_of(const AreaLight& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3 p_light,
                 Vec3 n_light) {
   if (auto* s = std::get_if<Sphere>(shape)) {

@@ -60,6 +60,22 @@ std::optional<LightLeSample> light_sample_le(const Light& light, const Shape* sh
                     light);
 }
 
+std::optional<LightPoint> light_sample_point(const Light& light, const Shape* shape, Vec2 u) {
+  if (const auto* area = std::get_if<AreaLight>(&light)) return sample_point_of(*area, *shape, u);
+  LightPoint lp;
+  if (const auto* l = std::get_if<PointLight>(&light))
+    lp.p = l->position;
+  else if (const auto* l = std::get_if<SpotLight>(&light))
+    lp.p = l->position;
+  else if (const auto* l = std::get_if<GoniometricLight>(&light))
+    lp.p = l->world_from_light.point(Vec3(0, 0, 0));
+  else if (const auto* l = std::get_if<ProjectionLight>(&light))
+    lp.p = l->world_from_light.point(Vec3(0, 0, 0));
+  else
+    return std::nullopt;
+  return lp;
+}
+
 Rgb light_power(const Light& light, const SceneBoundsInfo& bounds) {
   return std::visit([&](const auto& x) { return power_of(x, bounds); }, light);
 }

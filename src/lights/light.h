@@ -173,6 +173,18 @@ float light_pdf_li(const Light& l, const Shape* shape, Vec3 p_ref, Vec3 wi, Vec3
 // (WavelengthMaterials::light_spectrum; ignored for an image light).
 Spectrum area_light_radiance(const AreaLight& l, Vec3 n, Vec2 uv, Vec3 w, const Wavelengths& wl,
                              const Spectrum* spectrum = nullptr);
+// A point on a light drawn without regard to where it is seen from (equiangular sampling along a
+// ray in a medium, integrator/direct_light.h): an area light's uniformly by area, a point-like
+// light's own position. None for distant and infinite lights.
+struct LightPoint {
+  Vec3 p;
+  Vec3 n;  // surface normal (zero for a point-like light)
+  Vec2 uv;
+  float error = 0;     // p's error bound (SurfacePoint::error)
+  float pdf_area = 1;  // 1 for a point-like light (a delta)
+  bool is_delta = true;
+};
+std::optional<LightPoint> light_sample_point(const Light& l, const Shape* shape, Vec2 u);
 // Samples an emitted photon; u_pos picks the point, u_dir the direction. `spectrum`, when given,
 // is an area light's (without an image) radiance spectrum at wl, evaluated once by the caller for
 // many photons; other lights ignore it.

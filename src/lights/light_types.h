@@ -99,5 +99,6 @@ std::optional<LightLeSample> sample_le_of(const AreaLight& l, const Shape* shape
                                           const Wavelengths& wl,
                                           const Spectrum* spectrum = nullptr);
 Rgb power_of(const AreaLight& l, const SceneBoundsInfo& bounds);
+LightPoint sample_point_of(const AreaLight& l, const Shape& shape, Vec2 u);
 
 }  // namespace bpm

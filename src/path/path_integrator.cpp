@@ -11,7 +11,7 @@ namespace bpm {
 RenderStats render_path(const LoadedScene& ls, const IntegratorOptions& opt, Film* film) {
   const CameraSampler camera(ls.camera, ls.filter,
                              ls.film.raster_for(film->width(), film->height()), opt.seed);
-  const PathSettings settings{opt.max_depth};
+  const PathSettings settings{opt.max_depth, false, opt.equiangular};
   tbb::enumerable_thread_specific<PathCounters> counters;
   RenderStats stats;
   auto pass = [&](int pass, const RenderControl& control) {

@@ -29,6 +29,7 @@ std::string field_name(const std::string& key) {
   if (key == "integrator_settings") return "integrator settings";
   if (key == "max_depth") return "maxdepth";
   if (key == "m_images") return "M-images (--m-images)";
+  if (key == "equiangular") return "equiangular sampling (--no-equiangular)";
   return key;
 }
 
@@ -68,6 +69,7 @@ nlohmann::json render_identity(const std::vector<std::string>& scene_files, cons
           {"integrator_settings", settings},
           {"seed", opt.seed},
           {"max_depth", opt.max_depth},
+          {"equiangular", opt.equiangular},
           {"filter", Filter(ls.filter).name()},
           {"filter_radius", {ls.filter.radius.x, ls.filter.radius.y}},
           {"adaptive", opt.adaptive},
