@@ -608,7 +608,7 @@ void add_general_options(CLI::App* render, RenderArgs& ra) {
       ->group(kGeneral);
   render
       ->add_flag("--no-equiangular", ra.no_equiangular,
-                 "path and bpm: direct light in scattering media from free-flight points only, "
+                 "Direct light in scattering media from free-flight points only, "
                  "without equiangular sampling along the camera's rays")
       ->group(kGeneral);
   render->add_flag("-q,--quiet", ra.quiet, "No progress output")->group(kGeneral);

@@ -421,14 +421,25 @@ float gather_beam(const RenderScene& scene, const BackwardMaps& maps, const Ligh
                   std::vector<std::vector<PhotonEntry>>& out) {
   found.clear();
   prm.medium_spheres->query(b.medium, b.cls, b.ray, b.t_max, &found);
-  const float g_medium = scene.media[size_t(b.medium)].g;
+  if (found.empty()) return 0;
+  const Medium& m = scene.media[size_t(b.medium)];
+  const Wavelengths& wl = prm.materials->wl;
+  // sigma_t once per beam (medium_transmittance would sample it at every sphere).
+  const Spectrum sigma_t = m.rgb_grid ? Spectrum() : m.sigma_a.sample(wl) + m.sigma_s.sample(wl);
+  auto transmittance = [&](float t) {
+    if (m.rgb_grid) return medium_transmittance(scene, b.medium, b.ray, t, wl);
+    const float tau = m.depth(b.ray, 0, t);
+    Spectrum T;
+    for (int k = 0; k < Spectrum::kChannels; ++k) T[k] = std::exp(-sigma_t[k] * tau);
+    return T;
+  };
   float score = 0;
   for (const auto& [g, t] : found) {
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + b.bounces > prm.max_depth) continue;
-    Spectrum value = b.flux * medium_transmittance(scene, b.medium, b.ray, t, prm.materials->wl) *
-                     (henyey_greenstein(dot(bp.wo, b.ray.d), g_medium) *
-                      hero_join_factor(bp.hero_only, b.hero_only));
+    Spectrum value =
+        b.flux * transmittance(t) *
+        (henyey_greenstein(dot(bp.wo, b.ray.d), m.g) * hero_join_factor(bp.hero_only, b.hero_only));
     if (value.is_black()) continue;
     score += add_entry(bp, g, length_squared(b.ray.o + b.ray.d * t - bp.p), value, prm, owner, out);
   }

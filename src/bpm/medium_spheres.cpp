@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 
 #include "base/error.h"
 
@@ -14,6 +15,9 @@ struct MediumSpheres::Scenes {
   RTCDevice device = nullptr;
   std::vector<RTCScene> scenes;
   std::vector<std::vector<uint32_t>> ids;
+  // Each scene's spheres as centre and radius, in its primitives' order: the filter reads these
+  // rather than the (larger, scattered) backward photon records.
+  std::vector<std::vector<std::array<float, 4>>> spheres;
   std::vector<float> max_radius;
   void release() {
     for (RTCScene s : scenes)
@@ -30,8 +34,8 @@ namespace {
 
 struct QueryContext {
   RTCIntersectContext embree;  // first: Embree hands the filter this pointer
-  const BackwardMaps* maps;
   const std::vector<uint32_t>* ids;
+  const std::vector<std::array<float, 4>>* spheres;
   Vec3 o, d;  // the beam
   float t_max;
   std::vector<std::pair<uint32_t, float>>* found;
@@ -45,13 +49,14 @@ void collect_sphere(const RTCFilterFunctionNArguments* args) {
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
     args->valid[i] = 0;  // go on to the next sphere
-    const uint32_t g = (*q->ids)[RTCHitN_primID(args->hit, args->N, i)];
+    const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const uint32_t g = (*q->ids)[prim];
     if (!q->found->empty() && q->found->back().first == g) continue;
-    const BackwardPhoton& bp = q->maps->photons[g];
-    const Vec3 oc = bp.p - q->o;
+    const std::array<float, 4>& s = (*q->spheres)[prim];
+    const Vec3 oc = Vec3(s[0], s[1], s[2]) - q->o;
     const float t = dot(oc, q->d);
     if (!(t >= 0 && t <= q->t_max)) continue;
-    if (length_squared(oc - q->d * t) < bp.radius * bp.radius) q->found->push_back({g, t});
+    if (length_squared(oc - q->d * t) < s[3] * s[3]) q->found->push_back({g, t});
   }
 }
 
@@ -65,12 +70,12 @@ MediumSpheres::MediumSpheres() : scenes_(std::make_unique<Scenes>()) {
 MediumSpheres::~MediumSpheres() = default;
 
 void MediumSpheres::build(const BackwardMaps& maps, size_t object_count, size_t media) {
-  maps_ = &maps;
   spheres_ = 0;
   Scenes& s = *scenes_;
   s.release();
   s.scenes.assign(2 * media, nullptr);
   s.ids.resize(2 * media);
+  s.spheres.resize(2 * media);
   s.max_radius.assign(2 * media, 0);
   for (size_t m = 0; m < media; ++m) {
     const uint32_t begin = maps.object_begin[object_count + m];
@@ -87,12 +92,12 @@ void MediumSpheres::build(const BackwardMaps& maps, size_t object_count, size_t 
       RTCGeometry geom = rtcNewGeometry(s.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
       auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                             RTC_FORMAT_FLOAT4, 16, ids.size()));
+      std::vector<std::array<float, 4>>& spheres = s.spheres[k];
+      spheres.resize(ids.size());
       for (size_t j = 0; j < ids.size(); ++j) {
         const BackwardPhoton& bp = maps.photons[ids[j]];
-        v[4 * j] = bp.p.x;
-        v[4 * j + 1] = bp.p.y;
-        v[4 * j + 2] = bp.p.z;
-        v[4 * j + 3] = bp.radius;
+        spheres[j] = {bp.p.x, bp.p.y, bp.p.z, bp.radius};
+        std::copy(spheres[j].begin(), spheres[j].end(), v + 4 * j);
         s.max_radius[k] = std::max(s.max_radius[k], bp.radius);
       }
       rtcSetGeometryOccludedFilterFunction(geom, collect_sphere);
@@ -111,7 +116,7 @@ void MediumSpheres::query(int medium, PhotonClass cls, const Ray& ray, float t_m
   const size_t k = 2 * size_t(medium) + size_t(BackwardMaps::tree_class(cls));
   if (medium < 0 || k >= scenes_->scenes.size() || !scenes_->scenes[k]) return;
   const size_t first = found->size();
-  QueryContext q{{}, maps_, &scenes_->ids[k], ray.o, ray.d, t_max, found};
+  QueryContext q{{}, &scenes_->ids[k], &scenes_->spheres[k], ray.o, ray.d, t_max, found};
   rtcInitIntersectContext(&q.embree);
   // The ray runs a largest radius beyond both ends of the beam, so that it meets the surface of
   // every sphere whose centre's nearest point lies on the beam, even one that holds the whole beam.

@@ -36,7 +36,6 @@ class MediumSpheres {
  private:
   struct Scenes;
   std::unique_ptr<Scenes> scenes_;
-  const BackwardMaps* maps_ = nullptr;
   size_t spheres_ = 0;
 };
 

@@ -234,7 +234,10 @@ FpmEyeRadiance fpm_eye_radiance(const RenderScene& scene, const ForwardMaps& map
   ++c.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
-    const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, c.rays, emitter, L);
+    // Direct light along the pieces in media that lead to x1 (its next-event estimation's share).
+    const bool along = prm.equiangular && !gathering && depth < prm.max_depth;
+    const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, c.rays, emitter, L, false,
+                                        along ? &L : nullptr);
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == prm.max_depth) break;
     if (end == StepEnd::kMedium) {

@@ -20,6 +20,9 @@ struct FpmEyeParams {
   // In a scattering medium the radii are never those of a shorter path than this
   // (photons/medium_radius.h).
   float medium_min_length = 0;
+  // Direct light in media also sampled along the rays that lead to x1
+  // (IntegratorOptions::equiangular).
+  bool equiangular = true;
 };
 
 struct FpmEyeCounters {

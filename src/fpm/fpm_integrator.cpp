@@ -224,8 +224,14 @@ void FpmRender::eye_pass(const WavelengthMaterials& wm, int pass, int it,
   const auto t = Clock::now();
   float scale = radius_scale(s_, it);
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
-  FpmEyeParams ep{
-      &wm, &s_, opt_.max_depth, s_.k0 * scale, s_.k1 * scale, double(emitted_), medium_min_length_};
+  FpmEyeParams ep{&wm,
+                  &s_,
+                  opt_.max_depth,
+                  s_.k0 * scale,
+                  s_.k1 * scale,
+                  double(emitted_),
+                  medium_min_length_,
+                  opt_.equiangular};
   for_each_sampled_pixel(film_->width(), film_->height(), control, pass, [&](uint32_t pixel) {
     CameraSample cs = camera_.sample(it, pixel);
     const FpmEyeRadiance r = fpm_eye_radiance(scene_, maps_, ep, cs.camera_ray(), cs.footprint,

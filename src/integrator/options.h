@@ -36,7 +36,7 @@ struct IntegratorOptions {
   int threads = 0;          // 0: all hardware threads
   uint64_t seed = 0;
   int max_depth = 5;
-  // path and bpm: direct light in scattering media also sampled along the camera's rays
+  // Direct light in scattering media also sampled along the camera paths' rays
   // (integrator/direct_light.h, sample_direct_light_along).
   bool equiangular = true;
   bool progress = true;
