@@ -556,8 +556,8 @@ TEST(Bpm, AlbedoOneFurnaceInAMedium) {
 
 // A box of fog (an interface surface around it) over a floor, a small area light above it and a
 // glass sphere in it: light focused into the fog (a volumetric caustic) and onto the floor through
-// the fog, interreflection between fog and floor. bpm's and fpm's blocks agree with path's within
-// 4.5 sigma plus the edge bias of the radii.
+// the fog, interreflection between fog and floor. bpm's (with and without splitting in media)
+// and fpm's blocks agree with path's within 4.5 sigma plus the edge bias of the radii.
 TEST(Bpm, FogWithAGlassSphereMatchesPath) {
   const LoadedScene ls = load(R"(LookAt 0 1 -4  0 1 0  0 1 0
 Camera "perspective" "float fov" 40
@@ -591,6 +591,12 @@ AttributeEnd
   const BpmSettings s;
   expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, s), ref.film, 6, edge_bias(s, 24, 6),
                       "fog and glass, bpm");
+  // Eye paths that leave the choice between scattering on a piece and crossing it to the free
+  // flight, instead of splitting there (the default above).
+  BpmSettings unsplit;
+  unsplit.split_in_media = false;
+  expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, unsplit), ref.film, 6,
+                      edge_bias(unsplit, 24, 6), "fog and glass, bpm without splitting");
   FpmSettings f;
   f.final_gather = false;
   expect_blocks_agree(render_iterations(ls, "fpm", 24, 3, s, f), ref.film, 6, edge_bias(s, 24, 6),
@@ -810,6 +816,9 @@ TEST(Bpm, FirstDiffuseVertexGathersCausticsOverK0AndIndirectOverK1) {
     EXPECT_NEAR(length, 2.3f, 0.1f);
     if (c.diffuse_depth == 0 && c.r0 != c.r1) {
       ASSERT_EQ(all.size(), 2u);
+      // Stored in the order the probes need, the larger (indirect) disc first.
+      EXPECT_EQ(all[0].place + 1, all[1].place);
+      std::swap(all[0], all[1]);
       EXPECT_EQ(all[0].accepts, kAcceptsCaustic);
       EXPECT_EQ(all[1].accepts, kAcceptsIndirect);
       EXPECT_FLOAT_EQ(all[1].radius / all[0].radius, c.r1 / c.r0);

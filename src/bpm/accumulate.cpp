@@ -23,7 +23,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
   // of its sums, whose cache lines are at hand), and its place among its pixel's, in parallel over
   // the photons in the maps' order; each pixel then adds its shares in that order.
   const size_t places = size_t(sums->places);
-  BPM_CHECK(places >= 1 && places <= 8);
+  BPM_CHECK(places >= 1 && places <= kMaxBackwardPhotonsPerPath);
   std::vector<uint32_t>& at = sums->by_place;
   at.resize(size_t(w) * size_t(h) * places);
   tbb::parallel_for(
@@ -46,7 +46,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                          bias = bp.tau * radius_bias(nested, norm, settings.bias_model);
           light.flux[g] = share;
           light.flux_inner[g] = bias;
-          const size_t place = size_t(backward_photon_place(bp));
+          const size_t place = bp.place;
           BPM_CHECK(place < places);
           uint32_t& slot = at[size_t(bp.pixel) * places + place];
           BPM_CHECK(slot == PixelSums::kNone);
@@ -59,7 +59,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
         // In the maps' order (an insertion sort of a few).
-        uint32_t found[8];
+        uint32_t found[kMaxBackwardPhotonsPerPath];
         size_t n = 0;
         for (size_t k = 0; k < places; ++k) {
           const uint32_t g = at[p * places + k];

@@ -25,18 +25,12 @@ namespace bpm {
 //
 // `sums` holds, per pixel, its backward photons that received light (kept from one iteration to
 // the next, so that its memory is allocated once): `places` of them per pixel at most (one per
-// backward_photon_place), the diffuse depth plus 2.
+// BackwardPhoton::place), kMaxBackwardPhotonsPerPath.
 struct PixelSums {
   static constexpr uint32_t kNone = ~0u;
   int places = 0;
-  std::vector<uint32_t> by_place;  // [pixel * places + backward_photon_place(bp)]: g, or kNone
+  std::vector<uint32_t> by_place;  // [pixel * places + bp.place]: g, or kNone
 };
-
-// Where a backward photon sits among its pixel's: one per diffuse vertex, and the second of the
-// two a vertex stores when it splits the radii (the indirect one). Unique within a pixel.
-inline int backward_photon_place(const BackwardPhoton& bp) {
-  return bp.diffuse_index + (bp.accepts == kAcceptsIndirect ? 1 : 0);
-}
 
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums, EyePixels* eye,
                           const Wavelengths& wl, float max_component_value,

@@ -12,6 +12,15 @@ namespace bpm {
 
 enum AcceptMask : uint8_t { kAcceptsCaustic = 1, kAcceptsIndirect = 2 };
 
+// An eye path stores one backward photon at each of its diffuse vertices (D + 1 of them, D <= 3)
+// and a second at the last, and two (as at a last vertex) at each of at most kMaxMediumSplits
+// pieces of its rays through media where it splits (bpm/eye_pass.cpp).
+constexpr int kMaxMediumSplits = 4;
+constexpr int backward_photons_per_path(int diffuse_depth, bool splits) {
+  return diffuse_depth + 2 + (splits ? 2 * kMaxMediumSplits : 0);
+}
+constexpr int kMaxBackwardPhotonsPerPath = backward_photons_per_path(3, true);
+
 struct BackwardPhoton {
   Vec3 p;
   float radius;  // world units
@@ -27,12 +36,14 @@ struct BackwardPhoton {
   bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
   uint8_t disc_cut = 0;    // the disc probes that found no surface (photons/disc_probes.h)
   uint8_t disc_found = 0;  // and those that found some
+  uint8_t place = 0;       // its rank among its eye path's backward photons, in storing order
   // A point inside a scattering medium, this one (-1: a surface point): a sphere that gathers
   // photon beams, with no normals, surface coordinates or material.
   int16_t medium = -1;
 
-  // Sort key that fixes the order of backward photons whatever thread stored them.
-  uint64_t key() const { return (uint64_t(pixel) << 4) | (uint64_t(diffuse_index) << 2) | accepts; }
+  // Sort key that fixes the order of backward photons whatever thread stored them (an eye path
+  // stores fewer than 16: kMaxBackwardPhotonsPerPath).
+  uint64_t key() const { return (uint64_t(pixel) << 4) | place; }
 };
 
 }  // namespace bpm

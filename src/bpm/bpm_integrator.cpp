@@ -23,6 +23,12 @@
 namespace bpm {
 namespace {
 
+// The most backward photons one eye path stores (BackwardPhoton::place).
+int photons_per_path(const BpmSettings& s, const RenderScene& scene) {
+  return backward_photons_per_path(s.diffuse_depth,
+                                   s.split_in_media && scene.has_scattering_media());
+}
+
 void check(const BpmSettings& s) {
   if (s.diffuse_depth < 0 || s.diffuse_depth > 3)
     throw Error("bpm: --diffuse-depth (file: diffusedepth) must be in 0..3");
@@ -224,26 +230,28 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
           scene_.has_scattering_media()
               ? median_surface_distance(scene_, camera_.camera(), film->width(), film->height())
               : 0) {
-  pixel_sums_.places = s_.diffuse_depth + 2;
+  pixel_sums_.places = photons_per_path(s_, scene_);
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
   light_.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
 }
 
 // An eye path leaves at most D + 2 backward photons (two at x_1 when D = 0, one at each other
-// diffuse vertex): the worst iteration must fit the memory budget before the first one starts.
+// diffuse vertex), and kMaxMediumSplits more where it splits in media: the worst iteration must
+// fit the memory budget before the first one starts.
 // The light pass holds the hits of a group of photons, and its entries get what the film, the
 // actual maps and those hits leave (applied in more rounds).
 double BpmRender::reserve_memory() const {
   const double fixed_bytes =
       double(film_->bytes()) + double(n_pixels_) * kPixelBytes +
       light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),
-                           n_pixels_ * size_t(s_.diffuse_depth + 2));
-  check_memory("bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) +
-                   " (up to " + std::to_string(s_.diffuse_depth + 2) +
-                   " backward photons per pixel and iteration)",
-               fixed_bytes + double(n_pixels_) * (s_.diffuse_depth + 2) * kBackwardPhotonBytes,
-               opt_.memory_budget, kMemoryAdvice);
+                           n_pixels_ * size_t(photons_per_path(s_, scene_)));
+  check_memory(
+      "bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) + " (up to " +
+          std::to_string(photons_per_path(s_, scene_)) +
+          " backward photons per pixel and iteration)",
+      fixed_bytes + double(n_pixels_) * photons_per_path(s_, scene_) * kBackwardPhotonBytes,
+      opt_.memory_budget, kMemoryAdvice);
   return fixed_bytes;
 }
 
@@ -296,7 +304,8 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    s_.normal_cos,
                    s_.disc_probes,
                    &near_edges_,
-                   opt_.equiangular};
+                   opt_.equiangular,
+                   s_.split_in_media};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii.
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,

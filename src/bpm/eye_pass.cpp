@@ -52,6 +52,8 @@ struct EyePath {
   Rng& rng;
   ObjectPhotonLists& out;
   EyeCounters& counters;
+  int& stored;  // backward photons stored so far (BackwardPhoton::place)
+  int& splits;  // medium vertices drawn where the path splits (gather_forced_in_medium)
 };
 
 // Direct light at v by next-event estimation, shared by MIS with the BSDF sample that goes on.
@@ -72,6 +74,7 @@ inline bool store_backward_photon(const EyePath& path, const PathVertex& v, cons
   BackwardPhoton bp =
       backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
   if (bp.radius <= 0 || s.beta.is_black()) return false;
+  bp.place = uint8_t(path.stored++);
   if (v.medium >= 0) {  // after the objects' lists, one per medium
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
     ++path.counters.backward_photons;
@@ -158,6 +161,32 @@ inline bool gather_in_medium(const EyePath& path, const PathVertex& v, PathState
   return false;
 }
 
+// The last diffuse vertex drawn on a piece of the eye path's ray through a scattering medium,
+// which the path itself crosses (PathState::cross_media): every ray through the medium gathers
+// there, where a free flight would have scattered with the probability 1 - exp(-sigma_t tau) alone.
+// What it gathers goes to `out` (never emission: it is direct light and the photons'). `along`:
+// direct light was sampled along the piece too.
+inline void gather_forced_in_medium(const EyePath& path, PathState& s, const Ray& ray, float length,
+                                    const Spectrum& beta, int depth, int diffuse, bool along,
+                                    Spectrum& out) {
+  // The last piece allowed: the path draws its own vertices past it.
+  if (++path.splits == kMaxMediumSplits) s.cross_media = false;
+  PathState f = s;
+  f.beta = beta;
+  f.cross_media = false;
+  const float t = sample_forced_medium_distance(path.scene, s.medium, ray, length,
+                                                path.prm.materials->wl, path.rng, f.beta);
+  if (t < 0 || f.beta.is_black()) return;
+  f.length = s.length + t;
+  PathVertex v;
+  v.medium = s.medium;
+  v.sp.p = ray.o + ray.d * t;
+  v.wo = -ray.d;
+  v.piece = MediumPiece{ray, length, t, along, true};
+  EmitterWeight unused;
+  gather_in_medium(path, v, f, depth + 1, diffuse + 1, unused, out);
+}
+
 // Samples the BSDF at v and leaves the vertex along the sample; sets the weight of the emission
 // the next vertex sees. Returns false where the path ends (no sample, no throughput left).
 inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexChoice& choice,
@@ -189,7 +218,8 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
                                              uint32_t pixel, Rng& rng, ObjectPhotonLists& out,
                                              EyeCounters& counters, bool emission_only,
                                              uint8_t near_edge) {
-  const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters};
+  int stored = 0, splits = 0;
+  const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters, stored, splits};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;
@@ -211,8 +241,17 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
     PathVertex v;
     const bool sample_along =
         prm.equiangular && !emission_only && depth < prm.max_depth && diffuse <= prm.diffuse_depth;
+    // Toward the last diffuse vertex the path splits in media: it scatters on every piece and
+    // crosses it too (gather_forced_in_medium).
+    s.cross_media = prm.split_in_media && !emission_only && depth < prm.max_depth &&
+                    diffuse == prm.diffuse_depth && splits < kMaxMediumSplits;
+    auto on_piece = [&](const Ray& piece, float length, const Spectrum& beta) {
+      if (s.cross_media)
+        gather_forced_in_medium(path, s, piece, length, beta, depth, diffuse, sample_along, along);
+    };
     const StepEnd end = next_eye_vertex(scene, *prm.materials, s, v, counters.rays, emitter, L,
-                                        false, sample_along ? &along : nullptr);
+                                        false, sample_along ? &along : nullptr, on_piece);
+    s.cross_media = false;
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     if (depth++ == prm.max_depth) break;
     if (end == StepEnd::kMedium) {  // a diffuse vertex in a medium

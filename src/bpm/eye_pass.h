@@ -51,6 +51,9 @@ struct EyePassParams {
   // Direct light in media also sampled along the rays that lead to diffuse vertices
   // (IntegratorOptions::equiangular).
   bool equiangular = true;
+  // Eye paths toward their last diffuse vertex both scatter on every piece of their rays through
+  // a scattering medium and cross it (BpmSettings::split_in_media).
+  bool split_in_media = true;
 };
 
 struct EyeCounters {

@@ -28,6 +28,7 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("tree", b.centre_tree || tree == "spheres", "must be \"spheres\" or \"centres\"",
              in.loc);
   b.guide_emission = ps.get_bool("guideemission", b.guide_emission);
+  b.split_in_media = ps.get_bool("splitinmedia", b.split_in_media);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
@@ -48,7 +49,8 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"tree", s.centre_tree ? "centres" : "spheres"},
           {"guide_emission", s.guide_emission},
           {"disc_probes", s.disc_probes},
-          {"emission_samples", s.emission_samples}};
+          {"emission_samples", s.emission_samples},
+          {"split_in_media", s.split_in_media}};
 }
 
 }  // namespace bpm

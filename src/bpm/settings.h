@@ -25,6 +25,10 @@ struct BpmSettings : PhotonSettings {
   // When positive, the initial radius of every backward photon in world units (pbrt-v4 sppm's
   // "radius"), in place of k0 and k1; it shrinks with the radius policy like them.
   float radius = 0;
+  // Eye paths toward their last diffuse vertex split in scattering media: each piece of their
+  // ray through one gets a medium vertex, and the path also goes on past it
+  // (sample_forced_medium_distance), where a free flight would pick one of the two.
+  bool split_in_media = true;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"

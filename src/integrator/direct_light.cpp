@@ -81,42 +81,76 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);
 }
 
-namespace {
-
-// A medium at distance t along a unit ray from where it enters: the transmittance up to there,
-// sigma_s there, and the density per unit length with which next_vertex's free flight draws t
-// (sample_medium_distance, sample_rgb_grid_flight: the mixture over wavelengths).
-struct MediumAtDistance {
-  Spectrum T, sigma_s;
-  float flight_pdf = 0;
-};
 MediumAtDistance medium_at_distance(const RenderScene& scene, int medium, const Ray& unit, float t,
-                                    const Wavelengths& wl) {
+                                    const Wavelengths& wl, float forced_length) {
   constexpr int n = Spectrum::kChannels;
   const Medium& m = scene.media[size_t(medium)];
   const Vec3 x = unit.o + unit.d * t;
+  const bool forced = forced_length >= 0;
   MediumAtDistance r;
-  double pdf = 0;
+  Spectrum sigma_t_x, whole;  // sigma_t at x; the optical depth of the whole piece (forced)
   if (m.rgb_grid) {
     const Spectrum depth = m.rgb_grid->depth(unit, 0, t, wl);
     Spectrum a;
     m.rgb_grid->coefficients(x, wl, &a, &r.sigma_s);
-    for (int k = 0; k < n; ++k) {
-      r.T[k] = std::exp(-depth[k]);
-      pdf += double(a[k] + r.sigma_s[k]) * r.T[k];
-    }
+    sigma_t_x = a + r.sigma_s;
+    for (int k = 0; k < n; ++k) r.T[k] = std::exp(-depth[k]);
+    if (forced) whole = m.rgb_grid->depth(unit, 0, forced_length, wl);
   } else {
     const float density = m.density(x), tau = m.depth(unit, 0, t);
     const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
-    for (int k = 0; k < n; ++k) {
-      r.T[k] = std::exp(-sigma_t[k] * tau);
-      pdf += double(sigma_t[k]) * density * r.T[k];
-    }
+    for (int k = 0; k < n; ++k) r.T[k] = std::exp(-sigma_t[k] * tau);
     r.sigma_s = sigma_s * density;
+    sigma_t_x = sigma_t * density;
+    if (forced) whole = sigma_t * m.depth(unit, 0, forced_length);
+  }
+  double pdf = 0;
+  for (int k = 0; k < n; ++k) {
+    if (!forced)
+      pdf += double(sigma_t_x[k]) * r.T[k];
+    else if (whole[k] > 0)
+      pdf += double(sigma_t_x[k]) * r.T[k] / -std::expm1(-double(whole[k]));
+    else if (std::isfinite(forced_length) && forced_length > 0)
+      pdf += 1.0 / forced_length;  // no extinction on the piece: uniform over it
   }
   r.flight_pdf = float(pdf / n);
   return r;
 }
+
+float sample_forced_medium_distance(const RenderScene& scene, int medium, const Ray& unit,
+                                    float length, const Wavelengths& wl, Rng& rng, Spectrum& beta) {
+  constexpr int n = Spectrum::kChannels;
+  const Medium& m = scene.media[size_t(medium)];
+  const int j = std::min(int(rng.uniform() * n), n - 1);
+  const float u = rng.uniform();
+  // Wavelength j's optical depth over the piece, and the depth drawn in [0, it).
+  float whole, t = -1;
+  if (m.rgb_grid) {
+    whole = m.rgb_grid->depth(unit, 0, length, wl)[j];
+  } else {
+    const float sigma_t = m.sigma_a.sample(wl)[j] + m.sigma_s.sample(wl)[j];
+    whole = sigma_t * m.depth(unit, 0, length);
+  }
+  if (whole > 0) {
+    const float depth = std::min(float(-std::log1p(u * std::expm1(-double(whole)))), whole);
+    if (m.rgb_grid) {
+      t = m.rgb_grid->distance_at_depth(unit, j, depth, length, wl);
+    } else {
+      const float sigma_t = whole / m.depth(unit, 0, length);
+      t = m.distance_at_depth(unit, depth / sigma_t, length);
+    }
+  } else if (std::isfinite(length) && length > 0) {
+    t = u * length;
+  }
+  if (t < 0) return -1;
+  t = std::min(t, length);
+  const MediumAtDistance at = medium_at_distance(scene, medium, unit, t, wl, length);
+  if (!(at.flight_pdf > 0)) return -1;
+  beta *= at.T * at.sigma_s / at.flight_pdf;
+  return t;
+}
+
+namespace {
 
 // Equiangular sampling of the distance t in [0, length] along a unit ray about a point: uniform in
 // the angle under which the point sees the ray, so the density of t is
@@ -183,8 +217,10 @@ Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVerte
     float p_area = 1;  // next-event estimation's density of the light's point
     if (!ls->is_delta)
       p_area = ls->pdf_solid_angle * absdot(ls->n_light, ls->wi) / length_squared(ls->p_light - p);
-    const float p_flight =
-        medium_at_distance(scene, v.medium, v.piece.ray, v.piece.t, wl).flight_pdf * p_area;
+    const float p_flight = medium_at_distance(scene, v.medium, v.piece.ray, v.piece.t, wl,
+                                              v.piece.forced ? v.piece.length : -1.0f)
+                               .flight_pdf *
+                           p_area;
     const float p_along = eq->pdf(v.piece.t) * light_point_pdf(light);
     share *= p_flight > 0 ? p_flight / (p_flight + p_along) : 0.0f;
   }
@@ -192,8 +228,8 @@ Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVerte
 }
 
 Spectrum sample_direct_light_along(const RenderScene& scene, int medium, const Ray& ray,
-                                   float length, const WavelengthMaterials& wm, Rng& rng,
-                                   PathCounters& counters) {
+                                   float length, bool forced, const WavelengthMaterials& wm,
+                                   Rng& rng, PathCounters& counters) {
   const Wavelengths& wl = wm.wl;
   if (scene.lights.empty()) return {};
   float pmf;
@@ -237,7 +273,7 @@ Spectrum sample_direct_light_along(const RenderScene& scene, int medium, const R
   const float g = scene.media[size_t(medium)].g;
   const float phase = henyey_greenstein(dot(ray.d, wi), g);
   if (!(phase > 0)) return {};
-  const MediumAtDistance at = medium_at_distance(scene, medium, ray, t, wl);
+  const MediumAtDistance at = medium_at_distance(scene, medium, ray, t, wl, forced ? length : -1);
   if (at.sigma_s.is_black()) return {};
   ++counters.shadow_rays;
   const Spectrum f = shadow_transmittance(scene, x, target, medium, false, wl);

@@ -27,6 +27,27 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
                              bool use_mis, const WavelengthMaterials& wm, Rng& rng,
                              PathCounters& counters, BsdfPart part = BsdfPart::kAll);
 
+// A medium at distance t along a unit ray from where the ray enters it: the transmittance up to
+// there, sigma_s there, and the density per unit length with which t is drawn: by next_vertex's
+// free flight (sample_medium_distance, sample_rgb_grid_flight: the mixture over wavelengths), or
+// where forced_length >= 0, by sample_forced_medium_distance on a piece of that length.
+struct MediumAtDistance {
+  Spectrum T, sigma_s;
+  float flight_pdf = 0;
+};
+MediumAtDistance medium_at_distance(const RenderScene& scene, int medium, const Ray& unit, float t,
+                                    const Wavelengths& wl, float forced_length = -1);
+
+// A point where a ray scatters in a medium on a piece of `length` along the unit ray, drawn on the
+// piece whatever happens past it: one wavelength's free flight conditioned to end on the piece
+// (the wavelength drawn uniformly), beta weighted by sigma_s T over the mixture of all
+// wavelengths' densities. Paired with crossing the piece at full weight exp(-sigma_t tau)
+// (PathState::cross_media), it splits a path in two where a free flight picks one or the other,
+// and every ray through a thin medium then scatters. Returns the distance, or negative where
+// nothing could be drawn.
+float sample_forced_medium_distance(const RenderScene& scene, int medium, const Ray& unit,
+                                    float length, const Wavelengths& wl, Rng& rng, Spectrum& beta);
+
 // Direct light at a medium vertex v (StepEnd::kMedium) that scatters by a Henyey-Greenstein phase
 // function of asymmetry g: one light chosen by power, attenuated by the media up to it (the shadow
 // ray crosses interfaces, shadow_transmittance), by the power heuristic against phase sampling;
@@ -47,9 +68,10 @@ Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVerte
 // power heuristic against phase sampling as sample_direct_light_in_medium's), so a path that
 // samples along every piece where its next medium vertex would estimate direct light stays
 // unbiased. Distant and environment lights are not sampled so.
+// `forced`: a medium vertex on the piece would be drawn by sample_forced_medium_distance.
 Spectrum sample_direct_light_along(const RenderScene& scene, int medium, const Ray& ray,
-                                   float length, const WavelengthMaterials& wm, Rng& rng,
-                                   PathCounters& counters);
+                                   float length, bool forced, const WavelengthMaterials& wm,
+                                   Rng& rng, PathCounters& counters);
 
 // How emission found by the next ray of a path counts: in full (seen from the camera or through
 // specular vertices only), by the power heuristic against next-event estimation at the previous
@@ -80,11 +102,13 @@ void add_environment_emission(const RenderScene& scene, const Ray& ray, const Wa
 // `medium_light` says, the emission of the media crossed (in full: no other strategy finds it).
 // Where `along` is given, the direct light scattered along each piece crossed in a scattering
 // medium (sample_direct_light_along) is added to it: the caller passes it exactly where a medium
-// vertex drawn on the way would estimate direct light.
-inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
-                               PathState& s, PathVertex& v, PathCounters& counters,
-                               const EmitterWeight& emitter, Spectrum& L, bool medium_light = false,
-                               Spectrum* along = nullptr) {
+// vertex drawn on the way would estimate direct light. on_piece(ray, length, beta) is then called
+// for each such piece (with s.cross_media, where the caller draws the medium vertices itself).
+template <class OnPiece = NoMediumPieces>
+StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& materials,
+                        PathState& s, PathVertex& v, PathCounters& counters,
+                        const EmitterWeight& emitter, Spectrum& L, bool medium_light = false,
+                        Spectrum* along = nullptr, OnPiece&& on_piece = {}) {
   const Wavelengths& wl = materials.wl;
   StepEnd end = next_vertex(
       scene, materials, s, v, counters.bounce_rays, counters.observer,
@@ -93,9 +117,11 @@ inline StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMateria
       },
       [&](const Ray& ray, float distance, const Spectrum& beta) {
         if (medium_light) L += beta * medium_emission(scene, s.medium, ray, distance, wl);
-        if (along && scene.media[size_t(s.medium)].scatters())
-          *along += beta * sample_direct_light_along(scene, s.medium, ray, distance, materials,
-                                                     *s.rng, counters);
+        if (!scene.media[size_t(s.medium)].scatters()) return;
+        if (along)
+          *along += beta * sample_direct_light_along(scene, s.medium, ray, distance, s.cross_media,
+                                                     materials, *s.rng, counters);
+        on_piece(ray, distance, beta);
       });
   if (end == StepEnd::kEscaped) add_environment_emission(scene, s.ray, wl, s.beta, emitter, L);
   if (end == StepEnd::kMedium) v.piece.equiangular = along != nullptr;

@@ -23,16 +23,23 @@ struct PathState {
   float length = 0;        // world distance travelled, interfaces included
   bool hero_only = false;  // only the first wavelength goes on (hero_wavelength_only)
   Rng* rng = nullptr;      // draws where the ray scatters in a medium (next_vertex)
+  // The ray crosses scattering media as absorbing ones (exp(-sigma_t tau), no free flight): the
+  // caller draws the points where it scatters itself, along the pieces that in_medium reports
+  // (bpm's forced medium vertices, bpm/eye_pass.cpp).
+  bool cross_media = false;
 };
 
 // The piece of a ray through a scattering medium on which a medium vertex was drawn: from ray.o
 // along the unit ray.d, `length` long (kInf: without end), the vertex at distance t;
-// `equiangular`: the path also sampled direct light along the piece (direct_light.h).
+// `equiangular`: the path also sampled direct light along the piece (direct_light.h); `forced`:
+// t was drawn on the piece whatever the path did past it (sample_forced_medium_distance), not by
+// a free flight.
 struct MediumPiece {
   Ray ray;
   float length = 0;
   float t = 0;
   bool equiangular = false;
+  bool forced = false;
 };
 
 // A surface where the path scatters.
@@ -145,7 +152,8 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
     v.hit = Hit();
     const bool hit = scene.intersect(s.ray, &v.hit);
     const float distance = hit ? v.hit.t * length(s.ray.d) : kInf;
-    if (s.medium >= 0 && scene.media[size_t(s.medium)].scatters()) {
+    const bool scatters = s.medium >= 0 && scene.media[size_t(s.medium)].scatters();
+    if (scatters && !s.cross_media) {
       BPM_CHECK(s.rng);  // set by every path that may meet a scattering medium
       const Medium& m = scene.media[size_t(s.medium)];
       const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
@@ -173,7 +181,8 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       if (!hit) return StepEnd::kEscaped;
     } else {
       const Ray unit{s.ray.o, normalize(s.ray.d), kInf};
-      if (s.medium >= 0 && scene.media[size_t(s.medium)].emits()) in_medium(unit, distance, s.beta);
+      if (scatters || (s.medium >= 0 && scene.media[size_t(s.medium)].emits()))
+        in_medium(unit, distance, s.beta);
       if (!hit) {
         cross_medium(scene, s.medium, unit, kInf, wl, s.beta);
         return StepEnd::kEscaped;
