@@ -54,7 +54,7 @@ struct RenderArgs {
   bool no_guide = false;
   bool no_disc_probes = false;
   bool no_equiangular = false;
-  bool no_split_in_media = false;
+  bool split_in_media = false;
   bool debias = false;
   std::string bias_model;
   int emission_samples = 0;
@@ -160,7 +160,7 @@ RenderOptions render_options(const RenderArgs& a, const LoadedScene& ls,
   if (a.diffuse_depth >= 0) opt.bpm.diffuse_depth = a.diffuse_depth;
   if (!a.tree.empty()) opt.bpm.centre_tree = a.tree == "centres";
   if (a.no_guide) opt.bpm.guide_emission = false;
-  if (a.no_split_in_media) opt.bpm.split_in_media = false;
+  if (a.split_in_media) opt.bpm.split_in_media = true;
   if (a.no_disc_probes) opt.bpm.disc_probes = opt.fpm.disc_probes = false;
   if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;
   if (a.radius >= 0) opt.bpm.radius = a.radius;
@@ -720,10 +720,10 @@ void add_photon_options(CLI::App* render, RenderArgs& ra) {
                  "where a wall or an edge leaves photons part of it (file: bool discprobes false)")
       ->group(kBpm);
   render
-      ->add_flag("--no-split-in-media", ra.no_split_in_media,
-                 "bpm: an eye ray through a scattering medium gathers there only where a free "
-                 "flight makes it scatter, instead of on every piece it crosses (file: bool "
-                 "splitinmedia false)")
+      ->add_flag("--split-in-media", ra.split_in_media,
+                 "bpm: an eye ray through a scattering medium gathers on every piece it crosses "
+                 "and also goes on past it, instead of where a free flight makes it scatter "
+                 "(file: bool splitinmedia true)")
       ->group(kBpm);
   render
       ->add_flag("--debias", ra.debias,

@@ -556,7 +556,7 @@ TEST(Bpm, AlbedoOneFurnaceInAMedium) {
 
 // A box of fog (an interface surface around it) over a floor, a small area light above it and a
 // glass sphere in it: light focused into the fog (a volumetric caustic) and onto the floor through
-// the fog, interreflection between fog and floor. bpm's (with and without splitting in media)
+// the fog, interreflection between fog and floor. bpm's (without and with splitting in media)
 // and fpm's blocks agree with path's within 4.5 sigma plus the edge bias of the radii.
 TEST(Bpm, FogWithAGlassSphereMatchesPath) {
   const LoadedScene ls = load(R"(LookAt 0 1 -4  0 1 0  0 1 0
@@ -591,12 +591,12 @@ AttributeEnd
   const BpmSettings s;
   expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, s), ref.film, 6, edge_bias(s, 24, 6),
                       "fog and glass, bpm");
-  // Eye paths that leave the choice between scattering on a piece and crossing it to the free
-  // flight, instead of splitting there (the default above).
-  BpmSettings unsplit;
-  unsplit.split_in_media = false;
-  expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, unsplit), ref.film, 6,
-                      edge_bias(unsplit, 24, 6), "fog and glass, bpm without splitting");
+  // Eye paths that split on each piece of their rays through the fog (both scatter there and go
+  // on), instead of leaving the choice to the free flight (the default above).
+  BpmSettings split;
+  split.split_in_media = true;
+  expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, split), ref.film, 6,
+                      edge_bias(split, 24, 6), "fog and glass, bpm splitting in the fog");
   FpmSettings f;
   f.final_gather = false;
   expect_blocks_agree(render_iterations(ls, "fpm", 24, 3, s, f), ref.film, 6, edge_bias(s, 24, 6),

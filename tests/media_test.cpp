@@ -8,6 +8,7 @@
 
 #include "base/sampling.h"
 #include "camera/camera.h"
+#include "integrator/direct_light.h"
 #include "integrator/sensors.h"
 #include "test_util.h"
 
@@ -250,6 +251,49 @@ AttributeEnd
       var += v;
     }
     EXPECT_LT(std::fabs(diff), 4 * std::sqrt(var));
+  }
+}
+
+// A point drawn on a piece of ray by a free flight conditioned to end there (bpm's splitting in
+// media) carries sigma_s T / p: in a medium of albedo 1 its mean weight is the chance of scattering
+// on the piece, 1 - exp(-sigma_t L) at each wavelength, and 1 on a piece without end (the camera
+// in open fog looking at the sky); chromatic sigma_t, a homogeneous and a grid medium.
+TEST(Media, ForcedFreeFlightWeightsAreTheChanceOfScattering) {
+  for (const std::string medium :
+       {std::string("\"string type\" \"homogeneous\""), std::string(kGridMedium)}) {
+    SCOPED_TRACE(medium);
+    const LoadedScene ls = load(R"(LookAt 0 0 -0.5  0 0 1  0 1 0
+MakeNamedMedium "m" )" + medium +
+                                R"( "rgb sigma_a" [0 0 0] "rgb sigma_s" [0.3 0.8 1.6]
+MediumInterface "" "m"
+Camera "perspective"
+WorldBegin
+)");
+    const Wavelengths wl = sample_wavelengths(0.37f);
+    const Spectrum sigma_t = ls.scene.media[0].sigma_s.sample(wl);
+    const Ray ray{Vec3(-0.2f, 0.1f, -1.2f), normalize(Vec3(0.3f, 0.2f, 1)), kInf};
+    for (const float length : {0.7f, 2.5f, kInf}) {
+      SCOPED_TRACE(length);
+      Rng rng(11);
+      const int n = 200000;
+      std::vector<double> sum(Spectrum::kChannels, 0), sum2(Spectrum::kChannels, 0);
+      for (int i = 0; i < n; ++i) {
+        Spectrum beta(1.0f);
+        const float t = sample_forced_medium_distance(ls.scene, 0, ray, length, wl, rng, beta);
+        if (t < 0) continue;
+        ASSERT_LE(t, length);
+        for (int k = 0; k < Spectrum::kChannels; ++k) {
+          sum[size_t(k)] += beta[k];
+          sum2[size_t(k)] += double(beta[k]) * beta[k];
+        }
+      }
+      const float tau = ls.scene.media[0].depth(ray, 0, length);
+      for (int k = 0; k < Spectrum::kChannels; ++k) {
+        const double mean = sum[size_t(k)] / n;
+        const double sigma = std::sqrt(std::max(0.0, sum2[size_t(k)] / n - mean * mean) / n);
+        EXPECT_NEAR(mean, -std::expm1(-double(sigma_t[k]) * tau), 5 * sigma + 1e-4) << k;
+      }
+    }
   }
 }
 

@@ -53,7 +53,7 @@ struct EyePassParams {
   bool equiangular = true;
   // Eye paths toward their last diffuse vertex both scatter on every piece of their rays through
   // a scattering medium and cross it (BpmSettings::split_in_media).
-  bool split_in_media = true;
+  bool split_in_media = false;
 };
 
 struct EyeCounters {

@@ -27,8 +27,10 @@ struct BpmSettings : PhotonSettings {
   float radius = 0;
   // Eye paths toward their last diffuse vertex split in scattering media: each piece of their
   // ray through one gets a medium vertex, and the path also goes on past it
-  // (sample_forced_medium_distance), where a free flight would pick one of the two.
-  bool split_in_media = true;
+  // (sample_forced_medium_distance), where a free flight would pick one of the two. Off by
+  // default: at equal time it halves the error in open fog and doubles it in a thick grid medium
+  // (docs/MEASUREMENTS.md).
+  bool split_in_media = false;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"

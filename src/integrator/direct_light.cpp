@@ -102,7 +102,10 @@ MediumAtDistance medium_at_distance(const RenderScene& scene, int medium, const 
     for (int k = 0; k < n; ++k) r.T[k] = std::exp(-sigma_t[k] * tau);
     r.sigma_s = sigma_s * density;
     sigma_t_x = sigma_t * density;
-    if (forced) whole = sigma_t * m.depth(unit, 0, forced_length);
+    if (forced) {
+      const float depth = m.depth(unit, 0, forced_length);
+      for (int k = 0; k < n; ++k) whole[k] = sigma_t[k] > 0 ? sigma_t[k] * depth : 0.0f;
+    }
   }
   double pdf = 0;
   for (int k = 0; k < n; ++k) {
@@ -124,21 +127,17 @@ float sample_forced_medium_distance(const RenderScene& scene, int medium, const 
   const int j = std::min(int(rng.uniform() * n), n - 1);
   const float u = rng.uniform();
   // Wavelength j's optical depth over the piece, and the depth drawn in [0, it).
-  float whole, t = -1;
+  float whole, sigma_t = 0, t = -1;
   if (m.rgb_grid) {
     whole = m.rgb_grid->depth(unit, 0, length, wl)[j];
   } else {
-    const float sigma_t = m.sigma_a.sample(wl)[j] + m.sigma_s.sample(wl)[j];
-    whole = sigma_t * m.depth(unit, 0, length);
+    sigma_t = m.sigma_a.sample(wl)[j] + m.sigma_s.sample(wl)[j];
+    whole = sigma_t > 0 ? sigma_t * m.depth(unit, 0, length) : 0.0f;  // kInf long: kInf
   }
   if (whole > 0) {
     const float depth = std::min(float(-std::log1p(u * std::expm1(-double(whole)))), whole);
-    if (m.rgb_grid) {
-      t = m.rgb_grid->distance_at_depth(unit, j, depth, length, wl);
-    } else {
-      const float sigma_t = whole / m.depth(unit, 0, length);
-      t = m.distance_at_depth(unit, depth / sigma_t, length);
-    }
+    t = m.rgb_grid ? m.rgb_grid->distance_at_depth(unit, j, depth, length, wl)
+                   : m.distance_at_depth(unit, depth / sigma_t, length);
   } else if (std::isfinite(length) && length > 0) {
     t = u * length;
   }
