@@ -213,7 +213,7 @@ AttributeBegin
   Shape "sphere" "float radius" 0.1
 AttributeEnd
 )";
-  for (const std::string medium :
+  for (const std::string& medium :
        {std::string(kGridMedium) + " \"rgb sigma_a\" [0.2 0.3 0.1] \"rgb sigma_s\" [1 0.6 0.8]",
         std::string("\"string type\" \"homogeneous\" \"rgb sigma_a\" [0.05 0.05 0.05] "
                     "\"rgb sigma_s\" [0.4 0.5 0.6]")}) {
@@ -259,7 +259,7 @@ AttributeEnd
 // on the piece, 1 - exp(-sigma_t L) at each wavelength, and 1 on a piece without end (the camera
 // in open fog looking at the sky); chromatic sigma_t, a homogeneous and a grid medium.
 TEST(Media, ForcedFreeFlightWeightsAreTheChanceOfScattering) {
-  for (const std::string medium :
+  for (const std::string& medium :
        {std::string("\"string type\" \"homogeneous\""), std::string(kGridMedium)}) {
     SCOPED_TRACE(medium);
     const LoadedScene ls = load(R"(LookAt 0 0 -0.5  0 0 1  0 1 0

@@ -113,7 +113,7 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
     throw Error(ps.find_any("Lescale")->loc, "Lescale must not be negative");
   const float g = ps.get_float("g", 0);
   if (!(g > -1 && g < 1)) throw Error(ps.find_any("g")->loc, "g must lie in (-1, 1)");
-  Medium medium{name, SpectrumCurve(1.0f), SpectrumCurve(1.0f), g, nullptr, nullptr};
+  Medium medium{name, SpectrumCurve(1.0f), SpectrumCurve(1.0f), g, nullptr, nullptr, {}};
   if (m.name == "rgbgrid") {
     medium.rgb_grid = rgb_grid(m, scale);
     ps.warn_unused("medium \"" + name + "\"");
