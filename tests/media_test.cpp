@@ -65,28 +65,35 @@ PixelChord pixel_chord(const Camera& cam, int x, int y) {
   return p;
 }
 
+// Every pixel of a slab scene's film that does not graze the sphere against expected(chord), the
+// chord its ray cuts through the sphere (0 for one that misses it), within 5 of its rms; the
+// pixels whose rays cross the sphere must be more than 20.
+template <class Expected>
+void expect_pixels_follow_chords(const LoadedScene& ls, const Film& f, Expected expected) {
+  const Image img = f.image();
+  const std::vector<float> rms = f.rms();
+  const Camera cam(ls.camera, 12, 12);
+  int inside = 0;
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 12; ++x) {
+      const PixelChord p = pixel_chord(cam, x, y);
+      if (p.grazing) continue;
+      inside += p.hits;
+      EXPECT_NEAR(img.at(x, y).luminance(), expected(p.length()),
+                  5 * rms[size_t(y) * 12 + x] + 1e-3f)
+          << x << "," << y;
+    }
+  EXPECT_GT(inside, 20);
+}
+
 // At depth 0 only light that crosses the medium unscattered counts: exp(-sigma_t c) through a
 // chord c of the sphere, whatever part of sigma_t scatters. A chromatic medium renders as the
 // absorbing one with the same sigma_t, channel by channel (the one-sample MIS over wavelengths).
 TEST(Media, UnscatteredLightIsBeerLambertOfSigmaT) {
   const LoadedScene grey =
       load(slab_scene("\"rgb sigma_a\" [0.3 0.3 0.3] \"rgb sigma_s\" [0.5 0.5 0.5]", 0));
-  const Film f = render_path(grey, 64);
-  const Image img = f.image();
-  const std::vector<float> rms = f.rms();
-  const Camera cam(grey.camera, 12, 12);
-  int inside = 0;
-  for (int y = 0; y < 12; ++y)
-    for (int x = 0; x < 12; ++x) {
-      const PixelChord p = pixel_chord(cam, x, y);
-      if (p.grazing) continue;
-      const float chord = p.length();
-      inside += p.hits;
-      EXPECT_NEAR(img.at(x, y).luminance(), std::exp(-0.8f * chord),
-                  5 * rms[size_t(y) * 12 + x] + 1e-3f)
-          << x << "," << y;
-    }
-  EXPECT_GT(inside, 20);
+  expect_pixels_follow_chords(grey, render_path(grey, 64),
+                              [](float chord) { return std::exp(-0.8f * chord); });
   const Image chromatic =
       render_path(load(slab_scene("\"rgb sigma_a\" [0 0 0] \"rgb sigma_s\" [0.9 0.2 0.4]", 0)), 256)
           .image();
@@ -363,23 +370,9 @@ TEST(Media, EmittingMediumGlowsAlongItsChords) {
   scene.replace(scene.find("\"rgb L\" [1 1 1]"), 15, "\"rgb L\" [0 0 0]");
   const LoadedScene ls = load(scene);
   ASSERT_TRUE(ls.scene.has_emissive_media());
-  const Film f = render_path(ls, 16);
-  const Image img = f.image();
-  const std::vector<float> rms = f.rms();
-  const Camera cam(ls.camera, 12, 12);
-  int inside = 0;
-  for (int y = 0; y < 12; ++y)
-    for (int x = 0; x < 12; ++x) {
-      const PixelChord p = pixel_chord(cam, x, y);
-      if (p.grazing) continue;
-      const float chord = p.length();
-      inside += p.hits;
-      // Grey coefficients: the only noise is the glow's spectrum (D65) at the wavelengths drawn.
-      EXPECT_NEAR(img.at(x, y).luminance(), 3 * (1 - std::exp(-0.7f * chord)),
-                  5 * rms[size_t(y) * 12 + x] + 1e-3f)
-          << x << "," << y;
-    }
-  EXPECT_GT(inside, 20);
+  // Grey coefficients: the only noise is the glow's spectrum (D65) at the wavelengths drawn.
+  expect_pixels_follow_chords(ls, render_path(ls, 16),
+                              [](float chord) { return 3 * (1 - std::exp(-0.7f * chord)); });
   Film film(12, 12);
   EXPECT_THROW(render(ls, quiet_options(ls, "bpm", 1, 1), &film), Error);
 }

@@ -3,7 +3,6 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
-#include <array>
 
 #include "base/error.h"
 
@@ -15,9 +14,9 @@ struct MediumSpheres::Scenes {
   RTCDevice device = nullptr;
   std::vector<RTCScene> scenes;
   std::vector<std::vector<uint32_t>> ids;
-  // Each scene's spheres as centre and radius, in its primitives' order: the filter reads these
-  // rather than the (larger, scattered) backward photon records.
-  std::vector<std::vector<std::array<float, 4>>> spheres;
+  // Each scene's vertex buffer (centre and radius per sphere, in its primitives' order, alive as
+  // long as the scene): the filter reads these rather than the larger backward photon records.
+  std::vector<const float*> spheres;
   std::vector<float> max_radius;
   void release() {
     for (RTCScene s : scenes)
@@ -35,8 +34,8 @@ namespace {
 struct QueryContext {
   RTCIntersectContext embree;  // first: Embree hands the filter this pointer
   const std::vector<uint32_t>* ids;
-  const std::vector<std::array<float, 4>>* spheres;
-  Vec3 o, d;  // the beam
+  const float* spheres;  // x, y, z, radius per primitive
+  Vec3 o, d;             // the beam
   float t_max;
   std::vector<std::pair<uint32_t, float>>* found;
 };
@@ -52,7 +51,7 @@ void collect_sphere(const RTCFilterFunctionNArguments* args) {
     const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
     const uint32_t g = (*q->ids)[prim];
     if (!q->found->empty() && q->found->back().first == g) continue;
-    const std::array<float, 4>& s = (*q->spheres)[prim];
+    const float* s = q->spheres + 4 * size_t(prim);
     const Vec3 oc = Vec3(s[0], s[1], s[2]) - q->o;
     const float t = dot(oc, q->d);
     if (!(t >= 0 && t <= q->t_max)) continue;
@@ -75,7 +74,7 @@ void MediumSpheres::build(const BackwardMaps& maps, size_t object_count, size_t 
   s.release();
   s.scenes.assign(2 * media, nullptr);
   s.ids.resize(2 * media);
-  s.spheres.resize(2 * media);
+  s.spheres.assign(2 * media, nullptr);
   s.max_radius.assign(2 * media, 0);
   for (size_t m = 0; m < media; ++m) {
     const uint32_t begin = maps.object_begin[object_count + m];
@@ -92,14 +91,15 @@ void MediumSpheres::build(const BackwardMaps& maps, size_t object_count, size_t 
       RTCGeometry geom = rtcNewGeometry(s.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
       auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                             RTC_FORMAT_FLOAT4, 16, ids.size()));
-      std::vector<std::array<float, 4>>& spheres = s.spheres[k];
-      spheres.resize(ids.size());
       for (size_t j = 0; j < ids.size(); ++j) {
         const BackwardPhoton& bp = maps.photons[ids[j]];
-        spheres[j] = {bp.p.x, bp.p.y, bp.p.z, bp.radius};
-        std::copy(spheres[j].begin(), spheres[j].end(), v + 4 * j);
+        v[4 * j] = bp.p.x;
+        v[4 * j + 1] = bp.p.y;
+        v[4 * j + 2] = bp.p.z;
+        v[4 * j + 3] = bp.radius;
         s.max_radius[k] = std::max(s.max_radius[k], bp.radius);
       }
+      s.spheres[k] = v;
       rtcSetGeometryOccludedFilterFunction(geom, collect_sphere);
       rtcCommitGeometry(geom);
       s.scenes[k] = rtcNewScene(s.device);
@@ -116,7 +116,7 @@ void MediumSpheres::query(int medium, PhotonClass cls, const Ray& ray, float t_m
   const size_t k = 2 * size_t(medium) + size_t(BackwardMaps::tree_class(cls));
   if (medium < 0 || k >= scenes_->scenes.size() || !scenes_->scenes[k]) return;
   const size_t first = found->size();
-  QueryContext q{{}, &scenes_->ids[k], &scenes_->spheres[k], ray.o, ray.d, t_max, found};
+  QueryContext q{{}, &scenes_->ids[k], scenes_->spheres[k], ray.o, ray.d, t_max, found};
   rtcInitIntersectContext(&q.embree);
   // The ray runs a largest radius beyond both ends of the beam, so that it meets the surface of
   // every sphere whose centre's nearest point lies on the beam, even one that holds the whole beam.
