@@ -22,10 +22,12 @@ constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
 
 // Appends backward photon g's entry for a photon (or a beam's nearest point) at squared distance d2
 // from its centre with `value`, to the list of the slot that owns its pixel. Returns the entry's
-// part of the photon's score for the guide (0 when prm.pixel_weight is not set).
-inline float add_entry(const BackwardPhoton& bp, uint32_t g, float d2, const Spectrum& value,
-                       const LightPassParams& prm, const std::vector<uint16_t>& owner,
-                       std::vector<std::vector<PhotonEntry>>& out) {
+// part of the photon's score for the guide (0 when prm.pixel_weight is not set). `bp` is the
+// backward photon's record, or its sphere's (MediumSphere): its radius, pixel and tau are read.
+template <class Record>
+float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value,
+                const LightPassParams& prm, const std::vector<uint16_t>& owner,
+                std::vector<std::vector<PhotonEntry>>& out) {
   const float r2 = bp.radius * bp.radius;
   const uint32_t bits =
       (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
@@ -415,12 +417,12 @@ void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, cons
 // The entries of one beam: at each sphere it reaches, its flux at the point nearest the centre
 // times the phase function toward the sphere's eye path (before 1 / (pi r^2 N), as a hit's).
 // Returns the beam's score, as gather_at_hit's.
-float gather_beam(const RenderScene& scene, const BackwardMaps& maps, const LightPassParams& prm,
+float gather_beam(const RenderScene& scene, const LightPassParams& prm,
                   const std::vector<uint16_t>& owner, const PendingBeam& b,
-                  std::vector<std::pair<uint32_t, float>>& found,
+                  std::vector<std::pair<const MediumSphere*, float>>& found,
                   std::vector<std::vector<PhotonEntry>>& out) {
   found.clear();
-  prm.medium_spheres->query(b.medium, b.cls, b.ray, b.t_max, &found);
+  prm.medium_spheres->query(b.medium, b.cls, b.ray, b.t_max, prm.max_depth - b.bounces, &found);
   if (found.empty()) return 0;
   const Medium& m = scene.media[size_t(b.medium)];
   const Wavelengths& wl = prm.materials->wl;
@@ -434,32 +436,32 @@ float gather_beam(const RenderScene& scene, const BackwardMaps& maps, const Ligh
     return T;
   };
   float score = 0;
-  for (const auto& [g, t] : found) {
-    const BackwardPhoton& bp = maps.photons[g];
-    if (int(bp.eye_depth) + b.bounces > prm.max_depth) continue;
+  for (const auto& [sphere, t] : found) {
+    const MediumSphere& bp = *sphere;
     Spectrum value =
         b.flux * transmittance(t) *
         (henyey_greenstein(dot(bp.wo, b.ray.d), m.g) * hero_join_factor(bp.hero_only, b.hero_only));
     if (value.is_black()) continue;
-    score += add_entry(bp, g, length_squared(b.ray.o + b.ray.d * t - bp.p), value, prm, owner, out);
+    score += add_entry(bp, bp.index, length_squared(b.ray.o + b.ray.d * t - bp.p), value, prm,
+                       owner, out);
   }
   return score;
 }
 
 // The beams of the first `chunks` chunks: gathered chunk by chunk in parallel, each into lists of
 // its own, then applied chunk by chunk in order (as the hits' entries).
-void gather_and_apply_beams(const RenderScene& scene, const BackwardMaps& maps,
-                            const LightPassParams& prm, const PixelMasks& masks, int chunks,
-                            LightPassBuffers* buf, LightPassResult& res) {
+void gather_and_apply_beams(const RenderScene& scene, const LightPassParams& prm,
+                            const PixelMasks& masks, int chunks, LightPassBuffers* buf,
+                            LightPassResult& res) {
   if (!prm.medium_spheres || prm.medium_spheres->empty()) return;
   if (buf->beam_entries.size() < size_t(chunks)) buf->beam_entries.resize(size_t(chunks));
   tbb::parallel_for(0, chunks, [&](int c) {
     std::vector<std::vector<PhotonEntry>>& by_slot = buf->beam_entries[size_t(c)];
     by_slot.resize(size_t(masks.slots()));
     for (auto& v : by_slot) v.clear();
-    thread_local std::vector<std::pair<uint32_t, float>> found;
+    thread_local std::vector<std::pair<const MediumSphere*, float>> found;
     for (PendingBeam& b : buf->beams[size_t(c)])
-      b.score = gather_beam(scene, maps, prm, masks.owner(), b, found, by_slot);
+      b.score = gather_beam(scene, prm, masks.owner(), b, found, by_slot);
   });
   size_t entries = 0;
   for (int c = 0; c < chunks; ++c)
@@ -542,7 +544,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
     gather_and_apply(maps, prm, masks, buf, res, clock);
-    gather_and_apply_beams(scene, maps, prm, masks, tr.chunks, buf, res);
+    gather_and_apply_beams(scene, prm, masks, tr.chunks, buf, res);
     clock.lap(res.gather_s);
     if (guide && prm.pixel_weight) learn_scores(tr.chunks, buf, *guide);
     clock.lap(res.apply_s);

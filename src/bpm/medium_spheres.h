@@ -16,6 +16,20 @@
 
 namespace bpm {
 
+// What a beam's gathering reads of a backward photon in a medium, in one record: the sphere (the
+// first 16 bytes, which Embree reads as the sphere point's centre and radius), and the photon's
+// direction, pixel, throughput and depth.
+struct alignas(16) MediumSphere {
+  Vec3 p;
+  float radius;
+  Vec3 wo;
+  uint32_t pixel;
+  Spectrum tau;
+  uint32_t index;  // the backward photon's in the maps
+  uint16_t eye_depth;
+  bool hero_only;
+};
+
 class MediumSpheres {
  public:
   MediumSpheres();
@@ -27,11 +41,12 @@ class MediumSpheres {
   // are the media's, in order), by the classes they accept.
   void build(const BackwardMaps& maps, size_t object_count, size_t media);
   bool empty() const { return spheres_ == 0; }
-  // Appends to *found (index of the backward photon in maps, t of the beam's point nearest its
-  // centre) for every sphere of `medium` that accepts `cls` and that the beam from ray.o along
-  // the unit ray.d over [0, t_max] reaches, in index order.
-  void query(int medium, PhotonClass cls, const Ray& ray, float t_max,
-             std::vector<std::pair<uint32_t, float>>* found) const;
+  // Appends to *found (the sphere, t of the beam's point nearest its centre) for every sphere of
+  // `medium` that accepts `cls`, whose eye path has at most max_eye_depth scattering events, and
+  // that the beam from ray.o along the unit ray.d over [0, t_max] reaches, in the order of the
+  // backward photons' indices.
+  void query(int medium, PhotonClass cls, const Ray& ray, float t_max, int max_eye_depth,
+             std::vector<std::pair<const MediumSphere*, float>>* found) const;
 
  private:
   struct Scenes;
