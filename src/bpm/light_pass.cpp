@@ -426,11 +426,14 @@ float gather_beam(const RenderScene& scene, const LightPassParams& prm,
   if (found.empty()) return 0;
   const Medium& m = scene.media[size_t(b.medium)];
   const Wavelengths& wl = prm.materials->wl;
-  // sigma_t once per beam (medium_transmittance would sample it at every sphere).
+  // sigma_t once per beam (medium_transmittance would sample it at every sphere), and one
+  // exponential per sphere where it is the same at every wavelength (a grey medium).
   const Spectrum sigma_t = m.rgb_grid ? Spectrum() : m.sigma_a.sample(wl) + m.sigma_s.sample(wl);
+  const bool grey = sigma_t.max_component() == sigma_t.min_component();
   auto transmittance = [&](float t) {
     if (m.rgb_grid) return medium_transmittance(scene, b.medium, b.ray, t, wl);
     const float tau = m.depth(b.ray, 0, t);
+    if (grey) return Spectrum(std::exp(-sigma_t[0] * tau));
     Spectrum T;
     for (int k = 0; k < Spectrum::kChannels; ++k) T[k] = std::exp(-sigma_t[k] * tau);
     return T;
