@@ -883,6 +883,45 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
 // estimation's, so the photons that only reach the floor score nothing) and weights them by the
 // ratio of densities: whole renders, where the guide learns, still converge to path, and the
 // guide did move photons.
+// The light pass's own variance (from the two halves of its photons, bpm/photon_count.h) falls as
+// 1 / N, and it is the part of an iteration's variance that four times the photons take away:
+// with N and 4N photons (fixed counts, unguided: the guide learns faster from more photons) an
+// iteration's variance drops by 3/4 of the photons' part at N. Each figure is a mean over the
+// image of per-pixel variances from 48 iterations, heavy-tailed (a firefly can double one), so
+// each check takes the median over three pairs of renders; the tolerances are 4 standard
+// deviations of those medians, from the spread over ten seeds (ratios 4.0 +- 0.24, 0.97 +- 0.06).
+TEST(Bpm, LightPassVarianceFallsAsOneOverThePhotons) {
+  LoadedScene ls = load(cornell());
+  struct Figures {
+    double iteration, photons, balance;
+  };
+  auto figures = [&](int photons, uint64_t seed) {
+    BpmSettings s;
+    s.photons_per_iteration = photons;
+    s.guide_emission = false;
+    const RenderRun r = render_with(ls, "bpm", 48, 0, seed, s);
+    const nlohmann::json& light = r.stats.details["light"];
+    EXPECT_EQ(light["photons_per_iteration_last"].get<int>(), photons);  // fixed: not adapted
+    return Figures{light["iteration_variance"].get<double>(),
+                   light["photon_variance"].get<double>(), light["photons_balance"].get<double>()};
+  };
+  std::vector<double> falls, explained, balance;
+  for (uint64_t seed : {3, 5, 7}) {
+    const Figures n = figures(4096, seed), n4 = figures(16384, seed + 100);
+    falls.push_back(n.photons / n4.photons);
+    explained.push_back((n.iteration - n4.iteration) / (0.75 * n.photons));
+    balance.push_back(n.balance / n4.balance);
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[1];
+  };
+  EXPECT_NEAR(median(falls), 4.0, 4 * 0.24 / std::sqrt(3.0) * 1.25);
+  EXPECT_NEAR(median(explained), 1.0, 4 * 0.06 / std::sqrt(3.0) * 1.25);
+  // The balance is a property of the scene, not of the count it was measured with.
+  EXPECT_NEAR(median(balance), 1.0, 0.3);
+}
+
 TEST(Bpm, GuidedEmissionKeepsTheCausticUnbiased) {
   LoadedScene ls = load(caustic_scene());
   const Film ref = render_with(ls, "path", 4096).film;

@@ -15,7 +15,7 @@ namespace bpm {
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                           EyePixels* eye_pixels, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
-                          std::vector<double>* estimates) {
+                          std::vector<double>* estimates, std::vector<double>* moments) {
   const int w = film->width(), h = film->height();
   LightPassResult& light = *light_sums;
   EyePixels& eye = *eye_pixels;
@@ -46,6 +46,8 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                          bias = bp.tau * radius_bias(nested, norm, settings.bias_model);
           light.flux[g] = share;
           light.flux_inner[g] = bias;
+          const float odd_share = bp.disc_cut ? disc_share(bp.disc_found, bp.disc_cut, 0) : 1.0f;
+          light.flux_odd[g] = bp.tau * light.flux_odd[g] * (norm / odd_share);
           const size_t place = bp.place;
           BPM_CHECK(place < places);
           uint32_t& slot = at[size_t(bp.pixel) * places + place];
@@ -68,12 +70,22 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
           for (; i > 0 && found[i - 1] > g; --i) found[i] = found[i - 1];
           found[i] = g;
         }
-        Spectrum photon_L, bias;
+        Spectrum photon_L, bias, odd_L;
         for (size_t k = 0; k < n; ++k) {
           photon_L += light.flux[found[k]];
           bias += light.flux_inner[found[k]];
+          odd_L += light.flux_odd[found[k]];
         }
         Spectrum L = eye.radiance[p] + photon_L;
+        if (moments && L.is_finite()) {
+          const double l = L.average(), halves = (photon_L - odd_L * 2).average();
+          double* m = moments->data() + PixelMoments::kValues * size_t(p);
+          m[PixelMoments::kSum] += l;
+          m[PixelMoments::kSquares] += l * l;
+          m[PixelMoments::kPhotonVariance] += halves * halves;
+          m[PixelMoments::kPhotonVarianceTimesN] += halves * halves * double(light.emitted);
+          m[PixelMoments::kCount] += 1;
+        }
         if (settings.debias)
           L -= bias;
         else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))

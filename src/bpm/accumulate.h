@@ -32,9 +32,22 @@ struct PixelSums {
   std::vector<uint32_t> by_place;  // [pixel * places + bp.place]: g, or kNone
 };
 
+// Per pixel, sums over iterations of what the choice of the photon count reads (bpm_integrator):
+// the estimate L (the mean over its wavelengths) and its square, the variance of its photon part
+// over the light pass alone, and that variance times the photons emitted (the variance of one
+// photon's share), and the iterations summed.
+struct PixelMoments {
+  static constexpr size_t kValues = 5;
+  enum : size_t { kSum, kSquares, kPhotonVariance, kPhotonVarianceTimesN, kCount };
+};
+
+// `moments` (PixelMoments::kValues per pixel), when given, gets each sampled pixel's sums. The
+// photon part's variance over the light pass is (A - B)^2, A and B the parts that the photons of
+// even and of odd index brought (LightPassResult::flux_odd): two independent halves of the pass.
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums, EyePixels* eye,
                           const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
-                          std::vector<double>* estimates = nullptr);
+                          std::vector<double>* estimates = nullptr,
+                          std::vector<double>* moments = nullptr);
 
 }  // namespace bpm

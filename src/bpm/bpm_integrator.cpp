@@ -14,6 +14,7 @@
 #include "bpm/eye_pass.h"
 #include "bpm/light_pass.h"
 #include "bpm/masks.h"
+#include "bpm/photon_count.h"
 #include "bpm/statistics.h"
 #include "integrator/progressive.h"
 #include "photons/emission_guide.h"
@@ -66,12 +67,12 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 }
 
 // Memory (base/memory.h). Per pixel, what the eye pass (with the edges and near-edge marks of the
-// disc probes, and the emission statistics with their copy at the end of a round), the masks and
-// the emission guide keep.
-constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) +
-                               sizeof(uint16_t) + sizeof(float) +
-                               3 * sizeof(EmissionStats<double>) + sizeof(double) +
-                               sizeof(uint32_t) + sizeof(float) + sizeof(uint16_t);
+// disc probes, and the emission statistics with their copy at the end of a round), the masks,
+// the emission guide and the photon count's moments (the round's and the merged) keep.
+constexpr double kPixelBytes =
+    sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + sizeof(uint16_t) + sizeof(float) +
+    3 * sizeof(EmissionStats<double>) + sizeof(double) + sizeof(uint32_t) + sizeof(float) +
+    sizeof(uint16_t) + 2 * PixelMoments::kValues * sizeof(double);
 
 // What the extra emission samples cost against whole iterations (emission_sample_count), in rays:
 // all the rays the iterations cast and the pixels they sampled, the extra emission samples and
@@ -86,10 +87,10 @@ struct EmissionCost {
     return std::max(0.0, ((rays - sample_rays) / pixels) / (sample_rays / samples) - 1);
   }
 };
-// Per backward photon: the thread's list and the map's copy, its three fluxes (all, inner half,
-// inner quarter) and hit flag, its references in the two trees (about two per tree where spheres
-// overlap cells), and its place among its pixel's for the accumulation.
-constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 3 * sizeof(Spectrum) + 1 +
+// Per backward photon: the thread's list and the map's copy, its four fluxes (all, inner half,
+// inner quarter, odd photons) and hit flag, its references in the two trees (about two per tree
+// where spheres overlap cells), and its place among its pixel's for the accumulation.
+constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 4 * sizeof(Spectrum) + 1 +
                                         4 * (sizeof(SphereRef) + sizeof(uint32_t)) +
                                         sizeof(uint32_t);
 
@@ -98,7 +99,7 @@ double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
   return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
                 maps.first_bucket.capacity() * sizeof(uint32_t) +
                 size_t(maps.bucket_count() + 1) * sizeof(uint32_t) +
-                maps.photons.size() * (3 * sizeof(Spectrum) + 1) +
+                maps.photons.size() * (4 * sizeof(Spectrum) + 1) +
                 lp.photon_materials.capacity() * sizeof(Material));
 }
 
@@ -132,10 +133,15 @@ class BpmRender {
   void learnt(std::vector<double>* out);
   void merge(const std::vector<double>& sums);
   void keep_learnt(const std::vector<double>& sums);
+  size_t pixel_values() const;
   void save(ByteWriter& w);
   void load(ByteReader& r);
   std::pair<EmissionCost, EmissionCost> round_cost() const;
   void set_emission_samples();
+  // The work the counters have counted so far (photon_count.h), and the next photon count from
+  // what the rounds learnt.
+  PassWork work_now() const;
+  void choose_photons();
   // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
   double reserve_memory() const;
 
@@ -166,6 +172,12 @@ class BpmRender {
   // pixels' extra emission samples cost (their sample counts follow from it); counted_: the
   // counters' totals at the last round.
   EmissionCost cost_sum_, cost_new_, counted_;
+  // Photons per iteration: the settings' when they fix it, else chosen at the end of each round
+  // from the pixels' moments and the passes' work (photon_count.h), merged as the costs above.
+  const bool adapt_photons_;
+  int photons_;
+  std::vector<double> moments_sum_, moments_new_;
+  PassWork work_sum_, work_new_, work_counted_;
   const std::string size_;  // WxH, for messages
   const double fixed_bytes_;
   // In a scene where no light path can be a caustic, the backward photons that accept only
@@ -218,6 +230,10 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
       estimate_sum_(n_pixels_, 0.0),
       estimate_new_(2 * n_pixels_, 0.0),
       estimate_count_(n_pixels_, 0),
+      adapt_photons_(settings.photons_per_iteration == 0),
+      photons_(s_.photons_per_iteration),
+      moments_sum_(PixelMoments::kValues * n_pixels_, 0.0),
+      moments_new_(moments_sum_.size(), 0.0),
       size_(std::to_string(film->width()) + "x" + std::to_string(film->height())),
       fixed_bytes_(reserve_memory()),
       caustics_(may_have_caustics(scene_)),
@@ -354,7 +370,9 @@ bool BpmRender::build_maps(int pass, const RenderControl& control, LightPassPara
 }
 
 bool BpmRender::light_pass(const LightPassParams& lp, int pass, int it) {
-  run_light_pass(scene_, maps_, lp, s_, masks_, opt_.seed, it, &light_,
+  BpmSettings s = s_;
+  s.photons_per_iteration = photons_;
+  run_light_pass(scene_, maps_, lp, s, masks_, opt_.seed, it, &light_,
                  guide_.empty() ? nullptr : &guide_, &light_result_);
   // Its time counts even if the iteration is dropped below: its rays reach the counters.
   tot_.add_light_pass_time(light_result_);
@@ -362,9 +380,7 @@ bool BpmRender::light_pass(const LightPassParams& lp, int pass, int it) {
   // f of its photons adds variance ~ 1/f to a mean of n: with n - 1 whole ones, keeping it
   // helps only when ((n - 1) + 1/f) / n^2 < 1 / (n - 1), about f > 1/2. A later iteration with
   // less than half its photons is dropped; the first is always kept (an image needs one).
-  if (light_result_.cut && pass > 0 &&
-      2 * light_result_.emitted < uint64_t(s_.photons_per_iteration))
-    return false;
+  if (light_result_.cut && pass > 0 && 2 * light_result_.emitted < uint64_t(photons_)) return false;
   tot_.add_light_pass(light_result_);
   return true;
 }
@@ -372,8 +388,15 @@ bool BpmRender::light_pass(const LightPassParams& lp, int pass, int it) {
 void BpmRender::accumulate(const WavelengthMaterials& wm) {
   const auto t = Clock::now();
   accumulate_iteration(maps_, &light_result_, &eye_, wm.wl, ls_.film.max_component_value, s_, film_,
-                       &pixel_sums_, guide_.empty() ? nullptr : &estimate_new_);
+                       &pixel_sums_, guide_.empty() ? nullptr : &estimate_new_, &moments_new_);
   tot_.accumulate_s += since(t);
+  // The iteration's work, counted once it joined the image (a dropped one's goes with the next).
+  const PassWork now = work_now();
+  work_new_ += now - work_counted_;
+  work_counted_ = now;
+  work_new_.v[PassWork::kPhotons] += double(light_result_.emitted);
+  if (medium_spheres_) work_new_.v[PassWork::kMediumSpheres] += double(medium_spheres_->size());
+  work_new_.v[PassWork::kIterations] += 1;
   masks_.rebuild(eye_.cost_ns);
 }
 
@@ -430,14 +453,24 @@ void BpmRender::learnt(std::vector<double>* out) {
   out->insert(out->end(), round.v.begin(), round.v.end());
   counted_ = now;
   cost_new_ = {};
+  out->insert(out->end(), moments_new_.begin(), moments_new_.end());
+  std::fill(moments_new_.begin(), moments_new_.end(), 0.0);
+  out->insert(out->end(), work_new_.v.begin(), work_new_.v.end());
+  work_new_ = {};
   if (guide_.empty()) return;
   guide_.take_learnt(out);
   out->insert(out->end(), estimate_new_.begin(), estimate_new_.end());
   std::fill(estimate_new_.begin(), estimate_new_.end(), 0.0);
 }
 
+// The learnt sums before the guide's: per pixel whether it saw emission and its emission
+// statistics, the costs, the pixels' moments and the work.
+size_t BpmRender::pixel_values() const {
+  return (1 + kStats) * n_pixels_ + EmissionCost().v.size() + moments_new_.size() +
+         PassWork::kValues;
+}
+
 void BpmRender::merge(const std::vector<double>& sums) {
-  const size_t pixel_values = (1 + kStats) * n_pixels_ + EmissionCost().v.size();
   // Rounded to float before they join, as the guide's sums below.
   const double* stats = sums.data() + n_pixels_;
   for (size_t p = 0; p < n_pixels_; ++p) {
@@ -448,13 +481,18 @@ void BpmRender::merge(const std::vector<double>& sums) {
   const double* c = stats + kStats * n_pixels_;
   for (size_t k = 0; k < cost_sum_.v.size(); ++k) cost_sum_.v[k] += double(float(c[k]));
   set_emission_samples();
+  const double* m = c + cost_sum_.v.size();
+  for (size_t i = 0; i < moments_sum_.size(); ++i) moments_sum_[i] += double(float(m[i]));
+  const double* w = m + moments_sum_.size();
+  for (size_t k = 0; k < PassWork::kValues; ++k) work_sum_.v[k] += double(float(w[k]));
+  choose_photons();
   if (guide_.empty()) return;
   // A round's sums are rounded to float precision before they join: processes add their
   // shares in another order than one process adds passes, and a difference in the last bits
   // of a sum would move a boundary of the guided density, so that the same seed would draw
   // other photons.
-  std::vector<double> learnt(sums.size() - pixel_values);
-  for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[pixel_values + i]));
+  std::vector<double> learnt(sums.size() - pixel_values());
+  for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[pixel_values() + i]));
   guide_.merge(learnt.data());
   tot_.guide_moved = guide_.moved();
   const double* e = learnt.data() + 2 * guide_.cells();
@@ -466,7 +504,6 @@ void BpmRender::merge(const std::vector<double>& sums) {
 }
 
 void BpmRender::keep_learnt(const std::vector<double>& sums) {
-  const size_t pixel_values = (1 + kStats) * n_pixels_ + EmissionCost().v.size();
   const double* stats = sums.data() + n_pixels_;
   for (size_t p = 0; p < n_pixels_; ++p) {
     eye_.saw_emission[p] = sums[p] > 0;
@@ -474,10 +511,39 @@ void BpmRender::keep_learnt(const std::vector<double>& sums) {
   }
   const double* c = stats + kStats * n_pixels_;
   std::copy_n(c, cost_new_.v.size(), cost_new_.v.begin());
+  const double* m = c + cost_new_.v.size();
+  std::copy_n(m, moments_new_.size(), moments_new_.begin());
+  std::copy_n(m + moments_new_.size(), PassWork::kValues, work_new_.v.begin());
   if (guide_.empty()) return;
-  guide_.keep_learnt(sums.data() + pixel_values);
-  const double* e = sums.data() + pixel_values + 2 * guide_.cells();
+  guide_.keep_learnt(sums.data() + pixel_values());
+  const double* e = sums.data() + pixel_values() + 2 * guide_.cells();
   estimate_new_.assign(e, e + 2 * n_pixels_);
+}
+
+PassWork BpmRender::work_now() const {
+  PassWork w;
+  for (const EyeCounters& c : eye_counters_) {
+    w.v[PassWork::kEyeRays] += double(c.rays.total());
+    w.v[PassWork::kBackwardPhotons] += double(c.backward_photons);
+  }
+  for (const LightCounters& c : light_.counters) {
+    w.v[PassWork::kLightRays] += double(c.light_rays);
+    w.v[PassWork::kQueries] += double(c.queries);
+    w.v[PassWork::kBeams] += double(c.beams);
+    w.v[PassWork::kEntries] += double(c.entries);
+  }
+  return w;
+}
+
+// The balance is computed (and reported) for a fixed count too; only an adapting render takes it.
+void BpmRender::choose_photons() {
+  const PhotonCountChoice c =
+      choose_photon_count(moments_sum_, work_sum_, photons_, s_.photons_per_iteration);
+  if (adapt_photons_) photons_ = c.photons;
+  tot_.photon_share = c.photon_share;
+  tot_.photons_best = c.best;
+  tot_.variance = c.variance;
+  tot_.photon_variance = c.photon_variance;
 }
 
 void BpmRender::save(ByteWriter& w) {
@@ -487,6 +553,13 @@ void BpmRender::save(ByteWriter& w) {
   w.put_vector(eye_.round_stats);
   w.put(cost_sum_.v);
   w.put(round_cost().first.v);  // the counters start from zero when the render goes on
+  w.put(int32_t(photons_));
+  w.put_vector(moments_sum_);
+  w.put_vector(moments_new_);
+  w.put(work_sum_.v);
+  PassWork round = work_new_;  // as the costs: the counters start from zero again
+  round += work_now() - work_counted_;
+  w.put(round.v);
   w.put(uint8_t(!guide_.empty()));
   if (guide_.empty()) return;
   guide_.save(w);
@@ -508,6 +581,15 @@ void BpmRender::load(ByteReader& r) {
   // The counters start again from zero.
   counted_ = {};
   set_emission_samples();
+  photons_ = r.get<int32_t>();
+  moments_sum_ = r.get_vector<double>();
+  moments_new_ = r.get_vector<double>();
+  work_sum_.v = r.get<std::array<double, PassWork::kValues>>();
+  work_new_.v = r.get<std::array<double, PassWork::kValues>>();
+  work_counted_ = {};
+  const size_t moments = PixelMoments::kValues * n_pixels_;
+  if (photons_ < 1 || moments_sum_.size() != moments || moments_new_.size() != moments)
+    throw Error(r.what() + " is truncated or corrupt (photon count)");
   if (r.get<uint8_t>() != uint8_t(!guide_.empty()))
     throw Error(r.what() + " differs in guided emission (--no-guide)");
   if (guide_.empty()) return;
@@ -536,6 +618,7 @@ RenderStats BpmRender::finish(RenderStats stats) {
   for (const LightCounters& c : light_.counters) tot_.light.add(c);
   stats.rays = tot_.eye.rays;
   stats.light_rays = tot_.light.light_rays;
+  tot_.photons_last = photons_;
   stats.details = to_json(tot_, s_, stats.passes, n_pixels_);
   return stats;
 }

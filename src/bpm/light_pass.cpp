@@ -25,12 +25,13 @@ constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
 // part of the photon's score for the guide (0 when prm.pixel_weight is not set). `bp` is the
 // backward photon's record, or its sphere's (MediumSphere): its radius, pixel and tau are read.
 template <class Record>
-float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value,
+float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, uint32_t photon,
                 const LightPassParams& prm, const std::vector<uint16_t>& owner,
                 std::vector<std::vector<PhotonEntry>>& out) {
   const float r2 = bp.radius * bp.radius;
-  const uint32_t bits =
-      (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) | (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u);
+  const uint32_t bits = (2 * d2 < r2 ? PhotonEntry::kInnerBit : 0u) |
+                        (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u) |
+                        (photon & 1 ? PhotonEntry::kOddBit : 0u);
   out[owner[bp.pixel]].push_back({g | bits, value});
   if (!prm.pixel_weight) return 0;
   return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
@@ -53,7 +54,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, h.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
-    score += add_entry(bp, g, length_squared(h.p - bp.p), value, prm, owner, out);
+    score += add_entry(bp, g, length_squared(h.p - bp.p), value, h.photon, prm, owner, out);
   };
   // The backward photons found are fetched in groups before any is used: each record is likely a
   // cache miss, and their misses then overlap. They are used in the order the query found them.
@@ -171,6 +172,7 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     // Direct beams are never used either (next-event estimation in the medium).
     auto on_beam = [&](const PhotonBeam& b) {
       if (!media || b.cls == PhotonClass::kDirect) return;
+      ++lc.beams;
       beams.push_back({b.ray, b.t_max, b.flux, photon, int16_t(b.medium), int16_t(b.bounces), b.cls,
                        b.hero_only});
     };
@@ -328,11 +330,13 @@ void apply_entries(const std::vector<std::vector<std::vector<PhotonEntry>>>& chu
           const uint32_t b = e.backward_photon();
           if (!res->reached[b]) {
             res->reached[b] = 1;
-            res->flux[b] = res->flux_inner[b] = res->flux_quarter[b] = Spectrum();
+            res->flux[b] = res->flux_inner[b] = res->flux_quarter[b] = res->flux_odd[b] =
+                Spectrum();
           }
           res->flux[b] += e.value;
           if (e.inner()) res->flux_inner[b] += e.value;
           if (e.quarter()) res->flux_quarter[b] += e.value;
+          if (e.odd()) res->flux_odd[b] += e.value;
         }
   });
 }
@@ -377,6 +381,7 @@ void reset_result(size_t n_bp, LightPassResult& res) {
   res.flux.resize(n_bp);
   res.flux_inner.resize(n_bp);
   res.flux_quarter.resize(n_bp);
+  res.flux_odd.resize(n_bp);
   res.emitted = 0;
   res.cut = false;
   res.batches = 0;
@@ -445,8 +450,8 @@ float gather_beam(const RenderScene& scene, const LightPassParams& prm,
         b.flux * transmittance(t) *
         (henyey_greenstein(dot(bp.wo, b.ray.d), m.g) * hero_join_factor(bp.hero_only, b.hero_only));
     if (value.is_black()) continue;
-    score += add_entry(bp, bp.index, length_squared(b.ray.o + b.ray.d * t - bp.p), value, prm,
-                       owner, out);
+    score += add_entry(bp, bp.index, length_squared(b.ray.o + b.ray.d * t - bp.p), value, b.photon,
+                       prm, owner, out);
   }
   return score;
 }

@@ -30,13 +30,16 @@ struct PhotonEntry {
   // Index into BackwardMaps::photons, with kInnerBit set when the photon lies within r / sqrt 2 of
   // the backward photon (the inner half of its disc) and kQuarterBit within r / 2 (the inner
   // quarter), for the bias estimate (radius_bias in photons/density.h).
+  // kOddBit marks an entry of a photon of odd index in its chunk: the two halves of the photons
+  // estimate the light pass's own variance (LightPassResult::flux_odd).
   uint32_t key;
   Spectrum value;  // flux * f * |wi.ns| / |wi.ng of the photon's hit|, before 1 / (pi r^2 N)
-  static constexpr uint32_t kInnerBit = 1u << 31, kQuarterBit = 1u << 30;
-  static constexpr uint32_t kIndexMask = kQuarterBit - 1;
+  static constexpr uint32_t kInnerBit = 1u << 31, kQuarterBit = 1u << 30, kOddBit = 1u << 29;
+  static constexpr uint32_t kIndexMask = kOddBit - 1;
   uint32_t backward_photon() const { return key & kIndexMask; }
   bool inner() const { return key & kInnerBit; }
   bool quarter() const { return key & kQuarterBit; }
+  bool odd() const { return key & kOddBit; }
 };
 
 struct LightPassParams {
@@ -122,6 +125,7 @@ struct LightPassResult {
   std::vector<Spectrum> flux;          // per backward photon: the sum of its entries' values
   std::vector<Spectrum> flux_inner;    // the same over the entries of its inner half (inner())
   std::vector<Spectrum> flux_quarter;  // and of its inner quarter (quarter())
+  std::vector<Spectrum> flux_odd;      // and over the entries of the odd photons (odd())
   uint64_t emitted = 0;                // photons emitted, N of eq. (2)
   bool cut = false;                    // a stop request ended the pass before all its photons
   int batches = 0;  // gather rounds: one per group, more where the memory limit split one

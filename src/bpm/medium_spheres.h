@@ -41,6 +41,7 @@ class MediumSpheres {
   // are the media's, in order), by the classes they accept.
   void build(const BackwardMaps& maps, size_t object_count, size_t media);
   bool empty() const { return spheres_ == 0; }
+  size_t size() const { return spheres_; }  // spheres in all the scenes
   // Appends to *found (the sphere, t of the beam's point nearest its centre) for every sphere of
   // `medium` that accepts `cls`, whose eye path has at most max_eye_depth scattering events, and
   // that the beam from ray.o along the unit ray.d over [0, t_max] reaches, in the order of the

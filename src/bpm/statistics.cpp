@@ -73,6 +73,14 @@ nlohmann::json light_json(const BpmTotals& t, int iterations) {
       // A query descends to its leaf while the photon is traced, and is answered in the gather.
       {"queries_per_second", ratio(double(t.light.queries), t.light_trace_s + t.light_gather_s)},
       {"entries", t.light.entries},
+      {"beams", t.light.beams},
+      {"photons_per_iteration_last", t.photons_last},
+      // bpm/photon_count.h: the relative variance of an iteration and of its light pass alone
+      // (means over pixels), the light pass's share, and the balanced photon count N*.
+      {"iteration_variance", t.variance},
+      {"photon_variance", t.photon_variance},
+      {"photon_variance_share", t.photon_share},
+      {"photons_balance", t.photons_best},
       {"batches", t.batches},
       {"batches_per_iteration", ratio(double(t.batches), iterations)},
       {"coverage_mean", ratio(t.coverage_sum, iterations)},

@@ -26,6 +26,10 @@ struct BpmTotals {
   double duplication_sum = 0;
   int duplication_n = 0;
   double guide_moved = 0;  // share of photons the emission guide moved, at the end
+  // The photon count of the last iterations, the light pass's share of an iteration's variance
+  // and the balance N* (bpm/photon_count.h; a fixed count does not follow it).
+  int photons_last = 0;
+  double photon_share = -1, photons_best = 0, variance = 0, photon_variance = 0;
 
   // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.
   void add_maps(const BackwardMaps& maps);

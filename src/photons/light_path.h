@@ -79,6 +79,7 @@ struct LightCounters {
   uint64_t diffuse_hits = 0;  // photon hits on diffuse surfaces
   uint64_t queries = 0;       // map lookups (bpm)
   uint64_t entries = 0;  // accepted (backward photon, photon) pairs (bpm); photons stored (fpm)
+  uint64_t beams = 0;    // photon beams gathered at the spheres in media (bpm)
   RayObserver* observer = nullptr;
   void add(const LightCounters& o) {
     photons += o.photons;
@@ -86,6 +87,7 @@ struct LightCounters {
     diffuse_hits += o.diffuse_hits;
     queries += o.queries;
     entries += o.entries;
+    beams += o.beams;
   }
 };
 
