@@ -12,6 +12,22 @@
 
 namespace bpm {
 
+namespace {
+
+// A pixel's PixelMoments: its estimate L, whose photon part is photon_L, odd_L of it from the odd
+// photons of `emitted`.
+void add_moments(const Spectrum& L, const Spectrum& photon_L, const Spectrum& odd_L,
+                 uint64_t emitted, double* m) {
+  const double l = L.average(), halves = (photon_L - odd_L * 2).average();
+  m[PixelMoments::kSum] += l;
+  m[PixelMoments::kSquares] += l * l;
+  m[PixelMoments::kPhotonVariance] += halves * halves;
+  m[PixelMoments::kPhotonVarianceTimesN] += halves * halves * double(emitted);
+  m[PixelMoments::kCount] += 1;
+}
+
+}  // namespace
+
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                           EyePixels* eye_pixels, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
@@ -77,15 +93,9 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
           odd_L += light.flux_odd[found[k]];
         }
         Spectrum L = eye.radiance[p] + photon_L;
-        if (moments && L.is_finite()) {
-          const double l = L.average(), halves = (photon_L - odd_L * 2).average();
-          double* m = moments->data() + PixelMoments::kValues * size_t(p);
-          m[PixelMoments::kSum] += l;
-          m[PixelMoments::kSquares] += l * l;
-          m[PixelMoments::kPhotonVariance] += halves * halves;
-          m[PixelMoments::kPhotonVarianceTimesN] += halves * halves * double(light.emitted);
-          m[PixelMoments::kCount] += 1;
-        }
+        if (moments && L.is_finite())
+          add_moments(L, photon_L, odd_L, light.emitted,
+                      moments->data() + PixelMoments::kValues * size_t(p));
         if (settings.debias)
           L -= bias;
         else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))

@@ -12,8 +12,8 @@ namespace {
 // Moments of `pixels` pixels over n iterations whose estimates have mean `mean`, eye variance
 // eye_var and photon variance photon_var with `photons` photons, as the iterations would sum them
 // in expectation.
-std::vector<double> moments(size_t pixels, double n, double mean, double eye_var,
-                            double photon_var, double photons) {
+std::vector<double> moments(size_t pixels, double n, double mean, double eye_var, double photon_var,
+                            double photons) {
   std::vector<double> m(pixels * PixelMoments::kValues);
   for (size_t p = 0; p < pixels; ++p) {
     double* v = &m[p * PixelMoments::kValues];
@@ -64,25 +64,22 @@ TEST(PhotonCount, MovesAtMostTwofoldARound) {
                                 kMinPhotons, 100000)
                 .photons,
             kMinPhotons);
-  EXPECT_EQ(choose_photon_count(moments(16, 10, 1, 1e-6, 1.0, 1e5), work(10, 1e9, 1e5, 1),
-                                60000, 100000)
-                .photons,
-            100000);
+  EXPECT_EQ(
+      choose_photon_count(moments(16, 10, 1, 1e-6, 1.0, 1e5), work(10, 1e9, 1e5, 1), 60000, 100000)
+          .photons,
+      100000);
 }
 
 TEST(PhotonCount, KeepsTheCountWithoutEnoughToGoBy) {
   // One iteration per pixel: no variance across iterations yet.
-  EXPECT_EQ(
-      choose_photon_count(moments(16, 1, 1, 0.1, 0.1, 1e5), work(1, 1e5, 1e5, 5), 123904, 1e5)
-          .photons,
-      123904);
-  // No photon variance (the photons reached no pixel), or no work counted.
-  EXPECT_EQ(
-      choose_photon_count(moments(16, 10, 1, 0.1, 0, 1e5), work(10, 1e5, 1e5, 5), 123904, 1e5)
-          .photons,
-      123904);
-  EXPECT_EQ(choose_photon_count(moments(16, 10, 1, 0.1, 0.1, 1e5), PassWork{}, 123904, 1e5)
+  EXPECT_EQ(choose_photon_count(moments(16, 1, 1, 0.1, 0.1, 1e5), work(1, 1e5, 1e5, 5), 123904, 1e5)
                 .photons,
+            123904);
+  // No photon variance (the photons reached no pixel), or no work counted.
+  EXPECT_EQ(choose_photon_count(moments(16, 10, 1, 0.1, 0, 1e5), work(10, 1e5, 1e5, 5), 123904, 1e5)
+                .photons,
+            123904);
+  EXPECT_EQ(choose_photon_count(moments(16, 10, 1, 0.1, 0.1, 1e5), PassWork{}, 123904, 1e5).photons,
             123904);
 }
 
