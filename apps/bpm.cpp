@@ -710,8 +710,10 @@ void add_photon_options(CLI::App* render, RenderArgs& ra) {
       ->group(kBpm);
   render
       ->add_option("--photons", ra.photons,
-                   "Photons per iteration (default 100000 per 256x256 pixels, at least 100000; "
-                   "fpm: no more than --memory holds; file: integer photonsperiteration)")
+                   "Photons per iteration, fixed (bpm's default: chosen each round from the "
+                   "variances and costs of the eye and light passes, starting from and never "
+                   "above 100000 per 256x256 pixels, at least 100000; fpm's default: that count, "
+                   "no more than --memory holds; file: integer photonsperiteration)")
       ->check(CLI::Range(1, 1 << 30))
       ->group(kBpm);
   render
