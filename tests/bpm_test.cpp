@@ -879,10 +879,6 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
   expect_bpm_converges(ls, render_with(ls, "path", 4096).film, 5);
 }
 
-// Guided emission sends more photons toward the glass (the floor's direct light is next-event
-// estimation's, so the photons that only reach the floor score nothing) and weights them by the
-// ratio of densities: whole renders, where the guide learns, still converge to path, and the
-// guide did move photons.
 // The light pass's own variance (from the two halves of its photons, bpm/photon_count.h) falls as
 // 1 / N, and it is the part of an iteration's variance that four times the photons take away:
 // with N and 4N photons (fixed counts, unguided: the guide learns faster from more photons) an
@@ -922,6 +918,10 @@ TEST(Bpm, LightPassVarianceFallsAsOneOverThePhotons) {
   EXPECT_NEAR(median(balance), 1.0, 0.3);
 }
 
+// Guided emission sends more photons toward the glass (the floor's direct light is next-event
+// estimation's, so the photons that only reach the floor score nothing) and weights them by the
+// ratio of densities: whole renders, where the guide learns, still converge to path, and the
+// guide did move photons.
 TEST(Bpm, GuidedEmissionKeepsTheCausticUnbiased) {
   LoadedScene ls = load(caustic_scene());
   const Film ref = render_with(ls, "path", 4096).film;

@@ -528,6 +528,15 @@ TEST_F(Cli, ResumeRefusesAnotherRendersCheckpoint) {
                 checkpoint + " -o " + b)
                 .exit_code,
             0);
+  // A count bpm chooses as it goes is another setting than its starting count fixed by hand.
+  const std::string c = (dir_ / "c.exr").string();
+  ASSERT_EQ(
+      run("render " + scene + " -q --integrator bpm --spp 3 --write-every 100 -o " + c).exit_code,
+      0);
+  CliRun fixed = run("render " + scene + " -q --integrator bpm --spp 6 --photons 100000 --resume " +
+                     (dir_ / "c.checkpoint").string() + " -o " + (dir_ / "d.exr").string());
+  EXPECT_EQ(fixed.exit_code, 1);
+  EXPECT_NE(fixed.err.find("photons_chosen_by_the_render"), std::string::npos) << fixed.err;
 }
 
 // The data a scene reads from other files (a PLY mesh, a spectrum file) is part of the render's

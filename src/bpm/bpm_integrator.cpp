@@ -68,11 +68,12 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 
 // Memory (base/memory.h). Per pixel, what the eye pass (with the edges and near-edge marks of the
 // disc probes, and the emission statistics with their copy at the end of a round), the masks,
-// the emission guide and the photon count's moments (the round's and the merged) keep.
+// the emission guide and the photon count's moments (the round's, its copy at the end of a round
+// and the merged) keep.
 constexpr double kPixelBytes =
     sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + sizeof(uint16_t) + sizeof(float) +
     3 * sizeof(EmissionStats<double>) + sizeof(double) + sizeof(uint32_t) + sizeof(float) +
-    sizeof(uint16_t) + 2 * PixelMoments::kValues * sizeof(double);
+    sizeof(uint16_t) + 3 * PixelMoments::kValues * sizeof(double);
 
 // What the extra emission samples cost against whole iterations (emission_sample_count), in rays:
 // all the rays the iterations cast and the pixels they sampled, the extra emission samples and
@@ -94,9 +95,11 @@ constexpr double kBackwardPhotonBytes = 2 * sizeof(BackwardPhoton) + 4 * sizeof(
                                         4 * (sizeof(SphereRef) + sizeof(uint32_t)) +
                                         sizeof(uint32_t);
 
-// What an iteration's maps take once built, with the light pass's per-photon arrays.
+// What an iteration's maps take once built, with the light pass's per-photon arrays and the
+// spheres in media (their records and Embree's trees over them).
 double maps_bytes(const BackwardMaps& maps, const LightPassParams& lp) {
   return double(maps.photons.capacity() * sizeof(BackwardPhoton) + maps.tree_bytes() +
+                (lp.medium_spheres ? lp.medium_spheres->bytes() : 0) +
                 maps.first_bucket.capacity() * sizeof(uint32_t) +
                 size_t(maps.bucket_count() + 1) * sizeof(uint32_t) +
                 maps.photons.size() * (4 * sizeof(Spectrum) + 1) +
@@ -258,6 +261,13 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
 // The light pass holds the hits of a group of photons, and its entries get what the film, the
 // actual maps and those hits leave (applied in more rounds).
 double BpmRender::reserve_memory() const {
+  // A photon's entry names its backward photon in 29 bits (PhotonEntry::kIndexMask).
+  const double most = double(n_pixels_) * photons_per_path(s_, scene_);
+  if (most > double(PhotonEntry::kIndexMask))
+    throw Error("bpm at " + size_ + " would store up to " + std::to_string(uint64_t(most)) +
+                " backward photons per iteration, more than its entries can name (" +
+                std::to_string(PhotonEntry::kIndexMask) +
+                "): lower --resolution or --diffuse-depth");
   const double fixed_bytes =
       double(film_->bytes()) + double(n_pixels_) * kPixelBytes +
       light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),

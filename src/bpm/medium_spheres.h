@@ -42,6 +42,8 @@ class MediumSpheres {
   void build(const BackwardMaps& maps, size_t object_count, size_t media);
   bool empty() const { return spheres_ == 0; }
   size_t size() const { return spheres_; }  // spheres in all the scenes
+  // Their records, and Embree's trees over them (an estimate: a node per two spheres).
+  size_t bytes() const { return spheres_ * (sizeof(MediumSphere) + 64); }
   // Appends to *found (the sphere, t of the beam's point nearest its centre) for every sphere of
   // `medium` that accepts `cls`, whose eye path has at most max_eye_depth scattering events, and
   // that the beam from ray.o along the unit ray.d over [0, t_max] reaches, in the order of the

@@ -45,14 +45,16 @@ nlohmann::json render_identity(const std::vector<std::string>& scene_files, cons
     }
   char fingerprint[17];
   std::snprintf(fingerprint, sizeof fingerprint, "%016llx", (unsigned long long)h);
-  // The photon methods' settings with the photons per iteration resolved for this resolution (so
-  // that the automatic count and the same count set by hand are one setting).
+  // The photon methods' settings with the photons per iteration resolved for this resolution;
+  // bpm's automatic count is chosen as the render goes (bpm/photon_count.h), so it differs from
+  // the same starting count set by hand.
   const size_t pixels = size_t(ls.film.width) * size_t(ls.film.height);
   nlohmann::json settings;
   if (opt.integrator == "bpm") {
     BpmSettings s = opt.bpm;
     s.photons_per_iteration = photons_for(s, pixels);
     settings = settings_json(s);
+    settings["photons_chosen_by_the_render"] = opt.bpm.photons_per_iteration == 0;
   }
   if (opt.integrator == "fpm") {
     FpmSettings s = opt.fpm;
