@@ -501,8 +501,9 @@ void BpmRender::merge(const std::vector<double>& sums) {
   // shares in another order than one process adds passes, and a difference in the last bits
   // of a sum would move a boundary of the guided density, so that the same seed would draw
   // other photons.
-  std::vector<double> learnt(sums.size() - pixel_values());
-  for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[pixel_values() + i]));
+  const size_t guide_at = pixel_values();
+  std::vector<double> learnt(sums.size() - guide_at);
+  for (size_t i = 0; i < learnt.size(); ++i) learnt[i] = double(float(sums[guide_at + i]));
   guide_.merge(learnt.data());
   tot_.guide_moved = guide_.moved();
   const double* e = learnt.data() + 2 * guide_.cells();
@@ -525,8 +526,9 @@ void BpmRender::keep_learnt(const std::vector<double>& sums) {
   std::copy_n(m, moments_new_.size(), moments_new_.begin());
   std::copy_n(m + moments_new_.size(), PassWork::kValues, work_new_.v.begin());
   if (guide_.empty()) return;
-  guide_.keep_learnt(sums.data() + pixel_values());
-  const double* e = sums.data() + pixel_values() + 2 * guide_.cells();
+  const double* guide = sums.data() + pixel_values();
+  guide_.keep_learnt(guide);
+  const double* e = guide + 2 * guide_.cells();
   estimate_new_.assign(e, e + 2 * n_pixels_);
 }
 
