@@ -1,6 +1,7 @@
 // Analytic checks of the path integrator and of the render loop.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -562,7 +563,6 @@ TEST(PathIntegrator, ImageAreaLightShowsItsImage) {
   EXPECT_GT(img.at(8, 13).luminance(), img.at(8, 2).luminance() * 1.5f);
 }
 
-// Same seed and budget give the same image whatever the number of threads.
 // The film's clamp (maxcomponentvalue) holds for debiased estimates too, which may be negative:
 // on the largest magnitude, keeping the sign and the colour's proportions.
 TEST(Film, RecordPassClampsDebiasedEstimates) {
@@ -581,6 +581,32 @@ TEST(Film, RecordPassClampsDebiasedEstimates) {
   }
 }
 
+// A pixel's stream_uniform over the passes of one stream (pass j in stream j mod
+// Film::kStreams) puts the stream's first 2^k passes one in each interval of width 2^-k; pixels
+// and streams have scrambles of their own.
+TEST(CameraSampler, StreamUniformStratifiesTheStreamsPasses) {
+  const CameraSampler camera(CameraSettings{}, FilterSettings{}, 8, 8, 3);
+  for (uint32_t pixel : {0u, 9u, 63u}) {
+    std::vector<float> first(Film::kStreams);
+    for (int stream = 0; stream < Film::kStreams; ++stream) {
+      constexpr int k = 6, n = 1 << k;
+      std::vector<int> hits(n, 0);
+      for (int t = 0; t < n; ++t) {
+        const float u = camera.stream_uniform(t * Film::kStreams + stream, pixel);
+        ASSERT_GE(u, 0.0f);
+        ASSERT_LT(u, 1.0f);
+        ++hits[size_t(u * n)];
+      }
+      for (int j = 0; j < n; ++j) EXPECT_EQ(hits[size_t(j)], 1) << pixel << " " << stream;
+      first[size_t(stream)] = camera.stream_uniform(stream, pixel);
+    }
+    std::sort(first.begin(), first.end());
+    EXPECT_EQ(std::unique(first.begin(), first.end()), first.end()) << pixel;
+    EXPECT_NE(camera.stream_uniform(0, pixel), camera.stream_uniform(0, pixel + 1)) << pixel;
+  }
+}
+
+// Same seed and budget give the same image whatever the number of threads.
 TEST(Renderer, SameImageWithOneAndTwoThreads) {
   LoadedScene ls = load(R"(
     LookAt 0.5 0.5 -1.2  0.5 0.5 0  0 1 0

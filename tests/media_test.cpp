@@ -286,7 +286,9 @@ WorldBegin
       std::vector<double> sum(Spectrum::kChannels, 0), sum2(Spectrum::kChannels, 0);
       for (int i = 0; i < n; ++i) {
         Spectrum beta(1.0f);
-        const float t = sample_forced_medium_distance(ls.scene, 0, ray, length, wl, rng, beta);
+        float none = -1;
+        const float t =
+            sample_forced_medium_distance(ls.scene, 0, ray, length, wl, rng, none, beta);
         if (t < 0) continue;
         ASSERT_LE(t, length);
         for (int k = 0; k < Spectrum::kChannels; ++k) {

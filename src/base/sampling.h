@@ -83,6 +83,20 @@ inline uint32_t van_der_corput_bits(uint32_t i) {
 }
 inline double radical_inverse_base2(uint32_t i) { return double(van_der_corput_bits(i)) * 0x1p-32; }
 
+// The van der Corput sequence under a nested uniform (Owen) scramble keyed by `seed`, after Burley
+// (2020, "Practical hash-based Owen scrambling"): i goes through a permutation in which each bit
+// depends on the bits below it only, then is mirrored. The first 2^k values still fall one in
+// each interval of width 2^-k, now each at a random place within its interval; for a uniformly
+// random seed each value alone is uniform.
+inline uint32_t owen_van_der_corput_bits(uint32_t i, uint32_t seed) {
+  i += seed;
+  i ^= i * 0x6c50b47cu;
+  i ^= i * 0xb82f1e52u;
+  i ^= i * 0xc7afe638u;
+  i ^= i * 0x8d22f6e6u;
+  return van_der_corput_bits(i);
+}
+
 // The second dimension of the Sobol sequence, as 32 bits: with the van der Corput sequence it
 // forms a (0,2)-sequence: the first 2^k points put one point in every rectangle of area 2^-k
 // whose sides are powers of two.

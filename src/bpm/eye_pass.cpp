@@ -172,10 +172,11 @@ inline void gather_forced_in_medium(const EyePath& path, PathState& s, const Ray
   // The last piece allowed: the path draws its own vertices past it.
   if (++path.splits == kMaxMediumSplits) s.cross_media = false;
   PathState f = s;
+  s.flight_u = -1;  // the path's preset uniform number, if any, goes to the vertex drawn here
   f.beta = beta;
   f.cross_media = false;
-  const float t = sample_forced_medium_distance(path.scene, s.medium, ray, length,
-                                                path.prm.materials->wl, path.rng, f.beta);
+  const float t = sample_forced_medium_distance(
+      path.scene, s.medium, ray, length, path.prm.materials->wl, path.rng, f.flight_u, f.beta);
   if (t < 0 || f.beta.is_black()) return;
   f.length = s.length + t;
   PathVertex v;
@@ -217,12 +218,13 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
                                              CameraRay ray, PixelFootprint footprint,
                                              uint32_t pixel, Rng& rng, ObjectPhotonLists& out,
                                              EyeCounters& counters, bool emission_only,
-                                             uint8_t near_edge) {
+                                             uint8_t near_edge, float flight_u) {
   int stored = 0, splits = 0;
   const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters, stored, splits};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;
+  s.flight_u = flight_u;
   Spectrum L;
   // L up to the first diffuse vertex (its own emission included); until then L is all emission.
   std::optional<Spectrum> emission;
@@ -357,9 +359,11 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             }
             ++ec.pixels;
             CameraSample cs = camera.sample(pass_index, pixel);
+            // Where the camera's ray scatters in a medium, stratified over the pixel's iterations.
             EyeRadiance r =
                 trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
-                               false, prm.near_edges ? prm.near_edges->at(pixel) : 3);
+                               false, prm.near_edges ? prm.near_edges->at(pixel) : 3,
+                               camera.stream_uniform(pass_index, pixel));
             px->filter_weight[pixel] = cs.filter_weight;
             const Spectrum emission =
                 mean_emission(scene, prm, camera, pass_index, pixel,

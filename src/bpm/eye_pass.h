@@ -84,11 +84,13 @@ struct EyeRadiance {
 // appends the path's backward photons to out[object] (radii: k0 or k1 footprints). With
 // emission_only the path ends at its first diffuse vertex and stores nothing: only `emission` is
 // computed. near_edge: the pixel's mark_near_edges bits, which decide whether a first vertex seen
-// directly probes its discs. The ray's weight is the throughput the path starts with.
+// directly probes its discs. The ray's weight is the throughput the path starts with. flight_u:
+// when in [0, 1), the uniform number of the path's first free flight in a scattering medium
+// (PathState::flight_u).
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, CameraRay ray,
                            PixelFootprint footprint, uint32_t pixel, Rng& rng,
                            ObjectPhotonLists& out, EyeCounters& counters,
-                           bool emission_only = false, uint8_t near_edge = 3);
+                           bool emission_only = false, uint8_t near_edge = 3, float flight_u = -1);
 
 // A pixel's samples of emission seen before the first diffuse vertex (per camera sample), and of
 // the rest of its estimate (per iteration): counts, sums and sums of squares of their means over

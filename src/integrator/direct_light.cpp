@@ -121,11 +121,12 @@ MediumAtDistance medium_at_distance(const RenderScene& scene, int medium, const 
 }
 
 float sample_forced_medium_distance(const RenderScene& scene, int medium, const Ray& unit,
-                                    float length, const Wavelengths& wl, Rng& rng, Spectrum& beta) {
+                                    float length, const Wavelengths& wl, Rng& rng, float& preset_u,
+                                    Spectrum& beta) {
   constexpr int n = Spectrum::kChannels;
   const Medium& m = scene.media[size_t(medium)];
   const int j = std::min(int(rng.uniform() * n), n - 1);
-  const float u = rng.uniform();
+  const float u = flight_uniform(rng, preset_u);
   // Wavelength j's optical depth over the piece, and the depth drawn in [0, it).
   float whole, sigma_t = 0, t = -1;
   if (m.rgb_grid) {

@@ -44,9 +44,10 @@ MediumAtDistance medium_at_distance(const RenderScene& scene, int medium, const 
 // wavelengths' densities. Paired with crossing the piece at full weight exp(-sigma_t tau)
 // (PathState::cross_media), it splits a path in two where a free flight picks one or the other,
 // and every ray through a thin medium then scatters. Returns the distance, or negative where
-// nothing could be drawn.
+// nothing could be drawn. The distance's uniform number is preset_u when set (flight_uniform).
 float sample_forced_medium_distance(const RenderScene& scene, int medium, const Ray& unit,
-                                    float length, const Wavelengths& wl, Rng& rng, Spectrum& beta);
+                                    float length, const Wavelengths& wl, Rng& rng, float& preset_u,
+                                    Spectrum& beta);
 
 // Direct light at a medium vertex v (StepEnd::kMedium) that scatters by a Henyey-Greenstein phase
 // function of asymmetry g: one light chosen by power, attenuated by the media up to it (the shadow

@@ -23,6 +23,10 @@ struct PathState {
   float length = 0;        // world distance travelled, interfaces included
   bool hero_only = false;  // only the first wavelength goes on (hero_wavelength_only)
   Rng* rng = nullptr;      // draws where the ray scatters in a medium (next_vertex)
+  // When in [0, 1): the uniform number of the path's first free flight in a scattering medium (or
+  // of its first forced medium vertex), drawn by the caller instead of the stream (bpm stratifies
+  // it over a pixel's iterations, CameraSampler::stream_uniform); taken once.
+  float flight_u = -1;
   // The ray crosses scattering media as absorbing ones (exp(-sigma_t tau), no free flight): the
   // caller draws the points where it scatters itself, along the pieces that in_medium reports
   // (bpm's forced medium vertices, bpm/eye_pass.cpp).
@@ -66,6 +70,15 @@ struct PathVertex {
 
 enum class StepEnd { kVertex, kMedium, kEscaped, kAbsorbed };
 
+// The uniform number of a free flight: `preset` when the caller set one (PathState::flight_u),
+// which is then spent, else the next of the stream.
+inline float flight_uniform(Rng& rng, float& preset) {
+  if (!(preset >= 0)) return rng.uniform();
+  const float u = preset;
+  preset = -1;
+  return u;
+}
+
 // Where a ray in a scattering medium next scatters, before `distance` (kInf: none ahead), all
 // measured in optical depth in density units (scene/medium.h: a homogeneous medium's is the
 // distance). The distance follows one wavelength's free flight, the wavelength drawn uniformly, and
@@ -74,10 +87,10 @@ enum class StepEnd { kVertex, kMedium, kEscaped, kAbsorbed };
 // beta *= sigma_s T(t) / p(t), past it beta *= T(distance) / P(t > distance). Returns the
 // scattering distance, or a negative value when the ray gets past.
 inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sigma_s,
-                                    float distance, Rng& rng, Spectrum& beta) {
+                                    float distance, Rng& rng, float& preset_u, Spectrum& beta) {
   constexpr int n = Spectrum::kChannels;
   const int j = std::min(int(rng.uniform() * n), n - 1);
-  const float u = rng.uniform();
+  const float u = flight_uniform(rng, preset_u);
   const float t = sigma_t[j] > 0 ? -std::log1p(-u) / sigma_t[j] : kInf;
   if (t < distance) {
     double p = 0;
@@ -102,10 +115,11 @@ inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sig
 // point: wavelength j's free flight drawn in its own optical depth, every wavelength weighted by
 // the mixture of their densities sigma_t(x) T(t). Returns the distance, or negative past it.
 inline float sample_rgb_grid_flight(const RgbGrid& g, const Ray& unit, float distance,
-                                    const Wavelengths& wl, Rng& rng, Spectrum& beta) {
+                                    const Wavelengths& wl, Rng& rng, float& preset_u,
+                                    Spectrum& beta) {
   constexpr int n = Spectrum::kChannels;
   const int j = std::min(int(rng.uniform() * n), n - 1);
-  const float tau = -std::log1p(-rng.uniform());
+  const float tau = -std::log1p(-flight_uniform(rng, preset_u));
   Spectrum depth;  // up to the point drawn, or the whole way
   const float t = g.flight(unit, j, tau, distance, wl, &depth);
   if (t >= 0) {
@@ -160,12 +174,12 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       in_medium(unit, distance, s.beta);
       float t = -1;
       if (m.rgb_grid) {
-        t = sample_rgb_grid_flight(*m.rgb_grid, unit, distance, wl, *s.rng, s.beta);
+        t = sample_rgb_grid_flight(*m.rgb_grid, unit, distance, wl, *s.rng, s.flight_u, s.beta);
       } else {
         // The free flight in optical depth (density units), then as a distance (scene/medium.h).
         const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
-        const float tau =
-            sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance), *s.rng, s.beta);
+        const float tau = sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance),
+                                                 *s.rng, s.flight_u, s.beta);
         if (tau >= 0) t = m.distance_at_depth(unit, tau, distance);
       }
       if (t >= 0) {

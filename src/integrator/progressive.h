@@ -17,6 +17,7 @@
 
 #include "base/interrupt.h"
 #include "base/rng.h"
+#include "base/sampling.h"
 #include "camera/camera.h"
 #include "film/film.h"
 #include "film/filter.h"
@@ -94,6 +95,21 @@ class CameraSampler {
     Vec2 u_lens{rng.uniform(), rng.uniform()};
     const CameraRay r = camera_.generate_ray_full(p_film, u_lens);
     return {rng, r.ray, fs.weight, camera_.footprint(p_film), r.weight, r.medium};
+  }
+  // A uniform number of a pixel's pass, stratified over the passes of its stream (Film::kStreams):
+  // the t-th pass of a stream takes point t of the van der Corput sequence under a random digital
+  // shift of the pixel's and the stream's own, so that the stream's first 2^m passes put one
+  // number in each 2^-m of [0, 1). For one pass alone it is uniform and independent of the pass's
+  // random stream, and the streams stay independent estimates of each other.
+  float stream_uniform(int pass_index, uint32_t pixel) const {
+    const int x = int(pixel % uint32_t(raster_.width)) + raster_.x0,
+              y = int(pixel / uint32_t(raster_.width)) + raster_.y0;  // in the full raster
+    const int stream = pass_index % Film::kStreams;
+    Rng rng(stream_key(seed_ ^ 0x666c69676874ull, uint64_t(stream),
+                       uint64_t(y) * uint64_t(raster_.full_width) + uint64_t(x), 5));
+    const uint32_t bits =
+        owen_van_der_corput_bits(uint32_t(pass_index / Film::kStreams), rng.next_u32());
+    return float(bits >> 8) * 0x1p-24f;
   }
   const Camera& camera() const { return camera_; }
 
