@@ -117,7 +117,7 @@ StepEnd next_eye_vertex(const RenderScene& scene, const WavelengthMaterials& mat
         L += weighted_surface_emission(scene, s.ray, hit, sp, wl, s.beta, emitter);
       },
       [&](const Ray& ray, float distance, const Spectrum& beta) {
-        if (medium_light) L += beta * medium_emission(scene, s.medium, ray, distance, wl);
+        if (medium_light) L += beta * medium_emission(scene, s.medium, ray, distance, wl, s.rng);
         if (!scene.media[size_t(s.medium)].scatters()) return;
         if (along)
           *along += beta * sample_direct_light_along(scene, s.medium, ray, distance, s.cross_media,

@@ -22,6 +22,11 @@ namespace bpm::flatten_internal {
 
 inline float radians(float deg) { return deg * kPi / 180; }
 
+// pbrt-v4's "cloud" density at point p of the medium's space (media.h, CloudMedium::Density):
+// five octaves of Perlin noise at `frequency`, p first pushed along the noise's slope where
+// `wispiness` > 0, thinning with height (y) and solid below y = 0.5; in [0, 1].
+float cloud_density(Vec3 p, float density, float wispiness, float frequency);
+
 class Flattener {
  public:
   explicit Flattener(const ParsedScene& p);
@@ -100,6 +105,8 @@ class Flattener {
   // The media shapes, lights and the camera refer to (flatten_media.cpp).
   int medium_id(const std::string& name, const FileLoc& loc);
   std::shared_ptr<const DensityGrid> density_grid(const MediumEntity& m);
+  std::shared_ptr<const DensityGrid> cloud_grid(const MediumEntity& m);
+  std::shared_ptr<const DensityGrid> le_scale_grid(const MediumEntity& m);
   std::shared_ptr<const RgbGrid> rgb_grid(const MediumEntity& m, float scale);
 
   // Shapes and their area lights (flatten_shapes.cpp).

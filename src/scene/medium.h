@@ -90,8 +90,10 @@ struct Medium {
   // An rgbgrid's coefficients, which replace all of the above but g (sigma_a and sigma_s are 1).
   std::shared_ptr<const RgbGrid> rgb_grid;
   // The radiance emitted where sigma_a absorbs (pbrt-v4's Le times Lescale, normalised as a
-  // light's spectrum): a point emits sigma_a(x) Le per unit length (not with rgbgrid).
+  // light's spectrum): a point emits sigma_a(x) Le per unit length (not with rgbgrid), times
+  // le_scale(x) where a uniformgrid has that grid (pbrt-v4's LeScale).
   SpectrumCurve Le;
+  std::shared_ptr<const DensityGrid> le_scale;
 
   bool emits() const { return !Le.is_black(); }
 

@@ -1449,7 +1449,7 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
               at(3, 1), "unknown medium \"nope\""));
   // A scattering homogeneous medium, pbrt-v4's defaults included, is read.
   EXPECT_EQ(error_of(scene("\"string type\" \"homogeneous\"")), "");
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"cloud\"")), at(3, 1), "type \"cloud\""));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"gas\"")), at(3, 1), "type \"gas\""));
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\"")), at(1, 1),
                       "rgbgrid medium needs \"rgb sigma_a\" or \"rgb sigma_s\" values"));
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"integer nx\" 2 "
@@ -1482,9 +1482,6 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
   EXPECT_EQ(
       error_of(scene("\"string type\" \"homogeneous\" \"rgb sigma_s\" [0 0 0] \"rgb Le\" [1 1 1]")),
       "");
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [1] "
-                                     "\"rgb Le\" [1 1 1]")),
-                      at(3, 1), "it emits (Le)"));
   EXPECT_EQ(error_of(scene("\"string type\" \"homogeneous\" \"string preset\" \"Apple\"")), "");
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"homogeneous\" \"string preset\" \"Pear\"")),
                       at(1, 49), "unknown medium preset \"Pear\"; known: \"Apple\""));
@@ -1507,6 +1504,35 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
                         absorbing + "WorldBegin\nMediumInterface \"m\"\nLightSource \"point\"\n"))
           .scene.medium_of_light(0),
       0);
+}
+
+// pbrt-v4's cloud and a glowing uniformgrid are read; their parameters out of range are located
+// errors, and glow from temperature is refused.
+TEST(SceneParseError, CloudAndGlowingGridParameters) {
+  auto scene = [](const std::string& medium_params) {
+    return "MakeNamedMedium \"m\" " + medium_params +
+           "\nWorldBegin\nMediumInterface \"m\" \"\"\nShape \"sphere\"\n";
+  };
+  // pbrt-v4's cloud is read; its parameters out of range are located errors.
+  EXPECT_EQ(error_of(scene("\"string type\" \"cloud\" \"float frequency\" 1")), "");
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"cloud\" \"float frequency\" 0")), at(1, 43),
+                      "frequency"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"cloud\" \"float density\" -1")), at(1, 43),
+                      "density"));
+  EXPECT_TRUE(
+      IsError(error_of(scene("\"string type\" \"cloud\" \"point3 p1\" [1 0 1]")), at(1, 43), "p1"));
+  // A uniformgrid glows, by a grid of Lescale values of its size (or one voxel of 1).
+  EXPECT_EQ(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [1] "
+                           "\"rgb Le\" [1 1 1]")),
+            "");
+  const std::string short_le =
+      "\"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" "
+      "[1 1] \"rgb Le\" [1 1 1] \"float Lescale\" [1]";
+  EXPECT_TRUE(IsError(error_of(scene(short_le)), at(1, 20 + col(short_le, "\"float Lescale")),
+                      "uniformgrid has 1 Lescale values; nx * ny * nz = 2"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [1] "
+                                     "\"float temperature\" [900]")),
+                      at(3, 1), "it emits (temperature)"));
 }
 
 TEST(SceneParseError, ColorSpaceOtherThanSrgb) {

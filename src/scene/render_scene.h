@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "base/error.h"
 #include "base/ray.h"
+#include "base/rng.h"
 #include "base/sampling.h"
 #include "lights/light.h"
 #include "materials/material.h"
@@ -166,9 +168,11 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, const
 // The radiance that an emitting medium sends along the unit ray toward its origin from the first
 // `distance` of it, attenuated on the way: the integral of T(t) sigma_a(x) Le dt, which with
 // sigma = density (sigma per unit density) and d tau = density dt is
-// sigma_a Le (1 - exp(-sigma_t tau)) / sigma_t, exactly (scene/medium.h).
+// sigma_a Le (1 - exp(-sigma_t tau)) / sigma_t, exactly (scene/medium.h). Where a uniformgrid's
+// Lescale grid s(x) scales the glow, sigma_a Le times the integral of exp(-sigma_t tau) s over
+// tau has no closed form: one depth drawn by `rng` (the path's stream) estimates it.
 inline Spectrum medium_emission(const RenderScene& scene, int medium, const Ray& ray,
-                                float distance, const Wavelengths& wl) {
+                                float distance, const Wavelengths& wl, Rng* rng) {
   Spectrum L;
   if (medium < 0) return L;
   const Medium& m = scene.media[size_t(medium)];
@@ -176,6 +180,29 @@ inline Spectrum medium_emission(const RenderScene& scene, int medium, const Ray&
   const Spectrum sigma_a = m.sigma_a.sample(wl), sigma_t = sigma_a + m.sigma_s.sample(wl);
   const Spectrum Le = m.Le.sample(wl);
   const float tau = m.depth(ray, 0, distance);
+  if (m.le_scale) {
+    if (!(tau > 0)) return L;
+    BPM_CHECK(rng);  // set by every path that may cross a glowing grid
+    // A depth drawn from one wavelength's exp(-sigma_t tau) on [0, tau] (uniform where sigma_t is
+    // 0), the wavelength drawn uniformly; weighed by the mixture of all wavelengths' densities.
+    constexpr int n = Spectrum::kChannels;
+    const int j = std::min(int(rng->uniform() * n), n - 1);
+    const float u = rng->uniform();
+    const float whole = sigma_t[j] * tau;
+    const float at =
+        whole > 0 ? float(-std::log1p(u * std::expm1(-double(whole)))) / sigma_t[j] : u * tau;
+    double pdf = 0;
+    for (int k = 0; k < n; ++k)
+      pdf += sigma_t[k] * tau > 0 ? double(sigma_t[k]) * std::exp(-double(sigma_t[k]) * at) /
+                                        -std::expm1(-double(sigma_t[k]) * tau)
+                                  : 1.0 / tau;
+    pdf /= n;
+    const float t = m.distance_at_depth(ray, std::min(at, tau), distance);
+    const float s = m.le_scale->density(ray.o + ray.d * (t >= 0 ? t : distance));
+    for (int i = 0; i < n; ++i)
+      L[i] = float(sigma_a[i] * Le[i] * s * std::exp(-double(sigma_t[i]) * at) / pdf);
+    return L;
+  }
   for (int i = 0; i < Spectrum::kChannels; ++i)
     if (sigma_t[i] > 0) L[i] = sigma_a[i] * Le[i] * -std::expm1(-sigma_t[i] * tau) / sigma_t[i];
   return L;
