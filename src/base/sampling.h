@@ -1,5 +1,6 @@
 // Sampling routines; each says in its name the measure of the density it returns.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -82,6 +83,12 @@ inline uint32_t van_der_corput_bits(uint32_t i) {
   return ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
 }
 inline double radical_inverse_base2(uint32_t i) { return double(van_der_corput_bits(i)) * 0x1p-32; }
+
+// A depth in [0, whole] (whole > 0) drawn by the uniform u from the exponential density cut at
+// whole, exp(-tau) / (1 - exp(-whole)): a free flight conditioned to end within `whole`.
+inline float sample_truncated_exponential(float u, float whole) {
+  return std::min(float(-std::log1p(u * std::expm1(-double(whole)))), whole);
+}
 
 // The van der Corput sequence under a nested uniform (Owen) scramble keyed by `seed`, after Burley
 // (2020, "Practical hash-based Owen scrambling"): i goes through a permutation in which each bit

@@ -337,6 +337,8 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
                   EyePixels* px, EyeThreadData threads) {
   using Clock = std::chrono::steady_clock;
   const int slots = masks.slots();
+  // The stratified number of the camera ray's first free flight, only where one can scatter.
+  const bool flights = scene.has_scattering_media();
   std::atomic<bool> skipped{false};
   tbb::parallel_for(
       tbb::blocked_range<int>(0, masks.block_count() * slots, 1),
@@ -363,7 +365,7 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             EyeRadiance r =
                 trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
                                false, prm.near_edges ? prm.near_edges->at(pixel) : 3,
-                               camera.stream_uniform(pass_index, pixel));
+                               flights ? camera.stream_uniform(pass_index, pixel) : -1.0f);
             px->filter_weight[pixel] = cs.filter_weight;
             const Spectrum emission =
                 mean_emission(scene, prm, camera, pass_index, pixel,

@@ -136,7 +136,7 @@ float sample_forced_medium_distance(const RenderScene& scene, int medium, const 
     whole = sigma_t > 0 ? sigma_t * m.depth(unit, 0, length) : 0.0f;  // kInf long: kInf
   }
   if (whole > 0) {
-    const float depth = std::min(float(-std::log1p(u * std::expm1(-double(whole)))), whole);
+    const float depth = sample_truncated_exponential(u, whole);
     t = m.rgb_grid ? m.rgb_grid->distance_at_depth(unit, j, depth, length, wl)
                    : m.distance_at_depth(unit, depth / sigma_t, length);
   } else if (std::isfinite(length) && length > 0) {

@@ -189,8 +189,7 @@ inline Spectrum medium_emission(const RenderScene& scene, int medium, const Ray&
     const int j = std::min(int(rng->uniform() * n), n - 1);
     const float u = rng->uniform();
     const float whole = sigma_t[j] * tau;
-    const float at =
-        whole > 0 ? float(-std::log1p(u * std::expm1(-double(whole)))) / sigma_t[j] : u * tau;
+    const float at = whole > 0 ? sample_truncated_exponential(u, whole) / sigma_t[j] : u * tau;
     double pdf = 0;
     for (int k = 0; k < n; ++k)
       pdf += sigma_t[k] * tau > 0 ? double(sigma_t[k]) * std::exp(-double(sigma_t[k]) * at) /
