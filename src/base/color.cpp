@@ -515,15 +515,20 @@ SpectrumCurve SpectrumCurve::from_pairs(const std::vector<double>& pairs, Spectr
   return from_table(std::move(values), kind);
 }
 
-SpectrumCurve SpectrumCurve::blackbody(float T) {
+float blackbody(float lambda, float T) {
+  if (!(T > 0)) return 0;
   const double c = 299792458.0, h = 6.62606957e-34, kb = 1.3806488e-23;
   auto planck = [&](double l) {
     return (2 * h * c * c) / (std::pow(l, 5) * (std::exp((h * c) / (l * kb * T)) - 1));
   };
-  // Normalised to 1 at the peak of the curve (Wien's law), as pbrt-v4.
-  const double peak = planck(2.8977721e-3 / T);
+  return float(planck(double(lambda) * 1e-9) / planck(2.8977721e-3 / T));
+}
+
+double ybar_integral() { return tables().y_integral; }
+
+SpectrumCurve SpectrumCurve::blackbody(float T) {
   std::vector<float> values(kTableSize);
-  for (int i = 0; i < kTableSize; ++i) values[i] = float(planck((kLambdaMin + i) * 1e-9) / peak);
+  for (int i = 0; i < kTableSize; ++i) values[i] = bpm::blackbody(kLambdaMin + i, T);
   return from_table(std::move(values), SpectrumKind::kIlluminant);
 }
 

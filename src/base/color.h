@@ -51,6 +51,14 @@ Rgb spectrum_to_rgb(const Spectrum& L, const Wavelengths& wl);
 // M2 S2 at the CIE formula's chromaticity; below 4000 K a blackbody (1 at its peak). Relative
 // values, 1 near 560 nm.
 float daylight_spectrum(float temperature, float lambda);
+// Planck's law at wavelength lambda (nm) and temperature T (kelvin), 1 at the curve's peak
+// (Wien's law), as pbrt-v4's BlackbodySpectrum.
+float blackbody(float lambda, float temperature);
+// The integral of the CIE ybar matching function over [kLambdaMin, kLambdaMax] in nm (about
+// 106.86). A spectrum s has luminance (integral of s ybar) / this here; pbrt-v4's film reads
+// (integral of s ybar) itself, so an emission spectrum that pbrt-v4 does not normalise (the
+// glow of a temperature grid, an rgbgrid's Le) is this many times brighter in our units.
+double ybar_integral();
 // pbrt-v4's film "whitebalance" of temperature T (kelvin) for its cie1931 sensor, as a matrix on
 // linear sRGB (row-major): a Bradford adaptation from the white of D(T) (daylight_spectrum) to
 // sRGB's D65 white.

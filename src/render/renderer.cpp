@@ -45,7 +45,8 @@ RenderStats render(const LoadedScene& ls, const RenderOptions& opt, Film* film) 
     throw Error("a render without an image needs sensors (--sensors)");
   if (ls.scene.has_emissive_media() && opt.integrator != "path")
     throw Error(
-        "the photon methods do not render emitting media (Le) yet: render the scene with "
+        "the photon methods do not render glowing media (Le, temperature) yet: render the scene "
+        "with "
         "--integrator path");
   if (ls.scene.has_scattering_media() && opt.integrator != "path" && !opt.sensors.empty())
     throw Error(

@@ -107,6 +107,7 @@ class Flattener {
   std::shared_ptr<const DensityGrid> density_grid(const MediumEntity& m);
   std::shared_ptr<const DensityGrid> cloud_grid(const MediumEntity& m);
   std::shared_ptr<const DensityGrid> le_scale_grid(const MediumEntity& m);
+  void read_temperature(const MediumEntity& m, Medium* medium);
   std::shared_ptr<const RgbGrid> rgb_grid(const MediumEntity& m, float scale);
 
   // Shapes and their area lights (flatten_shapes.cpp).

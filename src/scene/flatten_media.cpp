@@ -146,9 +146,37 @@ std::shared_ptr<const DensityGrid> Flattener::le_scale_grid(const MediumEntity& 
                                        m.world_from_medium);
 }
 
+// A uniformgrid's glow by temperature (pbrt-v4's GridMedium::Create): nx x ny x nz kelvin values
+// on the density's box, then (T - "temperatureoffset") * "temperaturescale" (the offset read
+// from "temperaturecutoff" when only that is given). Le beside it is an error, as in pbrt-v4.
+void Flattener::read_temperature(const MediumEntity& m, Medium* medium) {
+  const ParamSet& ps = m.params;
+  const Param* given = ps.find("temperature", "float");
+  if (!given) return;
+  if (const Param* le = ps.find_any("Le"))
+    throw Error(le->loc, "a medium glows by \"Le\" or by \"temperature\", not both");
+  const GridBox box = grid_box(m);
+  std::vector<float> values = ps.get_floats("temperature");
+  if (values.size() != box.count())
+    throw Error(given->loc,
+                "uniformgrid has " + std::to_string(values.size()) +
+                    " temperature values; nx * ny * nz = " + std::to_string(box.count()));
+  for (float v : values)
+    if (!(v >= 0) || !std::isfinite(v))
+      throw Error(given->loc, "temperature values must be non-negative (kelvin)");
+  const float offset = ps.get_float("temperatureoffset", ps.get_float("temperaturecutoff", 0));
+  const float scale = ps.get_float("temperaturescale", 1);
+  if (!std::isfinite(offset) || !(scale >= 0) || !std::isfinite(scale))
+    throw Error(m.loc, "temperatureoffset must be finite and temperaturescale non-negative");
+  medium->temperature = std::make_shared<DensityGrid>(box.nx, box.ny, box.nz, std::move(values),
+                                                      box.p0, box.p1, m.world_from_medium);
+  medium->temperature_offset = offset;
+  medium->temperature_scale = scale;
+}
+
 // pbrt-v4's "rgbgrid": per voxel "rgb sigma_a" and "rgb sigma_s" colours (either may be absent:
-// 1 everywhere), nx x ny x nz of each, on the box [p0, p1], times "scale" (media.cpp,
-// RGBGridMedium::Create).
+// 1 everywhere), nx x ny x nz of each, on the box [p0, p1], times "scale", and per voxel "rgb Le"
+// colours times one "Lescale" (media.cpp, RGBGridMedium::Create).
 std::shared_ptr<const RgbGrid> Flattener::rgb_grid(const MediumEntity& m, float scale) {
   const ParamSet& ps = m.params;
   const GridBox box = grid_box(m);
@@ -170,17 +198,21 @@ std::shared_ptr<const RgbGrid> Flattener::rgb_grid(const MediumEntity& m, float 
     }
     return out;
   };
-  const std::vector<Rgb> a = colours("sigma_a"), s = colours("sigma_s");
+  const std::vector<Rgb> a = colours("sigma_a"), s = colours("sigma_s"), Le = colours("Le");
   if (a.empty() && s.empty())
     throw Error(m.loc, "rgbgrid medium needs \"rgb sigma_a\" or \"rgb sigma_s\" values");
-  return std::make_shared<RgbGrid>(box.nx, box.ny, box.nz, a, s, scale, box.p0, box.p1,
-                                   m.world_from_medium);
+  if (!Le.empty() && a.empty())
+    throw Error(ps.find_any("Le")->loc, "an rgbgrid that glows (\"rgb Le\") needs \"rgb sigma_a\"");
+  auto grid = std::make_shared<RgbGrid>(box.nx, box.ny, box.nz, a, s, scale, box.p0, box.p1,
+                                        m.world_from_medium);
+  if (!Le.empty()) grid->set_glow(Le, ps.get_float("Lescale", 1));
+  return grid;
 }
 
 // The index of a named medium, -1 for "" (vacuum). Coefficients default to 1 per unit distance
 // (times "scale"), g to 0; a preset names measured coefficients in mm^-1; Le (times one Lescale)
-// is emitted where sigma_a absorbs (a uniformgrid's times its Lescale grid). Other types, an
-// rgbgrid's and temperature's emission are refused.
+// is emitted where sigma_a absorbs (a uniformgrid's times its Lescale grid, or a blackbody by
+// temperature instead; an rgbgrid's per voxel). Other types are refused.
 int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   if (name.empty()) return -1;
   if (auto it = medium_ids_.find(name); it != medium_ids_.end()) return it->second;
@@ -203,10 +235,9 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   if (!(scale >= 0) || !std::isfinite(scale))
     throw Error(m.loc, "medium scale must be a non-negative number");
   // Homogeneous and uniformgrid media glow by Le (uniformgrid: times a grid of Lescale values,
-  // le_scale_grid); an rgbgrid's colours of Le, and glow from temperature, are refused.
-  if (m.name != "homogeneous" && m.name != "uniformgrid" && ps.find_any("Le"))
-    throw unsupported("it emits (Le)");
-  if (ps.find_any("temperature")) throw unsupported("it emits (temperature)");
+  // le_scale_grid), a uniformgrid by temperature in its place, an rgbgrid by a colour of Le per
+  // voxel (rgb_grid); a cloud does not glow.
+  if (m.name == "cloud" && ps.find_any("Le")) throw unsupported("it emits (Le)");
   std::optional<SpectrumCurve> Le;
   if (m.name == "homogeneous" || m.name == "uniformgrid")
     Le = spectrum_curve(ps, "Le", SpectrumKind::kIlluminant);
@@ -248,7 +279,9 @@ int Flattener::medium_id(const std::string& name, const FileLoc& loc) {
   medium.sigma_s = medium.sigma_s.scaled(scale);
   if (m.name == "uniformgrid") medium.grid = density_grid(m);
   if (m.name == "cloud") medium.grid = cloud_grid(m);
-  if (m.name == "uniformgrid" && Le && !Le->is_black()) medium.le_scale = le_scale_grid(m);
+  if (m.name == "uniformgrid") read_temperature(m, &medium);
+  if (m.name == "uniformgrid" && ((Le && !Le->is_black()) || medium.temperature))
+    medium.le_scale = le_scale_grid(m);
   if (Le && !Le->is_black()) medium.Le = Le->scaled(le_scale.empty() ? 1.0f : le_scale[0]);
   ps.warn_unused("medium \"" + name + "\"");
   scene().media.push_back(std::move(medium));

@@ -198,6 +198,23 @@ float DensityGrid::distance_at_depth(const Ray& ray, float tau, float t_max) con
   return end >= 0 && depth >= tau * (1 - 1e-5f) ? end : -1.0f;
 }
 
+namespace {
+
+// Colours as SpectrumCurve::from_rgb's unbounded ones: the largest channel scaled to 0.5 (an
+// illuminant's, pbrt-v4's RGBIlluminantSpectrum, is the same curve times D65).
+std::vector<RgbGrid::Voxel> rgb_voxels(const std::vector<Rgb>& rgb) {
+  std::vector<RgbGrid::Voxel> v(rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    const float m = rgb[i].max_component();
+    if (!(m > 0)) continue;
+    v[i].scale = 2 * m;
+    v[i].coeff = sigmoid_coefficients_lookup(rgb[i] / (2 * m));
+  }
+  return v;
+}
+
+}  // namespace
+
 RgbGrid::RgbGrid(int nx_, int ny_, int nz_, const std::vector<Rgb>& a, const std::vector<Rgb>& s,
                  float scale_, Vec3 p0, Vec3 p1, const Transform& world_from_medium)
     : nx(nx_),
@@ -205,19 +222,8 @@ RgbGrid::RgbGrid(int nx_, int ny_, int nz_, const std::vector<Rgb>& a, const std
       nz(nz_),
       scale(scale_),
       lattice_from_world(lattice_transform(nx_, ny_, nz_, p0, p1, world_from_medium)) {
-  // As SpectrumCurve::from_rgb's unbounded colours: the largest channel scaled to 0.5.
-  auto voxels = [](const std::vector<Rgb>& rgb) {
-    std::vector<Voxel> v(rgb.size());
-    for (size_t i = 0; i < rgb.size(); ++i) {
-      const float m = rgb[i].max_component();
-      if (!(m > 0)) continue;
-      v[i].scale = 2 * m;
-      v[i].coeff = sigmoid_coefficients_lookup(rgb[i] / (2 * m));
-    }
-    return v;
-  };
-  sigma_a = voxels(a);
-  sigma_s = voxels(s);
+  sigma_a = rgb_voxels(a);
+  sigma_s = rgb_voxels(s);
   scatters = scale > 0 && (s.empty() || std::any_of(s.begin(), s.end(), [](const Rgb& c) {
                              return c.max_component() > 0;
                            }));
@@ -227,21 +233,22 @@ namespace {
 
 // One voxel's colour at the wavelengths, times `scale`; 1 where the grid gives none, 0 beyond it.
 Spectrum voxel_spectrum(const RgbGrid& g, const std::vector<RgbGrid::Voxel>& voxels, int i, int j,
-                        int k, const Wavelengths& wl) {
-  if (voxels.empty()) return Spectrum(g.scale);
+                        int k, const Wavelengths& wl, float factor) {
+  if (voxels.empty()) return Spectrum(factor);
   if (i < 0 || j < 0 || k < 0 || i >= g.nx || j >= g.ny || k >= g.nz) return {};
   const RgbGrid::Voxel& v =
       voxels[(size_t(k) * size_t(g.ny) + size_t(j)) * size_t(g.nx) + size_t(i)];
   Spectrum s;
   if (v.scale == 0) return s;
   for (int c = 0; c < Spectrum::kChannels; ++c)
-    s[c] = g.scale * v.scale * sigmoid_spectrum(v.coeff, wl.lambda[c]);
+    s[c] = factor * v.scale * sigmoid_spectrum(v.coeff, wl.lambda[c]);
   return s;
 }
 
 Cell<Spectrum> sigma_t_cell(const RgbGrid& g, const int c[3], const Wavelengths& wl) {
   return Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-    return voxel_spectrum(g, g.sigma_a, i, j, k, wl) + voxel_spectrum(g, g.sigma_s, i, j, k, wl);
+    return voxel_spectrum(g, g.sigma_a, i, j, k, wl, g.scale) +
+           voxel_spectrum(g, g.sigma_s, i, j, k, wl, g.scale);
   });
 }
 
@@ -255,11 +262,31 @@ void RgbGrid::coefficients(Vec3 p, const Wavelengths& wl, Spectrum* a, Spectrum*
   if (!cell_of(q, n, c)) return;
   const Vec3 f = q - Vec3{float(c[0]), float(c[1]), float(c[2])};
   *a = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-         return voxel_spectrum(*this, sigma_a, i, j, k, wl);
+         return voxel_spectrum(*this, sigma_a, i, j, k, wl, scale);
        }).at(f);
   *s = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-         return voxel_spectrum(*this, sigma_s, i, j, k, wl);
+         return voxel_spectrum(*this, sigma_s, i, j, k, wl, scale);
        }).at(f);
+}
+
+void RgbGrid::set_glow(const std::vector<Rgb>& colours, float scale_of_le) {
+  Le = rgb_voxels(colours);
+  le_scale = scale_of_le;
+}
+
+Spectrum RgbGrid::glow(Vec3 p, const Wavelengths& wl) const {
+  Spectrum e;
+  const Vec3 q = lattice_from_world.point(p);
+  const int n[3] = {nx, ny, nz};
+  int c[3];
+  if (!glows() || !cell_of(q, n, c)) return e;
+  const Vec3 f = q - Vec3{float(c[0]), float(c[1]), float(c[2])};
+  e = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
+        return voxel_spectrum(*this, Le, i, j, k, wl, 1);
+      }).at(f);
+  const float k = le_scale * float(ybar_integral());
+  for (int i = 0; i < Spectrum::kChannels; ++i) e[i] *= k * d65_unit(wl.lambda[i]);
+  return e;
 }
 
 Spectrum RgbGrid::depth(const Ray& ray, float t0, float t1, const Wavelengths& wl) const {

@@ -63,12 +63,22 @@ struct RgbGrid {
   std::vector<Voxel> sigma_a, sigma_s;  // empty: 1 (before `scale`) everywhere in the box
   float scale = 1;
   bool scatters = true;
+  // pbrt-v4's per-voxel "Le" colours (illuminant spectra: the sigmoid times D65, not normalised)
+  // times one "Lescale": a point emits sigma_a(x) Le(x) per unit length. Empty: no glow.
+  std::vector<Voxel> Le;
+  float le_scale = 1;
   Transform lattice_from_world;  // as DensityGrid's
 
   RgbGrid(int nx, int ny, int nz, const std::vector<Rgb>& sigma_a, const std::vector<Rgb>& sigma_s,
           float scale, Vec3 p0, Vec3 p1, const Transform& world_from_medium);
+  // Sets the glow: nx ny nz colours of Le (none negative) times le_scale.
+  void set_glow(const std::vector<Rgb>& Le, float le_scale);
+  bool glows() const { return !Le.empty() && le_scale > 0; }
   // sigma_a and sigma_s at a world point (0 outside the box).
   void coefficients(Vec3 p, const Wavelengths& wl, Spectrum* sigma_a, Spectrum* sigma_s) const;
+  // The emitted radiance per unit of sigma_a at a world point, in our units (pbrt-v4 does not
+  // normalise it: its film reads it ybar_integral() times brighter than a light's spectrum).
+  Spectrum glow(Vec3 p, const Wavelengths& wl) const;
   // The optical depth of sigma_t along o + d t (d of unit length) over [t0, t1], per wavelength.
   Spectrum depth(const Ray& ray, float t0, float t1, const Wavelengths& wl) const;
   // The distance in [0, t_max] at which wavelength `channel`'s depth from 0 reaches tau; negative
@@ -94,8 +104,25 @@ struct Medium {
   // le_scale(x) where a uniformgrid has that grid (pbrt-v4's LeScale).
   SpectrumCurve Le;
   std::shared_ptr<const DensityGrid> le_scale;
+  // A uniformgrid that glows by temperature emits, in place of Le, a blackbody (1 at its peak,
+  // not normalised: times ybar_integral() in our units) at (T(x) - offset) * scale kelvin, none
+  // at 100 K or less (pbrt-v4's GridMedium), times le_scale(x).
+  std::shared_ptr<const DensityGrid> temperature;
+  float temperature_offset = 0, temperature_scale = 1;
 
-  bool emits() const { return !Le.is_black(); }
+  bool emits() const { return !Le.is_black() || temperature || (rgb_grid && rgb_grid->glows()); }
+  // The glow per unit of sigma_a at a point of a uniformgrid with an Lescale grid (le_scale set).
+  Spectrum varying_glow(Vec3 p, const Wavelengths& wl) const {
+    const float s = le_scale->density(p);
+    if (!(s > 0)) return Spectrum();
+    if (!temperature) return Le.sample(wl) * s;
+    const float T = (temperature->density(p) - temperature_offset) * temperature_scale;
+    Spectrum L;
+    if (!(T > 100)) return L;
+    const float k = float(ybar_integral()) * s;
+    for (int i = 0; i < Spectrum::kChannels; ++i) L[i] = k * blackbody(wl.lambda[i], T);
+    return L;
+  }
 
   bool scatters() const { return rgb_grid ? rgb_grid->scatters : !sigma_s.is_black(); }
   float density(Vec3 p) const { return grid ? grid->density(p) : 1.0f; }

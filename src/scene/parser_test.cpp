@@ -1457,9 +1457,18 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
                       at(1, 60), "rgbgrid has 1 sigma_s colours; nx * ny * nz = 2"));
   EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 -1 1]")),
                       at(1, 45), "sigma_a colours must be finite and not negative"));
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 1 1] "
+  // An rgbgrid glows by colours of Le where sigma_a is given; a cloud does not glow.
+  EXPECT_EQ(error_of(scene("\"string type\" \"rgbgrid\" \"rgb sigma_a\" [1 1 1] "
+                           "\"rgb Le\" [1 1 1]")),
+            "");
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"rgb sigma_s\" [1 1 1] "
                                      "\"rgb Le\" [1 1 1]")),
-                      at(3, 1), "it emits (Le)"));
+                      at(1, 67), "an rgbgrid that glows (\"rgb Le\") needs \"rgb sigma_a\""));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"rgbgrid\" \"integer nx\" 2 "
+                                     "\"rgb sigma_a\" [1 1 1  1 1 1] \"rgb Le\" [1 1 1]")),
+                      at(1, 89), "rgbgrid has 1 Le colours; nx * ny * nz = 2"));
+  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"cloud\" \"rgb Le\" [1 1 1]")), at(3, 1),
+                      "it emits (Le)"));
   EXPECT_EQ(error_of(scene("\"string type\" \"rgbgrid\" \"integer nx\" 2 "
                            "\"rgb sigma_s\" [1 1 1  0 0.5 2]")),
             "");
@@ -1506,8 +1515,8 @@ TEST(SceneParseError, MediaThatAreUnknownOrUnsupportedAreErrors) {
       0);
 }
 
-// pbrt-v4's cloud and a glowing uniformgrid are read; their parameters out of range are located
-// errors, and glow from temperature is refused.
+// pbrt-v4's cloud and a glowing uniformgrid (by Le or by temperature) are read; their parameters
+// out of range are located errors.
 TEST(SceneParseError, CloudAndGlowingGridParameters) {
   auto scene = [](const std::string& medium_params) {
     return "MakeNamedMedium \"m\" " + medium_params +
@@ -1530,9 +1539,25 @@ TEST(SceneParseError, CloudAndGlowingGridParameters) {
       "[1 1] \"rgb Le\" [1 1 1] \"float Lescale\" [1]";
   EXPECT_TRUE(IsError(error_of(scene(short_le)), at(1, 20 + col(short_le, "\"float Lescale")),
                       "uniformgrid has 1 Lescale values; nx * ny * nz = 2"));
-  EXPECT_TRUE(IsError(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [1] "
-                                     "\"float temperature\" [900]")),
-                      at(3, 1), "it emits (temperature)"));
+  // Or by temperature, one value per voxel, never beside Le.
+  EXPECT_EQ(error_of(scene("\"string type\" \"uniformgrid\" \"float density\" [1] "
+                           "\"float temperature\" [900]")),
+            "");
+  const std::string two_temperatures =
+      "\"string type\" \"uniformgrid\" \"float density\" [1] \"float temperature\" [900 800]";
+  EXPECT_TRUE(IsError(error_of(scene(two_temperatures)),
+                      at(1, 20 + col(two_temperatures, "\"float temperature")),
+                      "uniformgrid has 2 temperature values; nx * ny * nz = 1"));
+  const std::string both =
+      "\"string type\" \"uniformgrid\" \"float density\" [1] "
+      "\"float temperature\" [900] \"rgb Le\" [1 1 1]";
+  EXPECT_TRUE(IsError(error_of(scene(both)), at(1, 20 + col(both, "\"rgb Le")),
+                      "by \"Le\" or by \"temperature\", not both"));
+  const std::string negative =
+      "\"string type\" \"uniformgrid\" \"float density\" [1] "
+      "\"float temperature\" [-900]";
+  EXPECT_TRUE(IsError(error_of(scene(negative)), at(1, 20 + col(negative, "\"float temperature")),
+                      "temperature values must be non-negative"));
 }
 
 TEST(SceneParseError, ColorSpaceOtherThanSrgb) {

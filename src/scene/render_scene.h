@@ -165,20 +165,60 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, const
   return t;
 }
 
+// An rgbgrid's glow along the first `distance` of a unit ray: per wavelength i the integral of
+// exp(-tau_i(t)) sigma_a_i(x) Le_i(x) dt, each wavelength with its own optical depth tau_i. One
+// distance, drawn from one wavelength's exponential in its optical depth cut at the piece's end
+// (uniform where that wavelength's depth is 0), the wavelength drawn uniformly, estimates it,
+// weighed by the mixture of all wavelengths' densities there.
+inline Spectrum rgb_grid_emission(const RgbGrid& g, const Ray& ray, float distance,
+                                  const Wavelengths& wl, Rng& rng) {
+  constexpr int n = Spectrum::kChannels;
+  Spectrum L;
+  if (!(distance > 0) || !std::isfinite(distance)) return L;
+  const Spectrum whole = g.depth(ray, 0, distance, wl);
+  const int j = std::min(int(rng.uniform() * n), n - 1);
+  const float u = rng.uniform();
+  Spectrum tau;  // every wavelength's depth up to the point drawn
+  float t = u * distance;
+  if (whole[j] > 0) {
+    t = g.flight(ray, j, sample_truncated_exponential(u, whole[j]), distance, wl, &tau);
+    if (t < 0) t = distance;  // short of the depth by rounding: tau is then the whole depth
+  } else {
+    tau = g.depth(ray, 0, t, wl);
+  }
+  const Vec3 x = ray.o + ray.d * t;
+  Spectrum sigma_a, sigma_s;
+  g.coefficients(x, wl, &sigma_a, &sigma_s);
+  double pdf = 0;
+  for (int k = 0; k < n; ++k)
+    pdf += whole[k] > 0 ? double(sigma_a[k] + sigma_s[k]) * std::exp(-double(tau[k])) /
+                              -std::expm1(-double(whole[k]))
+                        : 1.0 / distance;
+  pdf /= n;
+  if (!(pdf > 0)) return L;
+  const Spectrum e = g.glow(x, wl);
+  for (int i = 0; i < n; ++i) L[i] = float(sigma_a[i] * e[i] * std::exp(-double(tau[i])) / pdf);
+  return L;
+}
+
 // The radiance that an emitting medium sends along the unit ray toward its origin from the first
 // `distance` of it, attenuated on the way: the integral of T(t) sigma_a(x) Le dt, which with
 // sigma = density (sigma per unit density) and d tau = density dt is
 // sigma_a Le (1 - exp(-sigma_t tau)) / sigma_t, exactly (scene/medium.h). Where a uniformgrid's
-// Lescale grid s(x) scales the glow, sigma_a Le times the integral of exp(-sigma_t tau) s over
-// tau has no closed form: one depth drawn by `rng` (the path's stream) estimates it.
+// glow varies (an Lescale grid s(x), a temperature grid), sigma_a times the integral of
+// exp(-sigma_t tau) s Le(x) over tau has no closed form: one depth drawn by `rng` (the path's
+// stream) estimates it.
 inline Spectrum medium_emission(const RenderScene& scene, int medium, const Ray& ray,
                                 float distance, const Wavelengths& wl, Rng* rng) {
   Spectrum L;
   if (medium < 0) return L;
   const Medium& m = scene.media[size_t(medium)];
-  if (!m.emits() || m.rgb_grid) return L;
+  if (!m.emits()) return L;
+  if (m.rgb_grid) {
+    BPM_CHECK(rng);  // set by every path that may cross a glowing grid
+    return rgb_grid_emission(*m.rgb_grid, ray, distance, wl, *rng);
+  }
   const Spectrum sigma_a = m.sigma_a.sample(wl), sigma_t = sigma_a + m.sigma_s.sample(wl);
-  const Spectrum Le = m.Le.sample(wl);
   const float tau = m.depth(ray, 0, distance);
   if (m.le_scale) {
     if (!(tau > 0)) return L;
@@ -197,11 +237,12 @@ inline Spectrum medium_emission(const RenderScene& scene, int medium, const Ray&
                                   : 1.0 / tau;
     pdf /= n;
     const float t = m.distance_at_depth(ray, std::min(at, tau), distance);
-    const float s = m.le_scale->density(ray.o + ray.d * (t >= 0 ? t : distance));
+    const Spectrum glow = m.varying_glow(ray.o + ray.d * (t >= 0 ? t : distance), wl);
     for (int i = 0; i < n; ++i)
-      L[i] = float(sigma_a[i] * Le[i] * s * std::exp(-double(sigma_t[i]) * at) / pdf);
+      L[i] = float(sigma_a[i] * glow[i] * std::exp(-double(sigma_t[i]) * at) / pdf);
     return L;
   }
+  const Spectrum Le = m.Le.sample(wl);
   for (int i = 0; i < Spectrum::kChannels; ++i)
     if (sigma_t[i] > 0) L[i] = sigma_a[i] * Le[i] * -std::expm1(-sigma_t[i] * tau) / sigma_t[i];
   return L;
