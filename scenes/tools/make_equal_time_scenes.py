@@ -6,8 +6,10 @@
   glass egg on a table;
 - spot-lens-fog: a spot light through a glass lens into a foggy room (a volumetric caustic);
 - underwater: a spot light and a dim sky over a wavy water surface, seen from inside murky water;
-- smoke: a plume of smoke (a uniformgrid medium) over a floor, lit by a spot light and a sky panel.
-    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those six scenes/*.pbrt
+- smoke: a plume of smoke (a uniformgrid medium) over a floor, lit by a spot light and a sky panel;
+- shelf-room: a living room lit by one small bright sphere, thin open shelves on a wall, a sofa, a
+  low table and red-tinted glass objects.
+    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those seven scenes/*.pbrt
 """
 import math
 import os
@@ -248,10 +250,62 @@ def smoke():
     return s
 
 
+def shelf_room():
+    s = header("# A living room lit by one small bright sphere: thin open shelves with books on the back\n"
+               "# wall, a sofa, a low table, red-tinted glass objects (glass around an absorbing medium).\n"
+               "# Thin geometry against walls and small gaps under furniture, lit mostly indirectly.\n",
+               "1.0 1.35 -0.2   -1.0 1.15 2.5   0 1 0", 50, (320, 180), 12, "shelf-room")
+    s += 'MakeNamedMedium "red" "string type" "homogeneous" "rgb sigma_a" [ 0.4 6 5 ]\n'
+    s += '    "rgb sigma_s" [ 0 0 0 ]\n'
+    s += 'Material "diffuse" "rgb reflectance" [ 0.72 0.7 0.66 ]\n'
+    s += quad((-3, 2.7, -2.5), (3, 2.7, -2.5), (3, 2.7, 2.5), (-3, 2.7, 2.5))   # ceiling
+    s += quad((-3, 0, 2.5), (-3, 2.7, 2.5), (3, 2.7, 2.5), (3, 0, 2.5))       # back wall
+    s += quad((-3, 0, -2.5), (-3, 0, 2.5), (-3, 2.7, 2.5), (-3, 2.7, -2.5))   # left wall
+    s += quad((3, 0, -2.5), (3, 2.7, -2.5), (3, 2.7, 2.5), (3, 0, 2.5))       # right wall
+    s += quad((-3, 0, -2.5), (3, 0, -2.5), (3, 2.7, -2.5), (-3, 2.7, -2.5))   # front wall
+    s += 'Material "diffuse" "rgb reflectance" [ 0.38 0.26 0.16 ]\n'
+    s += quad((-3, 0, -2.5), (-3, 0, 2.5), (3, 0, 2.5), (3, 0, -2.5))         # floor
+    # Open shelves on the back wall: four boards 2.5 cm thick and 28 cm deep between two thin sides.
+    s += 'Material "diffuse" "rgb reflectance" [ 0.62 0.6 0.56 ]\n'
+    for y in (1.0, 1.38, 1.76, 2.14):
+        s += box(-2.6, y, 2.22, -1.2, y + 0.025, 2.5)
+    s += box(-2.62, 1.0, 2.22, -2.6, 2.165, 2.5) + box(-1.2, 1.0, 2.22, -1.18, 2.165, 2.5)
+    # Books standing on the boards.
+    colours = [(0.5, 0.15, 0.1), (0.15, 0.25, 0.45), (0.55, 0.5, 0.3), (0.2, 0.35, 0.2)]
+    for i, y in enumerate((1.025, 1.405, 1.785)):
+        x = -2.55 + 0.17 * i
+        for j in range(5 - i):
+            c = colours[(i + j) % 4]
+            s += 'Material "diffuse" "rgb reflectance" [ %g %g %g ]\n' % c
+            h = 0.22 + 0.03 * ((i + 2 * j) % 3)
+            s += box(x, y, 2.27, x + 0.045, y + h, 2.47)
+            x += 0.055
+    # A sofa against the right half of the back wall, and a low table in front of it.
+    s += 'Material "diffuse" "rgb reflectance" [ 0.3 0.3 0.38 ]\n'
+    s += box(0.2, 0.05, 1.55, 2.4, 0.45, 2.35) + box(0.2, 0.45, 2.1, 2.4, 0.9, 2.4)
+    s += box(0.05, 0.05, 1.55, 0.2, 0.62, 2.4) + box(2.4, 0.05, 1.55, 2.55, 0.62, 2.4)
+    s += 'Material "diffuse" "rgb reflectance" [ 0.45 0.32 0.2 ]\n'
+    s += box(0.3, 0.36, 0.35, 1.7, 0.4, 1.05)
+    for x, z in ((0.35, 0.4), (1.62, 0.4), (0.35, 0.97), (1.62, 0.97)):
+        s += box(x, 0, z, x + 0.03, 0.36, z + 0.03)
+    # Red-tinted glass: a sphere and an upright ellipsoid on the table, a sphere on a shelf.
+    for t, sc, r in (("0.7 0.52 0.7", "1 1 1", 0.12), ("1.25 0.56 0.8", "1 1.6 1", 0.1),
+                     ("-1.6 1.84 2.36", "1 1 1", 0.06)):
+        s += ('AttributeBegin\n  Material "dielectric" "float eta" [ 1.5 ]\n'
+              '  MediumInterface "red" ""\n  Translate %s\n  Scale %s\n'
+              '  Shape "sphere" "float radius" [ %g ]\nAttributeEnd\n' % (t, sc, r))
+    # The light: one small bright sphere under the ceiling.
+    s += ('AttributeBegin\n  Translate 0.3 2.25 0.4\n'
+          '  AreaLightSource "diffuse" "blackbody L" [ 3000 ] "float scale" [ 4000 ]\n'
+          '  Shape "sphere" "float radius" [ 0.04 ]\nAttributeEnd\n')
+    return s
+
+
 def main():
     for name, text in [("spot-facets", spot_facets()), ("water-box", water_box()),
                        ("lamp-room", lamp_room()), ("spot-lens-fog", spot_lens_fog()),
-                       ("underwater", underwater()), ("smoke", smoke())]:
+                       ("underwater", underwater()), ("smoke", smoke()),
+                       ("shelf-room", shelf_room())]:
         with open(os.path.join(OUT, name + ".pbrt"), "w") as f:
             f.write(text)
 

@@ -30,9 +30,12 @@ struct BackwardPhoton {
   Spectrum tau;  // throughput from the camera (the paper's transmittance)
   uint32_t pixel;
   uint32_t material;
-  uint16_t eye_depth;      // scattering events on the eye path, this vertex included
-  uint8_t accepts;         // AcceptMask bits
-  uint8_t diffuse_index;   // j - 1 for the j-th diffuse vertex (0..3)
+  uint16_t eye_depth;         // scattering events on the eye path, this vertex included
+  uint8_t accepts;            // AcceptMask bits
+  uint8_t diffuse_index : 7;  // j - 1 for the j-th diffuse vertex (0..3)
+  // The disc's probes looked (DiscProbes::looked: other geometry is near): each photon is
+  // gathered only where nothing stands between it and the point (photon_cut_off).
+  uint8_t cut_off_tested : 1 = 0;
   bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
   uint8_t disc_cut = 0;    // the disc probes that found no surface (photons/disc_probes.h)
   uint8_t disc_found = 0;  // and those that found some

@@ -354,6 +354,7 @@ bool BpmRender::build_maps(int pass, const RenderControl& control, LightPassPara
     lp->medium_spheres = medium_spheres_.get();
   }
   lp->stop = [&control] { return control.stop_requested(); };
+  lp->scene = &scene_;
   resolve_photon_materials(maps_, lp);
   if (!guide_.empty() && !pixel_weight_.empty()) lp->pixel_weight = &pixel_weight_;
   if (opt_.memory_budget > 0) {

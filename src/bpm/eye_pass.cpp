@@ -65,35 +65,38 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 }
 
 // Stores one backward photon at diffuse vertex v. Its disc is probed where it may be cut
-// (disc_probes.h); `whole`: a larger disc about the same point was probed and found whole, and so
-// is this one. Returns whether a probe found the disc whole.
-inline bool store_backward_photon(const EyePath& path, const PathVertex& v, const PathState& s,
-                                  int depth, int diffuse, bool seen_directly, uint8_t accepts,
-                                  bool whole) {
+// (disc_probes.h); where a larger disc about the same point was found whole (`larger`), so is
+// this one, and its photons are tested as the larger one's are. Returns the disc's probes (none:
+// not probed).
+inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
+                                        const PathState& s, int depth, int diffuse,
+                                        bool seen_directly, uint8_t accepts,
+                                        const DiscProbes& larger) {
   const EyePassParams& prm = path.prm;
   BackwardPhoton bp =
       backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
-  if (bp.radius <= 0 || s.beta.is_black()) return false;
+  if (bp.radius <= 0 || s.beta.is_black()) return {};
   bp.place = uint8_t(path.stored++);
   if (v.medium >= 0) {  // after the objects' lists, one per medium
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
     ++path.counters.backward_photons;
-    return false;
+    return {};
   }
   const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
-  bool probed_whole = false;
-  if (prm.disc_probes && !whole && (!seen_directly || (path.near_edge & near_bit)) &&
-      may_cut_discs(path.scene.objects[size_t(v.object())].shape)) {
-    const DiscProbes probes =
-        probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
-                   prm.normal_cos, path.rng, path.counters.rays, v.hit.primitive);
+  DiscProbes probes;
+  if (larger.found && !larger.cut) {
+    bp.cut_off_tested = larger.looked;
+  } else if (prm.disc_probes && (!seen_directly || (path.near_edge & near_bit)) &&
+             may_cut_discs(path.scene.objects[size_t(v.object())].shape)) {
+    probes = probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
+                        prm.normal_cos, path.rng, path.counters.rays, v.hit.primitive);
     bp.disc_found = probes.found;
     bp.disc_cut = probes.cut;
-    probed_whole = probes.cut == 0;
+    bp.cut_off_tested = probes.looked;
   }
   path.out[size_t(v.object())].push_back(bp);
   ++path.counters.backward_photons;
-  return probed_whole;
+  return probes;
 }
 
 // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first vertex is
@@ -104,18 +107,18 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
   // Seen straight from the camera: the screen around the pixel says whether its discs may be
   // cut (disc_probes.h).
   const bool seen_directly = diffuse == 1 && depth == 1;
-  auto store = [&](uint8_t accepts, bool whole) {
-    return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, whole);
+  auto store = [&](uint8_t accepts, const DiscProbes& larger) {
+    return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, larger);
   };
   if (!prm.caustics) {
-    if (last) store(kAcceptsIndirect, false);
+    if (last) store(kAcceptsIndirect, {});
   } else if (!last) {
-    store(kAcceptsCaustic, false);
+    store(kAcceptsCaustic, {});
   } else if (diffuse > 1 || prm.world_radius > 0 || prm.k0 == prm.k1) {
-    store(kAcceptsCaustic | kAcceptsIndirect, false);
+    store(kAcceptsCaustic | kAcceptsIndirect, {});
   } else {
-    const bool whole = store(kAcceptsIndirect, false);  // r1 > r0: the larger disc first
-    store(kAcceptsCaustic, whole && prm.k0 < prm.k1);
+    const DiscProbes larger = store(kAcceptsIndirect, {});  // r1 > r0: the larger disc first
+    store(kAcceptsCaustic, prm.k0 < prm.k1 ? larger : DiscProbes{});
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include "base/error.h"
 #include "photons/density.h"
+#include "photons/disc_probes.h"
 
 namespace bpm {
 namespace {
@@ -44,10 +45,15 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                     const std::vector<uint16_t>& owner, const PendingHit& h,
                     std::vector<std::vector<PhotonEntry>>& out) {
   float score = 0;
+  PathCounters rays;  // not reported
   auto use = [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + h.bounces > prm.max_depth) return;
     if (dot(bp.ng, h.ng) < prm.normal_cos) return;
+    if (bp.cut_off_tested && prm.scene &&
+        photon_cut_off(*prm.scene, bp.p, dot(bp.ng, bp.wo) >= 0 ? bp.ng : -bp.ng, h.p, h.object,
+                       bp.radius, prm.normal_cos, rays))
+      return;
     // Resolved per backward photon when any material is textured (resolve_photon_materials).
     const Material& m = prm.photon_materials.empty() ? prm.materials->materials[bp.material]
                                                      : prm.photon_materials[g];

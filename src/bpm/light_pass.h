@@ -66,6 +66,9 @@ struct LightPassParams {
   SensorIteration* sensor_sums = nullptr;
   // The backward photons in scattering media, which gather the photons' beams. Null: none.
   const MediumSpheres* medium_spheres = nullptr;
+  // The scene, for the rays that test whether a photon is cut off from a backward photon whose
+  // disc has geometry near (BackwardPhoton::cut_off_tested). Null: no test.
+  const RenderScene* scene = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.

@@ -15,15 +15,16 @@ namespace {
 // sum f dPhi / (pi r^2 N), and the estimate of its bias (radius_bias). With knn > 0
 // the radius is the distance to the knn-th nearest photon within `radius` (Jensen's estimate),
 // else `radius`. probe(r) measures the share of the disc of radius r where photons can land
-// (photons/disc_probes.h), which the sums are divided by (the photon maps do not depend on the
-// threads, so neither do the probes made).
+// (photons/disc_probes.h), which the sums are divided by, and where it looked, a photon cut off
+// from the point is not gathered (the photon maps do not depend on the threads, so neither do the
+// probes made).
 struct Estimate {
   Spectrum L, bias;
 };
 template <class Accept, class Probe>
-Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only, float radius,
-                  int eye_depth, const FpmEyeParams& prm, Accept&& accept, Probe&& probe,
-                  FpmEyeCounters& c) {
+Estimate estimate(const RenderScene& scene, const PhotonMap& map, const PathVertex& v,
+                  bool eye_hero_only, float radius, int eye_depth, const FpmEyeParams& prm,
+                  Accept&& accept, Probe&& probe, FpmEyeCounters& c) {
   ++c.lookups;
   const SurfacePoint& sp = v.sp;
   auto usable = [&](const ForwardPhoton& ph) {
@@ -41,17 +42,22 @@ Estimate estimate(const PhotonMap& map, const PathVertex& v, bool eye_hero_only,
       r = std::sqrt(d2[size_t(prm.fpm->knn - 1)]) * 1.0001f;
     }
   }
+  // Probed before the gather where other geometry is near (DiscProbes::looked), each photon is
+  // then gathered only where nothing cuts it off from the point (photon_cut_off).
+  const DiscProbes d = probe(r);
+  const Vec3 n = dot(sp.ng, v.wo) >= 0 ? sp.ng : -sp.ng;
   NestedSums sums;
   map.tree.query_within(sp.p, r, [&](uint32_t i) {
     const ForwardPhoton& ph = map.photons[i];
     if (!usable(ph)) return;
+    if (d.looked &&
+        photon_cut_off(scene, sp.p, n, ph.p, v.object(), r, prm.fpm->normal_cos, c.rays))
+      return;
     ++c.photons_used;
     sums.add(photon_contribution(v.m(), ph.ng, sp.ns, v.wo, ph.wi, ph.flux) *
                  hero_join_factor(eye_hero_only, ph.hero_only),
              length_squared(ph.p - sp.p), r * r);
   });
-  // Nothing to divide where nothing was gathered: no probes.
-  const DiscProbes d = sums.all.is_black() ? DiscProbes{} : probe(r);
   divide_by_disc_shares(&sums, d.found, d.cut);
   const float norm = float(1.0 / (kPi * double(r) * r * prm.emitted));
   return {sums.all * norm, radius_bias(sums, norm, prm.fpm->bias_model)};
@@ -128,19 +134,24 @@ inline bool gather_at_diffuse_vertex(const FpmPath& path, const PathVertex& v, c
   // larger than one found whole is whole too.
   const bool seen_directly = depth == 1;
   float whole_radius = 0;
+  bool whole_looked = false;  // the whole disc's probes looked: its photons were tested
   auto gather = [&](const PhotonMap& map, float radius, uint8_t near_bit, auto accept) {
     auto probe = [&](float r) {
-      if (!prm.fpm->disc_probes || r <= whole_radius ||
-          (seen_directly && !(path.near_edge & near_bit)) ||
+      if (r <= whole_radius) return DiscProbes{0, 0, whole_looked};
+      if (!prm.fpm->disc_probes || (seen_directly && !(path.near_edge & near_bit)) ||
           !may_cut_discs(path.scene.objects[size_t(v.object())].shape))
         return DiscProbes{};
       const DiscProbes d =
           probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kAnyObject, r,
                      prm.fpm->normal_cos, path.rng, path.c.rays, v.hit.primitive);
-      if (!d.cut) whole_radius = r;
+      if (!d.cut) {
+        whole_radius = r;
+        whole_looked = d.looked;
+      }
       return d;
     };
-    const Estimate e = estimate(map, v, s.hero_only, radius, depth, prm, accept, probe, path.c);
+    const Estimate e =
+        estimate(path.scene, map, v, s.hero_only, radius, depth, prm, accept, probe, path.c);
     L += s.beta * e.L;
     bias += s.beta * e.bias;
   };

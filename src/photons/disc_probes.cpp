@@ -318,6 +318,7 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
   scene.intersect_bundle(probes, kDiscProbes, hits, found);
   for (const Ray& r : probes) count(rays, r);
   DiscProbes out;
+  out.looked = true;
   for (int i = 0; i < kDiscProbes; ++i) {
     const float travelled = cross_to_surface(disc, probes[i], hits[i], found[i], rays);
     const ProbeSays says =
@@ -329,9 +330,15 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
   return out;
 }
 
+bool photon_cut_off(const RenderScene& scene, Vec3 p, Vec3 n, Vec3 q, int object, float radius,
+                    float normal_cos, PathCounters& rays) {
+  const Vec3 lift = n * (1e-3f * radius);
+  return blocked_along(scene, p + lift, q + lift, object, n, normal_cos, rays);
+}
+
 namespace {
 
-// The surface seen through a pixel's centre (object -1: none).
+// The surface seen through a pixel's centre (object -1: none); ng faces the camera.
 struct FirstVertex {
   Vec3 p, ng;
   int object = -1;
@@ -345,7 +352,7 @@ FirstVertex first_surface(const RenderScene& scene, Ray ray) {
     const int m = scene.objects[size_t(h.object)].material;
     const bool interface = m >= 0 && size_t(m) < scene.materials.size() &&
                            std::holds_alternative<InterfaceMaterial>(scene.materials[size_t(m)]);
-    if (!interface) return {sp.p, sp.ng, h.object};
+    if (!interface) return {sp.p, dot(sp.ng, ray.d) > 0 ? -sp.ng : sp.ng, h.object};
     ray = spawn_ray(sp, ray.d);
   }
   return {};
@@ -394,10 +401,17 @@ std::vector<uint8_t> find_edges(const RenderScene& scene, const Camera& camera, 
       first[y * w + x] = first_surface(
           scene, camera.generate_ray({float(x) + 0.5f, float(y) + 0.5f}, {0.5f, 0.5f}).ray);
   });
-  // Whether each pixel breaks with its right neighbour, and with the one below.
+  // Whether each pixel breaks with its right neighbour, and with the one below: their surfaces
+  // are not one smooth piece, or something stands on it between the two points, too thin for a
+  // pixel's centre to see (a shelf board seen from above, a fin): a ray skimming the surface from
+  // one to the other, a thousandth of their distance above it, meets it.
   std::vector<uint8_t> right(first.size(), 1), down(first.size(), 1);
   auto breaks = [&](size_t p, size_t q) {
-    return !continuous(first[p], first[q]) || !continuous(first[q], first[p]);
+    const FirstVertex &a = first[p], &b = first[q];
+    if (!continuous(a, b) || !continuous(b, a)) return true;
+    const Vec3 lift = a.ng * (1e-3f * length(b.p - a.p));
+    PathCounters rays;  // before the render: not counted
+    return blocked_along(scene, a.p + lift, b.p + lift, a.object, a.ng, 0.9f, rays);
   };
   tbb::parallel_for(size_t(0), h, [&](size_t y) {
     for (size_t x = 0, p = y * w; x < w; ++x, ++p) {

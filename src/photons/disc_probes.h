@@ -33,6 +33,7 @@ namespace bpm {
 constexpr int kDiscProbes = 8;
 struct DiscProbes {
   uint8_t found = 0, cut = 0;
+  bool looked = false;  // probes were cast: the disc is not plainly whole (below)
 };
 
 // Where the photons an estimate gathers may lie: on the gathering point's own object (bpm keeps a
@@ -55,6 +56,16 @@ enum class PhotonSurfaces { kOwnObject, kAnyObject };
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays, int primitive = -1);
+
+// Whether a photon that landed at q is cut off from the disc's point p, as a probe would judge the
+// disc cut there: the segment from p to q, lifted off the surface along n (the normal on the
+// gathering side) by a thousandth of the radius, meets another object that light does not cross
+// (a shelf standing on a wall between them), or `object` where its normal disagrees (a crease).
+// The probes measure the share of the disc that photons reach along the surface; photons from the
+// rest of it (past a thin board, in a shadow the probes happened to miss) would otherwise leak
+// light across. Asked for the discs whose probes looked (DiscProbes::looked).
+bool photon_cut_off(const RenderScene& scene, Vec3 p, Vec3 n, Vec3 q, int object, float radius,
+                    float normal_cos, PathCounters& rays);
 
 // Whether the probes apply to the shape: not to spheres and cylinders, whose surface inside a
 // gathering sphere is whole (on a sphere its area is pi r^2 exactly, Archimedes' hat-box theorem)

@@ -130,6 +130,39 @@ TEST(DiscProbes, AnySurfaceThatStopsLightCountsWhereOneMapHoldsAll) {
   EXPECT_GT(shares(sphere, 0, Vec3(0.5f, 0, 0), 2000, any).mean, 0.97);
 }
 
+// A photon is cut off from a disc's point by a wall standing between them on the surface, and
+// not by open floor, a resting sphere's overhang or glass; a disc's probes say they looked only
+// where geometry is near (an open floor is whole on sight of the tree).
+TEST(DiscProbes, PhotonsPastAWallAreCutOff) {
+  const Vec3 up(0, 1, 0);
+  PathCounters rays;
+  LoadedScene wall = flatten_scene(parse_scene_string(kHeader + floor_at(0) + kWall));
+  EXPECT_TRUE(
+      photon_cut_off(wall.scene, Vec3(-0.3f, 0, 0), up, Vec3(0.2f, 0, 0.1f), 0, 1, 0.5f, rays));
+  EXPECT_FALSE(
+      photon_cut_off(wall.scene, Vec3(-0.3f, 0, 0), up, Vec3(-0.9f, 0, 0.4f), 0, 1, 0.5f, rays));
+  EXPECT_GT(rays.probe_rays, 0u);
+  LoadedScene sphere = flatten_scene(parse_scene_string(
+      kHeader + floor_at(0) +
+      "AttributeBegin\nTranslate 0 1 0\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n"));
+  EXPECT_FALSE(
+      photon_cut_off(sphere.scene, Vec3(0.9f, 0, 0), up, Vec3(0.3f, 0, 0.2f), 0, 1, 0.5f, rays));
+  LoadedScene glass = flatten_scene(
+      parse_scene_string(kHeader + floor_at(0) + "Material \"dielectric\"\n" + kWall));
+  EXPECT_FALSE(
+      photon_cut_off(glass.scene, Vec3(-0.3f, 0, 0), up, Vec3(0.2f, 0, 0.1f), 0, 1, 0.5f, rays));
+  // The probes of a disc on the open floor do not look; those of one by the wall do.
+  SurfacePoint sp;
+  sp.p = Vec3(-0.3f, 0, 0);
+  sp.ng = sp.ns = up;
+  Rng rng(stream_key(2, 0));
+  LoadedScene open = flatten_scene(parse_scene_string(kHeader + floor_at(0)));
+  EXPECT_FALSE(
+      probe_disc(open.scene, sp, up, 0, PhotonSurfaces::kOwnObject, 1, 0.5f, rng, rays).looked);
+  EXPECT_TRUE(
+      probe_disc(wall.scene, sp, up, 0, PhotonSurfaces::kOwnObject, 1, 0.5f, rng, rays).looked);
+}
+
 // Photons reach the floor under a resting sphere, and through glass: neither cuts the disc.
 TEST(DiscProbes, OverhangsAndGlassDoNotCut) {
   LoadedScene sphere = flatten_scene(parse_scene_string(
