@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
@@ -42,22 +43,28 @@ Estimate estimate(const RenderScene& scene, const PhotonMap& map, const PathVert
       r = std::sqrt(d2[size_t(prm.fpm->knn - 1)]) * 1.0001f;
     }
   }
-  // Probed before the gather where other geometry is near (DiscProbes::looked), each photon is
-  // then gathered only where nothing cuts it off from the point (photon_cut_off).
+  // The photons found are probed for only when there are some; where other geometry is near
+  // (DiscProbes::looked), each is then gathered only where nothing cuts it off from the point
+  // (photon_cut_off).
+  thread_local std::vector<uint32_t> found;
+  found.clear();
+  map.tree.query_within(sp.p, r, [&](uint32_t i) {
+    if (usable(map.photons[i])) found.push_back(i);
+  });
+  if (found.empty()) return {};
   const DiscProbes d = probe(r);
   const Vec3 n = dot(sp.ng, v.wo) >= 0 ? sp.ng : -sp.ng;
   NestedSums sums;
-  map.tree.query_within(sp.p, r, [&](uint32_t i) {
+  for (uint32_t i : found) {
     const ForwardPhoton& ph = map.photons[i];
-    if (!usable(ph)) return;
     if (d.looked &&
         photon_cut_off(scene, sp.p, n, ph.p, v.object(), r, prm.fpm->normal_cos, c.rays))
-      return;
+      continue;
     ++c.photons_used;
     sums.add(photon_contribution(v.m(), ph.ng, sp.ns, v.wo, ph.wi, ph.flux) *
                  hero_join_factor(eye_hero_only, ph.hero_only),
              length_squared(ph.p - sp.p), r * r);
-  });
+  }
   divide_by_disc_shares(&sums, d.found, d.cut);
   const float norm = float(1.0 / (kPi * double(r) * r * prm.emitted));
   return {sums.all * norm, radius_bias(sums, norm, prm.fpm->bias_model)};
