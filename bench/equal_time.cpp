@@ -5,13 +5,14 @@
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
 //              [--integrators path,bpm,fpm] [--references-only]
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
-// (references by bpm), lamp-room, room2, shelf-room, fog (reference by path), spot-lens-fog,
-// underwater (references by bpm), smoke (a uniformgrid medium; reference by path), the Cornell box
+// (references by bpm), lamp-room, room2, shelf-room, kitchen, fog (reference by path),
+// spot-lens-fog, underwater (references by bpm), smoke (a uniformgrid medium; reference by path),
+// the Cornell box
 // (../shared's at 256x256 when present, else ours) and, when ../shared has them, the staircase2
 // stand-in at 256x256 and other shared scenes (references by path), and volumetric-caustic at
 // 256x256 (reference by bpm). In scenes with media pbrt-v4 renders with volpath and bdpt (its path
 // and sppm ignore media). scenes/tools/make_equal_time_scenes.py writes spot-facets, water-box,
-// lamp-room, spot-lens-fog, underwater, smoke and shelf-room.
+// lamp-room, spot-lens-fog, underwater, smoke, shelf-room and kitchen.
 //
 // Ours (path, bpm, fpm) render in this process for --time seconds (render time, the scene already
 // loaded). pbrt-v4 (its path, bdpt and sppm), when ../shared/tools/pbrt-v4/pbrt or --pbrt is there,
@@ -67,6 +68,7 @@ std::vector<SceneEntry> default_scenes() {
       {"lamp-room", ours + "lamp-room.pbrt", "path"},
       {"room2", ours + "room2.pbrt", "path"},
       {"shelf-room", ours + "shelf-room.pbrt", "path"},
+      {"kitchen", ours + "kitchen.pbrt", "path"},
       {"fog", ours + "fog.pbrt", "path"},
       {"spot-lens-fog", ours + "spot-lens-fog.pbrt", "bpm"},
       {"underwater", ours + "underwater.pbrt", "bpm"},

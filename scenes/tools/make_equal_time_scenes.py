@@ -8,8 +8,10 @@
 - underwater: a spot light and a dim sky over a wavy water surface, seen from inside murky water;
 - smoke: a plume of smoke (a uniformgrid medium) over a floor, lit by a spot light and a sky panel;
 - shelf-room: a living room lit by one small bright sphere, thin open shelves on a wall, a sofa, a
-  low table and red-tinted glass objects.
-    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those seven scenes/*.pbrt
+  low table and red-tinted glass objects;
+- kitchen: a kitchen lit by a window and three strip lights under its wall cabinets, with glass
+  on the counter and the table.
+    python3 scenes/tools/make_equal_time_scenes.py   # rewrites those eight scenes/*.pbrt
 """
 import math
 import os
@@ -301,11 +303,64 @@ def shelf_room():
     return s
 
 
+def kitchen():
+    s = header("# A kitchen lit by a window (a bright panel in the left wall) and three strip lights under\n"
+               "# its wall cabinets: base cabinets with a counter, wall cabinets, a table with two\n"
+               "# chairs, glasses and a bottle on the counter and the table.\n",
+               "2.2 1.55 -1.9   -0.4 0.95 1.2   0 1 0", 62, (320, 180), 12, "kitchen")
+    s += 'Material "diffuse" "rgb reflectance" [ 0.75 0.74 0.7 ]\n'
+    s += quad((-2.5, 2.6, -2.5), (2.5, 2.6, -2.5), (2.5, 2.6, 2), (-2.5, 2.6, 2))   # ceiling
+    s += quad((-2.5, 0, 2), (-2.5, 2.6, 2), (2.5, 2.6, 2), (2.5, 0, 2))           # back wall
+    s += quad((-2.5, 0, -2.5), (-2.5, 0, 2), (-2.5, 2.6, 2), (-2.5, 2.6, -2.5))   # left wall
+    s += quad((2.5, 0, -2.5), (2.5, 2.6, -2.5), (2.5, 2.6, 2), (2.5, 0, 2))       # right wall
+    s += quad((-2.5, 0, -2.5), (2.5, 0, -2.5), (2.5, 2.6, -2.5), (-2.5, 2.6, -2.5))  # front wall
+    s += 'Material "diffuse" "rgb reflectance" [ 0.42 0.4 0.38 ]\n'
+    s += quad((-2.5, 0, -2.5), (-2.5, 0, 2), (2.5, 0, 2), (2.5, 0, -2.5))         # floor
+    # Base cabinets along the back wall, a counter on them, wall cabinets above.
+    s += 'Material "diffuse" "rgb reflectance" [ 0.55 0.5 0.42 ]\n'
+    for x in (-2.3, -1.5, -0.7, 0.1, 0.9):
+        s += box(x, 0.1, 1.4, x + 0.78, 0.86, 2)
+        s += box(x, 1.5, 1.65, x + 0.78, 2.3, 2)
+    s += 'Material "coateddiffuse" "rgb reflectance" [ 0.2 0.2 0.22 ] "float roughness" [ 0.2 ]\n'
+    s += box(-2.35, 0.86, 1.35, 1.72, 0.9, 2)
+    # Three strip lights under the wall cabinets.
+    for x in (-2.2, -1.0, 0.2):
+        s += ('AttributeBegin\n  AreaLightSource "diffuse" "blackbody L" [ 3500 ] "float scale" [ 30 ]\n'
+              '  ' + quad((x, 1.49, 1.72), (x + 0.9, 1.49, 1.72), (x + 0.9, 1.49, 1.76), (x, 1.49, 1.76)) +
+              'AttributeEnd\n')
+    # The window: a bright panel in the left wall, facing into the room.
+    s += ('AttributeBegin\n  AreaLightSource "diffuse" "blackbody L" [ 6500 ] "float scale" [ 12 ]\n'
+          '  ' + quad((-2.49, 0.9, -1.2), (-2.49, 2.2, -1.2), (-2.49, 2.2, 0.4), (-2.49, 0.9, 0.4)) +
+          'AttributeEnd\n')
+    # A table with two chairs.
+    s += 'Material "diffuse" "rgb reflectance" [ 0.5 0.36 0.22 ]\n'
+    s += box(-1.1, 0.72, -0.8, 0.3, 0.76, 0.1)
+    for x, z in ((-1.05, -0.75), (0.22, -0.75), (-1.05, 0.02), (0.22, 0.02)):
+        s += box(x, 0, z, x + 0.04, 0.72, z + 0.04)
+    for x0 in (-0.9, -0.1):
+        s += box(x0, 0.44, -1.3, x0 + 0.42, 0.47, -0.9) + box(x0, 0.47, -1.33, x0 + 0.42, 0.95, -1.3)
+        for x, z in ((x0, -1.3), (x0 + 0.39, -1.3), (x0, -0.93), (x0 + 0.39, -0.93)):
+            s += box(x, 0, z, x + 0.03, 0.44, z + 0.03)
+    # Glass: tumblers (open cylinders of glass with a disk base), a bottle, a bowl.
+    glass = '  Material "dielectric" "float eta" [ 1.5 ]\n'
+    for x, y, z in ((-0.7, 0.76, -0.4), (-0.4, 0.76, -0.2), (-1.2, 0.9, 1.6), (-0.9, 0.9, 1.55)):
+        s += ('AttributeBegin\n' + glass + '  Translate %g %g %g\n  Rotate -90 1 0 0\n'
+              '  Shape "cylinder" "float radius" [ 0.035 ] "float zmin" [ 0 ] "float zmax" [ 0.11 ]\n'
+              '  Shape "disk" "float radius" [ 0.035 ]\nAttributeEnd\n' % (x, y, z))
+    s += ('AttributeBegin\n' + glass + '  Translate 0.3 0.9 1.62\n  Rotate -90 1 0 0\n'
+          '  Shape "cylinder" "float radius" [ 0.045 ] "float zmin" [ 0 ] "float zmax" [ 0.24 ]\n'
+          '  Shape "disk" "float radius" [ 0.045 ]\n  Translate 0 0 0.24\n'
+          '  Shape "disk" "float radius" [ 0.045 ]\nAttributeEnd\n')
+    s += ('AttributeBegin\n' + glass + '  Translate -0.2 0.86 -0.5\n  Scale 1 0.5 1\n'
+          '  Shape "sphere" "float radius" [ 0.16 ]\nAttributeEnd\n')
+    return s
+
+
 def main():
     for name, text in [("spot-facets", spot_facets()), ("water-box", water_box()),
                        ("lamp-room", lamp_room()), ("spot-lens-fog", spot_lens_fog()),
                        ("underwater", underwater()), ("smoke", smoke()),
-                       ("shelf-room", shelf_room())]:
+                       ("shelf-room", shelf_room()), ("kitchen", kitchen())]:
         with open(os.path.join(OUT, name + ".pbrt"), "w") as f:
             f.write(text)
 
