@@ -43,9 +43,9 @@ float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, u
 // weight, when prm.pixel_weight is set.
 float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
                     const std::vector<uint16_t>& owner, const PendingHit& h,
-                    std::vector<std::vector<PhotonEntry>>& out) {
+                    std::vector<std::vector<PhotonEntry>>& out, LightCounters& counters) {
   float score = 0;
-  PathCounters rays;  // not reported
+  PathCounters rays;  // photon_cut_off's, added to counters.cut_off_rays
   auto use = [&](uint32_t g) {
     const BackwardPhoton& bp = maps.photons[g];
     if (int(bp.eye_depth) + h.bounces > prm.max_depth) return;
@@ -79,6 +79,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     __builtin_prefetch(record + sizeof(BackwardPhoton) - 1);
   });
   use_found();
+  counters.cut_off_rays += rays.probe_rays;
   return score;
 }
 
@@ -316,7 +317,7 @@ GatherRound gather_round(const BackwardMaps& maps, const LightPassParams& prm,
         __builtin_prefetch(next + sizeof(PendingHit) - 1);
       }
       PendingHit& h = *buf->order[k];
-      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot);
+      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot, buf->counters.local());
     }
     bytes += chunk_bytes(by_slot) - bytes_before;
   });

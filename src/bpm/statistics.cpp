@@ -74,6 +74,7 @@ nlohmann::json light_json(const BpmTotals& t, int iterations) {
       {"queries_per_second", ratio(double(t.light.queries), t.light_trace_s + t.light_gather_s)},
       {"entries", t.light.entries},
       {"beams", t.light.beams},
+      {"cut_off_rays", t.light.cut_off_rays},
       {"photons_per_iteration_last", t.photons_last},
       // bpm/photon_count.h: the relative variance of an iteration and of its light pass alone
       // (means over pixels), the light pass's share, and the balanced photon count N*.

@@ -80,6 +80,8 @@ struct LightCounters {
   uint64_t queries = 0;       // map lookups (bpm)
   uint64_t entries = 0;  // accepted (backward photon, photon) pairs (bpm); photons stored (fpm)
   uint64_t beams = 0;    // photon beams gathered at the spheres in media (bpm)
+  // Rays that tested whether a photon is cut off from a backward photon (photon_cut_off; bpm).
+  uint64_t cut_off_rays = 0;
   RayObserver* observer = nullptr;
   void add(const LightCounters& o) {
     photons += o.photons;
@@ -88,6 +90,7 @@ struct LightCounters {
     queries += o.queries;
     entries += o.entries;
     beams += o.beams;
+    cut_off_rays += o.cut_off_rays;
   }
 };
 
