@@ -40,6 +40,19 @@ def outward(points, tris, inside):
     return out
 
 
+def room_walls(x0, x1, h, z0, z1):
+    """A closed room's ceiling and four walls, facing in: x in [x0, x1], z in [z0, z1], height h."""
+    return (quad((x0, h, z0), (x1, h, z0), (x1, h, z1), (x0, h, z1)) +      # ceiling
+            quad((x0, 0, z1), (x0, h, z1), (x1, h, z1), (x1, 0, z1)) +      # back wall
+            quad((x0, 0, z0), (x0, 0, z1), (x0, h, z1), (x0, h, z0)) +      # left wall
+            quad((x1, 0, z0), (x1, h, z0), (x1, h, z1), (x1, 0, z1)) +      # right wall
+            quad((x0, 0, z0), (x1, 0, z0), (x1, h, z0), (x0, h, z0)))       # front wall
+
+
+def room_floor(x0, x1, z0, z1):
+    return quad((x0, 0, z0), (x0, 0, z1), (x1, 0, z1), (x1, 0, z0))
+
+
 def mesh(points, tris):
     idx = " ".join("%d %d %d" % t for t in tris)
     pts = "  ".join("%.5g %.5g %.5g" % tuple(p) for p in points)
@@ -116,13 +129,9 @@ def lamp_room():
                "# diffuse bounces.\n",
                "1.7 1.6 -2.7   0.0 0.8 1.2   0 1 0", 55, (256, 256), 10, "lamp-room")
     s += 'Material "diffuse" "rgb reflectance" [ 0.75 0.73 0.7 ]\n'
-    s += quad((-2, 3, -3), (2, 3, -3), (2, 3, 3), (-2, 3, 3))   # ceiling, facing down
-    s += quad((-2, 0, 3), (-2, 3, 3), (2, 3, 3), (2, 0, 3))     # back wall
-    s += quad((-2, 0, -3), (-2, 0, 3), (-2, 3, 3), (-2, 3, -3))  # left wall
-    s += quad((2, 0, -3), (2, 3, -3), (2, 3, 3), (2, 0, 3))     # right wall
-    s += quad((-2, 0, -3), (2, 0, -3), (2, 3, -3), (-2, 3, -3))  # front wall
+    s += room_walls(-2, 2, 3, -3, 3)
     s += 'Material "diffuse" "rgb reflectance" [ 0.45 0.35 0.25 ]\n'
-    s += quad((-2, 0, -3), (-2, 0, 3), (2, 0, 3), (2, 0, -3))   # floor
+    s += room_floor(-2, 2, -3, 3)
     s += 'Material "diffuse" "rgb reflectance" [ 0.5 0.4 0.3 ]\n' + box(-0.5, 0, 0.8, 0.7, 0.7, 1.6)
     # The lamp: a shade (open cylinder, dark outside and inside) around a small light facing up.
     s += ('AttributeBegin\n  Translate -1.4 0 2.2\n'
@@ -260,13 +269,9 @@ def shelf_room():
     s += 'MakeNamedMedium "red" "string type" "homogeneous" "rgb sigma_a" [ 0.4 6 5 ]\n'
     s += '    "rgb sigma_s" [ 0 0 0 ]\n'
     s += 'Material "diffuse" "rgb reflectance" [ 0.72 0.7 0.66 ]\n'
-    s += quad((-3, 2.7, -2.5), (3, 2.7, -2.5), (3, 2.7, 2.5), (-3, 2.7, 2.5))   # ceiling
-    s += quad((-3, 0, 2.5), (-3, 2.7, 2.5), (3, 2.7, 2.5), (3, 0, 2.5))       # back wall
-    s += quad((-3, 0, -2.5), (-3, 0, 2.5), (-3, 2.7, 2.5), (-3, 2.7, -2.5))   # left wall
-    s += quad((3, 0, -2.5), (3, 2.7, -2.5), (3, 2.7, 2.5), (3, 0, 2.5))       # right wall
-    s += quad((-3, 0, -2.5), (3, 0, -2.5), (3, 2.7, -2.5), (-3, 2.7, -2.5))   # front wall
+    s += room_walls(-3, 3, 2.7, -2.5, 2.5)
     s += 'Material "diffuse" "rgb reflectance" [ 0.38 0.26 0.16 ]\n'
-    s += quad((-3, 0, -2.5), (-3, 0, 2.5), (3, 0, 2.5), (3, 0, -2.5))         # floor
+    s += room_floor(-3, 3, -2.5, 2.5)
     # Open shelves on the back wall: four boards 2.5 cm thick and 28 cm deep between two thin sides.
     s += 'Material "diffuse" "rgb reflectance" [ 0.62 0.6 0.56 ]\n'
     for y in (1.0, 1.38, 1.76, 2.14):
@@ -309,13 +314,9 @@ def kitchen():
                "# chairs, glasses and a bottle on the counter and the table.\n",
                "2.2 1.55 -1.9   -0.4 0.95 1.2   0 1 0", 62, (320, 180), 12, "kitchen")
     s += 'Material "diffuse" "rgb reflectance" [ 0.75 0.74 0.7 ]\n'
-    s += quad((-2.5, 2.6, -2.5), (2.5, 2.6, -2.5), (2.5, 2.6, 2), (-2.5, 2.6, 2))   # ceiling
-    s += quad((-2.5, 0, 2), (-2.5, 2.6, 2), (2.5, 2.6, 2), (2.5, 0, 2))           # back wall
-    s += quad((-2.5, 0, -2.5), (-2.5, 0, 2), (-2.5, 2.6, 2), (-2.5, 2.6, -2.5))   # left wall
-    s += quad((2.5, 0, -2.5), (2.5, 2.6, -2.5), (2.5, 2.6, 2), (2.5, 0, 2))       # right wall
-    s += quad((-2.5, 0, -2.5), (2.5, 0, -2.5), (2.5, 2.6, -2.5), (-2.5, 2.6, -2.5))  # front wall
+    s += room_walls(-2.5, 2.5, 2.6, -2.5, 2)
     s += 'Material "diffuse" "rgb reflectance" [ 0.42 0.4 0.38 ]\n'
-    s += quad((-2.5, 0, -2.5), (-2.5, 0, 2), (2.5, 0, 2), (2.5, 0, -2.5))         # floor
+    s += room_floor(-2.5, 2.5, -2.5, 2)
     # Base cabinets along the back wall, a counter on them, wall cabinets above.
     s += 'Material "diffuse" "rgb reflectance" [ 0.55 0.5 0.42 ]\n'
     for x in (-2.3, -1.5, -0.7, 0.1, 0.9):

@@ -409,9 +409,9 @@ std::vector<uint8_t> find_edges(const RenderScene& scene, const Camera& camera, 
   auto breaks = [&](size_t p, size_t q) {
     const FirstVertex &a = first[p], &b = first[q];
     if (!continuous(a, b) || !continuous(b, a)) return true;
-    const Vec3 lift = a.ng * (1e-3f * length(b.p - a.p));
     PathCounters rays;  // before the render: not counted
-    return blocked_along(scene, a.p + lift, b.p + lift, a.object, a.ng, 0.9f, rays);
+    // As a photon at b would be cut off from a disc at a reaching it.
+    return photon_cut_off(scene, a.p, a.ng, b.p, a.object, length(b.p - a.p), 0.9f, rays);
   };
   tbb::parallel_for(size_t(0), h, [&](size_t y) {
     for (size_t x = 0, p = y * w; x < w; ++x, ++p) {
