@@ -11,7 +11,7 @@ import re
 import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-FOLDERS = ("src", "apps")
+FOLDERS = ("src", "apps", "python")
 
 
 def blank(text):

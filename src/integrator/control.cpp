@@ -109,17 +109,23 @@ void RenderControl::update_probabilities() {
 void RenderControl::after_pass(int done, uint64_t rays, const std::string& extra) {
   int passes = done + 1;
   double t = elapsed();
-  bool print = opt_.progress && (t - last_progress_ >= 0.5 || passes == opt_.spp);
+  const bool due = t - last_progress_ >= 0.5 || passes == opt_.spp;
+  const bool print = opt_.progress && due, report = opt_.on_progress && due;
   // The total error: noise, and for the photon methods their bias estimate as well; with sensors,
   // the larger of the image's and the sensors' (without an image, the sensors' alone).
-  if (opt_.accuracy > 0 || print) {
+  if (opt_.accuracy > 0 || print || report) {
     bias_ = film_.relative_error_bias();
     delta_ =
         std::sqrt(std::pow(film_.relative_error(), 2) + bias_ * bias_);  // relative_error_total
     if (film_.sensor_count() > 0) delta_ = std::max(delta_, film_.sensor_relative_error());
   }
-  if (!print) return;
+  if (!due || !(print || report)) return;
   last_progress_ = t;
+  if (report) opt_.on_progress({passes, t, delta_, bias_});
+  if (print) print_progress(passes, t, rays, extra);
+}
+
+void RenderControl::print_progress(int passes, double t, uint64_t rays, const std::string& extra) {
   char budget[32] = "";
   if (opt_.spp != std::numeric_limits<int>::max())
     std::snprintf(budget, sizeof budget, "/%d", opt_.spp);

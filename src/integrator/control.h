@@ -81,6 +81,7 @@ class RenderControl {
 
  private:
   void update_probabilities();
+  void print_progress(int passes, double t, uint64_t rays, const std::string& extra);
   const IntegratorOptions& opt_;
   const Film& film_;
   const char* unit_;

@@ -27,6 +27,14 @@ struct RenderState {
 
 class Team;  // integrator/team.h
 
+// Where a render stands after a pass, as its progress line says it.
+struct RenderProgress {
+  int passes = 0;      // done so far in this render
+  double seconds = 0;  // since the render began
+  double delta = 0;    // the image's total relative error (eq. 4, with the bias estimate)
+  double bias = 0;     // its bias part
+};
+
 struct IntegratorOptions {
   int spp = 16;             // passes (iterations for the photon integrators)
   int first_iteration = 0;  // index of the first pass: random streams and radii follow it, so
@@ -39,7 +47,10 @@ struct IntegratorOptions {
   // Direct light in scattering media also sampled along the camera paths' rays
   // (integrator/direct_light.h, sample_direct_light_along).
   bool equiangular = true;
-  bool progress = true;
+  bool progress = true;  // the progress line on stderr
+  // Called with the progress line's figures, as often as it is printed (twice a second and after
+  // the last pass), from the thread that runs the passes, whether or not the line is printed.
+  std::function<void(const RenderProgress&)> on_progress;
   double accuracy = 0;          // stop when the image error delta (eq. 4) is at most this; 0: off
   bool adaptive = false;        // adaptive sampling (integrator/control.h)
   float adaptive_floor = 0.1f;  // lowest probability of sampling a pixel in a pass

@@ -22,6 +22,15 @@ void ParamSet::add(Param p) {
   params_.push_back(std::move(p));
 }
 
+void ParamSet::set(Param p) {
+  for (Param& q : params_)
+    if (q.name == p.name) {
+      q = std::move(p);
+      return;
+    }
+  params_.push_back(std::move(p));
+}
+
 const Param* ParamSet::find_any(const std::string& name) const {
   for (const Param& p : params_)
     if (p.name == name) return &p;

@@ -24,6 +24,8 @@ struct Param {
 class ParamSet {
  public:
   void add(Param p);
+  // Replaces the parameter of p's name (whatever its type), or adds p.
+  void set(Param p);
   bool empty() const { return params_.empty(); }
   const std::vector<Param>& all() const { return params_; }
 

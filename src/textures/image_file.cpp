@@ -13,8 +13,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // The module's entry point, loaded once; null with the reason when it cannot be. It is looked for
-// beside the running program (bpm, its tests and benchmarks are built into one folder), then in
-// the folder it was built in, so a copied bpm still finds it while its build folder exists.
+// beside the running program (bpm, its tests and benchmarks are built into one folder), beside the
+// shared object this code is linked into (the Python module, which Python runs), then in the folder
+// it was built in, so a copied bpm still finds it while its build folder exists.
 struct Reader {
   ReadImageFileFn* read = nullptr;
   DrawTextFn* draw_text = nullptr;
@@ -27,6 +28,12 @@ Reader load_reader() {
   std::error_code ec;
   const fs::path program = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) places.push_back(program.parent_path() / kImageReaderModule);
+  Dl_info self{};
+  if (::dladdr(reinterpret_cast<void*>(&load_reader), &self) && self.dli_fname) {
+    const fs::path here = fs::path(self.dli_fname).parent_path() / kImageReaderModule;
+    if (places.empty() || fs::weakly_canonical(here, ec) != fs::weakly_canonical(places[0], ec))
+      places.push_back(here);
+  }
 #ifdef BPM_MODULE_DIR
   const fs::path built = fs::path(BPM_MODULE_DIR) / kImageReaderModule;
   if (places.empty() || fs::weakly_canonical(built, ec) != fs::weakly_canonical(places[0], ec))
