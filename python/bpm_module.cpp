@@ -86,6 +86,7 @@ Param make_param(const std::string& declaration, const py::handle& value,
 struct Scene {
   SceneFile file;
   std::string name;  // the file as given, or "<text>"
+  int renders = 0;   // so far: the first one's record counts the parse, the others read nothing
 
   std::string where(const std::string& call) const { return name + " (" + call + ")"; }
 };
@@ -280,7 +281,7 @@ RenderCall render_call(const Scene& scene, const py::kwargs& kwargs) {
 }
 
 // The render itself, on the render thread: what the program's `bpm render` does up to its outputs.
-Result run(const Scene& scene, const RenderRequest& request,
+Result run(const Scene& scene, const RenderRequest& request, double parse_s,
            const std::function<void(const RenderProgress&)>& on_progress) {
   const auto t = Clock::now();
   const LoadedScene ls = build_scene(scene.file, request);
@@ -294,8 +295,7 @@ Result run(const Scene& scene, const RenderRequest& request,
   const RenderStats st = render(ls, opt, film.get());
   opt.on_progress = nullptr;
   Result r{film, request, opt, ls.film, {}};
-  r.record =
-      run_record(request, ls, opt, st, *film, OutputPaths{}, {scene.file.parse_s, build_s, 0});
+  r.record = run_record(request, ls, opt, st, *film, OutputPaths{}, {parse_s, build_s, 0});
   r.record.erase("outputs");
   r.record.erase("sensors");
   r.record["stages_s"].erase("write_images");
@@ -355,8 +355,9 @@ void wait_for(Exchange& x, const py::object& progress,
   }
 }
 
-Result render_scene(const Scene& scene, const py::kwargs& kwargs) {
+Result render_scene(Scene& scene, const py::kwargs& kwargs) {
   const RenderCall call = render_call(scene, kwargs);
+  const double parse_s = scene.renders++ == 0 ? scene.file.parse_s : 0;
   Exchange x;
   Result result;
   interrupt_flag() = false;
@@ -366,7 +367,7 @@ Result render_scene(const Scene& scene, const py::kwargs& kwargs) {
   };
   std::thread worker([&] {
     try {
-      result = run(scene, call.request, on_progress);
+      result = run(scene, call.request, parse_s, on_progress);
     } catch (...) {
       x.error = std::current_exception();
     }
@@ -587,8 +588,9 @@ PYBIND11_MODULE(bpm, m) {
       "render",
       [](const py::object& scene, const py::kwargs& kwargs) {
         if (py::isinstance<bpm::Scene>(scene))
-          return bpm::render_scene(scene.cast<const bpm::Scene&>(), kwargs);
-        return bpm::render_scene(bpm::load_scene(scene), kwargs);
+          return bpm::render_scene(scene.cast<bpm::Scene&>(), kwargs);
+        bpm::Scene loaded = bpm::load_scene(scene);
+        return bpm::render_scene(loaded, kwargs);
       },
       py::arg("scene"), bpm::kRenderDoc);
   m.def("read_exr", &bpm::read_exr_rgb, py::arg("path"),

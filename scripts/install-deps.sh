@@ -10,6 +10,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 clang-format
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
   clang libclang-rt-14-dev
   libopenmpi-dev openmpi-bin
 )
