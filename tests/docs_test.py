@@ -5,13 +5,16 @@
                                (render, compare, luminaire) is documented in docs/USAGE.md (a table row whose
                                first cell starts with the flag), and every flag documented there
                                exists.
-  docs_test.py examples BPM [--mpi]
+  docs_test.py examples BPM [--mpi] [--python PYTHON MODULE_DIR]
                                every example marked runnable (a fenced block opened by
                                "```sh runnable") in README.md and docs/*.md runs, at a small
                                resolution and sample count, and exits 0. The blocks of a file run in
-                               order in one scratch folder that holds a link to scenes/, so a
-                               later example may read what an earlier one wrote. `mpirun` examples
-                               run only with --mpi (bpm built with MPI and mpirun installed).
+                               order in one scratch folder that holds links to scenes/ and
+                               examples/, so a later example may read what an earlier one wrote.
+                               `mpirun` examples run only with --mpi (bpm built with MPI and mpirun
+                               installed); `python3` examples only with --python, under PYTHON
+                               with the module from MODULE_DIR and BPM_EXAMPLE_QUICK=1 (the
+                               examples then render briefly).
   docs_test.py self-test BPM   the two checks above fail on a flag without documentation, on a
                                documented flag that does not exist and on a broken example.
 
@@ -138,11 +141,13 @@ def shrink(args):
     return out
 
 
-def prepare(command, bpm, mpi):
+def prepare(command, bpm, mpi, python=None):
     """The command as the test runs it (a list), or None when it cannot run here."""
     words = shlex.split(command, comments=True)
     if not words:
         return None
+    if words[0] == "python3":
+        return [python] + words[1:] if python else None
     prefix = []
     if words[0] == "mpirun":
         if not mpi:
@@ -151,17 +156,22 @@ def prepare(command, bpm, mpi):
         prefix = ["mpirun", "--oversubscribe", "-x", "ASAN_OPTIONS"] + words[1:k]
         words = words[k:]
     if words[0] != "bpm":
-        raise ValueError(f"a runnable example must be a bpm or mpirun command: {command}")
+        raise ValueError(f"a runnable example must be a bpm, mpirun or python3 command: {command}")
     args = words[1:]
     if args and args[0] == "render":
         args = shrink(args)
     return prefix + [bpm] + args
 
 
-def run_examples(bpm, mpi, files=None):
+def run_examples(bpm, mpi, files=None, python=None):
+    """python: (interpreter, the module's folder), or None to skip python3 examples."""
     problems = []
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               ASAN_OPTIONS=os.environ.get("ASAN_OPTIONS", "detect_leaks=0"))
+               ASAN_OPTIONS=os.environ.get("ASAN_OPTIONS", "detect_leaks=0"),
+               BPM_EXAMPLE_QUICK="1")
+    if python:
+        env["PYTHONPATH"] = os.pathsep.join(
+            [os.path.abspath(python[1])] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
     count = 0
     for rel in files or MANUAL_FILES:
         path = rel if os.path.isabs(rel) else os.path.join(ROOT, rel)
@@ -170,16 +180,18 @@ def run_examples(bpm, mpi, files=None):
             continue
         scratch = tempfile.mkdtemp(prefix="bpm-docs-")
         try:
-            os.symlink(os.path.join(ROOT, "scenes"), os.path.join(scratch, "scenes"))
+            for folder in ("scenes", "examples"):
+                os.symlink(os.path.join(ROOT, folder), os.path.join(scratch, folder))
             for line, commands in blocks:
                 for command in commands:
                     try:
-                        argv = prepare(command, bpm, mpi)
+                        argv = prepare(command, bpm, mpi, python[0] if python else None)
                     except ValueError as e:
                         problems.append(f"{rel}:{line}: {e}")
                         continue
                     if argv is None:
-                        print(f"{rel}:{line}: skipped (no MPI here): {command}")
+                        print(f"{rel}:{line}: skipped (no MPI or no Python module here): "
+                              f"{command}")
                         continue
                     count += 1
                     try:
@@ -233,7 +245,12 @@ def main():
         problems = check_flags(bpm, open(os.path.join(ROOT, "docs", "USAGE.md"),
                                          encoding="utf-8").read())
     elif what == "examples":
-        problems = run_examples(bpm, "--mpi" in sys.argv[3:] and shutil.which("mpirun"))
+        rest = sys.argv[3:]
+        python = None
+        if "--python" in rest:
+            k = rest.index("--python")
+            python = (rest[k + 1], rest[k + 2])
+        problems = run_examples(bpm, "--mpi" in rest and shutil.which("mpirun"), python=python)
     else:
         problems = self_test(bpm)
     for p in problems:
