@@ -15,9 +15,13 @@ fi
 version() { "$1" -c 'import sys; print("%d.%d" % sys.version_info[:2])'; }
 site="$("$py" - <<'PY'
 import os, site, sys
-# The first site folder this user may write to, else the user's own.
+# The first site folder this user may write to (or create), else the user's own.
+def writable(d):
+    while not os.path.exists(d):
+        d = os.path.dirname(d)
+    return os.access(d, os.W_OK)
 for d in site.getsitepackages():
-    if os.access(d, os.W_OK) or (not os.path.exists(d) and os.access(os.path.dirname(d), os.W_OK)):
+    if writable(d):
         print(d)
         sys.exit(0)
 print(site.getusersitepackages())
