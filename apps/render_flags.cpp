@@ -1,7 +1,20 @@
 #include "render_flags.h"
 
+#include <cmath>
+#include <cstdlib>
+
 namespace bpm {
 namespace {
+
+// CLI11's Range lets NaN through (every comparison with it is false), so the floats are checked to
+// be finite first. (A word that is no number at all is left to Range, which says so.)
+const CLI::Validator kFinite(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      return end != text.c_str() && !std::isfinite(v) ? "must be a finite number" : "";
+    },
+    "", "finite");
 
 // The flags of `bpm render`, in the manual's groups (docs/USAGE.md).
 const char* const kGeneral = "General";
@@ -53,12 +66,14 @@ void add_budget_options(CLI::App* render, RenderRequest& ra) {
   render
       ->add_option("--time", ra.time,
                    "Time budget in seconds (stops after the pass that exceeds it)")
+      ->check(kFinite)
       ->check(CLI::Range(0.0, 1e9))
       ->group(kBudgets);
   render
       ->add_option(
           "--accuracy", ra.accuracy,
           "Stop when the image error delta (eq. 4 of the paper) is at most this, e.g. 0.01")
+      ->check(kFinite)
       ->check(CLI::Range(1e-6, 1.0))
       ->group(kBudgets);
   render
@@ -75,6 +90,7 @@ void add_budget_options(CLI::App* render, RenderRequest& ra) {
       ->add_option(
           "--adaptive-floor", ra.adaptive_floor,
           "Lowest probability of sampling a pixel in a pass under adaptive sampling (default 0.1)")
+      ->check(kFinite)
       ->check(CLI::Range(0.01, 1.0))
       ->group(kBudgets);
 }
@@ -88,6 +104,7 @@ void add_output_options(CLI::App* render, RenderRequest& ra) {
       ->add_option("--write-every", ra.write_every,
                    "Write the outputs so far, and OUT.checkpoint to resume from, every SECONDS "
                    "(atomically)")
+      ->check(kFinite)
       ->check(CLI::Range(0.1, 1e9))
       ->group(kOutputs);
   render
@@ -117,11 +134,13 @@ void add_output_options(CLI::App* render, RenderRequest& ra) {
 // The photon flags both photon methods read (PhotonSettings), then bpm's own.
 void add_photon_options(CLI::App* render, RenderRequest& ra) {
   render->add_option("--k0", ra.k0, "Caustic radius in pixel footprints (default 1)")
+      ->check(kFinite)
       ->check(CLI::Range(1e-4, 1e4))
       ->group(kBpm);
   render
       ->add_option("--k1", ra.k1,
                    "Radius at the last diffuse vertex in pixel footprints (default 3)")
+      ->check(kFinite)
       ->check(CLI::Range(1e-4, 1e4))
       ->group(kBpm);
   render
@@ -131,6 +150,7 @@ void add_photon_options(CLI::App* render, RenderRequest& ra) {
   render
       ->add_option("--alpha", ra.alpha,
                    "Progressive radius alpha: r2 *= (i+alpha)/(i+1) (default 2/3)")
+      ->check(kFinite)
       ->check(CLI::Range(1e-3, 0.999))
       ->group(kBpm);
   render
@@ -183,6 +203,7 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
       ->add_option("--radius", ra.radius,
                    "Initial radius of every backward photon in scene units, in place of --k0 and "
                    "--k1 (default 0: off; file: float radius, also pbrt-v4 sppm's)")
+      ->check(kFinite)
       ->check(CLI::Range(0.0, 1e30))
       ->group(kBpm);
   render

@@ -41,8 +41,11 @@ def main():
         r = scene.render(integrator=integrator, seed=1,
                          progress=lambda p: curve.append((p["seconds"], p["delta"], p["passes"])),
                          **size)
+        if r.stop_reason == "interrupted":  # Ctrl-C ends this render; end the comparison too
+            break
         results[integrator] = (r, curve)
-        line = f"{integrator:5s} {r.stats['result']['passes']:6d} passes  delta {curve[-1][1]:.4f}"
+        delta = r.stats["result"]["relative_error_delta_total"]
+        line = f"{integrator:5s} {r.stats['result']['passes']:6d} passes  delta {delta:.4f}"
         if reference is not None:
             line += f"  relMSE {rel_mse(r.image, reference):.3e}"
         print(line)
@@ -52,6 +55,8 @@ def main():
         # delta from fewer than five passes says little (the render's own stopping rule waits
         # for five too).
         settled = [c for c in curve if c[2] >= 5] or curve
+        if not settled:
+            continue
         t, delta, _ = zip(*settled)
         axes[0].loglog(t, delta, label=integrator)
     axes[0].set_xlabel("seconds")

@@ -36,6 +36,8 @@ def main():
         scene.translate_light(1, (step, 0, 0))
         spacing_now = spacing
         r = scene.render(integrator="bpm", no_image=True, sensors=sensors, seed=1, **budget)
+        if r.stop_reason == "interrupted":  # Ctrl-C ends this render; end the sweep too
+            break
         plane, plane_error = r.sensors[:35], r.sensor_errors[:35]
         mean, lowest = plane.mean(), plane.argmin()
         u0 = plane[lowest] / mean

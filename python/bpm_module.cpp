@@ -10,7 +10,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
@@ -39,6 +41,32 @@ double seconds_since(Clock::time_point t) {
 // ---------------------------------------------------------------------------------------------
 // Scenes and their overrides
 
+// Python's bools and numpy's.
+bool is_bool(const py::handle& v) {
+  return py::isinstance<py::bool_>(v) ||
+         py::type::of(v).attr("__name__").cast<std::string>() == "bool_";
+}
+
+// A number that must be finite; `where` names it in the error.
+double finite(const py::handle& v, const std::string& where) {
+  double x;
+  try {
+    x = v.cast<double>();
+  } catch (const py::cast_error&) {
+    throw py::type_error(where + ": " + py::repr(v).cast<std::string>() + " is not a number");
+  }
+  // Finite in single precision too, where the scene keeps most numbers.
+  if (!std::isfinite(float(x)))
+    throw Error(where + ": " + py::repr(v).cast<std::string>() + " is not a finite number");
+  return x;
+}
+
+Vec3 finite3(const std::array<double, 3>& v, const std::string& where) {
+  for (double x : v)
+    if (!std::isfinite(float(x))) throw Error(where + ": every coordinate must be a finite number");
+  return Vec3(float(v[0]), float(v[1]), float(v[2]));
+}
+
 // A parameter as pbrt-v4 declares it ("float scale", "rgb reflectance") with a Python value: a
 // number, a bool, a string or a sequence of them. `where` names the call in error messages.
 Param make_param(const std::string& declaration, const py::handle& value,
@@ -55,12 +83,12 @@ Param make_param(const std::string& declaration, const py::handle& value,
   p.name = name;
   p.loc = FileLoc{where, 0, 0};
   auto add = [&](py::handle v) {
-    if (py::isinstance<py::bool_>(v))
-      p.bools.push_back(v.cast<bool>());
+    if (is_bool(v))
+      p.bools.push_back(PyObject_IsTrue(v.ptr()) == 1);
     else if (py::isinstance<py::str>(v))
       p.strings.push_back(v.cast<std::string>());
     else
-      p.numbers.push_back(v.cast<double>());
+      p.numbers.push_back(finite(v, where));
   };
   if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
     add(value);
@@ -85,11 +113,31 @@ Param make_param(const std::string& declaration, const py::handle& value,
 // A pbrt-v4 scene parsed once, rendered as often as asked, each time with its overrides.
 struct Scene {
   SceneFile file;
-  std::string name;  // the file as given, or "<text>"
-  int renders = 0;   // so far: the first one's record counts the parse, the others read nothing
+  std::string name;                    // the file as given, or "<string>" for text
+  int renders = 0;                     // so far: the first one's record counts the parse
+  int busy = 0;                        // renders reading it now: it may not change meanwhile
+  std::vector<std::string> overrides;  // as called, for the record
 
   std::string where(const std::string& call) const { return name + " (" + call + ")"; }
 };
+
+// "name(a, b)" with the arguments' repr: an override as the record lists it.
+std::string call_text(const std::string& name, std::initializer_list<py::object> args) {
+  std::string text = name + "(";
+  for (const py::object& a : args)
+    text += (text.back() == '(' ? "" : ", ") + py::repr(a).cast<std::string>();
+  return text + ")";
+}
+
+// An override: the scene must not be in a render; `apply` changes it, and then the call is
+// recorded.
+template <class Apply>
+void override_scene(Scene& s, const std::string& name, const std::string& call, Apply&& apply) {
+  if (s.busy > 0)
+    throw Error(s.where(name) + ": the scene is being rendered; change it when the render is done");
+  apply();
+  s.overrides.push_back(call);
+}
 
 // A path-like object or a string naming an existing file, or one line ending in .pbrt, is a file;
 // any other string is the scene's text.
@@ -106,9 +154,11 @@ Scene load_scene(const py::object& source) {
     if (one_line && (text.ends_with(".pbrt") || std::filesystem::is_regular_file(text, ec)))
       path = text;
     else {
+      // Relative names resolve against the folder current now, whenever the scene is built.
+      const std::string here = std::filesystem::current_path().string();
       py::gil_scoped_release release;
-      s.file = read_scene_text(text, ".");
-      s.name = "<text>";
+      s.file = read_scene_text(text, here);
+      s.name = "<string>";
       return s;
     }
   } else {
@@ -156,6 +206,8 @@ SceneEntity& material_at(Scene& s, const py::object& which) {
     throw py::key_error("no material named \"" + name +
                         "\" (named: " + (names.empty() ? "none" : names) + ")");
   }
+  if (!py::isinstance<py::int_>(which))
+    throw py::type_error("a material is its name or the index of its Material directive");
   const int index = which.cast<int>();
   if (index < 0 || index >= int(p.materials.size()))
     throw py::index_error("material " + std::to_string(index) + " of " +
@@ -163,14 +215,62 @@ SceneEntity& material_at(Scene& s, const py::object& which) {
   return p.materials[size_t(index)];
 }
 
-void look_at(Scene& s, std::array<float, 3> eye, std::array<float, 3> target,
-             std::array<float, 3> up) {
+void look_at(Scene& s, std::array<double, 3> eye, std::array<double, 3> target,
+             std::array<double, 3> up) {
+  const std::string where = s.where("look_at");
   const auto t =
-      Transform::look_at(Vec3(eye[0], eye[1], eye[2]), Vec3(target[0], target[1], target[2]),
-                         Vec3(up[0], up[1], up[2]));
-  if (!t) throw Error(s.where("look_at") + ": eye and target coincide, or up is along the view");
-  if (!s.file.parsed.camera) s.file.parsed.camera = CameraEntity{{"perspective", {}, {}}, {}, {}};
-  s.file.parsed.camera->camera_from_world = *t;
+      Transform::look_at(finite3(eye, where), finite3(target, where), finite3(up, where));
+  if (!t) throw Error(where + ": eye and target coincide, or up is along the view");
+  override_scene(s, "look_at",
+                 call_text("look_at", {py::cast(eye), py::cast(target), py::cast(up)}), [&] {
+                   if (!s.file.parsed.camera)
+                     s.file.parsed.camera = CameraEntity{{"perspective", {}, {}}, {}, {}};
+                   s.file.parsed.camera->camera_from_world = *t;
+                 });
+}
+
+// Scene.set_camera, set_film, set_integrator, set_light, set_material: a parameter of one
+// directive.
+void set_camera(Scene& s, const std::string& decl, const py::object& v) {
+  override_scene(s, "set_camera", call_text("set_camera", {py::str(decl), v}), [&] {
+    if (!s.file.parsed.camera) throw Error(s.where("set_camera") + ": no Camera directive");
+    s.file.parsed.camera->params.set(make_param(decl, v, s.where("set_camera")));
+  });
+}
+
+void set_film(Scene& s, const std::string& decl, const py::object& v) {
+  override_scene(s, "set_film", call_text("set_film", {py::str(decl), v}),
+                 [&] { s.file.parsed.film.params.set(make_param(decl, v, s.where("set_film"))); });
+}
+
+void set_integrator(Scene& s, const std::string& decl, const py::object& v) {
+  override_scene(s, "set_integrator", call_text("set_integrator", {py::str(decl), v}), [&] {
+    SceneFile f = s.file;
+    f.parsed.integrator.params.set(make_param(decl, v, s.where("set_integrator")));
+    f.settings = integrator_settings(f.parsed);
+    s.file = std::move(f);
+  });
+}
+
+void set_light(Scene& s, int i, const std::string& decl, const py::object& v) {
+  override_scene(s, "set_light", call_text("set_light", {py::int_(i), py::str(decl), v}), [&] {
+    light_at(s, i).params->params.set(make_param(decl, v, s.where("set_light")));
+  });
+}
+
+void translate_light(Scene& s, int i, std::array<double, 3> d) {
+  const Vec3 offset = finite3(d, s.where("translate_light"));
+  override_scene(s, "translate_light", call_text("translate_light", {py::int_(i), py::cast(d)}),
+                 [&] {
+                   Transform* world = light_at(s, i).world;
+                   *world = Transform::translate(offset) * *world;
+                 });
+}
+
+void set_material(Scene& s, const py::object& which, const std::string& decl, const py::object& v) {
+  override_scene(s, "set_material", call_text("set_material", {which, py::str(decl), v}), [&] {
+    material_at(s, which).params.set(make_param(decl, v, s.where("set_material")));
+  });
 }
 
 py::list light_list(Scene& s) {
@@ -206,29 +306,36 @@ struct RenderCall {
   py::object progress = py::none();
 };
 
-// Keyword arguments with no flag of their own, or whose flag would write files.
-const char* const kNotFlags[] = {"output", "write_every", "resume", "scene"};
+// Keyword arguments whose flags would write files.
+const char* const kNotFlags[] = {"output", "write_every", "resume"};
 
+// A keyword's value as its flag's: (w, h) as WxH, a float as Python writes it (the shortest text
+// that reads back as the same number, what a user would type).
 std::string flag_value(const std::string& key, const py::handle& v) {
   if (key == "resolution" && py::isinstance<py::sequence>(v) && !py::isinstance<py::str>(v)) {
-    const auto wh = v.cast<std::vector<int>>();
-    if (wh.size() != 2) throw Error("resolution is (width, height) or \"WxH\"");
-    return std::to_string(wh[0]) + "x" + std::to_string(wh[1]);
+    if (py::len(v) != 2 || !py::isinstance<py::int_>(v[py::int_(0)]) ||
+        !py::isinstance<py::int_>(v[py::int_(1)]))
+      throw py::type_error("resolution is (width, height), two ints, or \"WxH\"");
+    return py::str(v[py::int_(0)]).cast<std::string>() + "x" +
+           py::str(v[py::int_(1)]).cast<std::string>();
   }
-  if (py::isinstance<py::float_>(v)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.17g", v.cast<double>());
-    return buf;
-  }
-  return py::str(v).cast<std::string>();
+  if (py::isinstance<py::float_>(v)) return py::repr(v).cast<std::string>();
+  if (py::isinstance<py::str>(v) || py::isinstance<py::int_>(v) || py::hasattr(v, "__float__") ||
+      py::hasattr(v, "__index__"))
+    return py::str(v).cast<std::string>();
+  throw py::type_error(key + " = " + py::repr(v).cast<std::string>() +
+                       ": a number, a string or a bool");
 }
 
 // Sensors as a sequence of (x, y, z, nx, ny, nz): the lines a sensor file would hold.
 std::string sensor_lines(const py::handle& v) {
   std::string text;
   for (py::handle row : v) {
-    const auto s = row.cast<std::vector<double>>();
-    if (s.size() != 6) throw Error("a sensor is (x, y, z, nx, ny, nz)");
+    if (!py::isinstance<py::sequence>(row) || py::len(row) != 6)
+      throw py::type_error("sensors: each sensor is (x, y, z, nx, ny, nz); got " +
+                           py::repr(row).cast<std::string>());
+    std::vector<double> s;
+    for (py::handle x : row) s.push_back(finite(x, "sensors"));
     char line[256];
     std::snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g %.17g\n", s[0], s[1], s[2],
                   s[3], s[4], s[5]);
@@ -244,17 +351,21 @@ RenderCall render_call(const Scene& scene, const py::kwargs& kwargs) {
   bool quiet = true;
   std::string lines;
   for (const auto& [k, v] : kwargs) {
-    const std::string key = k.cast<std::string>();
+    std::string key = k.cast<std::string>();
+    std::replace(key.begin(), key.end(), '-', '_');
     for (const char* bad : kNotFlags)
       if (key == bad)
         throw py::type_error("render() takes no \"" + key +
                              "\": Result.save(path) writes the files");
+    if (key == "scene") throw py::type_error("render(): the scene is the first argument");
     if (key == "progress") {
+      if (!v.is_none() && !PyCallable_Check(v.ptr()))
+        throw py::type_error("progress must be a function (or None)");
       call.progress = py::reinterpret_borrow<py::object>(v);
       continue;
     }
     if (key == "quiet") {
-      quiet = v.cast<bool>();
+      quiet = PyObject_IsTrue(v.ptr()) == 1;
       continue;
     }
     if (v.is_none()) continue;
@@ -264,12 +375,14 @@ RenderCall render_call(const Scene& scene, const py::kwargs& kwargs) {
     }
     std::string flag = "--" + key;
     std::replace(flag.begin(), flag.end(), '_', '-');
-    if (py::isinstance<py::bool_>(v)) {
-      if (v.cast<bool>()) args.push_back(flag);
+    if (is_bool(v)) {
+      if (PyObject_IsTrue(v.ptr()) == 1) args.push_back(flag);
       continue;
     }
-    args.push_back(flag);
-    args.push_back(flag_value(key, v));
+    if (key == "sensors" && !py::isinstance<py::str>(v))
+      args.insert(args.end(), {flag, py::str(py::module_::import("os").attr("fspath")(v))});
+    else
+      args.insert(args.end(), {flag, flag_value(key, v)});
   }
   if (quiet) args.push_back("--quiet");
   call.request = parse_render_request(args);
@@ -283,6 +396,7 @@ RenderCall render_call(const Scene& scene, const py::kwargs& kwargs) {
 // The render itself, on the render thread: what the program's `bpm render` does up to its outputs.
 Result run(const Scene& scene, const RenderRequest& request, double parse_s,
            const std::function<void(const RenderProgress&)>& on_progress) {
+  const int warnings_before = warning_count();
   const auto t = Clock::now();
   const LoadedScene ls = build_scene(scene.file, request);
   const double build_s = seconds_since(t);
@@ -299,6 +413,9 @@ Result run(const Scene& scene, const RenderRequest& request, double parse_s,
   r.record.erase("outputs");
   r.record.erase("sensors");
   r.record["stages_s"].erase("write_images");
+  // This render's warnings (the count is the process's); the scene's overrides.
+  r.record["scene_stats"]["warnings"] = warning_count() - warnings_before;
+  if (!scene.overrides.empty()) r.record["overrides"] = scene.overrides;
   return r;
 }
 
@@ -345,9 +462,11 @@ void wait_for(Exchange& x, const py::object& progress,
     if (p && !progress.is_none() && !*raised && !interrupted()) {
       try {
         const py::object answer = progress(progress_dict(*p));
-        if (py::isinstance<py::bool_>(answer) && !answer.cast<bool>()) interrupt_flag() = true;
+        // False (or anything false but None) stops the render.
+        if (!answer.is_none() && PyObject_Not(answer.ptr()) != 0) interrupt_flag() = true;
       } catch (py::error_already_set& e) {
-        raised->emplace(std::move(e));
+        // Ctrl-C while the callback ran is Ctrl-C; anything else is the callback's error.
+        if (!e.matches(PyExc_KeyboardInterrupt)) raised->emplace(std::move(e));
         interrupt_flag() = true;
       }
     }
@@ -355,8 +474,37 @@ void wait_for(Exchange& x, const py::object& progress,
   }
 }
 
+// Renders run one at a time in a process (they share the interrupt flag, the thread limit and the
+// image writer's threads): a render waits for the one before, with the GIL released. A render
+// started from a progress callback (the thread whose render is running) is an error.
+class RenderTurn {
+ public:
+  RenderTurn() {
+    if (owner_.load() == std::this_thread::get_id())
+      throw Error("a render is running on this thread: a progress callback cannot start another");
+    py::gil_scoped_release release;
+    lock_ = std::unique_lock<std::mutex>(mutex_);
+    owner_ = std::this_thread::get_id();
+  }
+  ~RenderTurn() { owner_ = std::thread::id(); }
+
+ private:
+  static inline std::mutex mutex_;
+  static inline std::atomic<std::thread::id> owner_;
+  std::unique_lock<std::mutex> lock_;
+};
+
+// The scene may not change while a render reads it.
+struct Busy {
+  Scene& scene;
+  explicit Busy(Scene& s) : scene(s) { ++scene.busy; }
+  ~Busy() { --scene.busy; }
+};
+
 Result render_scene(Scene& scene, const py::kwargs& kwargs) {
   const RenderCall call = render_call(scene, kwargs);
+  RenderTurn turn;
+  Busy busy(scene);
   const double parse_s = scene.renders++ == 0 ? scene.file.parse_s : 0;
   Exchange x;
   Result result;
@@ -376,7 +524,14 @@ Result render_scene(Scene& scene, const py::kwargs& kwargs) {
     x.cv.notify_all();
   });
   std::optional<py::error_already_set> raised;
-  wait_for(x, call.progress, &raised);
+  try {
+    wait_for(x, call.progress, &raised);
+  } catch (...) {
+    interrupt_flag() = true;  // the render stops before its stack goes
+    py::gil_scoped_release release;
+    worker.join();
+    throw;
+  }
   {
     py::gil_scoped_release release;
     worker.join();
@@ -417,9 +572,13 @@ py::array_t<double> sensor_values(const Result& r, double (Film::*get)(size_t) c
   return a;
 }
 
-void save(const Result& r, const std::string& path) {
+std::string fspath(const py::object& path) {
+  return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+}
+
+void save(const Result& r, const py::object& path) {
   RenderRequest request = r.request;
-  request.output = path;
+  request.output = fspath(path);
   py::gil_scoped_release release;
   const OutputPaths paths = checked_output_paths(request, r.film_settings);
   const auto t = Clock::now();
@@ -430,8 +589,8 @@ void save(const Result& r, const std::string& path) {
   write_text_atomic(paths.json, rec.dump(2) + "\n");
 }
 
-py::array_t<float> read_exr_rgb(const std::string& path) {
-  const Image img = read_exr(path);
+py::array_t<float> read_exr_rgb(const py::object& path) {
+  const Image img = read_exr(fspath(path));
   return array(img.rgb, {img.height, img.width, 3});
 }
 
@@ -470,53 +629,25 @@ void bind_scene(py::module_& m) {
           },
           "The names of the named materials (MakeNamedMaterial).")
       .def("look_at", &look_at, py::arg("eye"), py::arg("target"), py::arg("up"),
-           "Places the camera as a LookAt directive would.")
-      .def(
-          "set_camera",
-          [](Scene& s, const std::string& decl, const py::object& v) {
-            if (!s.file.parsed.camera) throw Error(s.where("set_camera") + ": no Camera directive");
-            s.file.parsed.camera->params.set(make_param(decl, v, s.where("set_camera")));
-          },
-          py::arg("parameter"), py::arg("value"),
-          "Sets a Camera parameter, e.g. set_camera(\"float fov\", 40).")
-      .def(
-          "set_film",
-          [](Scene& s, const std::string& decl, const py::object& v) {
-            s.file.parsed.film.params.set(make_param(decl, v, s.where("set_film")));
-          },
-          py::arg("parameter"), py::arg("value"), "Sets a Film parameter, e.g. \"float iso\".")
-      .def(
-          "set_integrator",
-          [](Scene& s, const std::string& decl, const py::object& v) {
-            SceneFile f = s.file;
-            f.parsed.integrator.params.set(make_param(decl, v, s.where("set_integrator")));
-            f.settings = integrator_settings(f.parsed);
-            s.file = std::move(f);
-          },
-          py::arg("parameter"), py::arg("value"), "Sets a parameter of the Integrator line.")
-      .def(
-          "set_light",
-          [](Scene& s, int i, const std::string& decl, const py::object& v) {
-            light_at(s, i).params->params.set(make_param(decl, v, s.where("set_light")));
-          },
-          py::arg("index"), py::arg("parameter"), py::arg("value"),
-          "Sets a parameter of light `index`, e.g. set_light(0, \"float scale\", 2).")
-      .def(
-          "translate_light",
-          [](Scene& s, int i, std::array<float, 3> d) {
-            Transform* world = light_at(s, i).world;
-            *world = Transform::translate(Vec3(d[0], d[1], d[2])) * *world;
-          },
-          py::arg("index"), py::arg("offset"),
-          "Moves light `index` by offset (world units); an area light moves with its shape.")
-      .def(
-          "set_material",
-          [](Scene& s, const py::object& which, const std::string& decl, const py::object& v) {
-            material_at(s, which).params.set(make_param(decl, v, s.where("set_material")));
-          },
-          py::arg("material"), py::arg("parameter"), py::arg("value"),
-          "Sets a parameter of a named material (by name) or of the file's n-th Material "
-          "directive (by index), e.g. set_material(\"glass\", \"float eta\", 1.6).")
+           "Replaces the camera's whole transform with that of a LookAt directive (a transform the "
+           "file gives before its LookAt, such as a Scale -1 1 1, is dropped).")
+      .def("set_camera", &set_camera, py::arg("parameter"), py::arg("value"),
+           "Sets a Camera parameter, e.g. set_camera(\"float fov\", 40).")
+      .def("set_film", &set_film, py::arg("parameter"), py::arg("value"),
+           "Sets a Film parameter, e.g. set_film(\"float iso\", 200).")
+      .def("set_integrator", &set_integrator, py::arg("parameter"), py::arg("value"),
+           "Sets a parameter of the Integrator line.")
+      .def("set_light", &set_light, py::arg("index"), py::arg("parameter"), py::arg("value"),
+           "Sets a parameter of light `index` (Scene.lights), e.g. set_light(0, \"float scale\", "
+           "2).")
+      .def("translate_light", &translate_light, py::arg("index"), py::arg("offset"),
+           "Moves light `index` by offset (world units), after any move before; an area light "
+           "moves with its shape.")
+      .def("set_material", &set_material, py::arg("material"), py::arg("parameter"),
+           py::arg("value"),
+           "Sets a parameter of a named material (by name) or of the file's n-th Material "
+           "directive (by index), e.g. set_material(\"glass\", \"float eta\", 1.6).")
+      .def_readonly("overrides", &Scene::overrides, "The overrides set so far, as called.")
       .def("render", &render_scene, kRenderDoc);
 }
 

@@ -6,7 +6,7 @@
 # install-deps.sh put numpy. Idempotent; run by render-default.sh after the build.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-build="${BPM_BUILD_DIR:-$root/build}"
+build="$(cd "${BPM_BUILD_DIR:-$root/build}" && pwd)"
 py="${PYTHON:-python3}"
 if ! compgen -G "$build/python/bpm.*.so" >/dev/null; then
   echo "install-python: no module in $build/python (pybind11 or Python's headers missing?)" >&2

@@ -4,6 +4,7 @@ progress, and scenes rendered again with overrides without being read again.
 Run by ctest (Python.Module) with PYTHONPATH at the built module and BPM_BINARY the program."""
 import json
 import os
+import pathlib
 import shutil
 import signal
 import subprocess
@@ -99,9 +100,9 @@ def test_sensors_equal_the_programs(tmp_path):
     np.testing.assert_allclose(s.sensors, [float(row.split(",")[6]) for row in rows], rtol=1e-8)
 
 
-def test_scene_text_renders_as_its_file(tmp_path):
+def test_scene_text_renders_as_its_file(monkeypatch):
     text = open(scene("cornell-box.pbrt")).read()
-    os.chdir(SCENES)  # the text's relative names resolve against the current folder
+    monkeypatch.chdir(SCENES)  # the text's relative names resolve against the current folder
     a = bpm.render(text, **SMALL)
     b = bpm.render(scene("cornell-box.pbrt"), **SMALL)
     assert np.array_equal(a.image, b.image)
@@ -126,6 +127,44 @@ def test_errors_name_file_line_and_column(tmp_path):
         bpm.Scene(42)
 
 
+def test_bad_values_from_python_are_errors_not_crashes():
+    s = bpm.Scene(scene("office-downlight.pbrt"))
+    with pytest.raises(bpm.Error, match="finite"):
+        s.translate_light(0, (float("nan"), 0, 0))
+    with pytest.raises(bpm.Error, match="finite"):
+        s.translate_light(0, (1e39, 0, 0))
+    with pytest.raises(bpm.Error, match="finite"):
+        s.look_at((0, 1, float("inf")), (0, 0, 0), (0, 1, 0))
+    with pytest.raises(bpm.Error, match="finite"):
+        s.set_light(0, "float scale", float("nan"))
+    with pytest.raises(bpm.Error, match="finite"):
+        s.render(k0=float("nan"), **SMALL)
+    with pytest.raises(bpm.Error, match="finite"):
+        s.render(time=float("inf"), resolution=(8, 8))
+    with pytest.raises(TypeError, match="resolution"):
+        s.render(resolution=(16.5, 16), spp=1)
+    with pytest.raises(TypeError, match="sensor"):
+        s.render(no_image=True, sensors=[0, 0, 0, 0, 1, 0], spp=1)
+    with pytest.raises(TypeError, match="material"):
+        s.set_material(1.5, "float eta", 1.5)
+    with pytest.raises(TypeError, match="progress"):
+        s.render(progress=3, **SMALL)
+    assert s.overrides == []  # nothing above changed the scene
+    # numpy's bools and numbers are Python's
+    r = s.render(integrator="bpm", no_guide=np.True_, k1=np.float32(2.5), **SMALL)
+    assert r.stats["bpm"]["settings"]["guide_emission"] is False
+    assert r.stats["bpm"]["settings"]["k1"] == pytest.approx(2.5)
+
+
+def test_paths_may_be_path_objects(tmp_path):
+    s = bpm.Scene(pathlib.Path(scene("cornell-box.pbrt")))
+    r = s.render(no_image=True, sensors=pathlib.Path(scene("cornell-box-sensors.txt")), spp=1)
+    assert r.sensors.shape == (11,)
+    r = s.render(**SMALL)
+    r.save(tmp_path / "p.exr")
+    assert np.array_equal(bpm.read_exr(tmp_path / "p.exr"), r.image)
+
+
 def test_a_scene_is_read_once_and_rendered_with_overrides(tmp_path):
     path = tmp_path / "office.pbrt"
     for name in ("office-downlight.pbrt",):
@@ -147,6 +186,12 @@ def test_a_scene_is_read_once_and_rendered_with_overrides(tmp_path):
     s.set_camera("float fov", 40)
     looked = s.render(integrator="path", **SMALL)
     assert not np.allclose(looked.image, moved.image)
+    assert looked.stats["overrides"] == [
+        "set_light(0, 'float scale', 2.0)", "set_light(1, 'float scale', 2.0)",
+        "translate_light(0, [0.0, -1.0, 0.0])",
+        "look_at([2.0, 1.5, -1.0], [2.0, 0.5, 1.5], [0.0, 1.0, 0.0])",
+        "set_camera('float fov', 40)"]
+    assert "overrides" not in base.stats
     with pytest.raises(IndexError):
         s.set_light(2, "float scale", 1.0)
     with pytest.raises(bpm.Error, match="TYPE NAME"):
@@ -191,6 +236,40 @@ def test_a_callback_stops_the_render_or_raises():
 
     with pytest.raises(ValueError, match="from the callback"):
         bpm.render(scene("cornell-box.pbrt"), resolution=(32, 24), spp=100000, progress=fails)
+    # numpy's False stops it too
+    r = bpm.render(scene("cornell-box.pbrt"), resolution=(32, 24), spp=100000,
+                   progress=lambda p: np.bool_(p["passes"] < 3))
+    assert r.stop_reason == "interrupted"
+
+
+def test_ctrl_c_inside_the_callback_returns_the_result_so_far():
+    def interrupted(p):
+        if p["passes"] >= 2:
+            raise KeyboardInterrupt
+
+    r = bpm.render(scene("cornell-box.pbrt"), resolution=(32, 24), spp=100000,
+                   progress=interrupted)
+    assert r.stop_reason == "interrupted" and r.stats["result"]["passes"] >= 2
+
+
+def test_renders_take_turns_and_a_scene_does_not_change_under_one():
+    s = bpm.Scene(scene("cornell-box.pbrt"))
+    # A callback can neither start a render nor change the scene being rendered.
+    with pytest.raises(bpm.Error, match="callback cannot start another"):
+        s.render(resolution=(32, 24), spp=50, progress=lambda p: bpm.render(s, **SMALL))
+    with pytest.raises(bpm.Error, match="being rendered"):
+        s.render(resolution=(32, 24), spp=50,
+                 progress=lambda p: s.set_material("white", "rgb reflectance", [0.5, 0.5, 0.5]))
+    # A render on another thread waits for this one, and neither stops the other.
+    other = {}
+    thread = threading.Thread(target=lambda: other.update(
+        r=bpm.render(scene("cornell-box.pbrt"), resolution=(32, 24), time=1)))
+    thread.start()
+    mine = bpm.render(scene("cornell-box.pbrt"), resolution=(32, 24), spp=100000,
+                      progress=lambda p: p["passes"] < 5)
+    thread.join()
+    assert mine.stop_reason == "interrupted"
+    assert other["r"].stop_reason == "time"
 
 
 def test_ctrl_c_returns_the_result_so_far():
