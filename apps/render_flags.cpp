@@ -139,7 +139,7 @@ void add_photon_options(CLI::App* render, RenderRequest& ra) {
       ->group(kBpm);
   render
       ->add_option("--k1", ra.k1,
-                   "Radius at the last diffuse vertex in pixel footprints (default 3)")
+                   "Radius at the last diffuse vertex in pixel footprints (default 4.5)")
       ->check(kFinite)
       ->check(CLI::Range(1e-4, 1e4))
       ->group(kBpm);

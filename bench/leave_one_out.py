@@ -10,7 +10,7 @@ scene, the relMSE with each and their ratio: how much the scene loses by having 
 the choice (1.00: nothing). Prints figures; never fails.
 
   PYTHONPATH=build/python /usr/bin/python3 bench/leave_one_out.py [--time S] [--seeds 1,2]
-      [--scenes a,b] [--defaults k0,k1] [--json OUT.json]
+      [--scenes a,b] [--defaults k0,k1] [--values 4.5,6] [--json OUT.json]
 
 Run from the project root, where equal_time_references/ is (make missing references with
 `build/equal_time --references-only --scenes ...`)."""
@@ -40,7 +40,7 @@ SCENES = {
 # Each default with its value and the values tried beside it (keyword arguments of bpm.render).
 CANDIDATES = {
     "k0": (1.0, [0.7, 1.4]),
-    "k1": (3.0, [2.0, 4.5]),
+    "k1": (3.0, [2.0, 4.5, 6.0]),
     "emission_samples": (8, [4, 16]),
     "alpha": (2 / 3, [0.5, 0.8]),
 }
@@ -73,6 +73,8 @@ def main():
     ap.add_argument("--seeds", default="1")
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--defaults", default="k0,k1")
+    ap.add_argument("--values", default="",
+                    help="the values to try beside the default, for one default: 4.5,6")
     ap.add_argument("--json", default="")
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",")]
@@ -87,6 +89,8 @@ def main():
     results = {}
     for default in a.defaults.split(","):
         value, others = CANDIDATES[default]
+        if a.values:
+            others = [float(v) for v in a.values.split(",")]
         values = [value] + others
         scores = {}
         for name, path, ref, size in scenes:

@@ -843,9 +843,9 @@ TEST(Bpm, CornellBoxConvergesToPathForDiffuseDepths0To2) {
 
 // Without the disc probes, every estimate near a wall or an edge of the box divides the photons
 // it finds by its whole disc, of which a part lies past the wall: the image is darker than path's
-// by a share that grows with the radius (here k1 = 3 pixels of 32). With them its mean agrees with
-// path's, except for the small excess of 1 / share over a share's inverse. So in bpm (a map per
-// object) and in fpm (one map for all objects).
+// by a share that grows with the radius (here k1 = 4.5 pixels of 32). With them its mean agrees
+// with path's, except for the small excess of 1 / share over a share's inverse. So in bpm (a map
+// per object) and in fpm (one map for all objects).
 TEST(DiscProbes, RemoveTheDeficitAtWallsAndEdgesInBpmAndFpm) {
   LoadedScene ls = load(cornell());
   const Film ref = render_with(ls, "path", 4096).film;

@@ -23,8 +23,9 @@ inline const char* to_string(BiasModel m) { return m == BiasModel::kSquare ? "r2
 struct PhotonSettings {
   // Integration radii in pixel footprints (the side of one pixel seen at the vertex): k0 for
   // caustic photons before the last diffuse vertex (bpm) or in the caustic map (fpm), k1 for the
-  // last diffuse vertex (bpm) or the global map (fpm).
-  float k0 = 1, k1 = 3;
+  // last diffuse vertex (bpm) or the global map (fpm). k1 4.5: docs/MEASUREMENTS.md,
+  // "Leave-one-out".
+  float k0 = 1, k1 = 4.5f;
   RadiusPolicy radius_policy = RadiusPolicy::kProgressive;
   // Knaus & Zwicker 2011: r_(i+1)^2 = r_i^2 (i + alpha) / (i + 1).
   float alpha = 2.0f / 3.0f;
