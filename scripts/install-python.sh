@@ -28,6 +28,7 @@ print(site.getusersitepackages())
 PY
 )"
 mkdir -p "$site"
+rm -f "$site/bpm.pth"  # so that what it named before does not decide what it names now
 lines="$build/python"
 debian=/usr/lib/python3/dist-packages
 if ! "$py" -c 'import numpy' 2>/dev/null && [ -x /usr/bin/python3 ] &&
