@@ -15,6 +15,7 @@
 #include "film/image_compare.h"
 #include "film/image_io.h"
 #include "film/outputs.h"
+#include "integrator/control.h"
 #include "integrator/team.h"
 #include "lights/photometric_file.h"
 #include "path/sensors.h"
@@ -31,11 +32,6 @@
 namespace {
 
 using namespace bpm;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // The bpm statistics a user wants to see at the end of a run (all of them are in the JSON).
 void print_bpm_summary(const nlohmann::json& d) {
@@ -128,7 +124,7 @@ int run_render(RenderRequest a, Team* team, bool* rendering) {
   const SceneFile file = read_scene_file(a.scene);
   auto t = Clock::now();
   const LoadedScene ls = build_scene(file, a);
-  const double build_s = seconds_since(t);
+  const double build_s = since(t);
   RenderOptions opt = render_options(a, ls, file.settings);
   const OutputPaths paths = checked_output_paths(a, ls.film);
   if (!a.quiet)
@@ -163,7 +159,7 @@ int run_render(RenderRequest a, Team* team, bool* rendering) {
 
   t = Clock::now();
   write_outputs(ls.film, opt, film, paths);
-  const double write_s = seconds_since(t);
+  const double write_s = since(t);
   nlohmann::json rec = run_record(a, ls, opt, st, film, paths, {file.parse_s, build_s, write_s});
   write_text_atomic(paths.json, rec.dump(2) + "\n");
   print_result(a, opt, st, film, paths);

@@ -24,6 +24,7 @@
 #include "base/error.h"
 #include "base/interrupt.h"
 #include "film/image_io.h"
+#include "integrator/control.h"
 #include "render/render_job.h"
 #include "render_flags.h"
 
@@ -32,14 +33,13 @@ namespace py = pybind11;
 namespace bpm {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
 // ---------------------------------------------------------------------------------------------
 // Scenes and their overrides
+
+// A str or os.PathLike as a path.
+std::string fspath(const py::handle& path) {
+  return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+}
 
 // Python's bools and numpy's.
 bool is_bool(const py::handle& v) {
@@ -146,7 +146,7 @@ Scene load_scene(const py::object& source) {
   const py::module_ os = py::module_::import("os");
   std::string path;
   if (py::isinstance(source, os.attr("PathLike"))) {
-    path = os.attr("fspath")(source).cast<std::string>();
+    path = fspath(source);
   } else if (py::isinstance<py::str>(source)) {
     const std::string text = source.cast<std::string>();
     std::error_code ec;
@@ -380,7 +380,7 @@ RenderCall render_call(const Scene& scene, const py::kwargs& kwargs) {
       continue;
     }
     if (key == "sensors" && !py::isinstance<py::str>(v))
-      args.insert(args.end(), {flag, py::str(py::module_::import("os").attr("fspath")(v))});
+      args.insert(args.end(), {flag, fspath(v)});
     else
       args.insert(args.end(), {flag, flag_value(key, v)});
   }
@@ -399,7 +399,7 @@ Result run(const Scene& scene, const RenderRequest& request, double parse_s,
   const int warnings_before = warning_count();
   const auto t = Clock::now();
   const LoadedScene ls = build_scene(scene.file, request);
-  const double build_s = seconds_since(t);
+  const double build_s = since(t);
   RenderOptions opt = render_options(request, ls, scene.file.settings);
   check_film_memory(request, ls, opt, false, false);
   auto film =
@@ -572,10 +572,6 @@ py::array_t<double> sensor_values(const Result& r, double (Film::*get)(size_t) c
   return a;
 }
 
-std::string fspath(const py::object& path) {
-  return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
-}
-
 void save(const Result& r, const py::object& path) {
   RenderRequest request = r.request;
   request.output = fspath(path);
@@ -584,7 +580,7 @@ void save(const Result& r, const py::object& path) {
   const auto t = Clock::now();
   write_outputs(r.film_settings, r.options, *r.film, paths);
   nlohmann::json rec = r.record;
-  rec["stages_s"]["write_images"] = seconds_since(t);
+  rec["stages_s"]["write_images"] = since(t);
   record_outputs(request, r.options, *r.film, paths, &rec);
   write_text_atomic(paths.json, rec.dump(2) + "\n");
 }

@@ -11,15 +11,12 @@
 #include "base/error.h"
 #include "base/memory.h"
 #include "film/image_io.h"
+#include "integrator/control.h"
 #include "integrator/team.h"
 #include "path/sensors.h"
 
 namespace bpm {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 // Bytes per pixel the outputs take while they are written (the image, its error channels and
 // their copies in the EXR writer's layout): an upper estimate.
@@ -68,22 +65,27 @@ IntegratorSettings integrator_settings(const ParsedScene& parsed) {
   return {bpm_settings_from_file(parsed.integrator), fpm_settings_from_file(parsed.integrator)};
 }
 
-SceneFile read_scene_file(const std::string& path) {
+namespace {
+
+// A parsed scene with its Integrator line's settings, timed.
+template <class Parse>
+SceneFile read_scene(Parse&& parse) {
   SceneFile f;
-  const auto t = std::chrono::steady_clock::now();
-  f.parsed = parse_scene_file(path);
+  const auto t = Clock::now();
+  f.parsed = parse();
   f.settings = integrator_settings(f.parsed);
-  f.parse_s = seconds_since(t);
+  f.parse_s = since(t);
   return f;
 }
 
+}  // namespace
+
+SceneFile read_scene_file(const std::string& path) {
+  return read_scene([&] { return parse_scene_file(path); });
+}
+
 SceneFile read_scene_text(const std::string& text, const std::string& directory) {
-  SceneFile f;
-  const auto t = std::chrono::steady_clock::now();
-  f.parsed = parse_scene_string(text, directory);
-  f.settings = integrator_settings(f.parsed);
-  f.parse_s = seconds_since(t);
-  return f;
+  return read_scene([&] { return parse_scene_string(text, directory); });
 }
 
 LoadedScene build_scene(const SceneFile& file, const RenderRequest& request) {
