@@ -213,6 +213,13 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
                    "variance pays for (default 8; file: integer emissionsamples)")
       ->check(CLI::Range(1, 1024))
       ->group(kBpm);
+  render
+      ->add_option("--direct-samples", ra.direct_samples,
+                   "Most samples of direct light per iteration at an eye path's last diffuse "
+                   "vertex; each pixel takes what its measured variance pays for (default 8; "
+                   "file: integer directsamples)")
+      ->check(CLI::Range(1, 1024))
+      ->group(kBpm);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))
       ->group(kBpm);

@@ -17,8 +17,8 @@ namespace bpm {
 // of the pass over its photon part (radius_bias under bias_model) goes to the film beside its
 // estimate, or with `debias` is taken from it. When `estimates` is given (2 per pixel), each
 // sampled pixel's estimate (the mean over its wavelengths) is added to its first and 1 to its
-// second. The rest of the estimate of each sampled pixel that sees emission, less its emission
-// part, goes to its round statistics (EyePixels::round_stats).
+// second. Each sampled pixel's estimate goes to its round statistics (EyePixels::round_stats), and
+// where the pixel sees emission, the estimate less its emission part too.
 //
 // The light pass's sums are used up: afterwards flux[g] and flux_inner[g] hold backward photon g's
 // parts of its pixel's estimate and bias (its shares), where it received light.

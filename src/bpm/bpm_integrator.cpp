@@ -39,6 +39,8 @@ void check(const BpmSettings& s) {
     throw Error("bpm: --photons (file: photonsperiteration) must be positive");
   if (s.emission_samples < 1 || s.emission_samples > 1024)
     throw Error("bpm: --emission-samples (file: emissionsamples) must be in 1..1024");
+  if (s.direct_samples < 1 || s.direct_samples > 1024)
+    throw Error("bpm: --direct-samples (file: directsamples) must be in 1..1024");
   if (!(s.radius >= 0) || !std::isfinite(s.radius))
     throw Error("bpm: --radius (file: radius) must not be negative");
 }
@@ -67,25 +69,28 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 }
 
 // Memory (base/memory.h). Per pixel, what the eye pass (with the edges and near-edge marks of the
-// disc probes, and the emission statistics with their copy at the end of a round), the masks,
+// disc probes, and the sample statistics with their copy at the end of a round), the masks,
 // the emission guide and the photon count's moments (the round's, its copy at the end of a round
 // and the merged) keep.
 constexpr double kPixelBytes =
-    sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + sizeof(uint16_t) + sizeof(float) +
-    3 * sizeof(EmissionStats<double>) + sizeof(double) + sizeof(uint32_t) + sizeof(float) +
-    sizeof(uint16_t) + 3 * PixelMoments::kValues * sizeof(double);
+    sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + 2 * sizeof(uint16_t) +
+    sizeof(float) + 3 * sizeof(SampleStats<double>) + sizeof(double) + sizeof(uint32_t) +
+    sizeof(float) + sizeof(uint16_t) + 3 * PixelMoments::kValues * sizeof(double);
 
-// What the extra emission samples cost against whole iterations (emission_sample_count), in rays:
-// all the rays the iterations cast and the pixels they sampled, the extra emission samples and
-// their rays.
-struct EmissionCost {
-  std::array<double, 4> v{};  // rays (the extra samples' included), pixels, samples, sample rays
-  // What an iteration costs per pixel without extra samples over what one extra sample costs,
-  // less one (at least 0); -1 while no extra sample has been taken (unknown).
-  double ratio() const {
-    const auto [rays, pixels, samples, sample_rays] = v;
-    if (!(pixels > 0) || !(samples > 0) || !(sample_rays > 0)) return -1;
-    return std::max(0.0, ((rays - sample_rays) / pixels) / (sample_rays / samples) - 1);
+// What the extra samples of emission and of direct light cost against whole iterations
+// (emission_sample_count, direct_sample_count), in rays: all the rays the iterations cast and the
+// pixels they sampled, and of each kind the extra samples and their rays.
+struct ExtraSampleCost {
+  enum : size_t { kRays, kPixels, kEmissionSamples, kEmissionRays, kDirectSamples, kDirectRays };
+  std::array<double, 6> v{};
+  // What an iteration costs per pixel without extra samples over what one extra sample of the
+  // kind (kEmissionSamples or kDirectSamples) costs, less one (at least 0); -1 while no extra
+  // sample of the kind has been taken (unknown).
+  double ratio(size_t kind) const {
+    const double samples = v[kind], sample_rays = v[kind + 1];
+    const double base = v[kRays] - v[kEmissionRays] - v[kDirectRays];
+    if (!(v[kPixels] > 0) || !(samples > 0) || !(sample_rays > 0)) return -1;
+    return std::max(0.0, (base / v[kPixels]) / (sample_rays / samples) - 1);
   }
 };
 // Per backward photon: the thread's list and the map's copy, its four fluxes (all, inner half,
@@ -139,8 +144,8 @@ class BpmRender {
   size_t pixel_values() const;
   void save(ByteWriter& w);
   void load(ByteReader& r);
-  std::pair<EmissionCost, EmissionCost> round_cost() const;
-  void set_emission_samples();
+  std::pair<ExtraSampleCost, ExtraSampleCost> round_cost() const;
+  void set_sample_counts();
   // The work the counters have counted so far (photon_count.h), and the next photon count from
   // what the rounds learnt.
   PassWork work_now() const;
@@ -172,9 +177,9 @@ class BpmRender {
   std::vector<uint32_t> estimate_count_;
   std::vector<float> pixel_weight_;
   // Carried from one iteration to the next, and merged at the end of each round: what the
-  // pixels' extra emission samples cost (their sample counts follow from it); counted_: the
-  // counters' totals at the last round.
-  EmissionCost cost_sum_, cost_new_, counted_;
+  // pixels' extra samples cost (their sample counts follow from it); counted_: the counters'
+  // totals at the last round.
+  ExtraSampleCost cost_sum_, cost_new_, counted_;
   // Photons per iteration: the settings' when they fix it, else chosen at the end of each round
   // from the pixels' moments and the passes' work (photon_count.h), merged as the costs above.
   const bool adapt_photons_;
@@ -253,6 +258,7 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
   light_.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
+  set_sample_counts();
 }
 
 // An eye path leaves at most D + 2 backward photons (two at x_1 when D = 0, one at each other
@@ -324,6 +330,7 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    s_.k0 * scale,
                    s_.k1 * scale,
                    s_.emission_samples,
+                   s_.direct_samples,
                    s_.radius * scale,
                    medium_min_length_,
                    caustics_,
@@ -425,29 +432,35 @@ PassResult BpmRender::progress() const {
 
 // The round's costs so far: cost_new_ (kept from a checkpoint or another process's share) and
 // what the counters added since the last round; and the counters' totals now.
-std::pair<EmissionCost, EmissionCost> BpmRender::round_cost() const {
-  EmissionCost now, round = cost_new_;
+std::pair<ExtraSampleCost, ExtraSampleCost> BpmRender::round_cost() const {
+  using C = ExtraSampleCost;
+  C now, round = cost_new_;
   for (const EyeCounters& c : eye_counters_) {
-    now.v[0] += double(c.rays.total());
-    now.v[1] += double(c.pixels);
-    now.v[2] += double(c.emission_samples);
-    now.v[3] += double(c.emission_rays);
+    now.v[C::kRays] += double(c.rays.total());
+    now.v[C::kPixels] += double(c.pixels);
+    now.v[C::kEmissionSamples] += double(c.emission_samples);
+    now.v[C::kEmissionRays] += double(c.emission_rays);
+    now.v[C::kDirectSamples] += double(c.direct_samples);
+    now.v[C::kDirectRays] += double(c.direct_rays);
   }
-  for (const LightCounters& c : light_.counters) now.v[0] += double(c.light_rays);
+  for (const LightCounters& c : light_.counters) now.v[C::kRays] += double(c.light_rays);
   for (size_t k = 0; k < now.v.size(); ++k) round.v[k] += now.v[k] - counted_.v[k];
   return {round, now};
 }
 
-void BpmRender::set_emission_samples() {
-  const double ratio = cost_sum_.ratio();
-  for (size_t p = 0; p < n_pixels_; ++p)
+void BpmRender::set_sample_counts() {
+  const double emission = cost_sum_.ratio(ExtraSampleCost::kEmissionSamples),
+               direct = cost_sum_.ratio(ExtraSampleCost::kDirectSamples);
+  for (size_t p = 0; p < n_pixels_; ++p) {
+    const SampleStats<double>& st = eye_.sample_stats[p];
     eye_.emission_samples[p] =
-        eye_.sees_emission[p]
-            ? uint16_t(emission_sample_count(eye_.emission_stats[p], ratio, s_.emission_samples))
-            : 1;
+        eye_.sees_emission[p] ? uint16_t(emission_sample_count(st, emission, s_.emission_samples))
+                              : 1;
+    eye_.direct_samples[p] = uint16_t(direct_sample_count(st, direct, s_.direct_samples));
+  }
 }
 
-constexpr size_t kStats = EmissionStats<double>::kValues;
+constexpr size_t kStats = SampleStats<double>::kValues;
 
 // The learnt sums: per pixel whether it saw emission, then its emission statistics, the round's
 // costs, and with guided emission the guide's cells and the pixels' estimate sums and counts.
@@ -456,7 +469,7 @@ void BpmRender::learnt(std::vector<double>* out) {
     out->push_back(saw);
     saw = 0;
   }
-  for (EmissionStats<double>& st : eye_.round_stats) {
+  for (SampleStats<double>& st : eye_.round_stats) {
     out->insert(out->end(), st.v.begin(), st.v.end());
     st = {};
   }
@@ -477,7 +490,7 @@ void BpmRender::learnt(std::vector<double>* out) {
 // The learnt sums before the guide's: per pixel whether it saw emission and its emission
 // statistics, the costs, the pixels' moments and the work.
 size_t BpmRender::pixel_values() const {
-  return (1 + kStats) * n_pixels_ + EmissionCost().v.size() + moments_new_.size() +
+  return (1 + kStats) * n_pixels_ + ExtraSampleCost().v.size() + moments_new_.size() +
          PassWork::kValues;
 }
 
@@ -485,13 +498,13 @@ void BpmRender::merge(const std::vector<double>& sums) {
   // Rounded to float before they join, as the guide's sums below.
   const double* stats = sums.data() + n_pixels_;
   for (size_t p = 0; p < n_pixels_; ++p) {
-    std::array<double, kStats>& st = eye_.emission_stats[p].v;
+    std::array<double, kStats>& st = eye_.sample_stats[p].v;
     for (size_t k = 0; k < kStats; ++k) st[k] += double(float(stats[kStats * p + k]));
     if (sums[p] > 0) eye_.sees_emission[p] = 1;
   }
   const double* c = stats + kStats * n_pixels_;
   for (size_t k = 0; k < cost_sum_.v.size(); ++k) cost_sum_.v[k] += double(float(c[k]));
-  set_emission_samples();
+  set_sample_counts();
   const double* m = c + cost_sum_.v.size();
   for (size_t i = 0; i < moments_sum_.size(); ++i) moments_sum_[i] += double(float(m[i]));
   const double* w = m + moments_sum_.size();
@@ -562,7 +575,7 @@ void BpmRender::choose_photons() {
 void BpmRender::save(ByteWriter& w) {
   w.put_vector(eye_.sees_emission);
   w.put_vector(eye_.saw_emission);
-  w.put_vector(eye_.emission_stats);
+  w.put_vector(eye_.sample_stats);
   w.put_vector(eye_.round_stats);
   w.put(cost_sum_.v);
   w.put(round_cost().first.v);  // the counters start from zero when the render goes on
@@ -584,16 +597,16 @@ void BpmRender::save(ByteWriter& w) {
 void BpmRender::load(ByteReader& r) {
   eye_.sees_emission = r.get_vector<uint8_t>();
   eye_.saw_emission = r.get_vector<uint8_t>();
-  eye_.emission_stats = r.get_vector<EmissionStats<double>>();
-  eye_.round_stats = r.get_vector<EmissionStats<double>>();
+  eye_.sample_stats = r.get_vector<SampleStats<double>>();
+  eye_.round_stats = r.get_vector<SampleStats<double>>();
   if (eye_.sees_emission.size() != n_pixels_ || eye_.saw_emission.size() != n_pixels_ ||
-      eye_.emission_stats.size() != n_pixels_ || eye_.round_stats.size() != n_pixels_)
+      eye_.sample_stats.size() != n_pixels_ || eye_.round_stats.size() != n_pixels_)
     throw Error(r.what() + " is truncated or corrupt (pixels that see emission)");
-  cost_sum_.v = r.get<std::array<double, 4>>();
-  cost_new_.v = r.get<std::array<double, 4>>();
+  cost_sum_.v = r.get<decltype(cost_sum_.v)>();
+  cost_new_.v = r.get<decltype(cost_new_.v)>();
   // The counters start again from zero.
   counted_ = {};
-  set_emission_samples();
+  set_sample_counts();
   photons_ = r.get<int32_t>();
   moments_sum_ = r.get_vector<double>();
   moments_new_ = r.get_vector<double>();

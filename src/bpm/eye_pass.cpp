@@ -52,8 +52,10 @@ struct EyePath {
   Rng& rng;
   ObjectPhotonLists& out;
   EyeCounters& counters;
-  int& stored;  // backward photons stored so far (BackwardPhoton::place)
-  int& splits;  // medium vertices drawn where the path splits (gather_forced_in_medium)
+  int& stored;              // backward photons stored so far (BackwardPhoton::place)
+  int& splits;              // medium vertices drawn where the path splits (gather_forced_in_medium)
+  int direct_samples;       // at the last diffuse vertex of a surface
+  double& direct_variance;  // of those samples, where there are two or more (EyeRadiance)
 };
 
 // Direct light at v by next-event estimation, shared by MIS with the BSDF sample that goes on.
@@ -122,23 +124,46 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
   }
 }
 
-// The diffuse-th diffuse vertex: its direct light and backward photons, and at the last one the
-// light only a BSDF sample finds. Returns whether the path ends here (at the last one).
+// Direct light at the last diffuse vertex, where the path ends: the mean of path.direct_samples
+// samples, each next-event estimation and a BSDF sample that only looks for the light, shared by
+// MIS (none where every light is a point or a direction: those next-event estimation counts in
+// full). The samples beyond the first are counted apart, and the sample variance of two or more
+// goes to path.direct_variance.
+inline Spectrum direct_light_at_last(const EyePath& path, const PathVertex& v, const PathState& s,
+                                     BsdfPart part) {
+  const int n = path.direct_samples;
+  uint64_t first_rays = 0;  // the rays counted after the first sample
+  Spectrum sum;
+  double mean = 0, m2 = 0;  // Welford's running mean and squared deviations
+  for (int k = 0; k < n; ++k) {
+    if (k == 1) first_rays = path.counters.rays.total();
+    const Spectrum d = direct_light_at(path, v, s, part) +
+                       direct_light_by_bsdf(path.scene, *path.prm.materials, v, s, part, path.rng,
+                                            path.counters.rays);
+    sum += d;
+    const double x = d.average(), delta = x - mean;
+    mean += delta / (k + 1);
+    m2 += delta * (x - mean);
+  }
+  if (n < 2) return sum;
+  path.counters.direct_samples += uint64_t(n - 1);
+  path.counters.direct_rays += path.counters.rays.total() - first_rays;
+  path.direct_variance = m2 / (n - 1);
+  return sum / float(n);
+}
+
+// The diffuse-th diffuse vertex: its direct light and backward photons. Returns whether the path
+// ends here (at the last one).
 inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, const PathState& s,
                                      const EyeVertexChoice& choice, int depth, int diffuse,
                                      Spectrum& L) {
   bool last = diffuse == path.prm.diffuse_depth + 1;
-  // Direct light: shared by MIS with the BSDF sample that continues the path; at the last
-  // vertex, where the path ends, with one that only looks for the light (none where every
-  // light is a point or a direction: those next-event estimation counts in full).
-  L += direct_light_at(path, v, s, choice.part);
+  // Direct light: before the last vertex shared by MIS with the BSDF sample that continues the
+  // path.
+  L += last ? direct_light_at_last(path, v, s, choice.part)
+            : direct_light_at(path, v, s, choice.part);
   store_backward_photons(path, v, s, depth, diffuse, last);
-  if (last) {
-    L += direct_light_by_bsdf(path.scene, *path.prm.materials, v, s, choice.part, path.rng,
-                              path.counters.rays);
-    return true;
-  }
-  return false;
+  return last;
 }
 
 // The diffuse-th diffuse vertex, inside a scattering medium: direct light by next-event
@@ -221,9 +246,22 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
                                              CameraRay ray, PixelFootprint footprint,
                                              uint32_t pixel, Rng& rng, ObjectPhotonLists& out,
                                              EyeCounters& counters, bool emission_only,
-                                             uint8_t near_edge, float flight_u) {
+                                             uint8_t near_edge, float flight_u,
+                                             int direct_samples) {
   int stored = 0, splits = 0;
-  const EyePath path{scene, prm, footprint, pixel, near_edge, rng, out, counters, stored, splits};
+  double direct_variance = -1;
+  const EyePath path{scene,
+                     prm,
+                     footprint,
+                     pixel,
+                     near_edge,
+                     rng,
+                     out,
+                     counters,
+                     stored,
+                     splits,
+                     std::clamp(direct_samples, 1, std::max(1, prm.direct_samples)),
+                     direct_variance};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;
@@ -288,7 +326,7 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
     if (direct_here) L += direct_light_at(path, v, s, choice.part);
     if (!scatter(path, v, choice, direct_here, diffuse, s, emitter)) break;
   }
-  return {L + along, emission ? *emission : L};
+  return {L + along, emission ? *emission : L, direct_variance};
 }
 
 namespace {
@@ -300,7 +338,7 @@ namespace {
 Spectrum mean_emission(const RenderScene& scene, const EyePassParams& prm,
                        const CameraSampler& camera, int pass_index, uint32_t pixel, int count,
                        float first_weight, const Spectrum& first_emission, ObjectPhotonLists& lists,
-                       EyeCounters& ec, EmissionStats<double>* stats) {
+                       EyeCounters& ec, SampleStats<double>* stats) {
   if (stats) stats->add_emission(first_emission.average());
   if (count <= 1 || first_weight == 0) return first_emission;
   Spectrum sum = first_emission;
@@ -320,19 +358,28 @@ Spectrum mean_emission(const RenderScene& scene, const EyePassParams& prm,
 
 }  // namespace
 
-int emission_sample_count(const EmissionStats<double>& s, double cost_ratio, int max_samples) {
+int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples) {
   if (max_samples <= 1) return 1;
   if (s.emission_n() < 2 || s.rest_n() < 2) return 1;
   if (cost_ratio < 0) return max_samples;
-  auto variance = [&](int at) {
-    const double n = s.v[size_t(at)], sum = s.v[size_t(at) + 1], sum2 = s.v[size_t(at) + 2];
-    return std::max(0.0, (sum2 - sum * sum / n) / (n - 1));
-  };
-  const double v_emission = variance(0), v_rest = variance(3);
+  const double v_emission = s.variance(0), v_rest = s.variance(3);
   if (!(v_rest > 0)) return v_emission > 0 ? max_samples : 1;
   const double e = std::sqrt(cost_ratio * v_emission / v_rest);
   if (!std::isfinite(e)) return max_samples;
   return int(std::clamp(std::round(e), 1.0, double(max_samples)));
+}
+
+int direct_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples) {
+  if (max_samples <= 1) return 1;
+  const double estimates = s.v[6], variances = s.v[10];
+  if (estimates < 2 || variances < 1 || cost_ratio < 0) return 2;
+  const double v_direct = s.v[11] / variances;
+  if (!(v_direct > 0)) return 1;
+  const double v_rest = s.variance(6) - v_direct * s.v[9] / estimates;
+  if (!(v_rest > 0)) return max_samples;
+  const double k = std::sqrt(cost_ratio * v_direct / v_rest);
+  if (!std::isfinite(k)) return max_samples;
+  return int(std::clamp(std::round(k), 1.0, double(max_samples)));
 }
 
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const CameraSampler& camera,
@@ -368,7 +415,9 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             EyeRadiance r =
                 trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
                                false, prm.near_edges ? prm.near_edges->at(pixel) : 3,
-                               flights ? camera.stream_uniform(pass_index, pixel) : -1.0f);
+                               flights ? camera.stream_uniform(pass_index, pixel) : -1.0f,
+                               px->direct_samples[pixel]);
+            px->round_stats[pixel].add_direct_variance(r.direct_variance);
             px->filter_weight[pixel] = cs.filter_weight;
             const Spectrum emission =
                 mean_emission(scene, prm, camera, pass_index, pixel,

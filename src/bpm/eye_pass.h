@@ -8,6 +8,7 @@
 #pragma once
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -33,6 +34,10 @@ struct EyePassParams {
   // vertex (emitter edges, lights behind glass): cheap paths that end at that vertex, averaged
   // with the full path's share. Each pixel takes EyePixels::emission_samples of them.
   int emission_samples = 1;
+  // At most this many samples of direct light (next-event estimation and a BSDF sample that looks
+  // for the light, averaged) at the last diffuse vertex of a surface; each pixel takes
+  // EyePixels::direct_samples of them.
+  int direct_samples = 1;
   // When positive, every backward photon's radius in world units instead of the per-length radii
   // (BpmSettings::radius, times the iteration's radius scale).
   float world_radius = 0;
@@ -62,12 +67,16 @@ struct EyeCounters {
   uint64_t pixels = 0;  // pixels sampled (over the iterations)
   // The extra camera samples for emission, and the rays they cast (counted in `rays` too).
   uint64_t emission_samples = 0, emission_rays = 0;
+  // The extra samples of direct light beyond the first, and the rays they cast (in `rays` too).
+  uint64_t direct_samples = 0, direct_rays = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);
     backward_photons += o.backward_photons;
     pixels += o.pixels;
     emission_samples += o.emission_samples;
     emission_rays += o.emission_rays;
+    direct_samples += o.direct_samples;
+    direct_rays += o.direct_rays;
   }
 };
 
@@ -75,9 +84,12 @@ struct EyeCounters {
 using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 
 // What an eye path counts itself: everything, and the part of it seen before the first diffuse
-// vertex (emitters seen directly or through specular vertices only).
+// vertex (emitters seen directly or through specular vertices only); and where it took two or
+// more samples of direct light at its last vertex, their sample variance (of their means over the
+// wavelengths; -1 where it took fewer).
 struct EyeRadiance {
   Spectrum total, emission;
+  double direct_variance = -1;
 };
 
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
@@ -86,24 +98,44 @@ struct EyeRadiance {
 // computed. near_edge: the pixel's mark_near_edges bits, which decide whether a first vertex seen
 // directly probes its discs. The ray's weight is the throughput the path starts with. flight_u:
 // when in [0, 1), the uniform number of the path's first free flight in a scattering medium
-// (PathState::flight_u).
+// (PathState::flight_u). direct_samples: the samples of direct light at the last diffuse vertex
+// of a surface, at most params.direct_samples.
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, CameraRay ray,
                            PixelFootprint footprint, uint32_t pixel, Rng& rng,
                            ObjectPhotonLists& out, EyeCounters& counters,
-                           bool emission_only = false, uint8_t near_edge = 3, float flight_u = -1);
+                           bool emission_only = false, uint8_t near_edge = 3, float flight_u = -1,
+                           int direct_samples = 1);
 
-// A pixel's samples of emission seen before the first diffuse vertex (per camera sample), and of
-// the rest of its estimate (per iteration): counts, sums and sums of squares of their means over
-// the wavelengths, in that order.
+// A pixel's statistics for its extra samples, over the iterations: of emission seen before the
+// first diffuse vertex (per camera sample) and of the rest of its estimate (per iteration), for
+// the emission samples; of its whole estimate (per iteration, with the sum of 1 / the direct
+// samples it took) and the sample variances of its direct light at one vertex, for the direct
+// samples. Counts, sums and sums of squares of means over the wavelengths.
 template <class T>
-struct EmissionStats {
-  static constexpr int kValues = 6;
+struct SampleStats {
+  static constexpr int kValues = 12;
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
   void add_emission(double x) { add(0, x); }
   void add_rest(double x) { add(3, x); }
+  void add_estimate(double x, int direct_samples) {
+    if (!std::isfinite(x)) return;
+    add(6, x);
+    v[9] += T(1.0 / direct_samples);
+  }
+  void add_direct_variance(double s2) {
+    if (!std::isfinite(s2) || s2 < 0) return;
+    v[10] += 1;
+    v[11] += T(s2);
+  }
   T emission_n() const { return v[0]; }
   T rest_n() const { return v[3]; }
+  // The sample variance of the values added at `at` (0, 3 or 6); 0 with fewer than two.
+  double variance(int at) const {
+    const double n = double(v[size_t(at)]), sum = double(v[size_t(at) + 1]),
+                 sum2 = double(v[size_t(at) + 2]);
+    return n < 2 ? 0.0 : std::max(0.0, (sum2 - sum * sum / n) / (n - 1));
+  }
 
  private:
   void add(int at, double x) {
@@ -120,7 +152,15 @@ struct EmissionStats {
 // V_emission / E times its cost C + (E - 1) c least: E = sqrt(cost_ratio V_emission / V_rest)
 // rounded, where cost_ratio = C / c - 1. Within [1, max_samples]: 1 until both parts have two
 // samples, then max_samples while the cost ratio is unknown (negative).
-int emission_sample_count(const EmissionStats<double>& s, double cost_ratio, int max_samples);
+int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples);
+
+// Samples of direct light per iteration at a pixel's last diffuse vertex, by the same balance:
+// V_direct is the mean sample variance of direct light at one vertex (what more samples there
+// average away), V_rest what remains of the variance of the pixel's estimate per iteration (its
+// variance less V_direct times the mean of 1 / the samples it took). Within [1, max_samples]: 2
+// (at most max_samples) until the statistics and the cost ratio are known; max_samples where
+// nothing but direct light varies.
+int direct_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
@@ -136,10 +176,13 @@ struct EyePixels {
   // wavelengths).
   std::vector<uint16_t> emission_samples;
   std::vector<float> emission_part;
-  // The emission statistics of the pixels that see emission: of every round so far, and of this
-  // round (summed over processes at its end).
-  std::vector<EmissionStats<double>> emission_stats;
-  std::vector<EmissionStats<double>> round_stats;
+  // Samples of direct light per iteration at the pixel's last vertex (direct_sample_count, set
+  // at the end of each round; at most EyePassParams::direct_samples of them are taken).
+  std::vector<uint16_t> direct_samples;
+  // The pixels' statistics for their extra samples (the emission ones only of pixels that see
+  // emission): of every round so far, and of this round (summed over processes at its end).
+  std::vector<SampleStats<double>> sample_stats;
+  std::vector<SampleStats<double>> round_stats;
   explicit EyePixels(size_t n)
       : radiance(n),
         filter_weight(n),
@@ -149,7 +192,8 @@ struct EyePixels {
         saw_emission(n, 0),
         emission_samples(n, 1),
         emission_part(n, 0.0f),
-        emission_stats(n),
+        direct_samples(n, 2),
+        sample_stats(n),
         round_stats(n) {}
 };
 

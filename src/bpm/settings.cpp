@@ -32,6 +32,9 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
+  b.direct_samples = ps.get_int("directsamples", b.direct_samples);
+  ps.require("directsamples", b.direct_samples >= 1 && b.direct_samples <= 1024,
+             "must be in 1..1024", in.loc);
   return b;
 }
 
@@ -50,6 +53,7 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"guide_emission", s.guide_emission},
           {"disc_probes", s.disc_probes},
           {"emission_samples", s.emission_samples},
+          {"direct_samples", s.direct_samples},
           {"split_in_media", s.split_in_media}};
 }
 

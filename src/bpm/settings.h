@@ -22,6 +22,10 @@ struct BpmSettings : PhotonSettings {
   // that show any (EyePassParams::emission_samples): emitter edges and lights seen through glass
   // converge with these, not with the iterations.
   int emission_samples = 8;
+  // The most samples of direct light per iteration at an eye path's last diffuse vertex
+  // (EyePassParams::direct_samples): each pixel takes what its measured variance pays for
+  // (direct_sample_count).
+  int direct_samples = 8;
   // When positive, the initial radius of every backward photon in world units (pbrt-v4 sppm's
   // "radius"), in place of k0 and k1; it shrinks with the radius policy like them.
   float radius = 0;

@@ -50,6 +50,10 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
           // (counted among the camera, bounce and shadow rays).
           {"emission_samples", t.eye.emission_samples},
           {"emission_sample_rays", t.eye.emission_rays},
+          // The samples of direct light beyond the first at last vertices
+          // (EyePixels::direct_samples) and their rays (among the bounce and shadow rays).
+          {"direct_samples", t.eye.direct_samples},
+          {"direct_sample_rays", t.eye.direct_rays},
           {"backward_photons", t.eye.backward_photons},
           // The paper's Table 1 counts per ray traced from the camera with all its continuations
           // (an eye path); per segment counts every camera and bounce ray.

@@ -123,6 +123,7 @@ RenderOptions render_options(const RenderRequest& a, const LoadedScene& ls,
   if (a.split_in_media) opt.bpm.split_in_media = true;
   if (a.no_disc_probes) opt.bpm.disc_probes = opt.fpm.disc_probes = false;
   if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;
+  if (a.direct_samples > 0) opt.bpm.direct_samples = a.direct_samples;
   if (a.radius >= 0) opt.bpm.radius = a.radius;
   for (PhotonSettings* p :
        {static_cast<PhotonSettings*>(&opt.bpm), static_cast<PhotonSettings*>(&opt.fpm)}) {

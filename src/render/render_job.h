@@ -39,6 +39,7 @@ struct RenderRequest {
   bool debias = false;
   std::string bias_model;
   int emission_samples = 0;
+  int direct_samples = 0;
   float radius = -1;
   int photons = 0;
   bool final_gather = false;
