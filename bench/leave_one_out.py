@@ -36,12 +36,14 @@ SCENES = {
     "spot-lens-fog": "scenes/spot-lens-fog.pbrt",
     "underwater": "scenes/underwater.pbrt",
     "volumetric-caustic": "../shared/scenes/volumetric-caustic/scene-v4.pbrt",
+    "coffee": "../shared/scenes/coffee/scene-v4.pbrt",
 }
 # Each default with its value and the values tried beside it (keyword arguments of bpm.render).
 CANDIDATES = {
     "k0": (1.0, [0.7, 1.4]),
-    "k1": (3.0, [2.0, 4.5, 6.0]),
+    "k1": (4.5, [2.0, 3.0, 6.0]),
     "emission_samples": (8, [4, 16]),
+    "direct_samples": (8, [1, 2, 32]),
     "alpha": (2 / 3, [0.5, 0.8]),
 }
 

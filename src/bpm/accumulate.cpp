@@ -101,10 +101,9 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))
           film->add_bias(x, y, film->rgb_of(bias, wl), spectrum_to_luminance(bias, wl));
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
-        if (L.is_finite()) {
-          if (eye.sees_emission[p]) eye.round_stats[p].add_rest(L.average() - eye.emission_part[p]);
-          eye.round_stats[p].add_estimate(L.average(), eye.direct_samples[p]);
-        }
+        if (eye.sees_emission[p] && L.is_finite())
+          eye.round_stats[p].add_rest(L.average() - eye.emission_part[p]);
+        eye.round_stats[p].add_estimate(L.average(), eye.direct_samples[p]);  // finite ones
         if (estimates && L.is_finite()) {
           (*estimates)[2 * size_t(p)] += L.average();
           (*estimates)[2 * size_t(p) + 1] += 1;

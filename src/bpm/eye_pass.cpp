@@ -250,18 +250,9 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
                                              int direct_samples) {
   int stored = 0, splits = 0;
   double direct_variance = -1;
-  const EyePath path{scene,
-                     prm,
-                     footprint,
-                     pixel,
-                     near_edge,
-                     rng,
-                     out,
-                     counters,
-                     stored,
-                     splits,
-                     std::clamp(direct_samples, 1, std::max(1, prm.direct_samples)),
-                     direct_variance};
+  const int direct = std::clamp(direct_samples, 1, std::max(1, prm.direct_samples));
+  const EyePath path{scene, prm,      footprint, pixel,  near_edge, rng,
+                     out,   counters, stored,    splits, direct,    direct_variance};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;
@@ -362,7 +353,7 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
   if (max_samples <= 1) return 1;
   if (s.emission_n() < 2 || s.rest_n() < 2) return 1;
   if (cost_ratio < 0) return max_samples;
-  const double v_emission = s.variance(0), v_rest = s.variance(3);
+  const double v_emission = s.variance(s.kEmission), v_rest = s.variance(s.kRest);
   if (!(v_rest > 0)) return v_emission > 0 ? max_samples : 1;
   const double e = std::sqrt(cost_ratio * v_emission / v_rest);
   if (!std::isfinite(e)) return max_samples;
@@ -371,11 +362,10 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
 
 int direct_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples) {
   if (max_samples <= 1) return 1;
-  const double estimates = s.v[6], variances = s.v[10];
-  if (estimates < 2 || variances < 1 || cost_ratio < 0) return 2;
-  const double v_direct = s.v[11] / variances;
+  if (s.estimate_n() < 2 || s.direct_n() < 1 || cost_ratio < 0) return 2;
+  const double v_direct = s.direct_variance();
   if (!(v_direct > 0)) return 1;
-  const double v_rest = s.variance(6) - v_direct * s.v[9] / estimates;
+  const double v_rest = s.variance(s.kEstimate) - v_direct * s.mean_inverse_samples();
   if (!(v_rest > 0)) return max_samples;
   const double k = std::sqrt(cost_ratio * v_direct / v_rest);
   if (!std::isfinite(k)) return max_samples;

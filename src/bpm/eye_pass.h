@@ -114,23 +114,32 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params
 template <class T>
 struct SampleStats {
   static constexpr int kValues = 12;
+  // Where each group starts in v: count, sum and sum of squares for the first three; then the
+  // sum of 1 / direct samples over the estimates, and the count and sum of direct variances.
+  enum : int { kEmission = 0, kRest = 3, kEstimate = 6, kInverseSamples = 9, kDirect = 10 };
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
-  void add_emission(double x) { add(0, x); }
-  void add_rest(double x) { add(3, x); }
+  void add_emission(double x) { add(kEmission, x); }
+  void add_rest(double x) { add(kRest, x); }
   void add_estimate(double x, int direct_samples) {
     if (!std::isfinite(x)) return;
-    add(6, x);
-    v[9] += T(1.0 / direct_samples);
+    add(kEstimate, x);
+    v[kInverseSamples] += T(1.0 / direct_samples);
   }
   void add_direct_variance(double s2) {
     if (!std::isfinite(s2) || s2 < 0) return;
-    v[10] += 1;
-    v[11] += T(s2);
+    v[kDirect] += 1;
+    v[kDirect + 1] += T(s2);
   }
-  T emission_n() const { return v[0]; }
-  T rest_n() const { return v[3]; }
-  // The sample variance of the values added at `at` (0, 3 or 6); 0 with fewer than two.
+  T emission_n() const { return v[kEmission]; }
+  T rest_n() const { return v[kRest]; }
+  T estimate_n() const { return v[kEstimate]; }
+  T direct_n() const { return v[kDirect]; }
+  // The mean of the direct variances, and of 1 / the direct samples of the estimates.
+  double direct_variance() const { return double(v[kDirect + 1]) / double(v[kDirect]); }
+  double mean_inverse_samples() const { return double(v[kInverseSamples]) / double(v[kEstimate]); }
+  // The sample variance of the values added at `at` (kEmission, kRest or kEstimate); 0 with
+  // fewer than two.
   double variance(int at) const {
     const double n = double(v[size_t(at)]), sum = double(v[size_t(at) + 1]),
                  sum2 = double(v[size_t(at) + 2]);
