@@ -92,7 +92,7 @@ def main():
     for default in a.defaults.split(","):
         value, others = CANDIDATES[default]
         if a.values:
-            others = [float(v) for v in a.values.split(",")]
+            others = [type(value)(v) for v in a.values.split(",")]
         values = [value] + others
         scores = {}
         for name, path, ref, size in scenes:

@@ -1194,6 +1194,18 @@ TEST(Integrators, InterfaceAroundALampChangesNothing) {
   }
 }
 
+// The RMS over the renders' pixels of their luminance's difference from the reference's.
+double pixel_rms_error(const Iterations& its, const Image& ref) {
+  double sum = 0;
+  for (const Image& img : its.images)
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        double d = img.at(x, y).luminance() - ref.at(x, y).luminance();
+        sum += d * d;
+      }
+  return std::sqrt(sum / double(its.images.size() * ref.rgb.size() / 3));
+}
+
 // Emission seen before the first diffuse vertex takes up to EyePassParams::emission_samples
 // camera samples in pixels that have shown some: a light whose edges cross pixels, partly behind a
 // glass sphere, and nothing that reflects light, so that all of a pixel's variance is its
@@ -1213,17 +1225,7 @@ TEST(Bpm, EmissionSamplesAverageEmitterEdgesWithoutBias) {
        "Shape \"sphere\" \"float radius\" 0.3\nAttributeEnd\n";
   LoadedScene ls = load(s);
   RenderRun ref = render_with(ls, "path", 4096);
-  Image ref_image = ref.film.image();
-  auto rms_error = [&](const Iterations& its) {
-    double sum = 0;
-    for (const Image& img : its.images)
-      for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-          double d = img.at(x, y).luminance() - ref_image.at(x, y).luminance();
-          sum += d * d;
-        }
-    return std::sqrt(sum / double(its.images.size() * ref_image.rgb.size() / 3));
-  };
+  auto rms_error = [&](const Iterations& its) { return pixel_rms_error(its, ref.film.image()); };
   BpmSettings one, eight;
   one.emission_samples = 1;
   eight.emission_samples = 8;
@@ -1285,17 +1287,7 @@ TEST(Bpm, DirectSamplesAverageDirectLightWithoutBias) {
        "Shape \"bilinearmesh\" \"point3 P\" [-3 0 -3  3 0 -3  -3 0 3  3 0 3]\n";
   LoadedScene ls = load(s);
   RenderRun ref = render_with(ls, "path", 4096);
-  Image ref_image = ref.film.image();
-  auto rms_error = [&](const Iterations& its) {
-    double sum = 0;
-    for (const Image& img : its.images)
-      for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-          double d = img.at(x, y).luminance() - ref_image.at(x, y).luminance();
-          sum += d * d;
-        }
-    return std::sqrt(sum / double(its.images.size() * ref_image.rgb.size() / 3));
-  };
+  auto rms_error = [&](const Iterations& its) { return pixel_rms_error(its, ref.film.image()); };
   BpmSettings one, eight;
   one.direct_samples = 1;
   eight.direct_samples = 8;
