@@ -1307,34 +1307,37 @@ TEST(Bpm, DirectSamplesAverageDirectLightWithoutBias) {
 // the estimate per iteration less V_direct times the mean of 1 / samples; within [1, max]; 2
 // while the statistics or the cost ratio are not known.
 TEST(Bpm, DirectSampleCountBalancesVarianceAndCost) {
-  // Estimates 1 or 5 (sample variance 16/3 over four), each iteration with `taken` samples whose
-  // sample variances are `variances`.
+  // Four estimates of sample variance 16/3 (1 or 5: PixelMoments), each iteration with `taken`
+  // samples whose sample variances are `variances`.
   auto stats = [](int taken, std::vector<double> variances) {
     SampleStats<double> s;
-    for (double e : {1.0, 5.0, 1.0, 5.0}) s.add_estimate(e, taken);
+    for (int k = 0; k < 4; ++k) s.add_direct_taken(taken);
     for (double v : variances) s.add_direct_variance(v);
     return s;
   };
+  auto count = [](const SampleStats<double>& s, double cost_ratio, int max_samples) {
+    return direct_sample_count(s, 4, 16.0 / 3, cost_ratio, max_samples);
+  };
   // V_direct 4, V_rest 16/3 - 4/2 = 10/3: sqrt(ratio * 1.2).
   const SampleStats<double> two = stats(2, {4, 4, 4, 4});
-  EXPECT_EQ(direct_sample_count(two, 7.5, 8), 3);  // sqrt(9)
-  EXPECT_EQ(direct_sample_count(two, 1.0, 8), 1);  // sqrt(1.2)
-  EXPECT_EQ(direct_sample_count(two, 200.0, 8), 8);
-  EXPECT_EQ(direct_sample_count(two, 7.5, 1), 1);
+  EXPECT_EQ(count(two, 7.5, 8), 3);  // sqrt(9)
+  EXPECT_EQ(count(two, 1.0, 8), 1);  // sqrt(1.2)
+  EXPECT_EQ(count(two, 200.0, 8), 8);
+  EXPECT_EQ(count(two, 7.5, 1), 1);
   // Taken one at a time the same estimates leave V_rest 16/3 - 4 = 4/3: sqrt(ratio * 3).
-  EXPECT_EQ(direct_sample_count(stats(1, {4}), 3.0, 8), 3);
+  EXPECT_EQ(count(stats(1, {4}), 3.0, 8), 3);
   // Direct light that does not vary; all the variance its; nothing known yet.
-  EXPECT_EQ(direct_sample_count(stats(2, {0, 0}), 7.5, 8), 1);
-  EXPECT_EQ(direct_sample_count(stats(2, {16, 16}), 7.5, 8), 8);
-  EXPECT_EQ(direct_sample_count(stats(2, {}), 7.5, 8), 2);
-  EXPECT_EQ(direct_sample_count(SampleStats<double>{}, 7.5, 8), 2);
-  EXPECT_EQ(direct_sample_count(two, -1.0, 8), 2);
-  EXPECT_EQ(direct_sample_count(two, 0.0, 8), 1);  // an extra sample costs a whole iteration
-  // Non-finite values are left out.
+  EXPECT_EQ(count(stats(2, {0, 0}), 7.5, 8), 1);
+  EXPECT_EQ(count(stats(2, {16, 16}), 7.5, 8), 8);
+  EXPECT_EQ(count(stats(2, {}), 7.5, 8), 2);
+  EXPECT_EQ(count(SampleStats<double>{}, 7.5, 8), 2);
+  EXPECT_EQ(direct_sample_count(two, 1, 0.0, 7.5, 8), 2);  // one estimate: no variance yet
+  EXPECT_EQ(count(two, -1.0, 8), 2);
+  EXPECT_EQ(count(two, 0.0, 8), 1);  // an extra sample costs a whole iteration
+  // Non-finite variances are left out.
   SampleStats<double> odd = two;
   odd.add_direct_variance(std::nan(""));
-  odd.add_estimate(INFINITY, 2);
-  EXPECT_EQ(direct_sample_count(odd, 7.5, 8), 3);
+  EXPECT_EQ(count(odd, 7.5, 8), 3);
 }
 
 // pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon

@@ -15,9 +15,10 @@ namespace bpm {
 namespace {
 
 // A pixel's PixelMoments: its estimate L, whose photon part is photon_L, odd_L of it from the odd
-// photons of `emitted`.
+// photons of `emitted`; and beside them in its round statistics, 1 / the direct samples it took.
 void add_moments(const Spectrum& L, const Spectrum& photon_L, const Spectrum& odd_L,
-                 uint64_t emitted, double* m) {
+                 uint64_t emitted, int direct_samples, double* m, SampleStats<double>* stats) {
+  stats->add_direct_taken(direct_samples);
   const double l = L.average(), halves = (photon_L - odd_L * 2).average();
   m[PixelMoments::kSum] += l;
   m[PixelMoments::kSquares] += l * l;
@@ -94,8 +95,8 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         }
         Spectrum L = eye.radiance[p] + photon_L;
         if (moments && L.is_finite())
-          add_moments(L, photon_L, odd_L, light.emitted,
-                      moments->data() + PixelMoments::kValues * size_t(p));
+          add_moments(L, photon_L, odd_L, light.emitted, eye.direct_samples[p],
+                      moments->data() + PixelMoments::kValues * size_t(p), &eye.round_stats[p]);
         if (settings.debias)
           L -= bias;
         else if (bias.is_finite() && eye.filter_weight[p] != 0 && recordable(L))
@@ -103,7 +104,6 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         record_pass(film, p, L, wl, eye.filter_weight[p], max_component_value, settings.debias);
         if (eye.sees_emission[p] && L.is_finite())
           eye.round_stats[p].add_rest(L.average() - eye.emission_part[p]);
-        eye.round_stats[p].add_estimate(L.average(), eye.direct_samples[p]);  // finite ones
         if (estimates && L.is_finite()) {
           (*estimates)[2 * size_t(p)] += L.average();
           (*estimates)[2 * size_t(p) + 1] += 1;

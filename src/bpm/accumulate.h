@@ -17,8 +17,8 @@ namespace bpm {
 // of the pass over its photon part (radius_bias under bias_model) goes to the film beside its
 // estimate, or with `debias` is taken from it. When `estimates` is given (2 per pixel), each
 // sampled pixel's estimate (the mean over its wavelengths) is added to its first and 1 to its
-// second. Each sampled pixel's estimate goes to its round statistics (EyePixels::round_stats), and
-// where the pixel sees emission, the estimate less its emission part too.
+// second. Where the pixel sees emission, the estimate less its emission part goes to its round
+// statistics (EyePixels::round_stats).
 //
 // The light pass's sums are used up: afterwards flux[g] and flux_inner[g] hold backward photon g's
 // parts of its pixel's estimate and bias (its shares), where it received light.
@@ -41,7 +41,8 @@ struct PixelMoments {
   enum : size_t { kSum, kSquares, kPhotonVariance, kPhotonVarianceTimesN, kCount };
 };
 
-// `moments` (PixelMoments::kValues per pixel), when given, gets each sampled pixel's sums. The
+// `moments` (PixelMoments::kValues per pixel), when given, gets each sampled pixel's sums, and its
+// round statistics 1 / the direct samples it took (SampleStats::add_direct_taken). The
 // photon part's variance over the light pass is (A - B)^2, A and B the parts that the photons of
 // even and of odd index brought (LightPassResult::flux_odd): two independent halves of the pass.
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums, EyePixels* eye,

@@ -456,7 +456,12 @@ void BpmRender::set_sample_counts() {
     eye_.emission_samples[p] =
         eye_.sees_emission[p] ? uint16_t(emission_sample_count(st, emission, s_.emission_samples))
                               : 1;
-    eye_.direct_samples[p] = uint16_t(direct_sample_count(st, direct, s_.direct_samples));
+    // The pixel's estimates: their count and sample variance, from its moments.
+    const double* m = moments_sum_.data() + PixelMoments::kValues * p;
+    const double n = m[PixelMoments::kCount], sum = m[PixelMoments::kSum];
+    const double variance = n < 2 ? 0.0 : (m[PixelMoments::kSquares] - sum * sum / n) / (n - 1);
+    eye_.direct_samples[p] =
+        uint16_t(direct_sample_count(st, n, std::max(0.0, variance), direct, s_.direct_samples));
   }
 }
 
@@ -504,9 +509,9 @@ void BpmRender::merge(const std::vector<double>& sums) {
   }
   const double* c = stats + kStats * n_pixels_;
   for (size_t k = 0; k < cost_sum_.v.size(); ++k) cost_sum_.v[k] += double(float(c[k]));
-  set_sample_counts();
   const double* m = c + cost_sum_.v.size();
   for (size_t i = 0; i < moments_sum_.size(); ++i) moments_sum_[i] += double(float(m[i]));
+  set_sample_counts();
   const double* w = m + moments_sum_.size();
   for (size_t k = 0; k < PassWork::kValues; ++k) work_sum_.v[k] += double(float(w[k]));
   choose_photons();
@@ -606,7 +611,6 @@ void BpmRender::load(ByteReader& r) {
   cost_new_.v = r.get<decltype(cost_new_.v)>();
   // The counters start again from zero.
   counted_ = {};
-  set_sample_counts();
   photons_ = r.get<int32_t>();
   moments_sum_ = r.get_vector<double>();
   moments_new_ = r.get_vector<double>();
@@ -616,6 +620,7 @@ void BpmRender::load(ByteReader& r) {
   const size_t moments = PixelMoments::kValues * n_pixels_;
   if (photons_ < 1 || moments_sum_.size() != moments || moments_new_.size() != moments)
     throw Error(r.what() + " is truncated or corrupt (photon count)");
+  set_sample_counts();
   if (r.get<uint8_t>() != uint8_t(!guide_.empty()))
     throw Error(r.what() + " differs in guided emission (--no-guide)");
   if (guide_.empty()) return;

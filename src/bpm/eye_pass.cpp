@@ -360,12 +360,13 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
   return int(std::clamp(std::round(e), 1.0, double(max_samples)));
 }
 
-int direct_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples) {
+int direct_sample_count(const SampleStats<double>& s, double estimates, double estimate_variance,
+                        double cost_ratio, int max_samples) {
   if (max_samples <= 1) return 1;
-  if (s.estimate_n() < 2 || s.direct_n() < 1 || cost_ratio < 0) return 2;
+  if (estimates < 2 || s.direct_n() < 1 || cost_ratio < 0) return 2;
   const double v_direct = s.direct_variance();
   if (!(v_direct > 0)) return 1;
-  const double v_rest = s.variance(s.kEstimate) - v_direct * s.mean_inverse_samples();
+  const double v_rest = estimate_variance - v_direct * double(s.v[s.kInverseSamples]) / estimates;
   if (!(v_rest > 0)) return max_samples;
   const double k = std::sqrt(cost_ratio * v_direct / v_rest);
   if (!std::isfinite(k)) return max_samples;

@@ -108,24 +108,21 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params
 
 // A pixel's statistics for its extra samples, over the iterations: of emission seen before the
 // first diffuse vertex (per camera sample) and of the rest of its estimate (per iteration), for
-// the emission samples; of its whole estimate (per iteration, with the sum of 1 / the direct
-// samples it took) and the sample variances of its direct light at one vertex, for the direct
-// samples. Counts, sums and sums of squares of means over the wavelengths.
+// the emission samples (counts, sums and sums of squares of means over the wavelengths); the sum
+// of 1 / the direct samples it took per estimate (the estimates' own moments are PixelMoments,
+// bpm/accumulate.h) and the sample variances of its direct light at one vertex, for the direct
+// samples.
 template <class T>
 struct SampleStats {
-  static constexpr int kValues = 12;
-  // Where each group starts in v: count, sum and sum of squares for the first three; then the
-  // sum of 1 / direct samples over the estimates, and the count and sum of direct variances.
-  enum : int { kEmission = 0, kRest = 3, kEstimate = 6, kInverseSamples = 9, kDirect = 10 };
+  static constexpr int kValues = 9;
+  // Where each group starts in v: count, sum and sum of squares for the first two; then the sum
+  // of 1 / direct samples over the estimates, and the count and sum of direct variances.
+  enum : int { kEmission = 0, kRest = 3, kInverseSamples = 6, kDirect = 7 };
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
   void add_emission(double x) { add(kEmission, x); }
   void add_rest(double x) { add(kRest, x); }
-  void add_estimate(double x, int direct_samples) {
-    if (!std::isfinite(x)) return;
-    add(kEstimate, x);
-    v[kInverseSamples] += T(1.0 / direct_samples);
-  }
+  void add_direct_taken(int direct_samples) { v[kInverseSamples] += T(1.0 / direct_samples); }
   void add_direct_variance(double s2) {
     if (!std::isfinite(s2) || s2 < 0) return;
     v[kDirect] += 1;
@@ -133,13 +130,10 @@ struct SampleStats {
   }
   T emission_n() const { return v[kEmission]; }
   T rest_n() const { return v[kRest]; }
-  T estimate_n() const { return v[kEstimate]; }
   T direct_n() const { return v[kDirect]; }
-  // The mean of the direct variances, and of 1 / the direct samples of the estimates.
+  // The mean of the direct variances.
   double direct_variance() const { return double(v[kDirect + 1]) / double(v[kDirect]); }
-  double mean_inverse_samples() const { return double(v[kInverseSamples]) / double(v[kEstimate]); }
-  // The sample variance of the values added at `at` (kEmission, kRest or kEstimate); 0 with
-  // fewer than two.
+  // The sample variance of the values added at `at` (kEmission or kRest); 0 with fewer than two.
   double variance(int at) const {
     const double n = double(v[size_t(at)]), sum = double(v[size_t(at) + 1]),
                  sum2 = double(v[size_t(at) + 2]);
@@ -166,10 +160,11 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
 // Samples of direct light per iteration at a pixel's last diffuse vertex, by the same balance:
 // V_direct is the mean sample variance of direct light at one vertex (what more samples there
 // average away), V_rest what remains of the variance of the pixel's estimate per iteration (its
-// variance less V_direct times the mean of 1 / the samples it took). Within [1, max_samples]: 2
-// (at most max_samples) until the statistics and the cost ratio are known; max_samples where
-// nothing but direct light varies.
-int direct_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples);
+// sample variance over its `estimates` estimates, less V_direct times the mean of 1 / the samples
+// it took). Within [1, max_samples]: 2 (at most max_samples) until the statistics and the cost
+// ratio are known; max_samples where nothing but direct light varies.
+int direct_sample_count(const SampleStats<double>& s, double estimates, double estimate_variance,
+                        double cost_ratio, int max_samples);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
