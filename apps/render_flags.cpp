@@ -220,6 +220,14 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
                    "file: integer directsamples)")
       ->check(CLI::Range(1, 1024))
       ->group(kBpm);
+  render
+      ->add_option("--estimators", ra.estimators,
+                   "partition (default): indirect light at the last diffuse vertex comes from the "
+                   "photons alone; combined: the eye path also goes on from there, and each light "
+                   "path is weighed between the photons and the continuation by multiple "
+                   "importance sampling (scenes without media; file: string estimators)")
+      ->check(CLI::IsMember({"partition", "combined"}))
+      ->group(kBpm);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))
       ->group(kBpm);

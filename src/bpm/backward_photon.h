@@ -32,7 +32,10 @@ struct BackwardPhoton {
   uint32_t material;
   uint16_t eye_depth;         // scattering events on the eye path, this vertex included
   uint8_t accepts;            // AcceptMask bits
-  uint8_t diffuse_index : 7;  // j - 1 for the j-th diffuse vertex (0..3)
+  uint8_t diffuse_index : 6;  // j - 1 for the j-th diffuse vertex (0..3)
+  // The eye path went on from here (combined estimators, photons/merge_weights.h): the photons
+  // it gathers are weighed against that.
+  uint8_t combined : 1 = 0;
   // The disc's probes looked (DiscProbes::looked: other geometry is near): each photon is
   // gathered only where nothing stands between it and the point (photon_cut_off).
   uint8_t cut_off_tested : 1 = 0;

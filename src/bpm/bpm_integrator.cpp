@@ -150,6 +150,8 @@ class BpmRender {
   // what the rounds learnt.
   PassWork work_now() const;
   void choose_photons();
+  // Combined estimators run: asked for, in a scene without media (photons/merge_weights.h).
+  bool combined() const { return s_.combine && scene_.media.empty(); }
   // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
   double reserve_memory() const;
 
@@ -304,6 +306,8 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   if (opt_.image && !eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
   // 2. Per-object sphere trees over the backward photons.
   LightPassParams lp{&wm, opt_.max_depth, s_.normal_cos, {}};
+  lp.combine = combined();
+  lp.merge_photons = double(photons_);
   if (!build_maps(pass, control, &lp)) return PassResult{false, 0, "", "memory"};
   if (sensors_) {
     sensors_->set_scale(scale);
@@ -338,7 +342,9 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    s_.disc_probes,
                    &near_edges_,
                    opt_.equiangular,
-                   s_.split_in_media};
+                   s_.split_in_media,
+                   combined(),
+                   double(photons_)};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii.
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,

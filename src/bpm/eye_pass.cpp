@@ -11,6 +11,7 @@
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
 #include "photons/disc_probes.h"
+#include "photons/merge_weights.h"
 
 namespace bpm {
 namespace {
@@ -69,15 +70,17 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 // Stores one backward photon at diffuse vertex v. Its disc is probed where it may be cut
 // (disc_probes.h); where a larger disc about the same point was found whole (`larger`), so is
 // this one, and its photons are tested as the larger one's are. Returns the disc's probes (none:
-// not probed).
+// not probed). With merge_density, the eye path goes on from the vertex (combined estimators): the
+// backward photon is marked so, and *merge_density set to its pi r^2 s N (0 where none is stored).
 inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
                                         const PathState& s, int depth, int diffuse,
                                         bool seen_directly, uint8_t accepts,
-                                        const DiscProbes& larger) {
+                                        const DiscProbes& larger, double* merge_density) {
   const EyePassParams& prm = path.prm;
   BackwardPhoton bp =
       backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
   if (bp.radius <= 0 || s.beta.is_black()) return {};
+  bp.combined = merge_density != nullptr;
   bp.place = uint8_t(path.stored++);
   if (v.medium >= 0) {  // after the objects' lists, one per medium
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
@@ -96,21 +99,27 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
     bp.disc_cut = probes.cut;
     bp.cut_off_tested = probes.looked;
   }
+  if (merge_density)
+    *merge_density = kPi * double(bp.radius) * bp.radius *
+                     disc_share(bp.disc_found, bp.disc_cut, 0) * prm.merge_photons;
   path.out[size_t(v.object())].push_back(bp);
   ++path.counters.backward_photons;
   return probes;
 }
 
 // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first vertex is
-// also the last: two backward photons, one per radius.
+// also the last: two backward photons, one per radius. With merge_density, the one that accepts
+// indirect light is combined with the eye path's continuation (store_backward_photon).
 inline void store_backward_photons(const EyePath& path, const PathVertex& v, const PathState& s,
-                                   int depth, int diffuse, bool last) {
+                                   int depth, int diffuse, bool last,
+                                   double* merge_density = nullptr) {
   const EyePassParams& prm = path.prm;
   // Seen straight from the camera: the screen around the pixel says whether its discs may be
   // cut (disc_probes.h).
   const bool seen_directly = diffuse == 1 && depth == 1;
   auto store = [&](uint8_t accepts, const DiscProbes& larger) {
-    return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, larger);
+    return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, larger,
+                                 accepts & kAcceptsIndirect ? merge_density : nullptr);
   };
   if (!prm.caustics) {
     if (last) store(kAcceptsIndirect, {});
@@ -152,8 +161,149 @@ inline Spectrum direct_light_at_last(const EyePath& path, const PathVertex& v, c
   return sum / float(n);
 }
 
+// Where the eye path goes on past its last diffuse vertex x (combined estimators,
+// photons/merge_weights.h): a vertex e_j, j from 1, with the running ratio of the merge's density
+// to the continuation's for the path so far (merge_density times A of x .. e_(j-2), over B of
+// e_1 .. e_j), the vertex before (e_0 = x) and the eye's BSDF density there of the way to e_j.
+struct Continuation {
+  double ratio;
+  Vec3 prev_p, prev_n;
+  double pdf_prev = 0;
+  double cos_prev = 0, d2 = 1;  // |cos| at the vertex before toward e_j; their squared distance
+};
+
+// At e_j (v), next-event estimation of an area light, weighed against the BSDF sample that could
+// find it and the merge at x.
+inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v, const PathState& s,
+                                       const Continuation& c) {
+  const RenderScene& scene = path.scene;
+  const WavelengthMaterials& wm = *path.prm.materials;
+  float pmf;
+  const int li = scene.light_distribution.sample(path.rng.uniform(), &pmf);
+  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
+  const Light& light = scene.lights[size_t(li)];
+  if (!std::holds_alternative<AreaLight>(light)) return {};  // not combined: the merge's
+  auto ls = light_sample_li(light, scene.light_shape(light), v.sp.p, u, scene.bounds_info, wm.wl,
+                            wm.light_spectrum(li));
+  if (!ls || ls->radiance.is_black() || !(ls->pdf_solid_angle > 0)) return {};
+  const Vec3 wi_local = v.frame.to_local(ls->wi);
+  Spectrum f =
+      bsdf_f(v.m(), v.wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
+  if (f.is_black()) return {};
+  ++path.counters.rays.shadow_rays;
+  const Vec3 origin = offset_origin(v.sp.p, v.sp.ng, ls->wi, v.sp.error);
+  const Vec3 target = offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error);
+  f *= shadow_transmittance(scene, origin, target, s.medium, false, wm.wl);
+  if (f.is_black()) return {};
+  // The share a photon from the light would draw through v's gathered part (merge_weights.h).
+  const float g =
+      bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
+  if (!(g > 0)) return {};
+  f *= g;
+  const double b_light = light_sample_density(scene, li, v.sp.p, ls->p_light, ls->n_light);
+  const double b_bsdf =
+      area_density(bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance), v.sp.p,
+                   ls->p_light, ls->n_light);
+  // The photon's densities: the light's point and direction, e_j from there, e_(j-1) from e_j.
+  const double a_prev = double(g) *
+                        bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kImportance) *
+                        c.cos_prev / c.d2;
+  const double merge =
+      c.ratio * a_prev *
+      area_density(emission_density(scene, li, ls->n_light, ls->wi), ls->p_light, v.sp.p, v.sp.ng);
+  const double w = b_light / (b_light + b_bsdf + merge);
+  if (!std::isfinite(w)) return {};
+  return s.beta * f * ls->radiance * float(w / (double(pmf) * ls->pdf_solid_angle));
+}
+
+// Indirect light at the last diffuse vertex x by the eye path's continuation (combined
+// estimators, photons/merge_weights.h): BSDF samples from x on, through vertices with gathered
+// lobes only, each finding area lights by next-event estimation and by its BSDF sample, every
+// path weighed against the merge at x's backward photon, whose density is merge_density
+// (pi r^2 s N; 0: none). The continuation goes on by Russian roulette on its change of
+// throughput. depth: x's scattering events, as the backward photon's eye_depth; part: the lobes x
+// gathers with (EyeVertexChoice). Past x each path is weighed by the share of it that photons
+// draw through gathered lobes (bsdf_gathered_probability: 1 but at split coats).
+inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, BsdfPart part,
+                                  PathState s, int depth, double merge_density) {
+  const RenderScene& scene = path.scene;
+  const WavelengthMaterials& wm = *path.prm.materials;
+  PathCounters& rays = path.counters.rays;
+  const uint64_t rays_before = rays.total();
+  ++path.counters.continued;
+  Continuation c{merge_density, x.sp.p, x.sp.ng};
+  Spectrum L;
+  const PathVertex* at = &x;
+  PathVertex vertices[2];  // e_j and e_(j-1) in turn (a vertex is not copied)
+  for (int j = 1;; ++j) {
+    const PathVertex& v = *at;
+    // The BSDF sample that leaves v: to e_j.
+    const float uc = path.rng.uniform();
+    const Vec2 u{path.rng.uniform(), path.rng.uniform()};
+    const BsdfPart lobes = j == 1 ? part : BsdfPart::kAll;
+    const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, lobes);
+    if (!bs || bs->is_specular() || (j == 1 && bs->is_traced())) break;
+    Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+    if (j > 1) {
+      // The photons' gathered share at v, arriving from e_j; then Russian roulette on the change
+      // of throughput.
+      const float g =
+          bsdf_gathered_probability(v.m(), bs->wi, v.wo_local, TransportMode::kImportance);
+      if (!(g > 0)) break;
+      beta *= g;
+      const float q = std::fmax(0.0f, 1 - beta.max_component() / s.beta.max_component());
+      if (path.rng.uniform() < q) break;
+      s.beta = beta / (1 - q);
+      // A of e_(j-2) (x at j = 2), from e_(j-1) = v, arriving from e_j.
+      c.ratio *= double(g) * bsdf_pdf(v.m(), bs->wi, v.wo_local, TransportMode::kImportance) *
+                 c.cos_prev / c.d2;
+    } else {
+      s.beta = beta;
+    }
+    if (s.beta.is_black() || !s.beta.is_finite()) break;
+    c.pdf_prev = bsdf_pdf(v.m(), v.wo_local, bs->wi, TransportMode::kRadiance, lobes);
+    c.prev_p = v.sp.p;
+    c.prev_n = v.sp.ng;
+    leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+    ++rays.bounce_rays;
+    PathVertex& e = vertices[j & 1];
+    Spectrum none;
+    const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, EmitterWeight::none(), none);
+    if (end != StepEnd::kVertex) break;
+    const Vec3 d = e.sp.p - c.prev_p;
+    c.d2 = double(length_squared(d));
+    if (!(c.d2 > 0)) break;
+    const double len = std::sqrt(c.d2);
+    c.cos_prev = std::fabs(double(dot(c.prev_n, d))) / len;
+    const double cos_here = std::fabs(double(dot(e.sp.ng, d))) / len;
+    // Emission found by v's BSDF sample (x's own is its direct light): a path of j - 1 vertices
+    // between the light and x.
+    const int li = scene.light_of_hit(e.hit);
+    if (j > 1 && li >= 0) {
+      const Spectrum Le = area_light_radiance(std::get<AreaLight>(scene.lights[size_t(li)]),
+                                              e.sp.ng, e.sp.uv, -s.ray.d, wm.wl);
+      const double b_bsdf = c.pdf_prev * cos_here / c.d2;
+      const double b_light = light_sample_density(scene, li, c.prev_p, e.sp.p, e.sp.ng);
+      const double merge =
+          c.ratio * emission_density(scene, li, e.sp.ng, d / float(len)) * c.cos_prev / c.d2;
+      const double w = b_bsdf / (b_bsdf + b_light + merge);
+      if (!Le.is_black() && std::isfinite(w)) L += s.beta * Le * float(w);
+    }
+    // Paths of j vertices between the light and x: within the merge's depth.
+    if (depth + j > path.prm.max_depth || !combinable_vertex(e) || e.wo_local.z == 0) break;
+    keep_hero_wavelength_at(e, s);
+    c.ratio /= c.pdf_prev * cos_here / c.d2;  // B of e_j
+    if (!std::isfinite(c.ratio)) break;
+    L += continued_light_sample(path, e, s, c);
+    at = &e;
+  }
+  path.counters.continuation_rays += rays.total() - rays_before;
+  return L;
+}
+
 // The diffuse-th diffuse vertex: its direct light and backward photons. Returns whether the path
-// ends here (at the last one).
+// ends here (at the last one), where with combined estimators it may go on for indirect light
+// (continue_eye_path).
 inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, const PathState& s,
                                      const EyeVertexChoice& choice, int depth, int diffuse,
                                      Spectrum& L) {
@@ -162,7 +312,10 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   // path.
   L += last ? direct_light_at_last(path, v, s, choice.part)
             : direct_light_at(path, v, s, choice.part);
-  store_backward_photons(path, v, s, depth, diffuse, last);
+  const bool go_on = last && path.prm.combine && combinable_vertex(v);
+  double merge_density = 0;
+  store_backward_photons(path, v, s, depth, diffuse, last, go_on ? &merge_density : nullptr);
+  if (go_on) L += continue_eye_path(path, v, choice.part, s, depth, merge_density);
   return last;
 }
 

@@ -59,6 +59,11 @@ struct EyePassParams {
   // Eye paths toward their last diffuse vertex both scatter on every piece of their rays through
   // a scattering medium and cross it (BpmSettings::split_in_media).
   bool split_in_media = false;
+  // Combined estimators (photons/merge_weights.h; BpmSettings::combine): the eye path goes on
+  // from its last diffuse vertex on a surface for indirect light, weighed against the merge there
+  // with merge_photons photons.
+  bool combine = false;
+  double merge_photons = 0;
 };
 
 struct EyeCounters {
@@ -69,6 +74,9 @@ struct EyeCounters {
   uint64_t emission_samples = 0, emission_rays = 0;
   // The extra samples of direct light beyond the first, and the rays they cast (in `rays` too).
   uint64_t direct_samples = 0, direct_rays = 0;
+  // Eye paths that went on past their last diffuse vertex (combined estimators), and their rays
+  // (in `rays` too).
+  uint64_t continued = 0, continuation_rays = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);
     backward_photons += o.backward_photons;
@@ -77,6 +85,8 @@ struct EyeCounters {
     emission_rays += o.emission_rays;
     direct_samples += o.direct_samples;
     direct_rays += o.direct_rays;
+    continued += o.continued;
+    continuation_rays += o.continuation_rays;
   }
 };
 

@@ -38,6 +38,22 @@ float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, u
   return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
 }
 
+// The weight of merging photon hit h at backward photon bp, whose eye path went on from it
+// (photons/merge_weights.h): the eye's BSDF density there of the photon's direction against the
+// merge's pi r^2 s N.
+float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const PendingHit& h,
+                            const LightPassParams& prm) {
+  const Frame frame = Frame::from_z(bp.ns);
+  const Vec3 wo = frame.to_local(bp.wo);
+  // The lobes the eye path gathered with at x (choose_eye_vertex).
+  const BsdfPart part =
+      bsdf_traced_part_probability(m, wo) == 0 ? BsdfPart::kAll : BsdfPart::kGathered;
+  const float p = bsdf_pdf(m, wo, frame.to_local(h.wi), TransportMode::kRadiance, part);
+  const double density = kPi * double(bp.radius) * bp.radius *
+                         disc_share(bp.disc_found, bp.disc_cut, 0) * prm.merge_photons;
+  return merge_weight(h.merge_factor, p, density);
+}
+
 // Adds the entries of one diffuse hit (its query was counted when it was recorded). Returns the
 // sum of the entries' contributions to their pixels (per unit of 1 / N), each times the pixel's
 // weight, when prm.pixel_weight is set.
@@ -60,6 +76,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, h.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
+    if (bp.combined && h.merge_factor > 0) value *= combined_merge_weight(bp, m, h, prm);
     score += add_entry(bp, g, length_squared(h.p - bp.p), value, h.photon, prm, owner, out);
   };
   // The backward photons found are fetched in groups before any is used: each record is likely a
@@ -174,7 +191,7 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
       const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
       if (bucket == BackwardMaps::kNoBucket) return;
       hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object, int16_t(h.bounces),
-                      h.cls, h.hero_only});
+                      h.cls, h.hero_only, 0.0f, h.merge_factor});
     };
     // Direct beams are never used either (next-event estimation in the medium).
     auto on_beam = [&](const PhotonBeam& b) {
@@ -185,7 +202,8 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     };
     trace_light_path(
         scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit,
-        SensorSegments(scene, sensors, g.prm.materials->wl, crossings, g.prm.max_depth), on_beam);
+        SensorSegments(scene, sensors, g.prm.materials->wl, crossings, g.prm.max_depth), on_beam,
+        g.prm.combine);
     if (g.scored) emitted.push_back({e.cell, e.weight});
   }
   buf->hits[size_t(c)].swap(hits);

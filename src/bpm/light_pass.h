@@ -69,6 +69,10 @@ struct LightPassParams {
   // The scene, for the rays that test whether a photon is cut off from a backward photon whose
   // disc has geometry near (BackwardPhoton::cut_off_tested). Null: no test.
   const RenderScene* scene = nullptr;
+  // Combined estimators (photons/merge_weights.h): the photons carry their merge factors, and
+  // each merge at a backward photon whose eye path went on is weighed, with N = merge_photons.
+  bool combine = false;
+  double merge_photons = 0;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -84,7 +88,8 @@ struct PendingHit {
   int16_t bounces;
   PhotonClass cls;
   bool hero_only;
-  float score = 0;  // set by the gather: the hit's part of its photon's score for the guide
+  float score = 0;         // set by the gather: the hit's part of its photon's score for the guide
+  float merge_factor = 0;  // PhotonHit's
 };
 
 // A beam of a photon through a scattering medium (PhotonBeam), waiting for its gather.

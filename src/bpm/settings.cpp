@@ -29,6 +29,10 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
              in.loc);
   b.guide_emission = ps.get_bool("guideemission", b.guide_emission);
   b.split_in_media = ps.get_bool("splitinmedia", b.split_in_media);
+  const std::string estimators = ps.get_string("estimators", b.combine ? "combined" : "partition");
+  ps.require("estimators", estimators == "combined" || estimators == "partition",
+             "must be \"partition\" or \"combined\"", in.loc);
+  b.combine = estimators == "combined";
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
@@ -54,7 +58,8 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"disc_probes", s.disc_probes},
           {"emission_samples", s.emission_samples},
           {"direct_samples", s.direct_samples},
-          {"split_in_media", s.split_in_media}};
+          {"split_in_media", s.split_in_media},
+          {"estimators", s.combine ? "combined" : "partition"}};
 }
 
 }  // namespace bpm

@@ -35,6 +35,10 @@ struct BpmSettings : PhotonSettings {
   // default: at equal time it halves the error in open fog and doubles it in a thick grid medium
   // (docs/MEASUREMENTS.md).
   bool split_in_media = false;
+  // Combined estimators (photons/merge_weights.h): indirect light at the last diffuse vertex is
+  // both gathered from the photons and found by the eye path going on from there, each path
+  // weighed between the two by multiple importance sampling, instead of the photons' alone.
+  bool combine = false;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"

@@ -54,6 +54,10 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
           // (EyePixels::direct_samples) and their rays (among the bounce and shadow rays).
           {"direct_samples", t.eye.direct_samples},
           {"direct_sample_rays", t.eye.direct_rays},
+          // Eye paths that went on past their last diffuse vertex (--estimators combined) and
+          // their rays (among the bounce and shadow rays).
+          {"continued_paths", t.eye.continued},
+          {"continuation_rays", t.eye.continuation_rays},
           {"backward_photons", t.eye.backward_photons},
           // The paper's Table 1 counts per ray traced from the camera with all its continuations
           // (an eye path); per segment counts every camera and bounce ray.

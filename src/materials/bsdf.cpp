@@ -405,6 +405,14 @@ bool bsdf_all_traced(const Material& m) {
   return all_lobes(m, [](const Roughness& r) { return r.traced(); });
 }
 
+float bsdf_gathered_probability(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
+  if (bsdf_all_traced(m)) return 0;
+  if (std::holds_alternative<CoatedDiffuseMaterial>(m) ||
+      std::holds_alternative<CoatedConductorMaterial>(m))
+    return layered_gathered_probability(m, wo, wi, mode);
+  return 1;
+}
+
 float bsdf_traced_part_probability(const Material& m, Vec3 wo) {
   const CoatLayer* layer = coat_layer(m);
   if (!layer || !layer->roughness.traced() || bsdf_all_traced(m)) return 0;

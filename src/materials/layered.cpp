@@ -568,4 +568,20 @@ std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, V
   return layered_sample(layer_of(m, part), wo, uc, u, mode);
 }
 
+float layered_gathered_probability(const Material& m, Vec3 wo, Vec3 wi, TransportMode) {
+  const Layer L = layer_of(m, BsdfPart::kAll);
+  if (!L.top.roughness.traced() || L.base.specular || L.base_traced()) return 1;  // no split
+  if (!L.walk_table) return -1;
+  if (wo.z < 0) {
+    wo = -wo;
+    wi = -wi;
+  }
+  if (wo.z == 0 || wi.z <= 0) return 0;
+  // layered_pdf's mixture (with a walk table, layered_sample's exactly): the walks' share.
+  const float q = walks_share(L, wo.z);
+  const float walks = q * cosine_hemisphere_pdf_solid_angle(wi.z);
+  const float coat = (1 - q) * dielectric_pdf(L.top, wo, wi, kReflection);
+  return walks + coat > 0 ? walks / (walks + coat) : 0.0f;
+}
+
 }  // namespace bpm

@@ -20,6 +20,8 @@ namespace bpm {
 // the whole material.
 Spectrum layered_f(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part);
 float layered_pdf(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode, BsdfPart part);
+// bsdf_gathered_probability of a layered material.
+float layered_gathered_probability(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
 std::optional<BsdfSample> layered_sample(const Material& m, Vec3 wo, float uc, Vec2 u,
                                          TransportMode mode, BsdfPart part);
 

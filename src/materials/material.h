@@ -228,6 +228,12 @@ std::optional<BsdfSample> bsdf_sample(const Material& m, Vec3 wo, float uc, Vec2
 bool bsdf_is_specular(const Material& m);
 // Every lobe of the material is traced (BsdfPart): never a gathering vertex.
 bool bsdf_all_traced(const Material& m);
+// The probability that bsdf_sample of all lobes draws wi at wo through the gathered part
+// (BsdfPart): 1 for a material with gathered lobes only, 0 for one whose every lobe is traced; for
+// a coated material that splits, the walks' share of the density at wi; -1 where that share is
+// not known (a split coat without a walk table). The combined estimators weigh paths by it
+// (photons/merge_weights.h).
+float bsdf_gathered_probability(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
 // For a material with both parts, the probability with which the photon methods' eye paths take
 // the traced part at wo: the coating's reflectance, but at least 1/4 (highlights come through it);
 // 0 for a material with one part only.

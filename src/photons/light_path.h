@@ -18,6 +18,7 @@
 #include "integrator/counters.h"
 #include "integrator/path_vertex.h"
 #include "photons/emission_guide.h"
+#include "photons/merge_weights.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -120,6 +121,8 @@ struct PhotonHit {
   int bounces;
   bool hero_only;   // the photon keeps its hero wavelength alone (PathState)
   int medium = -1;  // a point where the photon scatters in this medium (object -1, sp.p only)
+  // PhotonMis::merge_factor where the light path is traced for combined estimators; else 0.
+  float merge_factor = 0;
 };
 
 // A straight piece of a photon's path, from ray.o along ray.d up to t_max (in units of ray.d; kInf
@@ -176,12 +179,15 @@ struct NoSegments {
 
 // The photon a light path starts with, emitted as `e` says: its ray, flux and medium. None where
 // the light sends nothing.
+// With `mis`, its products start there (PhotonMis::start).
 inline std::optional<PathState> emit_photon(const RenderScene& scene, const WavelengthMaterials& wm,
-                                            const EmissionDraw& e, Rng& rng) {
+                                            const EmissionDraw& e, Rng& rng,
+                                            PhotonMis* mis = nullptr) {
   const Light& light = scene.lights[size_t(e.light)];
   auto le = light_sample_le(light, scene.light_shape(light), e.u_pos, e.u_dir, scene.bounds_info,
                             wm.wl, wm.light_spectrum(e.light));
   if (!le || le->flux.is_black()) return std::nullopt;
+  if (mis) mis->start(scene, e.light, le->origin, le->n_light, le->direction);
   bool has_surface = length_squared(le->n_light) > 0;
   PathState s{
       Ray{has_surface ? offset_origin(le->origin, le->n_light, le->direction, le->origin_error)
@@ -202,8 +208,10 @@ inline std::optional<PathState> emit_photon(const RenderScene& scene, const Wave
 // Scatters a photon at the surface vertex v with the adjoint BSDF, Russian roulette on its change
 // of power (pbrt-v4's SPPM photon pass). Returns whether the lobe sampled was traced (a caustic
 // stays a caustic through it), or none where the photon ends.
+// With `mis`, the photon's products follow it (PhotonMis::scatter; v is its bounces-th vertex).
 inline std::optional<bool> scatter_photon_at_surface(const RenderScene& scene, const PathVertex& v,
-                                                     Rng& rng, PathState& s) {
+                                                     Rng& rng, PathState& s,
+                                                     PhotonMis* mis = nullptr, int k = 0) {
   if (v.wo_local.z == 0) return std::nullopt;
   keep_hero_wavelength_at(v, s);
   Vec2 u{rng.uniform(), rng.uniform()};  // drawn before uc
@@ -222,6 +230,7 @@ inline std::optional<bool> scatter_photon_at_surface(const RenderScene& scene, c
   if (rng.uniform() < q) return std::nullopt;
   s.beta = bnew / (1 - q);
   if (s.beta.is_black() || !s.beta.is_finite()) return std::nullopt;
+  if (mis) mis->scatter(v, wi, bs->is_traced(), k);
   leave_vertex(scene, v, wi, s);
   return bs->is_traced() || v.on_curve;
 }
@@ -247,16 +256,19 @@ inline bool scatter_photon_in_medium(const RenderScene& scene, const PathVertex&
 // asks for. The path stops when neither wants more. In a scattering medium the photon scatters
 // where its free flight ends (by the phase function, a diffuse event), and on_beam(const
 // PhotonBeam&) is called for each of its ways through the medium after at most the bounces of a hit
-// reported.
+// reported. With `combine` (a scene without media), each hit carries its merge factor
+// (PhotonHit::merge_factor, photons/merge_weights.h).
 template <class OnHit, class OnSegment = NoSegments, class OnBeam = NoBeams>
 void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
                       int min_eye_vertices, const EmissionDraw& e, Rng& rng,
                       LightCounters& counters, OnHit&& on_hit, OnSegment&& segments = {},
-                      OnBeam&& on_beam = {}) {
+                      OnBeam&& on_beam = {}, bool combine = false) {
   ++counters.photons;
   if (scene.lights.empty() || max_depth < min_eye_vertices || e.light_pmf == 0 || e.weight == 0)
     return;
-  std::optional<PathState> emitted = emit_photon(scene, wm, e, rng);
+  PhotonMis mis_state;
+  PhotonMis* mis = combine ? &mis_state : nullptr;
+  std::optional<PathState> emitted = emit_photon(scene, wm, e, rng, mis);
   if (!emitted) return;
   PathState& s = *emitted;
   int bounces = 0;
@@ -294,19 +306,21 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     }
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     const bool in_medium = end == StepEnd::kMedium;
+    if (mis && !in_medium) mis->arrive(scene, v, bounces + 1);
     // A surface with gathered lobes (BsdfPart), or a point in a medium: the photon's estimate
     // there sees those alone.
     if (bounces <= hit_depth && (in_medium || !vertex_all_traced(v))) {
       ++counters.diffuse_hits;
       on_hit(PhotonHit{in_medium ? -1 : v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only,
-                       in_medium ? v.medium : -1});
+                       in_medium ? v.medium : -1, mis ? mis->merge_factor() : 0.0f});
     }
     if (bounces + 1 > depth) break;
     if (in_medium) {
       if (!scatter_photon_in_medium(scene, v, beta_before, rng, s)) break;
       all_specular = false;
     } else {
-      const std::optional<bool> traced = scatter_photon_at_surface(scene, v, rng, s);
+      const std::optional<bool> traced =
+          scatter_photon_at_surface(scene, v, rng, s, mis, bounces + 1);
       if (!traced) break;
       // Through a traced lobe (delta, or glossy and sharp) a caustic stays a caustic.
       all_specular = all_specular && *traced;

@@ -36,6 +36,7 @@ struct RenderRequest {
   bool no_disc_probes = false;
   bool no_equiangular = false;
   bool split_in_media = false;
+  std::string estimators;  // bpm: "partition" or "combined"
   bool debias = false;
   std::string bias_model;
   int emission_samples = 0;

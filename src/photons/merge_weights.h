@@ -1,0 +1,88 @@
+// Combined estimators (DESIGN.md, "Where the estimator may go"): a light path that reaches the
+// last diffuse vertex x of an eye path after bouncing on the way (indirect light there) is made
+// two ways, by merging the photon at x's backward photon, and by continuing the eye path from x
+// by BSDF sampling until it finds the light, by next-event estimation or by a BSDF sample. Each
+// counts it with its density over the sum of all three (the balance heuristic; vertex connection
+// and merging, Georgiev et al. 2012, restricted to these strategies). For the path
+// y0 (on a light), z1 .. zm, x, in area measure and with the eye path up to x left out (common):
+//   merging:       A0 A1 ... A(m+1) * pi r^2 s N   the photon's densities: y0 and its direction by
+//                                                 emission, z(k+1) by the adjoint BSDF at zk; the
+//                                                 disc of radius r, its share s where photons can
+//                                                 land (disc_probes.h), N photons per iteration
+//   continuation:  B0 B1 ... Bm                    the eye's: zm from x, z(k-1) from zk by the BSDF,
+//                                                 y0 by next-event estimation or by the BSDF (B0 is
+//                                                 the sum of the two)
+// The emission densities are the unguided ones (lights by power, uniform points, cosine
+// directions): guided emission changes the photons' weights, not what they are weighed against.
+// Only paths whose light is an area light and whose vertices z all have gathered lobes only (on a
+// surface, not a curve) are combined; every other path stays the merge's alone, and the
+// continuation leaves it out. Both passes compute the same products, each from its own end of the
+// path, so that the weights of a path sum to one.
+#pragma once
+#include "integrator/path_vertex.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+// Whether a combined path may pass through v: a surface (not a curve) with gathered lobes, not
+// Phong's (whose sampling is not reciprocal). Where a coat splits (BsdfPart), only the share of
+// the light that the photon draws through the gathered part is combined: the photon's vertex then
+// counts in A with the density of that draw, and the continuation's path is weighed by the same
+// share (bsdf_gathered_probability); the share drawn through the coat stays the photon's alone.
+bool combinable_vertex(const PathVertex& v);
+
+// A solid-angle density at `from` of the direction to `to`, turned into an area density at `to`
+// (whose geometric normal is n_to).
+inline double area_density(double pdf_solid_angle, Vec3 from, Vec3 to, Vec3 n_to) {
+  const Vec3 d = to - from;
+  const double d2 = double(length_squared(d));
+  if (!(d2 > 0)) return 0;
+  return pdf_solid_angle * std::fabs(double(dot(n_to, d))) / (d2 * std::sqrt(d2));
+}
+
+// A0 times the solid-angle density of A1 for area light `light` (unguided emission: the light by
+// power, a uniform point, a cosine-weighted direction): the density of emitting along the unit
+// direction w from a point of geometric normal n; 0 for other lights.
+double emission_density(const RenderScene& scene, int light, Vec3 n, Vec3 w);
+
+// B0 by next-event estimation from p (sample_direct_light: the light by power, then its own
+// sampling) of the point y on area light `light`, of geometric normal n: an area density.
+double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n);
+
+// The running products of a photon's path (the light pass's side): after its k-th vertex z_k,
+// B0 .. B(k-2) over A0 .. Ak. start() at emission, arrive() at each surface vertex, scatter() when
+// it leaves one; merge_factor() is what a merge at a backward photon needs of it.
+class PhotonMis {
+ public:
+  // The photon leaves area light `light` at y, of geometric normal n, along the unit direction w.
+  // Any other light: not combined.
+  void start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w);
+  // The photon arrives at its k-th vertex v (k from 1).
+  void arrive(const RenderScene& scene, const PathVertex& v, int k);
+  // It leaves v, its k-th vertex, along the world direction wi, drawn through a traced lobe or
+  // not.
+  void scatter(const PathVertex& v, Vec3 wi, bool traced, int k);
+  // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
+  // the vertex before over the squared distance, so that the merge's weight is
+  // 1 / (1 + factor * p / (pi r^2 s N)) with p the eye's BSDF density at x of the photon's
+  // direction. 0: not combined (the merge counts the path in full).
+  float merge_factor() const { return on_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
+
+ private:
+  bool on_ = false;
+  double r_ = 0, b0_ = 0;
+  int light_ = -1;
+  Vec3 y_, n_y_;        // the light's point and normal
+  Vec3 prev_, prev_n_;  // the vertex before the current one, and its geometric normal
+  double seg_cos_ = 0, seg_d2_ = 1;  // |cos| at prev toward the current vertex, squared distance
+};
+
+// The merge's weight at a backward photon whose eye path went on (BackwardPhoton::combined):
+// factor (PhotonMis::merge_factor), p the eye's BSDF density (radiance transport) at x of the
+// photon's direction, merge_density = pi r^2 s N.
+inline float merge_weight(float factor, float p, double merge_density) {
+  if (factor == 0) return 1;
+  return float(1 / (1 + double(factor) * double(p) / merge_density));
+}
+
+}  // namespace bpm
