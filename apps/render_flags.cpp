@@ -228,6 +228,11 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
                    "importance sampling (scenes without media; file: string estimators)")
       ->check(CLI::IsMember({"partition", "combined"}))
       ->group(kBpm);
+  render
+      ->add_flag("--no-coat-split", ra.no_coat_split,
+                 "At a coated surface where gathering would end the eye path, take its coat or "
+                 "its base by chance instead of both (file: bool splitcoats false)")
+      ->group(kBpm);
   render->add_option("--tree", ra.tree, "Backward photon kd-tree: spheres (default) or centres")
       ->check(CLI::IsMember({"spheres", "centres"}))
       ->group(kBpm);

@@ -13,11 +13,12 @@ namespace bpm {
 enum AcceptMask : uint8_t { kAcceptsCaustic = 1, kAcceptsIndirect = 2 };
 
 // An eye path stores one backward photon at each of its diffuse vertices (D + 1 of them, D <= 3)
-// and a second at the last, and two (as at a last vertex) at each of at most kMaxMediumSplits
-// pieces of its rays through media where it splits (bpm/eye_pass.cpp).
+// and a second at the last, two more (as at a last vertex) where it takes both parts of a coat
+// (EyePassParams::split_coats), and two at each of at most kMaxMediumSplits pieces of its rays
+// through media where it splits (bpm/eye_pass.cpp).
 constexpr int kMaxMediumSplits = 4;
 constexpr int backward_photons_per_path(int diffuse_depth, bool splits) {
-  return diffuse_depth + 2 + (splits ? 2 * kMaxMediumSplits : 0);
+  return diffuse_depth + 4 + (splits ? 2 * kMaxMediumSplits : 0);
 }
 constexpr int kMaxBackwardPhotonsPerPath = backward_photons_per_path(3, true);
 

@@ -344,7 +344,8 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    opt_.equiangular,
                    s_.split_in_media,
                    combined(),
-                   double(photons_)};
+                   double(photons_),
+                   s_.split_coats};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii.
   near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,

@@ -423,6 +423,9 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
   // Direct light sampled along the pieces of rays in media that lead to a diffuse vertex that
   // estimates it (the next one, while it is not past the last): never emission.
   Spectrum along;
+  // What the gathered part of a split vertex counts, and whether the path has split.
+  Spectrum gathered;
+  bool split = false;
   ++counters.rays.camera_rays;
   for (int guard = 0; guard < 10000; ++guard) {
     PathVertex v;
@@ -452,7 +455,19 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
-    const EyeVertexChoice choice = choose_eye_vertex(v, rng, s);
+    // Where a material has both parts and gathering would end the path, the path takes both:
+    // its gathered part ends here, its traced part goes on (once per path).
+    EyeVertexChoice choice;
+    if (prm.split_coats && !split && diffuse == prm.diffuse_depth && !vertex_all_traced(v) &&
+        bsdf_traced_part_probability(v.m(), v.wo_local) > 0) {
+      split = true;
+      if (!emission_only)
+        gather_at_diffuse_vertex(path, v, s, {true, BsdfPart::kGathered}, depth, diffuse + 1,
+                                 gathered);
+      choice = {false, BsdfPart::kTraced};
+    } else {
+      choice = choose_eye_vertex(v, rng, s);
+    }
     const bool is_diffuse = choice.gather;
     if (is_diffuse && !emission) {
       emission = L;
@@ -470,7 +485,7 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
     if (direct_here) L += direct_light_at(path, v, s, choice.part);
     if (!scatter(path, v, choice, direct_here, diffuse, s, emitter)) break;
   }
-  return {L + along, emission ? *emission : L, direct_variance};
+  return {L + along + gathered, emission ? *emission : L, direct_variance};
 }
 
 namespace {

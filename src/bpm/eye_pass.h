@@ -64,6 +64,9 @@ struct EyePassParams {
   // with merge_photons photons.
   bool combine = false;
   double merge_photons = 0;
+  // At the first vertex of a material with both parts (BsdfPart) where gathering would end the
+  // path, it takes both parts instead of one by chance (BpmSettings::split_coats).
+  bool split_coats = true;
 };
 
 struct EyeCounters {

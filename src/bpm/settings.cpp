@@ -33,6 +33,7 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   ps.require("estimators", estimators == "combined" || estimators == "partition",
              "must be \"partition\" or \"combined\"", in.loc);
   b.combine = estimators == "combined";
+  b.split_coats = ps.get_bool("splitcoats", b.split_coats);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
@@ -59,7 +60,8 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"emission_samples", s.emission_samples},
           {"direct_samples", s.direct_samples},
           {"split_in_media", s.split_in_media},
-          {"estimators", s.combine ? "combined" : "partition"}};
+          {"estimators", s.combine ? "combined" : "partition"},
+          {"split_coats", s.split_coats}};
 }
 
 }  // namespace bpm

@@ -39,6 +39,11 @@ struct BpmSettings : PhotonSettings {
   // both gathered from the photons and found by the eye path going on from there, each path
   // weighed between the two by multiple importance sampling, instead of the photons' alone.
   bool combine = false;
+  // At the first vertex of a material with both parts (a sharp coat over a diffuse base, BsdfPart)
+  // where gathering would end the eye path, the path takes both parts, instead of one by chance
+  // with its weight divided by the chance (EyePassParams::split_coats): a coated floor seen from
+  // the camera no longer carries the noise of that choice.
+  bool split_coats = true;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"

@@ -65,12 +65,13 @@ void PhotonMis::scatter(const PathVertex& v, Vec3 wi, bool traced, int k) {
   const Vec3 wi_local = v.frame.to_local(wi);
   // A_(k+1)'s solid-angle density: the adjoint BSDF's at v, from where the photon came, through
   // the gathered part (where a coat splits, its share of the density).
-  const double g = bsdf_gathered_probability(v.m(), v.wo_local, wi_local, TransportMode::kImportance);
+  const double g =
+      bsdf_gathered_probability(v.m(), v.wo_local, wi_local, TransportMode::kImportance);
   const double a = g * bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kImportance);
   // B_(k-1): the eye's BSDF at v, arriving from wi, toward the vertex before (y0 when k = 1,
   // where next-event estimation's density joins it).
-  double b = double(bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kRadiance)) * seg_cos_ /
-             seg_d2_;
+  double b =
+      double(bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kRadiance)) * seg_cos_ / seg_d2_;
   if (k == 1) b += b0_;
   if (!(a > 0)) {
     on_ = false;

@@ -9,7 +9,8 @@
 //                                                 emission, z(k+1) by the adjoint BSDF at zk; the
 //                                                 disc of radius r, its share s where photons can
 //                                                 land (disc_probes.h), N photons per iteration
-//   continuation:  B0 B1 ... Bm                    the eye's: zm from x, z(k-1) from zk by the BSDF,
+//   continuation:  B0 B1 ... Bm                    the eye's: zm from x, z(k-1) from zk by the
+//   BSDF,
 //                                                 y0 by next-event estimation or by the BSDF (B0 is
 //                                                 the sum of the two)
 // The emission densities are the unguided ones (lights by power, uniform points, cosine
@@ -72,8 +73,8 @@ class PhotonMis {
   bool on_ = false;
   double r_ = 0, b0_ = 0;
   int light_ = -1;
-  Vec3 y_, n_y_;        // the light's point and normal
-  Vec3 prev_, prev_n_;  // the vertex before the current one, and its geometric normal
+  Vec3 y_, n_y_;                     // the light's point and normal
+  Vec3 prev_, prev_n_;               // the vertex before the current one, and its geometric normal
   double seg_cos_ = 0, seg_d2_ = 1;  // |cos| at prev toward the current vertex, squared distance
 };
 

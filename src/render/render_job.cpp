@@ -122,6 +122,7 @@ RenderOptions render_options(const RenderRequest& a, const LoadedScene& ls,
   if (a.no_guide) opt.bpm.guide_emission = false;
   if (a.split_in_media) opt.bpm.split_in_media = true;
   if (!a.estimators.empty()) opt.bpm.combine = a.estimators == "combined";
+  if (a.no_coat_split) opt.bpm.split_coats = false;
   if (a.no_disc_probes) opt.bpm.disc_probes = opt.fpm.disc_probes = false;
   if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;
   if (a.direct_samples > 0) opt.bpm.direct_samples = a.direct_samples;

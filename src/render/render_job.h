@@ -37,6 +37,7 @@ struct RenderRequest {
   bool no_equiangular = false;
   bool split_in_media = false;
   std::string estimators;  // bpm: "partition" or "combined"
+  bool no_coat_split = false;
   bool debias = false;
   std::string bias_model;
   int emission_samples = 0;
