@@ -391,6 +391,22 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
   return true;
 }
 
+// The choice at surface vertex v (choose_eye_vertex), except where its material has both parts
+// and gathering would end the path (EyePassParams::split_coats; once per path, `split`): then the
+// path takes both, its gathered part ending here (what it counts goes to `gathered`; nothing for
+// an emission_only path), its traced part going on.
+inline EyeVertexChoice choose_or_split(const EyePath& path, const PathVertex& v, PathState& s,
+                                       int depth, int diffuse, bool emission_only, bool& split,
+                                       Spectrum& gathered) {
+  if (!path.prm.split_coats || split || diffuse != path.prm.diffuse_depth || vertex_all_traced(v) ||
+      bsdf_traced_part_probability(v.m(), v.wo_local) == 0)
+    return choose_eye_vertex(v, path.rng, s);
+  split = true;
+  if (!emission_only)
+    gather_at_diffuse_vertex(path, v, s, {true, BsdfPart::kGathered}, depth, diffuse + 1, gathered);
+  return {false, BsdfPart::kTraced};
+}
+
 }  // namespace
 
 // Out of line: GCC 12 would inline the whole path, its steps included, into the eye pass's pixel
@@ -455,19 +471,8 @@ inline bool scatter(const EyePath& path, const PathVertex& v, const EyeVertexCho
     if (v.wo_local.z == 0) break;
     keep_hero_wavelength_at(v, s);
     // A diffuse vertex gathers; a specular one (delta or sharp glossy lobes) is gone through.
-    // Where a material has both parts and gathering would end the path, the path takes both:
-    // its gathered part ends here, its traced part goes on (once per path).
-    EyeVertexChoice choice;
-    if (prm.split_coats && !split && diffuse == prm.diffuse_depth && !vertex_all_traced(v) &&
-        bsdf_traced_part_probability(v.m(), v.wo_local) > 0) {
-      split = true;
-      if (!emission_only)
-        gather_at_diffuse_vertex(path, v, s, {true, BsdfPart::kGathered}, depth, diffuse + 1,
-                                 gathered);
-      choice = {false, BsdfPart::kTraced};
-    } else {
-      choice = choose_eye_vertex(v, rng, s);
-    }
+    const EyeVertexChoice choice =
+        choose_or_split(path, v, s, depth, diffuse, emission_only, split, gathered);
     const bool is_diffuse = choice.gather;
     if (is_diffuse && !emission) {
       emission = L;
