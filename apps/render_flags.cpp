@@ -222,11 +222,13 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
       ->group(kBpm);
   render
       ->add_option("--estimators", ra.estimators,
-                   "partition (default): indirect light at the last diffuse vertex comes from the "
-                   "photons alone; combined: the eye path also goes on from there, and each light "
-                   "path is weighed between the photons and the continuation by multiple "
-                   "importance sampling (scenes without media; file: string estimators)")
-      ->check(CLI::IsMember({"partition", "combined"}))
+                   "partition: indirect light at the last diffuse vertex comes from the photons "
+                   "alone; combined: the eye path also goes on from there, and each light path is "
+                   "weighed between the photons and the continuation by multiple importance "
+                   "sampling; glossy (default): combined where that vertex's gathered lobes "
+                   "include a glossy one, partition elsewhere (scenes without media; file: string "
+                   "estimators)")
+      ->check(CLI::IsMember({"partition", "glossy", "combined"}))
       ->group(kBpm);
   render
       ->add_flag("--no-coat-split", ra.no_coat_split,

@@ -896,8 +896,9 @@ TEST(Bpm, CombinedEstimatorsConvergeToPath) {
     BpmSettings partition = small_batches(k.diffuse_depth);
     partition.photons_per_iteration = k.photons;
     partition.k1 = k.k1;
+    partition.combine = CombineAt::kNowhere;
     BpmSettings combined = partition;
-    combined.combine = true;
+    combined.combine = CombineAt::kEverywhere;
     const Iterations c = render_iterations(ls, "bpm", few ? 512 : 96, 5, combined);
     const Iterations p = render_iterations(ls, "bpm", 96, 5, partition);
     expect_blocks_agree(c, ref, 8, edge_bias(combined, 96, 8), what + " combined");
@@ -912,6 +913,26 @@ TEST(Bpm, CombinedEstimatorsConvergeToPath) {
     if (!few) continue;
     EXPECT_LT(ec, 0.75 * ep) << what << ": combined " << ec << ", partition " << ep;
     EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var)) << what;
+  }
+}
+
+// By default (--estimators glossy) the eye path goes on only from last vertices whose gathered
+// lobes include a glossy one: the rough coat's reflection, not a diffuse wall, nor the walks under
+// a traced coat.
+TEST(Bpm, EstimatorsCombineByDefaultAtGlossyLastVertices) {
+  for (const char* floor : {"\"float roughness\" 0.3", "\"float roughness\" 0.001", ""}) {
+    const std::string material =
+        *floor
+            ? std::string("Material \"coateddiffuse\" \"rgb reflectance\" [0.6 0.6 0.6] ") + floor
+            : std::string("Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]");
+    LoadedScene ls = load(cornell(material));
+    const RenderRun r = render_with(ls, "bpm", 4, 0, 1, small_batches(0));
+    EXPECT_EQ(r.stats.details["settings"]["estimators"], "glossy");
+    const double continued = r.stats.details["eye"]["continued_paths"].get<double>();
+    if (std::string(floor) == "\"float roughness\" 0.3")
+      EXPECT_GT(continued, 0.0) << material;
+    else
+      EXPECT_EQ(continued, 0.0) << material;
   }
 }
 

@@ -151,7 +151,7 @@ class BpmRender {
   PassWork work_now() const;
   void choose_photons();
   // Combined estimators run: asked for, in a scene without media (photons/merge_weights.h).
-  bool combined() const { return s_.combine && scene_.media.empty(); }
+  CombineAt combined() const { return scene_.media.empty() ? s_.combine : CombineAt::kNowhere; }
   // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
   double reserve_memory() const;
 
@@ -306,9 +306,12 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   if (opt_.image && !eye_pass(wm, scale, pass, it, control)) return PassResult{false, 0, "", ""};
   // 2. Per-object sphere trees over the backward photons.
   LightPassParams lp{&wm, opt_.max_depth, s_.normal_cos, {}};
-  lp.combine = combined();
-  lp.merge_photons = double(photons_);
   if (!build_maps(pass, control, &lp)) return PassResult{false, 0, "", "memory"};
+  // The photons carry their merge factors where some backward photon is combined.
+  lp.combine = combined() != CombineAt::kNowhere &&
+               std::any_of(maps_.photons.begin(), maps_.photons.end(),
+                           [](const BackwardPhoton& bp) { return bp.combined; });
+  lp.merge_photons = double(photons_);
   if (sensors_) {
     sensors_->set_scale(scale);
     sensor_sums_.clear();

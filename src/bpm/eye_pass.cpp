@@ -312,7 +312,9 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   // path.
   L += last ? direct_light_at_last(path, v, s, choice.part)
             : direct_light_at(path, v, s, choice.part);
-  const bool go_on = last && path.prm.combine && combinable_vertex(v);
+  const CombineAt at = path.prm.combine;
+  const bool go_on = last && at != CombineAt::kNowhere && combinable_vertex(v) &&
+                     (at == CombineAt::kEverywhere || bsdf_gathers_glossy(v.m(), choice.part));
   double merge_density = 0;
   store_backward_photons(path, v, s, depth, diffuse, last, go_on ? &merge_density : nullptr);
   if (go_on) L += continue_eye_path(path, v, choice.part, s, depth, merge_density);

@@ -19,6 +19,7 @@
 #include "integrator/counters.h"
 #include "integrator/progressive.h"
 #include "photons/disc_probes.h"
+#include "photons/settings.h"
 #include "scene/render_scene.h"
 
 namespace bpm {
@@ -62,7 +63,7 @@ struct EyePassParams {
   // Combined estimators (photons/merge_weights.h; BpmSettings::combine): the eye path goes on
   // from its last diffuse vertex on a surface for indirect light, weighed against the merge there
   // with merge_photons photons.
-  bool combine = false;
+  CombineAt combine = CombineAt::kNowhere;
   double merge_photons = 0;
   // At the first vertex of a material with both parts (BsdfPart) where gathering would end the
   // path, it takes both parts instead of one by chance (BpmSettings::split_coats).

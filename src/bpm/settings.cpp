@@ -29,10 +29,10 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
              in.loc);
   b.guide_emission = ps.get_bool("guideemission", b.guide_emission);
   b.split_in_media = ps.get_bool("splitinmedia", b.split_in_media);
-  const std::string estimators = ps.get_string("estimators", b.combine ? "combined" : "partition");
-  ps.require("estimators", estimators == "combined" || estimators == "partition",
-             "must be \"partition\" or \"combined\"", in.loc);
-  b.combine = estimators == "combined";
+  const std::string estimators = ps.get_string("estimators", to_string(b.combine));
+  ps.require("estimators", parse_combine_at(estimators).has_value(),
+             "must be \"partition\", \"glossy\" or \"combined\"", in.loc);
+  b.combine = *parse_combine_at(estimators);
   b.split_coats = ps.get_bool("splitcoats", b.split_coats);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
@@ -60,7 +60,7 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"emission_samples", s.emission_samples},
           {"direct_samples", s.direct_samples},
           {"split_in_media", s.split_in_media},
-          {"estimators", s.combine ? "combined" : "partition"},
+          {"estimators", to_string(s.combine)},
           {"split_coats", s.split_coats}};
 }
 

@@ -405,6 +405,27 @@ bool bsdf_all_traced(const Material& m) {
   return all_lobes(m, [](const Roughness& r) { return r.traced(); });
 }
 
+bool bsdf_gathers_glossy(const Material& m, BsdfPart part) {
+  if (part == BsdfPart::kTraced) return false;
+  struct V {
+    bool operator()(const DiffuseMaterial&) const { return false; }
+    bool operator()(const ConductorMaterial& c) const { return !c.roughness.traced(); }
+    bool operator()(const DielectricMaterial& d) const {
+      return d.eta != 1 && !d.roughness.traced();
+    }
+    bool operator()(const ThinDielectricMaterial&) const { return false; }
+    bool operator()(const DiffuseTransmissionMaterial&) const { return false; }
+    bool operator()(const PhongMaterial&) const { return true; }
+    bool operator()(const InterfaceMaterial&) const { return false; }
+    // A traced coat leaves the diffuse walks under it to the gathered part.
+    bool operator()(const CoatedDiffuseMaterial& c) const { return !c.layer.roughness.traced(); }
+    bool operator()(const CoatedConductorMaterial& c) const {
+      return !c.layer.roughness.traced() || !c.conductor.roughness.traced();
+    }
+  };
+  return std::visit(V{}, m);
+}
+
 float bsdf_gathered_probability(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode) {
   if (bsdf_all_traced(m)) return 0;
   if (std::holds_alternative<CoatedDiffuseMaterial>(m) ||

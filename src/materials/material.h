@@ -234,6 +234,10 @@ bool bsdf_all_traced(const Material& m);
 // not known (a split coat without a walk table). The combined estimators weigh paths by it
 // (photons/merge_weights.h).
 float bsdf_gathered_probability(const Material& m, Vec3 wo, Vec3 wi, TransportMode mode);
+// Whether the lobes of `part` include a glossy one (a microfacet lobe rougher than kTracedAlpha,
+// or a rough coat's): there a photon estimate is noisy where f peaks, and bpm combines its merges
+// with the eye path's continuation by default (photons/merge_weights.h).
+bool bsdf_gathers_glossy(const Material& m, BsdfPart part);
 // For a material with both parts, the probability with which the photon methods' eye paths take
 // the traced part at wo: the coating's reflectance, but at least 1/4 (highlights come through it);
 // 0 for a material with one part only.

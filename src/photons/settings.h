@@ -2,11 +2,20 @@
 // they shrink over iterations, photons per batch and the normal test. Filled from the scene file's
 // Integrator line and the command line, and printed in the run's JSON record.
 #pragma once
+#include <optional>
+#include <string>
+
 #include "scene/parsed_scene.h"
 
 namespace bpm {
 
 enum class RadiusPolicy { kFixed, kProgressive };
+
+// Where bpm combines its photon merges with the eye path's continuation (photons/merge_weights.h):
+// nowhere (the partition), at last diffuse vertices whose gathered lobes include a glossy one
+// (bsdf_gathers_glossy), or at every last diffuse vertex. As the file and the flag name them:
+// "partition", "glossy", "combined".
+enum class CombineAt { kNowhere, kGlossy, kEverywhere };
 
 // How the bias of a radius-r density estimate is estimated from the same photons gathered over
 // nested discs (PhotonSettings::bias_model).
@@ -46,6 +55,15 @@ struct PhotonSettings {
 
 inline const char* to_string(RadiusPolicy p) {
   return p == RadiusPolicy::kFixed ? "fixed" : "progressive";
+}
+
+inline const char* to_string(CombineAt c) {
+  return c == CombineAt::kNowhere ? "partition" : c == CombineAt::kGlossy ? "glossy" : "combined";
+}
+inline std::optional<CombineAt> parse_combine_at(const std::string& s) {
+  for (CombineAt c : {CombineAt::kNowhere, CombineAt::kGlossy, CombineAt::kEverywhere})
+    if (s == to_string(c)) return c;
+  return std::nullopt;
 }
 
 // Photons per iteration for an image of `pixels` pixels: the count set, or by default 100000 per
