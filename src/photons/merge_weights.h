@@ -20,6 +20,8 @@
 // continuation leaves it out. Both passes compute the same products, each from its own end of the
 // path, so that the weights of a path sum to one.
 #pragma once
+#include <cmath>
+
 #include "integrator/path_vertex.h"
 #include "scene/render_scene.h"
 
