@@ -177,24 +177,14 @@ struct Continuation {
 inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v, const PathState& s,
                                        const Continuation& c) {
   const RenderScene& scene = path.scene;
-  const WavelengthMaterials& wm = *path.prm.materials;
-  float pmf;
-  const int li = scene.light_distribution.sample(path.rng.uniform(), &pmf);
-  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
-  const Light& light = scene.lights[size_t(li)];
-  if (!std::holds_alternative<AreaLight>(light)) return {};  // not combined: the merge's
-  auto ls = light_sample_li(light, scene.light_shape(light), v.sp.p, u, scene.bounds_info, wm.wl,
-                            wm.light_spectrum(li));
-  if (!ls || ls->radiance.is_black() || !(ls->pdf_solid_angle > 0)) return {};
-  const Vec3 wi_local = v.frame.to_local(ls->wi);
-  Spectrum f =
-      bsdf_f(v.m(), v.wo_local, wi_local, TransportMode::kRadiance) * std::fabs(wi_local.z);
-  if (f.is_black()) return {};
-  ++path.counters.rays.shadow_rays;
-  const Vec3 origin = offset_origin(v.sp.p, v.sp.ng, ls->wi, v.sp.error);
-  const Vec3 target = offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error);
-  f *= shadow_transmittance(scene, origin, target, s.medium, false, wm.wl);
-  if (f.is_black()) return {};
+  const auto sample = sample_light_at(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local,
+                                      *path.prm.materials, path.rng, path.counters.rays);
+  // Other lights than area lights are not combined: the merge's.
+  if (!sample || !std::holds_alternative<AreaLight>(scene.lights[size_t(sample->light)])) return {};
+  const int li = sample->light;
+  const LightLiSample* ls = &sample->ls;
+  const Vec3 wi_local = sample->wi_local;
+  Spectrum f = sample->f;
   // The share a photon from the light would draw through v's gathered part (merge_weights.h).
   const float g =
       bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
@@ -213,7 +203,7 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
       area_density(emission_density(scene, li, ls->n_light, ls->wi), ls->p_light, v.sp.p, v.sp.ng);
   const double w = b_light / (b_light + b_bsdf + merge);
   if (!std::isfinite(w)) return {};
-  return s.beta * f * ls->radiance * float(w / (double(pmf) * ls->pdf_solid_angle));
+  return s.beta * f * ls->radiance * float(w / (double(sample->pmf) * ls->pdf_solid_angle));
 }
 
 // Indirect light at the last diffuse vertex x by the eye path's continuation (combined

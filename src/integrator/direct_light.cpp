@@ -42,12 +42,13 @@ Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target
   return {};
 }
 
-Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
-                             int medium, const Material& m, const Frame& frame, Vec3 wo_local,
-                             bool use_mis, const WavelengthMaterials& wm, Rng& rng,
-                             PathCounters& counters, BsdfPart part) {
+std::optional<LightSampleAt> sample_light_at(const RenderScene& scene, const SurfacePoint& sp,
+                                             int object, int medium, const Material& m,
+                                             const Frame& frame, Vec3 wo_local,
+                                             const WavelengthMaterials& wm, Rng& rng,
+                                             PathCounters& counters, BsdfPart part) {
   const Wavelengths& wl = wm.wl;
-  if (scene.lights.empty()) return {};
+  if (scene.lights.empty()) return std::nullopt;
   float pmf;
   float ul = rng.uniform();
   int li = scene.light_distribution.sample(ul, &pmf);
@@ -55,11 +56,11 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   Vec2 u{rng.uniform(), rng.uniform()};
   auto ls = light_sample_li(light, scene.light_shape(light), sp.p, u, scene.bounds_info, wl,
                             wm.light_spectrum(li));
-  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
+  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return std::nullopt;
   Vec3 wi_local = frame.to_local(ls->wi);
   Spectrum f =
       bsdf_f(m, wo_local, wi_local, TransportMode::kRadiance, part) * std::fabs(wi_local.z);
-  if (f.is_black()) return {};
+  if (f.is_black()) return std::nullopt;
   ++counters.shadow_rays;
   Vec3 origin = offset_origin(sp.p, sp.ng, ls->wi, sp.error);
   // Lights with a surface get the shadow ray's end lifted off that surface.
@@ -74,8 +75,21 @@ Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, i
   f *= shadow_transmittance(scene, origin, target,
                             medium_toward(scene, object, sp.ng, ls->wi, medium), ls->is_infinite,
                             wl);
-  if (f.is_black()) return {};
-  float p_light = pmf * ls->pdf_solid_angle;
+  if (f.is_black()) return std::nullopt;
+  return LightSampleAt{li, pmf, *ls, wi_local, f};
+}
+
+Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
+                             int medium, const Material& m, const Frame& frame, Vec3 wo_local,
+                             bool use_mis, const WavelengthMaterials& wm, Rng& rng,
+                             PathCounters& counters, BsdfPart part) {
+  const auto s =
+      sample_light_at(scene, sp, object, medium, m, frame, wo_local, wm, rng, counters, part);
+  if (!s) return {};
+  const LightLiSample* ls = &s->ls;
+  const Spectrum& f = s->f;
+  const Vec3 wi_local = s->wi_local;
+  float p_light = s->pmf * ls->pdf_solid_angle;
   if (ls->is_delta || !use_mis) return ls->radiance * f / p_light;
   float p_bsdf = bsdf_pdf(m, wo_local, wi_local, TransportMode::kRadiance, part);
   return ls->radiance * f * (power_heuristic(p_light, p_bsdf) / p_light);

@@ -2,6 +2,8 @@
 // the emission a path finds by BSDF sampling, weighted so that each light path is counted once
 // (Veach 1997, 9.2.4: the power heuristic between the two strategies).
 #pragma once
+#include <optional>
+
 #include "base/rng.h"
 #include "integrator/counters.h"
 #include "integrator/path_vertex.h"
@@ -16,6 +18,24 @@ namespace bpm {
 // direction, the last stretch infinitely long.
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
                               bool infinite, const Wavelengths& wl);
+
+// One sample for next-event estimation at sp: a light chosen by power (light, pmf), a point on it
+// by its own sampling (ls), and f, the BSDF of `part` times |cos| times the shadow ray's
+// transmittance (wi_local: the light's direction in `frame`). None where the light sends nothing
+// there or f is black. sample_direct_light weighs it; bpm's continuation weighs it otherwise.
+struct LightSampleAt {
+  int light;
+  float pmf;
+  LightLiSample ls;
+  Vec3 wi_local;
+  Spectrum f;
+};
+std::optional<LightSampleAt> sample_light_at(const RenderScene& scene, const SurfacePoint& sp,
+                                             int object, int medium, const Material& m,
+                                             const Frame& frame, Vec3 wo_local,
+                                             const WavelengthMaterials& wm, Rng& rng,
+                                             PathCounters& counters,
+                                             BsdfPart part = BsdfPart::kAll);
 
 // Direct light at a non-specular vertex by sampling one light chosen by power, with the power
 // heuristic against BSDF sampling when use_mis (the caller then weights the emitters its BSDF
