@@ -2,7 +2,9 @@
 // (DESIGN.md, vocabulary) with the sphere over which it gathers; a photon's class says how the
 // light reached the surface it hit, and each backward photon accepts some classes only.
 #pragma once
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
 
 #include "base/spectrum.h"
 #include "base/vec.h"
@@ -33,13 +35,16 @@ struct BackwardPhoton {
   uint32_t material;
   uint16_t eye_depth;         // scattering events on the eye path, this vertex included
   uint8_t accepts;            // AcceptMask bits
-  uint8_t diffuse_index : 6;  // j - 1 for the j-th diffuse vertex (0..3)
+  uint8_t diffuse_index : 5;  // j - 1 for the j-th diffuse vertex (0..3)
   // The eye path went on from here (combined estimators, photons/merge_weights.h): the photons
   // it gathers are weighed against that.
   uint8_t combined : 1 = 0;
   // The disc's probes looked (DiscProbes::looked: other geometry is near): each photon is
   // gathered only where nothing stands between it and the point (photon_cut_off).
   uint8_t cut_off_tested : 1 = 0;
+  // Its disc may be cut, and is probed after the light pass if it gathers light
+  // (bpm/disc_shares.h); until then disc_found and disc_cut are 0, a share of 1.
+  uint8_t probes_pending : 1 = 0;
   bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
   uint8_t disc_cut = 0;    // the disc probes that found no surface (photons/disc_probes.h)
   uint8_t disc_found = 0;  // and those that found some
@@ -47,10 +52,25 @@ struct BackwardPhoton {
   // A point inside a scattering medium, this one (-1: a surface point): a sphere that gathers
   // photon beams, with no normals, surface coordinates or material.
   int16_t medium = -1;
+  // The point's floating-point error bound (SurfacePoint::error), for the pending probes: the upper
+  // half of its float, rounded up.
+  uint16_t error_high = 0;
+  void set_error(float e) {
+    uint32_t bits;
+    std::memcpy(&bits, &e, 4);
+    error_high = uint16_t(std::min<uint32_t>((bits + 0xffffu) >> 16, 0x7f80u));
+  }
+  float error() const {
+    const uint32_t bits = uint32_t(error_high) << 16;
+    float e;
+    std::memcpy(&e, &bits, 4);
+    return e;
+  }
 
   // Sort key that fixes the order of backward photons whatever thread stored them (an eye path
   // stores fewer than 16: kMaxBackwardPhotonsPerPath).
   uint64_t key() const { return (uint64_t(pixel) << 4) | place; }
 };
+static_assert(sizeof(BackwardPhoton) == 112, "the maps' memory: keep a backward photon small");
 
 }  // namespace bpm

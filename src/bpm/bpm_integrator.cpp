@@ -11,6 +11,7 @@
 #include "base/memory.h"
 #include "bpm/accumulate.h"
 #include "bpm/backward_maps.h"
+#include "bpm/disc_shares.h"
 #include "bpm/eye_pass.h"
 #include "bpm/light_pass.h"
 #include "bpm/masks.h"
@@ -133,7 +134,8 @@ class BpmRender {
                 const RenderControl& control);
   bool build_maps(int pass, const RenderControl& control, LightPassParams* lp);
   bool light_pass(const LightPassParams& lp, int pass, int it);
-  void accumulate(const WavelengthMaterials& wm);
+  // Probes the discs that gathered light (disc_shares.h), then adds the iteration to the film.
+  void accumulate(const WavelengthMaterials& wm, int it);
   PassResult progress() const;
 
   // What the round learnt, as sums that add across processes (IntegratorState::learnt, merge,
@@ -324,7 +326,7 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
     sensor_sums_.finish(scene_, *sensors_, opt_.max_depth, s_.bias_model, opt_.seed, it,
                         light_result_.emitted);
   // 4. Accumulation of the iteration into the film; masks balanced for the next one.
-  if (opt_.image) accumulate(wm);
+  if (opt_.image) accumulate(wm, it);
   return progress();
 }
 
@@ -413,8 +415,12 @@ bool BpmRender::light_pass(const LightPassParams& lp, int pass, int it) {
   return true;
 }
 
-void BpmRender::accumulate(const WavelengthMaterials& wm) {
-  const auto t = Clock::now();
+void BpmRender::accumulate(const WavelengthMaterials& wm, int it) {
+  auto t = Clock::now();
+  if (s_.disc_probes)
+    probe_lit_discs(scene_, light_result_, s_.normal_cos, opt_.seed, it, &maps_, &eye_counters_);
+  tot_.probe_s += since(t);
+  t = Clock::now();
   accumulate_iteration(maps_, &light_result_, &eye_, wm.wl, ls_.film.max_component_value, s_, film_,
                        &pixel_sums_, guide_.empty() ? nullptr : &estimate_new_, &moments_new_);
   tot_.accumulate_s += since(t);

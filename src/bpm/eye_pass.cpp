@@ -67,11 +67,13 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
                                       path.counters.rays, part);
 }
 
-// Stores one backward photon at diffuse vertex v. Its disc is probed where it may be cut
-// (disc_probes.h); where a larger disc about the same point was found whole (`larger`), so is
-// this one, and its photons are tested as the larger one's are. Returns the disc's probes (none:
-// not probed). With merge_density, the eye path goes on from the vertex (combined estimators): the
-// backward photon is marked so, and *merge_density set to its pi r^2 s N (0 where none is stored).
+// Stores one backward photon at diffuse vertex v. Where its disc may be cut (disc_probes.h) and
+// is not whole on plain sight, it is probed after the light pass, if it gathers light
+// (bpm/disc_shares.h); where a larger disc about the same point was found whole (`larger`), so is
+// this one, and its photons are tested as the larger one's are. Returns what was found of the
+// disc (nothing: not looked at). With merge_density, the eye path goes on from the vertex (combined
+// estimators): the backward photon is marked so, and *merge_density set to its pi r^2 N (0 where
+// none is stored).
 inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
                                         const PathState& s, int depth, int diffuse,
                                         bool seen_directly, uint8_t accepts,
@@ -93,15 +95,17 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
     bp.cut_off_tested = larger.looked;
   } else if (prm.disc_probes && (!seen_directly || (path.near_edge & near_bit)) &&
              may_cut_discs(path.scene.objects[size_t(v.object())].shape)) {
-    probes = probe_disc(path.scene, v.sp, v.wo, v.object(), PhotonSurfaces::kOwnObject, bp.radius,
-                        prm.normal_cos, path.rng, path.counters.rays, v.hit.primitive);
-    bp.disc_found = probes.found;
-    bp.disc_cut = probes.cut;
-    bp.cut_off_tested = probes.looked;
+    if (disc_plainly_whole(path.scene, v.sp, v.object(), v.hit.primitive, bp.radius,
+                           prm.normal_cos)) {
+      probes.found = bp.disc_found = 0xff;
+    } else {
+      probes.looked = true;
+      bp.cut_off_tested = 1;
+      bp.probes_pending = 1;
+      bp.set_error(v.sp.error);
+    }
   }
-  if (merge_density)
-    *merge_density = kPi * double(bp.radius) * bp.radius *
-                     disc_share(bp.disc_found, bp.disc_cut, 0) * prm.merge_photons;
+  if (merge_density) *merge_density = kPi * double(bp.radius) * bp.radius * prm.merge_photons;
   path.out[size_t(v.object())].push_back(bp);
   ++path.counters.backward_photons;
   return probes;
@@ -210,7 +214,7 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
 // estimators, photons/merge_weights.h): BSDF samples from x on, through vertices with gathered
 // lobes only, each finding area lights by next-event estimation and by its BSDF sample, every
 // path weighed against the merge at x's backward photon, whose density is merge_density
-// (pi r^2 s N; 0: none). The continuation goes on by Russian roulette on its change of
+// (pi r^2 N; 0: none). The continuation goes on by Russian roulette on its change of
 // throughput. depth: x's scattering events, as the backward photon's eye_depth; part: the lobes x
 // gathers with (EyeVertexChoice). Past x each path is weighed by the share of it that photons
 // draw through gathered lobes (bsdf_gathered_probability: 1 but at split coats).

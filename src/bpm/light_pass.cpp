@@ -40,7 +40,7 @@ float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, u
 
 // The weight of merging photon hit h at backward photon bp, whose eye path went on from it
 // (photons/merge_weights.h): the eye's BSDF density there of the photon's direction against the
-// merge's pi r^2 s N.
+// merge's pi r^2 N.
 float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const PendingHit& h,
                             const LightPassParams& prm) {
   const Frame frame = Frame::from_z(bp.ns);
@@ -49,8 +49,7 @@ float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const P
   const BsdfPart part =
       bsdf_traced_part_probability(m, wo) == 0 ? BsdfPart::kAll : BsdfPart::kGathered;
   const float p = bsdf_pdf(m, wo, frame.to_local(h.wi), TransportMode::kRadiance, part);
-  const double density = kPi * double(bp.radius) * bp.radius *
-                         disc_share(bp.disc_found, bp.disc_cut, 0) * prm.merge_photons;
+  const double density = kPi * double(bp.radius) * bp.radius * prm.merge_photons;
   return merge_weight(h.merge_factor, p, density);
 }
 

@@ -118,6 +118,7 @@ nlohmann::json to_json(const BpmTotals& t, const BpmSettings& s, int iterations,
         {"light_trace", t.light_trace_s},
         {"light_gather", t.light_gather_s},
         {"light_apply", t.light_apply_s},
+        {"disc_probes", t.probe_s},
         {"accumulate", t.accumulate_s}}},
   };
 }

@@ -16,7 +16,7 @@ struct BpmTotals {
   LightCounters light;
   size_t peak_photon_bytes = 0, peak_tree_bytes = 0, peak_entry_bytes = 0;
   double eye_s = 0, build_s = 0, light_trace_s = 0, light_gather_s = 0, light_apply_s = 0,
-         accumulate_s = 0;
+         probe_s = 0, accumulate_s = 0;
   uint64_t batches = 0;
   // Photons kept in the estimates (N of eq. 2 summed over iterations; a cut pass traces a few it
   // does not keep), and the iterations whose light pass a stop request cut short.

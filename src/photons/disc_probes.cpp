@@ -101,6 +101,8 @@ float distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
   return length(p - (a + ab * t));
 }
 
+}  // namespace
+
 // Whether the disc is whole on plain sight of the geometry near it, so that probes would find no
 // cut: everything within two radii of the point (the probes' origins and paths) is a triangle of
 // its own mesh lying in its tangent plane (its normal within 0.26 degrees, or normal_cos if
@@ -110,8 +112,8 @@ float distance_to_segment(Vec3 p, Vec3 a, Vec3 b) {
 // probes. One query of Embree's tree, where the probes cast nine rays or more; none when the
 // point's own triangle (`primitive`, -1 when not known) has a neighbour off its plane. NaN from a
 // degenerate triangle fails every test.
-bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, int primitive,
-                   float radius, float normal_cos) {
+bool disc_plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, int primitive,
+                        float radius, float normal_cos) {
   const Object& obj = scene.objects[size_t(object)];
   const auto* mesh = std::get_if<TriangleMesh>(&obj.shape);
   if (!mesh || obj.has_alpha() || mesh->open_edges.empty() || mesh->face_normals.empty())
@@ -159,6 +161,8 @@ bool plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object,
   });
   return whole;
 }
+
+namespace {
 
 // Unit directions a common rotation apart, in a bit-reversed order of angles so that each nested
 // set of probes (0-1, 0-3, all) spreads around the point.
@@ -291,9 +295,15 @@ inline ProbeSays judge_probe(const Disc& d, const Ray& ray, const Hit& h, bool f
 DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays, int primitive) {
-  static_assert(kDiscProbes == RenderScene::kBundle);
-  if (plainly_whole(scene, sp, object, primitive, radius, normal_cos))
+  if (disc_plainly_whole(scene, sp, object, primitive, radius, normal_cos))
     return {0xff, 0};  // as if every probe found it
+  return cast_disc_probes(scene, sp, wo, object, where, radius, normal_cos, rng, rays);
+}
+
+DiscProbes cast_disc_probes(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
+                            PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
+                            PathCounters& rays) {
+  static_assert(kDiscProbes == RenderScene::kBundle);
   const Vec3 n = dot(sp.ng, wo) >= 0 ? sp.ng : -sp.ng;
   const Frame frame = Frame::from_z(n);
   const float rotation = 2 * kPi * rng.uniform();

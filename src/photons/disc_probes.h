@@ -57,6 +57,15 @@ DiscProbes probe_disc(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo,
                       PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
                       PathCounters& rays, int primitive = -1);
 
+// probe_disc in two steps, for a caller that casts the probes later or not at all: the look at
+// the scene's tree (no rays; true: the disc is whole), and the probes themselves (sp.p, sp.ng and
+// sp.error are read).
+bool disc_plainly_whole(const RenderScene& scene, const SurfacePoint& sp, int object, int primitive,
+                        float radius, float normal_cos);
+DiscProbes cast_disc_probes(const RenderScene& scene, const SurfacePoint& sp, Vec3 wo, int object,
+                            PhotonSurfaces where, float radius, float normal_cos, Rng& rng,
+                            PathCounters& rays);
+
 // Whether a photon that landed at q is cut off from the disc's point p, as a probe would judge the
 // disc cut there: the segment from p to q, lifted off the surface along n (the normal on the
 // gathering side) by a thousandth of the radius, meets another object that light does not cross

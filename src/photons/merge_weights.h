@@ -5,10 +5,12 @@
 // counts it with its density over the sum of all three (the balance heuristic; vertex connection
 // and merging, Georgiev et al. 2012, restricted to these strategies). For the path
 // y0 (on a light), z1 .. zm, x, in area measure and with the eye path up to x left out (common):
-//   merging:       A0 A1 ... A(m+1) * pi r^2 s N   the photon's densities: y0 and its direction by
+//   merging:       A0 A1 ... A(m+1) * pi r^2 N     the photon's densities: y0 and its direction by
 //                                                 emission, z(k+1) by the adjoint BSDF at zk; the
-//                                                 disc of radius r, its share s where photons can
-//                                                 land (disc_probes.h), N photons per iteration
+//                                                 whole disc of radius r (its probes come after
+//                                                 the light pass; any density both passes use alike
+//                                                 keeps the weights summing to one), N photons per
+//                                                 iteration
 //   continuation:  B0 B1 ... Bm                    the eye's: zm from x, z(k-1) from zk by the
 //   BSDF,
 //                                                 y0 by next-event estimation or by the BSDF (B0 is
@@ -67,7 +69,7 @@ class PhotonMis {
   void scatter(const PathVertex& v, Vec3 wi, bool traced, int k);
   // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
   // the vertex before over the squared distance, so that the merge's weight is
-  // 1 / (1 + factor * p / (pi r^2 s N)) with p the eye's BSDF density at x of the photon's
+  // 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density at x of the photon's
   // direction. 0: not combined (the merge counts the path in full).
   float merge_factor() const { return on_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
 
@@ -82,7 +84,7 @@ class PhotonMis {
 
 // The merge's weight at a backward photon whose eye path went on (BackwardPhoton::combined):
 // factor (PhotonMis::merge_factor), p the eye's BSDF density (radiance transport) at x of the
-// photon's direction, merge_density = pi r^2 s N.
+// photon's direction, merge_density = pi r^2 N.
 inline float merge_weight(float factor, float p, double merge_density) {
   if (factor == 0) return 1;
   return float(1 / (1 + double(factor) * double(p) / merge_density));

@@ -1,0 +1,103 @@
+// The disc probes that the eye pass leaves pending run after the light pass, only for the backward
+// photons that gathered light: by a wall such a disc is found cut, on the open floor whole; a disc
+// that gathered nothing, or was never pending, is left as it was; and what the probes find depends
+// on the seed and the iteration, not on the threads.
+#include "bpm/disc_shares.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include "scene/flatten.h"
+#include "scene/parsed_scene.h"
+
+namespace bpm {
+namespace {
+
+// A 20 x 20 floor (object 0) and a wall in the plane x = 0 (object 1).
+const char* kScene = R"(LookAt 0 3 -5  0 0 0  0 1 0
+Camera "perspective"
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8
+WorldBegin
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-10 0 -10  -10 0 10  10 0 10  10 0 -10]
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [0 0 -10  0 0 10  0 2 10  0 2 -10]
+)";
+
+BackwardPhoton on_floor(Vec3 p, uint32_t pixel, bool pending) {
+  BackwardPhoton bp{};
+  bp.p = p;
+  bp.radius = 1;
+  bp.ng = bp.ns = bp.wo = Vec3(0, 1, 0);
+  bp.pixel = pixel;
+  bp.probes_pending = pending;
+  bp.cut_off_tested = pending;
+  bp.set_error(1e-6f);
+  return bp;
+}
+
+// Four backward photons on the floor, the light they gathered, and the maps that hold them.
+struct Case {
+  BackwardMaps maps;
+  LightPassResult light;
+  Case() {
+    maps.photons = {on_floor(Vec3(0.3f, 0, 0), 0, true),    // by the wall, lit
+                    on_floor(Vec3(0.3f, 0, 2), 1, true),    // by the wall, unlit
+                    on_floor(Vec3(-5, 0, 0), 2, true),      // in the open, lit
+                    on_floor(Vec3(0.3f, 0, -2), 3, false)};  // by the wall, never pending
+    maps.object_begin = {0, 4, 4};
+    light.reached = {1, 0, 1, 1};
+    light.flux = {Spectrum(1.0f), Spectrum(), Spectrum(1.0f), Spectrum(1.0f)};
+  }
+};
+
+std::vector<std::pair<uint8_t, uint8_t>> probe_with(const LoadedScene& ls, int threads, int seed,
+                                                    int iteration, uint64_t* rays = nullptr) {
+  Case c;
+  tbb::enumerable_thread_specific<EyeCounters> counters;
+  tbb::task_arena(threads).execute([&] {
+    probe_lit_discs(ls.scene, c.light, 0.5f, uint64_t(seed), iteration, &c.maps, &counters);
+  });
+  if (rays) {
+    *rays = 0;
+    for (const EyeCounters& e : counters) *rays += e.rays.probe_rays;
+  }
+  std::vector<std::pair<uint8_t, uint8_t>> bits;
+  for (const BackwardPhoton& bp : c.maps.photons) bits.emplace_back(bp.disc_found, bp.disc_cut);
+  return bits;
+}
+
+TEST(DiscShares, OnlyLitPendingDiscsAreProbed) {
+  const LoadedScene ls = flatten_scene(parse_scene_string(kScene));
+  uint64_t rays = 0;
+  const auto bits = probe_with(ls, 2, 1, 0, &rays);
+  // By the wall: the disc reaches 0.7 past it, 25% of its area; some of 8 probes find the wall.
+  EXPECT_NE(bits[0].second, 0);
+  EXPECT_NE(bits[0].first, 0);
+  EXPECT_EQ(bits[1], std::make_pair(uint8_t(0), uint8_t(0)));
+  EXPECT_EQ(bits[2].second, 0);
+  EXPECT_NE(bits[2].first, 0);
+  EXPECT_EQ(bits[3], std::make_pair(uint8_t(0), uint8_t(0)));
+  // Two discs probed, each with at least its eight probes.
+  EXPECT_GE(rays, uint64_t(2 * kDiscProbes));
+  // By the wall the share found is near the disc's part this side of it, over many iterations.
+  double share = 0;
+  constexpr int kIterations = 400;
+  for (int it = 0; it < kIterations; ++it) {
+    const auto b = probe_with(ls, 2, 1, it);
+    share += disc_share(b[0].first, b[0].second, 0) / double(kIterations);
+  }
+  const double d = 0.3, segment = (std::acos(d) - d * std::sqrt(1 - d * d)) / M_PI;
+  EXPECT_NEAR(share, 1 - segment, 0.03);
+}
+
+TEST(DiscShares, ProbesDependOnTheSeedAndIterationNotTheThreads) {
+  const LoadedScene ls = flatten_scene(parse_scene_string(kScene));
+  const auto one = probe_with(ls, 1, 7, 3), two = probe_with(ls, 2, 7, 3);
+  EXPECT_EQ(one, two);
+  // Other iterations draw other probes: the wall's disc is not found the same way in all of them.
+  bool differs = false;
+  for (int it = 4; it < 20 && !differs; ++it) differs = probe_with(ls, 2, 7, it)[0] != one[0];
+  EXPECT_TRUE(differs);
+}
+
+}  // namespace
+}  // namespace bpm
