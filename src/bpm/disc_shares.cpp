@@ -25,15 +25,17 @@ void probe_lit_discs(const RenderScene& scene, const LightPassResult& light, flo
         for (size_t g = r.begin(); g < r.end(); ++g) {
           BackwardPhoton& bp = maps->photons[g];
           if (!bp.probes_pending || !light.reached[g] || light.flux[g].is_black()) continue;
-          const int object = int(std::upper_bound(begin.begin(), begin.end(), g) - begin.begin()) - 1;
+          const int object =
+              int(std::upper_bound(begin.begin(), begin.end(), g) - begin.begin()) - 1;
           SurfacePoint sp;
           sp.p = bp.p;
           sp.ng = bp.ng;
           sp.ns = bp.ns;
           sp.error = bp.error();
           Rng rng(stream_key(seed ^ kProbeStream, uint64_t(iteration), bp.pixel, bp.place));
-          const DiscProbes probes = cast_disc_probes(
-              scene, sp, bp.wo, object, PhotonSurfaces::kOwnObject, bp.radius, normal_cos, rng, rays);
+          const DiscProbes probes =
+              cast_disc_probes(scene, sp, bp.wo, object, PhotonSurfaces::kOwnObject, bp.radius,
+                               normal_cos, rng, rays);
           bp.disc_found = probes.found;
           bp.disc_cut = probes.cut;
         }

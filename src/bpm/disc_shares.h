@@ -5,9 +5,9 @@
 // photons few), so this costs a fraction of probing every disc in the eye pass, and the estimate
 // is the same in expectation.
 #pragma once
-#include <cstdint>
-
 #include <tbb/enumerable_thread_specific.h>
+
+#include <cstdint>
 
 #include "bpm/backward_maps.h"
 #include "bpm/eye_pass.h"

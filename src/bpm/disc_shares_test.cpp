@@ -39,9 +39,9 @@ struct Case {
   BackwardMaps maps;
   LightPassResult light;
   Case() {
-    maps.photons = {on_floor(Vec3(0.3f, 0, 0), 0, true),    // by the wall, lit
-                    on_floor(Vec3(0.3f, 0, 2), 1, true),    // by the wall, unlit
-                    on_floor(Vec3(-5, 0, 0), 2, true),      // in the open, lit
+    maps.photons = {on_floor(Vec3(0.3f, 0, 0), 0, true),     // by the wall, lit
+                    on_floor(Vec3(0.3f, 0, 2), 1, true),     // by the wall, unlit
+                    on_floor(Vec3(-5, 0, 0), 2, true),       // in the open, lit
                     on_floor(Vec3(0.3f, 0, -2), 3, false)};  // by the wall, never pending
     maps.object_begin = {0, 4, 4};
     light.reached = {1, 0, 1, 1};
