@@ -44,7 +44,7 @@ void print_bpm_summary(const nlohmann::json& d) {
       "batches/iteration, "
       "%.2f of the last backward photons hit\n"
       "bpm: stages: eye %.2f s, trees %.2f s, light trace %.2f + gather %.2f + apply %.2f s, "
-      "accumulate %.2f s\n",
+      "disc probes %.2f s, accumulate %.2f s\n",
       double(eye["camera_rays"].get<uint64_t>() + eye["bounce_rays"].get<uint64_t>() +
              eye["shadow_rays"].get<uint64_t>()),
       double(eye["backward_photons"].get<uint64_t>()),
@@ -57,7 +57,7 @@ void print_bpm_summary(const nlohmann::json& d) {
       light["batches_per_iteration"].get<double>(), light["coverage_mean"].get<double>(),
       st["eye"].get<double>(), st["tree_build"].get<double>(), st["light_trace"].get<double>(),
       st["light_gather"].get<double>(), st["light_apply"].get<double>(),
-      st["accumulate"].get<double>());
+      st["disc_probes"].get<double>(), st["accumulate"].get<double>());
 }
 
 void print_fpm_summary(const nlohmann::json& d) {

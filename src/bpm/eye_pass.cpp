@@ -69,8 +69,9 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 
 // Stores one backward photon at diffuse vertex v. Where its disc may be cut (disc_probes.h) and
 // is not whole on plain sight, it is probed after the light pass, if it gathers light
-// (bpm/disc_shares.h); where a larger disc about the same point was found whole (`larger`), so is
-// this one, and its photons are tested as the larger one's are. Returns what was found of the
+// (bpm/disc_shares.h); where a larger disc about the same point was whole on plain sight
+// (`larger`), so is this one. (A larger disc left to its probes tells this one nothing: it is
+// looked at, and probed, on its own.) Returns what was found of the
 // disc (nothing: not looked at). With merge_density, the eye path goes on from the vertex (combined
 // estimators): the backward photon is marked so, and *merge_density set to its pi r^2 N (0 where
 // none is stored).

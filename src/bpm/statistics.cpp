@@ -66,7 +66,8 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
           {"backward_photons_per_backward_segment", ratio(backward_photons, double(backward_rays))},
           {"backward_photons_per_pixel_iteration",
            ratio(backward_photons, double(iterations) * double(pixels))},
-          {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s)}};
+          // The probes run after the light pass (disc_shares.h): their time with the eye pass's.
+          {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s + t.probe_s)}};
 }
 
 nlohmann::json light_json(const BpmTotals& t, int iterations) {
