@@ -225,10 +225,11 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
                    "partition: indirect light at the last diffuse vertex comes from the photons "
                    "alone; combined: the eye path also goes on from there, and each light path is "
                    "weighed between the photons and the continuation by multiple importance "
-                   "sampling; glossy (default): combined where that vertex's gathered lobes "
-                   "include a glossy one, partition elsewhere (scenes without media; file: string "
-                   "estimators)")
-      ->check(CLI::IsMember({"partition", "glossy", "combined"}))
+                   "sampling; glossy: combined where that vertex's gathered lobes include a glossy "
+                   "one, partition elsewhere; auto (default): as glossy, and elsewhere combined "
+                   "with a probability each pixel chooses from its own variance and cost (scenes "
+                   "without media; file: string estimators)")
+      ->check(CLI::IsMember({"partition", "glossy", "combined", "auto"}))
       ->group(kBpm);
   render
       ->add_flag("--no-coat-split", ra.no_coat_split,

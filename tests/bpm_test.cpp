@@ -916,17 +916,45 @@ TEST(Bpm, CombinedEstimatorsConvergeToPath) {
   }
 }
 
-// By default (--estimators glossy) the eye path goes on only from last vertices whose gathered
-// lobes include a glossy one: the rough coat's reflection, not a diffuse wall, nor the walks under
-// a traced coat.
-TEST(Bpm, EstimatorsCombineByDefaultAtGlossyLastVertices) {
+// With --estimators auto the eye path goes on from a last vertex that is not glossy with a
+// probability each pixel chooses (continue_level): its light over the probability, its density
+// times it in the weights on both sides. With many photons over wide discs the merges take nearly
+// all the weight, and the pixels lower their probability; the image still agrees with path's,
+// block by block and in its mean within 4.5 sigma (a probability left out of either side's weight,
+// or of the light's division, shows).
+TEST(Bpm, ContinuationsTakenByChanceConvergeToPath) {
+  LoadedScene ls = load(cornell());
+  const Film ref = render_with(ls, "path", 2048).film;
+  BpmSettings s = small_batches(0);
+  s.combine = CombineAt::kChosen;
+  // Whole renders, whose pixels choose at each round's end: 8 seeds of 40 iterations.
+  const Iterations c = render_seeds(ls, 8, 40, s);
+  const double q = c.last.details["eye"]["continue_probability_mean"].get<double>();
+  const BlockStats mc = image_mean(c), mr = block_stats(ref, 32)[0];
+  std::printf("mean probability of going on %.3f; mean %.5f, path %.5f (sigma %.5f)\n", q, mc.mean,
+              mr.mean, std::sqrt(mc.var + mr.var));
+  EXPECT_EQ(c.last.details["settings"]["estimators"], "auto");
+  EXPECT_GT(c.last.details["eye"]["continued_paths"].get<double>(), 0.0);
+  EXPECT_LT(q, 0.9);
+  EXPECT_GT(q, 0.0);
+  expect_blocks_agree(c, ref, 8, edge_bias(s, 40, 8), "auto");
+  EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var));
+}
+
+// With --estimators glossy the eye path goes on only from last vertices whose gathered lobes
+// include a glossy one: the rough coat's reflection, not a diffuse wall, nor the walks under a
+// traced coat. (The default is auto.)
+TEST(Bpm, GlossyEstimatorsCombineAtGlossyLastVerticesOnly) {
   for (const char* floor : {"\"float roughness\" 0.3", "\"float roughness\" 0.001", ""}) {
     const std::string material =
         *floor
             ? std::string("Material \"coateddiffuse\" \"rgb reflectance\" [0.6 0.6 0.6] ") + floor
             : std::string("Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]");
     LoadedScene ls = load(cornell(material));
-    const RenderRun r = render_with(ls, "bpm", 4, 0, 1, small_batches(0));
+    EXPECT_EQ(to_string(BpmSettings().combine), std::string("auto"));
+    BpmSettings s = small_batches(0);
+    s.combine = CombineAt::kGlossy;
+    const RenderRun r = render_with(ls, "bpm", 4, 0, 1, s);
     EXPECT_EQ(r.stats.details["settings"]["estimators"], "glossy");
     const double continued = r.stats.details["eye"]["continued_paths"].get<double>();
     if (std::string(floor) == "\"float roughness\" 0.3")
@@ -1423,6 +1451,39 @@ TEST(Bpm, DirectSampleCountBalancesVarianceAndCost) {
   EXPECT_EQ(count(odd, 7.5, 8), 3);
 }
 
+// A pixel's probability of going on from a last vertex that is not glossy minimises its variance
+// times its cost: q = sqrt(E[X^2] C / (V_rest c)), as a level k with q = 2^-k in [0, 4]; 1 until
+// two continuations and two estimates are known.
+TEST(Bpm, ContinueLevelBalancesVarianceAndCost) {
+  // Ten iterations met such a vertex and added 2 or 0 in turn (variance 10/9); of `taken`
+  // continuations, E[X^2] = x2 and `rays` rays each.
+  auto stats = [](double taken, double x2, double rays) {
+    SampleStats<double> s;
+    constexpr int c = SampleStats<double>::kContinued;
+    s.v[c] = 10;
+    s.v[c + 1] = 10;
+    s.v[c + 2] = 20;
+    s.v[c + 3] = taken;
+    s.v[c + 4] = taken * x2;
+    s.v[c + 5] = taken * rays;
+    return s;
+  };
+  // V_rest = 16 (the estimate's variance less the continuations'), C = 100 rays per iteration.
+  const double v = 16 + 10.0 / 9;
+  // E[X^2] = 1, c = 100: q = sqrt(1 * 100 / (16 * 100)) = 1/4.
+  const SampleStats<double> s = stats(5, 1, 100);
+  EXPECT_EQ(continue_level(s, 10, v, 100), 2);
+  // Costly continuations, or none that found light: the least probability; cheap ones: 1.
+  EXPECT_EQ(continue_level(stats(5, 1, 1e6), 10, v, 100), kMaxContinueLevel);
+  EXPECT_EQ(continue_level(stats(5, 0, 100), 10, v, 100), kMaxContinueLevel);
+  EXPECT_EQ(continue_level(stats(5, 1, 1), 10, v, 100), 0);
+  // Not yet known: one continuation, one estimate, no cost.
+  EXPECT_EQ(continue_level(stats(1, 1, 100), 10, v, 100), 0);
+  EXPECT_EQ(continue_level(s, 1, v, 100), 0);
+  EXPECT_EQ(continue_level(s, 10, v, 0), 0);
+  EXPECT_EQ(continue_level(SampleStats<double>{}, 10, v, 100), 0);
+}
+
 // pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon
 // count; sppm's default of -1 photons (one per pixel) keeps ours; a negative radius is an error.
 TEST(BpmSettings, SppmLineGivesDepth0ItsRadiusAndItsPhotons) {
@@ -1786,6 +1847,9 @@ TEST(Bpm, TimeBudgetCutsTheLightPassToAPrefixOfItsPhotons) {
   for (const std::string integrator : {"bpm", "fpm"}) {
     BpmSettings s = small_batches(1);
     s.photons_per_iteration = 2000000000;  // hours of photons
+    // Combined estimators weigh merges with the planned count (the same in both passes, whatever
+    // is kept): the partition, so that the cut render is the whole one of its photons exactly.
+    s.combine = CombineAt::kNowhere;
     RenderRun cut{Film(ls.film.width, ls.film.height), {}};
     RenderOptions opt = test_options(ls, integrator, 1000, 9, s);
     opt.time_limit_s = 0.3;

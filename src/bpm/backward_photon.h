@@ -35,7 +35,10 @@ struct BackwardPhoton {
   uint32_t material;
   uint16_t eye_depth;         // scattering events on the eye path, this vertex included
   uint8_t accepts;            // AcceptMask bits
-  uint8_t diffuse_index : 5;  // j - 1 for the j-th diffuse vertex (0..3)
+  uint8_t diffuse_index : 2;  // j - 1 for the j-th diffuse vertex (0..3)
+  // With `combined`: the eye path went on from here with the probability 2^-continue_level
+  // (EyePixels::continue_level), and the merge's weight counts the continuation's density so.
+  uint8_t continue_level : 3 = 0;
   // The eye path went on from here (combined estimators, photons/merge_weights.h): the photons
   // it gathers are weighed against that.
   uint8_t combined : 1 = 0;

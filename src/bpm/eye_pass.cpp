@@ -57,6 +57,8 @@ struct EyePath {
   int& splits;              // medium vertices drawn where the path splits (gather_forced_in_medium)
   int direct_samples;       // at the last diffuse vertex of a surface
   double& direct_variance;  // of those samples, where there are two or more (EyeRadiance)
+  int continue_level;       // EyePixels::continue_level
+  EyeContinuation& continued;
 };
 
 // Direct light at v by next-event estimation, shared by MIS with the BSDF sample that goes on.
@@ -78,12 +80,14 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
                                         const PathState& s, int depth, int diffuse,
                                         bool seen_directly, uint8_t accepts,
-                                        const DiscProbes& larger, double* merge_density) {
+                                        const DiscProbes& larger, double* merge_density,
+                                        uint8_t continue_level) {
   const EyePassParams& prm = path.prm;
   BackwardPhoton bp =
       backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
   if (bp.radius <= 0 || s.beta.is_black()) return {};
   bp.combined = merge_density != nullptr;
+  bp.continue_level = merge_density ? continue_level : 0;
   bp.place = uint8_t(path.stored++);
   if (v.medium >= 0) {  // after the objects' lists, one per medium
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
@@ -114,17 +118,19 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
 
 // Caustic light at x_1..x_(D+1), indirect light at x_(D+1) only. With D = 0 the first vertex is
 // also the last: two backward photons, one per radius. With merge_density, the one that accepts
-// indirect light is combined with the eye path's continuation (store_backward_photon).
+// indirect light is combined with the eye path's continuation (store_backward_photon), which goes
+// on with the probability 2^-continue_level.
 inline void store_backward_photons(const EyePath& path, const PathVertex& v, const PathState& s,
                                    int depth, int diffuse, bool last,
-                                   double* merge_density = nullptr) {
+                                   double* merge_density = nullptr, uint8_t continue_level = 0) {
   const EyePassParams& prm = path.prm;
   // Seen straight from the camera: the screen around the pixel says whether its discs may be
   // cut (disc_probes.h).
   const bool seen_directly = diffuse == 1 && depth == 1;
   auto store = [&](uint8_t accepts, const DiscProbes& larger) {
     return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, larger,
-                                 accepts & kAcceptsIndirect ? merge_density : nullptr);
+                                 accepts & kAcceptsIndirect ? merge_density : nullptr,
+                                 continue_level);
   };
   if (!prm.caustics) {
     if (last) store(kAcceptsIndirect, {});
@@ -308,11 +314,27 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   L += last ? direct_light_at_last(path, v, s, choice.part)
             : direct_light_at(path, v, s, choice.part);
   const CombineAt at = path.prm.combine;
-  const bool go_on = last && at != CombineAt::kNowhere && combinable_vertex(v) &&
-                     (at == CombineAt::kEverywhere || bsdf_gathers_glossy(v.m(), choice.part));
+  bool go_on = last && at != CombineAt::kNowhere && combinable_vertex(v);
+  // Where the gathered lobes are not glossy: with kChosen the pixel's probability
+  // (EyePixels::continue_level), with kGlossy never.
+  int level = 0;
+  bool chosen_here = false;
+  if (go_on && at != CombineAt::kEverywhere && !bsdf_gathers_glossy(v.m(), choice.part)) {
+    go_on = chosen_here = at == CombineAt::kChosen;
+    level = path.continue_level;
+  }
   double merge_density = 0;
-  store_backward_photons(path, v, s, depth, diffuse, last, go_on ? &merge_density : nullptr);
-  if (go_on) L += continue_eye_path(path, v, choice.part, s, depth, merge_density);
+  store_backward_photons(path, v, s, depth, diffuse, last, go_on ? &merge_density : nullptr,
+                         uint8_t(level));
+  if (!go_on) return last;
+  if (chosen_here) path.continued.at_vertex = true;
+  // Taken with the probability q: its density q B against the merge's, its light over q.
+  const double q = std::ldexp(1.0, -level);
+  if (level > 0 && !(path.rng.uniform() < q)) return last;
+  const uint64_t rays = path.counters.rays.total();
+  const Spectrum c = continue_eye_path(path, v, choice.part, s, depth, merge_density / q);
+  L += c / float(q);
+  if (chosen_here) path.continued.add(c.average(), q, path.counters.rays.total() - rays);
   return last;
 }
 
@@ -412,13 +434,15 @@ inline EyeVertexChoice choose_or_split(const EyePath& path, const PathVertex& v,
                                              CameraRay ray, PixelFootprint footprint,
                                              uint32_t pixel, Rng& rng, ObjectPhotonLists& out,
                                              EyeCounters& counters, bool emission_only,
-                                             uint8_t near_edge, float flight_u,
-                                             int direct_samples) {
+                                             uint8_t near_edge, float flight_u, int direct_samples,
+                                             int continue_level) {
   int stored = 0, splits = 0;
   double direct_variance = -1;
+  EyeContinuation continued;
   const int direct = std::clamp(direct_samples, 1, std::max(1, prm.direct_samples));
-  const EyePath path{scene, prm,      footprint, pixel,  near_edge, rng,
-                     out,   counters, stored,    splits, direct,    direct_variance};
+  const EyePath path{
+      scene,  prm,    footprint, pixel,           near_edge,      rng,      out, counters,
+      stored, splits, direct,    direct_variance, continue_level, continued};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;
@@ -487,7 +511,7 @@ inline EyeVertexChoice choose_or_split(const EyePath& path, const PathVertex& v,
     if (direct_here) L += direct_light_at(path, v, s, choice.part);
     if (!scatter(path, v, choice, direct_here, diffuse, s, emitter)) break;
   }
-  return {L + along + gathered, emission ? *emission : L, direct_variance};
+  return {L + along + gathered, emission ? *emission : L, direct_variance, continued};
 }
 
 namespace {
@@ -543,6 +567,24 @@ int direct_sample_count(const SampleStats<double>& s, double estimates, double e
   return int(std::clamp(std::round(k), 1.0, double(max_samples)));
 }
 
+int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
+                   double base_rays) {
+  const double n = s.v[SampleStats<double>::kContinued],
+               taken = s.v[SampleStats<double>::kContinued + 3];
+  if (estimates < 2 || n < 2 || taken < 2 || !(base_rays > 0)) return 0;
+  const double x2 = s.v[SampleStats<double>::kContinued + 4] / taken,
+               rays = s.v[SampleStats<double>::kContinued + 5] / taken;
+  if (!(x2 > 0) || !(rays > 0)) return kMaxContinueLevel;
+  // What the continuations added varies by this much of the estimate's variance; the rest, at
+  // least 2% of it.
+  const double v_continued = s.variance(SampleStats<double>::kContinued);
+  const double v_rest = std::max(estimate_variance - v_continued, 0.02 * estimate_variance);
+  if (!(v_rest > 0)) return 0;
+  const double q = std::sqrt(x2 * base_rays / (v_rest * rays));
+  if (!(q < 1)) return 0;
+  return int(std::clamp(std::round(-std::log2(q)), 0.0, double(kMaxContinueLevel)));
+}
+
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const CameraSampler& camera,
                   const PixelMasks& masks, const RenderControl& control, int pass, int pass_index,
                   EyePixels* px, EyeThreadData threads) {
@@ -577,8 +619,9 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
                 trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
                                false, prm.near_edges ? prm.near_edges->at(pixel) : 3,
                                flights ? camera.stream_uniform(pass_index, pixel) : -1.0f,
-                               px->direct_samples[pixel]);
+                               px->direct_samples[pixel], px->continue_level[pixel]);
             px->round_stats[pixel].add_direct_variance(r.direct_variance);
+            px->round_stats[pixel].add_continuation(r.continued);
             px->filter_weight[pixel] = cs.filter_weight;
             const Spectrum emission =
                 mean_emission(scene, prm, camera, pass_index, pixel,

@@ -101,9 +101,27 @@ using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 // vertex (emitters seen directly or through specular vertices only); and where it took two or
 // more samples of direct light at its last vertex, their sample variance (of their means over the
 // wavelengths; -1 where it took fewer).
+// With CombineAt::kChosen, what the path's continuations from last vertices whose gathered lobes
+// are not glossy brought (each taken with the probability q of EyePixels::continue_level, its
+// light then divided by q): whether it met such a vertex, the sum of what they added, and of those
+// taken their count, the sum of the squares of their light before the division, and their rays.
+// Light as means over the wavelengths.
+struct EyeContinuation {
+  bool at_vertex = false;
+  double sum = 0, taken = 0, squares = 0, rays = 0;
+  void add(double x, double q, uint64_t continuation_rays) {
+    if (!std::isfinite(x)) return;
+    sum += x / q;
+    taken += 1;
+    squares += x * x;
+    rays += double(continuation_rays);
+  }
+};
+
 struct EyeRadiance {
   Spectrum total, emission;
   double direct_variance = -1;
+  EyeContinuation continued;
 };
 
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
@@ -113,25 +131,29 @@ struct EyeRadiance {
 // directly probes its discs. The ray's weight is the throughput the path starts with. flight_u:
 // when in [0, 1), the uniform number of the path's first free flight in a scattering medium
 // (PathState::flight_u). direct_samples: the samples of direct light at the last diffuse vertex
-// of a surface, at most params.direct_samples.
+// of a surface, at most params.direct_samples. continue_level: with CombineAt::kChosen, the path
+// goes on from a last vertex whose gathered lobes are not glossy with the probability
+// 2^-continue_level (EyeRadiance::continued).
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, CameraRay ray,
                            PixelFootprint footprint, uint32_t pixel, Rng& rng,
                            ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only = false, uint8_t near_edge = 3, float flight_u = -1,
-                           int direct_samples = 1);
+                           int direct_samples = 1, int continue_level = 0);
 
 // A pixel's statistics for its extra samples, over the iterations: of emission seen before the
 // first diffuse vertex (per camera sample) and of the rest of its estimate (per iteration), for
 // the emission samples (counts, sums and sums of squares of means over the wavelengths); the sum
 // of 1 / the direct samples it took per estimate (the estimates' own moments are PixelMoments,
 // bpm/accumulate.h) and the sample variances of its direct light at one vertex, for the direct
-// samples.
+// samples; and what its continuations brought (EyeContinuation), for their probability.
 template <class T>
 struct SampleStats {
-  static constexpr int kValues = 9;
+  static constexpr int kValues = 15;
   // Where each group starts in v: count, sum and sum of squares for the first two; then the sum
-  // of 1 / direct samples over the estimates, and the count and sum of direct variances.
-  enum : int { kEmission = 0, kRest = 3, kInverseSamples = 6, kDirect = 7 };
+  // of 1 / direct samples over the estimates, and the count and sum of direct variances; then the
+  // iterations whose path met a vertex where the continuation is chosen, the sum and squares of
+  // what the continuations added there, and of those taken the count, squares and rays.
+  enum : int { kEmission = 0, kRest = 3, kInverseSamples = 6, kDirect = 7, kContinued = 9 };
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
   void add_emission(double x) { add(kEmission, x); }
@@ -141,6 +163,13 @@ struct SampleStats {
     if (!std::isfinite(s2) || s2 < 0) return;
     v[kDirect] += 1;
     v[kDirect + 1] += T(s2);
+  }
+  void add_continuation(const EyeContinuation& c) {
+    if (!c.at_vertex) return;
+    add(kContinued, c.sum);
+    v[kContinued + 3] += T(c.taken);
+    v[kContinued + 4] += T(c.squares);
+    v[kContinued + 5] += T(c.rays);
   }
   T emission_n() const { return v[kEmission]; }
   T rest_n() const { return v[kRest]; }
@@ -180,6 +209,19 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
 int direct_sample_count(const SampleStats<double>& s, double estimates, double estimate_variance,
                         double cost_ratio, int max_samples);
 
+// The probability q = 2^-level with which the pixel's eye paths go on from last vertices whose
+// gathered lobes are not glossy (CombineAt::kChosen), by the same balance: taken with the
+// probability q, a continuation adds E[X^2] / q - E[X]^2 to the pixel's variance per iteration
+// (X its light) and q c to its cost (c its rays), so that (V_rest + E[X^2] / q) (C + q c) is
+// least at q = sqrt(E[X^2] C / (V_rest c)); V_rest is the rest of the estimate's variance, C an
+// iteration's rays per pixel (`base_rays`, the light pass's included). Within [2^-kMaxLevel, 1]:
+// 1 until two continuations and two estimates are known. At least 1/16: once a round (a quarter of
+// the iterations before it) has 16 iterations, a pixel still takes a continuation about once a
+// round, and what it measures keeps up with the radii as they shrink.
+constexpr int kMaxContinueLevel = 4;
+int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
+                   double base_rays);
+
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
   std::vector<Spectrum> radiance;    // the eye pass's own part of the pixel's estimate
@@ -197,6 +239,10 @@ struct EyePixels {
   // Samples of direct light per iteration at the pixel's last vertex (direct_sample_count, set
   // at the end of each round; at most EyePassParams::direct_samples of them are taken).
   std::vector<uint16_t> direct_samples;
+  // With CombineAt::kChosen, the level of the probability 2^-level that the pixel's paths go on
+  // from a last vertex whose gathered lobes are not glossy (continue_level, set at the end of each
+  // round).
+  std::vector<uint8_t> continue_level;
   // The pixels' statistics for their extra samples (the emission ones only of pixels that see
   // emission): of every round so far, and of this round (summed over processes at its end).
   std::vector<SampleStats<double>> sample_stats;
@@ -211,6 +257,7 @@ struct EyePixels {
         emission_samples(n, 1),
         emission_part(n, 0.0f),
         direct_samples(n, 2),
+        continue_level(n, 0),
         sample_stats(n),
         round_stats(n) {}
 };

@@ -49,7 +49,8 @@ float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const P
   const BsdfPart part =
       bsdf_traced_part_probability(m, wo) == 0 ? BsdfPart::kAll : BsdfPart::kGathered;
   const float p = bsdf_pdf(m, wo, frame.to_local(h.wi), TransportMode::kRadiance, part);
-  const double density = kPi * double(bp.radius) * bp.radius * prm.merge_photons;
+  const double density =
+      std::ldexp(kPi * double(bp.radius) * bp.radius * prm.merge_photons, bp.continue_level);
   return merge_weight(h.merge_factor, p, density);
 }
 

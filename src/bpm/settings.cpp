@@ -31,7 +31,7 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   b.split_in_media = ps.get_bool("splitinmedia", b.split_in_media);
   const std::string estimators = ps.get_string("estimators", to_string(b.combine));
   ps.require("estimators", parse_combine_at(estimators).has_value(),
-             "must be \"partition\", \"glossy\" or \"combined\"", in.loc);
+             "must be \"partition\", \"glossy\", \"combined\" or \"auto\"", in.loc);
   b.combine = *parse_combine_at(estimators);
   b.split_coats = ps.get_bool("splitcoats", b.split_coats);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);

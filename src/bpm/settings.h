@@ -38,9 +38,10 @@ struct BpmSettings : PhotonSettings {
   // Combined estimators (photons/merge_weights.h): indirect light at the last diffuse vertex is
   // both gathered from the photons and found by the eye path going on from there, each path
   // weighed between the two by multiple importance sampling, instead of the photons' alone. By
-  // default where that vertex's gathered lobes include a glossy one, over which a photon estimate
-  // is noisy (docs/MEASUREMENTS.md, "Combined estimators").
-  CombineAt combine = CombineAt::kGlossy;
+  // default always where that vertex's gathered lobes include a glossy one, over which a photon
+  // estimate is noisy, and elsewhere with a probability each pixel chooses from its own variance
+  // and cost (docs/MEASUREMENTS.md, "Combined estimators").
+  CombineAt combine = CombineAt::kChosen;
   // At the first vertex of a material with both parts (a sharp coat over a diffuse base, BsdfPart)
   // where gathering would end the eye path, the path takes both parts, instead of one by chance
   // with its weight divided by the chance (EyePassParams::split_coats): a coated floor seen from

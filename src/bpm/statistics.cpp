@@ -58,6 +58,7 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
           // their rays (among the bounce and shadow rays).
           {"continued_paths", t.eye.continued},
           {"continuation_rays", t.eye.continuation_rays},
+          {"continue_probability_mean", t.continue_probability},
           {"backward_photons", t.eye.backward_photons},
           // The paper's Table 1 counts per ray traced from the camera with all its continuations
           // (an eye path); per segment counts every camera and bounce ray.

@@ -29,6 +29,9 @@ struct BpmTotals {
   // The photon count of the last iterations, the light pass's share of an iteration's variance
   // and the balance N* (bpm/photon_count.h; a fixed count does not follow it).
   int photons_last = 0;
+  // With --estimators auto: the mean over the pixels of their probability of going on from a last
+  // vertex that is not glossy (EyePixels::continue_level; -1 otherwise).
+  double continue_probability = -1;
   double photon_share = -1, photons_best = 0, variance = 0, photon_variance = 0;
 
   // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.

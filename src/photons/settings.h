@@ -13,9 +13,10 @@ enum class RadiusPolicy { kFixed, kProgressive };
 
 // Where bpm combines its photon merges with the eye path's continuation (photons/merge_weights.h):
 // nowhere (the partition), at last diffuse vertices whose gathered lobes include a glossy one
-// (bsdf_gathers_glossy), or at every last diffuse vertex. As the file and the flag name them:
-// "partition", "glossy", "combined".
-enum class CombineAt { kNowhere, kGlossy, kEverywhere };
+// (bsdf_gathers_glossy), at every last diffuse vertex, or at the glossy ones always and at the
+// others with a probability each pixel chooses from its own statistics (bpm/eye_pass.h,
+// continue_level). As the file and the flag name them: "partition", "glossy", "combined", "auto".
+enum class CombineAt { kNowhere, kGlossy, kEverywhere, kChosen };
 
 // How the bias of a radius-r density estimate is estimated from the same photons gathered over
 // nested discs (PhotonSettings::bias_model).
@@ -58,10 +59,21 @@ inline const char* to_string(RadiusPolicy p) {
 }
 
 inline const char* to_string(CombineAt c) {
-  return c == CombineAt::kNowhere ? "partition" : c == CombineAt::kGlossy ? "glossy" : "combined";
+  switch (c) {
+    case CombineAt::kNowhere:
+      return "partition";
+    case CombineAt::kGlossy:
+      return "glossy";
+    case CombineAt::kEverywhere:
+      return "combined";
+    case CombineAt::kChosen:
+      break;
+  }
+  return "auto";
 }
 inline std::optional<CombineAt> parse_combine_at(const std::string& s) {
-  for (CombineAt c : {CombineAt::kNowhere, CombineAt::kGlossy, CombineAt::kEverywhere})
+  for (CombineAt c :
+       {CombineAt::kNowhere, CombineAt::kGlossy, CombineAt::kEverywhere, CombineAt::kChosen})
     if (s == to_string(c)) return c;
   return std::nullopt;
 }

@@ -36,7 +36,7 @@ struct RenderRequest {
   bool no_disc_probes = false;
   bool no_equiangular = false;
   bool split_in_media = false;
-  std::string estimators;  // bpm: "partition", "glossy" or "combined"
+  std::string estimators;  // bpm: "partition", "glossy", "combined" or "auto"
   bool no_coat_split = false;
   bool debias = false;
   std::string bias_model;
