@@ -89,9 +89,8 @@ struct ExtraSampleCost {
   // sample of the kind has been taken (unknown).
   double ratio(size_t kind) const {
     const double samples = v[kind], sample_rays = v[kind + 1];
-    const double base = v[kRays] - v[kEmissionRays] - v[kDirectRays];
     if (!(v[kPixels] > 0) || !(samples > 0) || !(sample_rays > 0)) return -1;
-    return std::max(0.0, (base / v[kPixels]) / (sample_rays / samples) - 1);
+    return std::max(0.0, base_rays() / (sample_rays / samples) - 1);
   }
   // What an iteration costs per pixel without extra samples, in rays (0: unknown).
   double base_rays() const {
@@ -483,7 +482,7 @@ void BpmRender::set_sample_counts() {
     const double variance = n < 2 ? 0.0 : (m[PixelMoments::kSquares] - sum * sum / n) / (n - 1);
     eye_.direct_samples[p] =
         uint16_t(direct_sample_count(st, n, std::max(0.0, variance), direct, s_.direct_samples));
-    if (s_.combine == CombineAt::kChosen)
+    if (combined() == CombineAt::kChosen)
       eye_.continue_level[p] =
           uint8_t(continue_level(st, n, std::max(0.0, variance), cost_sum_.base_rays()));
   }
@@ -674,7 +673,7 @@ RenderStats BpmRender::finish(RenderStats stats) {
   stats.rays = tot_.eye.rays;
   stats.light_rays = tot_.light.light_rays;
   tot_.photons_last = photons_;
-  if (s_.combine == CombineAt::kChosen && combined() == CombineAt::kChosen) {
+  if (combined() == CombineAt::kChosen) {
     double sum = 0;
     for (uint8_t level : eye_.continue_level) sum += std::ldexp(1.0, -int(level));
     tot_.continue_probability = n_pixels_ > 0 ? sum / double(n_pixels_) : -1;

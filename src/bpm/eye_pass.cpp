@@ -73,10 +73,9 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 // is not whole on plain sight, it is probed after the light pass, if it gathers light
 // (bpm/disc_shares.h); where a larger disc about the same point was whole on plain sight
 // (`larger`), so is this one. (A larger disc left to its probes tells this one nothing: it is
-// looked at, and probed, on its own.) Returns what was found of the
-// disc (nothing: not looked at). With merge_density, the eye path goes on from the vertex (combined
-// estimators): the backward photon is marked so, and *merge_density set to its pi r^2 N (0 where
-// none is stored).
+// looked at, and probed, on its own.) Returns what was found of the disc (nothing: not looked
+// at). With merge_density, the eye path goes on from the vertex (combined estimators): the
+// backward photon is marked so, and *merge_density set to its pi r^2 N (0 where none is stored).
 inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
                                         const PathState& s, int depth, int diffuse,
                                         bool seen_directly, uint8_t accepts,
@@ -96,10 +95,10 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
   }
   const uint8_t near_bit = diffuse == 1 && accepts == kAcceptsCaustic ? 2 : 1;
   DiscProbes probes;
-  if (larger.found && !larger.cut) {
-    bp.cut_off_tested = larger.looked;
-  } else if (prm.disc_probes && (!seen_directly || (path.near_edge & near_bit)) &&
-             may_cut_discs(path.scene.objects[size_t(v.object())].shape)) {
+  // A larger disc about the same point was whole on plain sight: so is this one.
+  const bool larger_whole = larger.found && !larger.cut;
+  if (!larger_whole && prm.disc_probes && (!seen_directly || (path.near_edge & near_bit)) &&
+      may_cut_discs(path.scene.objects[size_t(v.object())].shape)) {
     if (disc_plainly_whole(path.scene, v.sp, v.object(), v.hit.primitive, bp.radius,
                            prm.normal_cos)) {
       probes.found = bp.disc_found = 0xff;

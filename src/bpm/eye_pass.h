@@ -97,10 +97,6 @@ struct EyeCounters {
 // Backward photons of one thread, one list per scene object (no locks: each thread has its own).
 using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 
-// What an eye path counts itself: everything, and the part of it seen before the first diffuse
-// vertex (emitters seen directly or through specular vertices only); and where it took two or
-// more samples of direct light at its last vertex, their sample variance (of their means over the
-// wavelengths; -1 where it took fewer).
 // With CombineAt::kChosen, what the path's continuations from last vertices whose gathered lobes
 // are not glossy brought (each taken with the probability q of EyePixels::continue_level, its
 // light then divided by q): whether it met such a vertex, the sum of what they added, and of those
@@ -118,6 +114,10 @@ struct EyeContinuation {
   }
 };
 
+// What an eye path counts itself: everything, and the part of it seen before the first diffuse
+// vertex (emitters seen directly or through specular vertices only); and where it took two or
+// more samples of direct light at its last vertex, their sample variance (of their means over the
+// wavelengths; -1 where it took fewer); and what its continuations brought (EyeContinuation).
 struct EyeRadiance {
   Spectrum total, emission;
   double direct_variance = -1;
