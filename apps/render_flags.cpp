@@ -144,8 +144,9 @@ void add_photon_options(CLI::App* render, RenderRequest& ra) {
       ->check(CLI::Range(1e-4, 1e4))
       ->group(kBpm);
   render
-      ->add_option("--radius-policy", ra.radius_policy, "fixed, or progressive shrinking (default)")
-      ->check(CLI::IsMember({"fixed", "progressive"}))
+      ->add_option("--radius-policy", ra.radius_policy,
+                   "fixed, progressive (fpm's default) or perpixel (bpm's default)")
+      ->check(CLI::IsMember({"fixed", "progressive", "perpixel"}))
       ->group(kBpm);
   render
       ->add_option("--alpha", ra.alpha,

@@ -70,6 +70,8 @@ RenderRun render_with(const LoadedScene& ls, const std::string& integrator, int 
   return r;
 }
 
+// The radius of the last iteration of the shared schedule: under the per-pixel policy that of the
+// pixels whose discs received photons in every iteration (in these boxes, nearly all).
 double edge_bias(const BpmSettings& s, int iterations, int block) {
   float r_px = (s.diffuse_depth == 0 ? s.k1 : s.k0) * radius_scale(s, iterations - 1);
   return 2.0 / (3.0 * M_PI) * 2 * r_px / block + 0.01;
@@ -333,7 +335,8 @@ void expect_furnace(const std::string& integrator, const BpmSettings& s, const F
 
 TEST(Bpm, SphereFurnaceMatchesAnalyticRadianceForEveryDiffuseDepth) {
   for (int d : {0, 1, 2, 3})
-    for (RadiusPolicy policy : {RadiusPolicy::kFixed, RadiusPolicy::kProgressive}) {
+    for (RadiusPolicy policy :
+         {RadiusPolicy::kFixed, RadiusPolicy::kProgressive, RadiusPolicy::kPerPixel}) {
       BpmSettings s = small_batches(d);
       s.radius_policy = policy;
       // At D = 0 every pixel reads the photons directly: their noise is shared by all pixels
@@ -938,6 +941,60 @@ TEST(Bpm, ContinuationsTakenByChanceConvergeToPath) {
   EXPECT_LT(q, 0.9);
   EXPECT_GT(q, 0.0);
   expect_blocks_agree(c, ref, 8, edge_bias(s, 40, 8), "auto");
+  EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var));
+}
+
+// The per-pixel radius policy follows the progressive schedule at a fractional iteration: at
+// whole iterations exactly radius_scale's, in between the squared scales interpolated linearly;
+// a pixel whose discs received photons in every iteration has the shared schedule's radii, one
+// whose discs never did keeps the first iteration's.
+TEST(RadiusPolicy, PerPixelScalesFollowTheScheduleAtTheLitShare) {
+  PhotonSettings s;
+  EXPECT_EQ(radius_scale_at(s, 0), 1.0f);
+  EXPECT_EQ(radius_scale_at(s, -3), 1.0f);
+  for (int i = 0; i < 200; ++i) {
+    EXPECT_EQ(radius_scale_at(s, i), radius_scale(s, i)) << i;
+    const double a = radius_scale(s, i), b = radius_scale(s, i + 1);
+    const double mid = radius_scale_at(s, i + 0.5);
+    EXPECT_NEAR(mid * mid, 0.5 * (a * a + b * b), 1e-6) << i;
+    EXPECT_LT(b, a) << i;
+  }
+  SampleStats<double> st;
+  EXPECT_EQ(st.lit_share()[0], 1.0f);  // nothing known: the shared schedule
+  EXPECT_EQ(st.lit_share()[1], 1.0f);
+  for (int k = 0; k < 8; ++k) st.add_lit(k % 4 == 0, true);
+  EXPECT_EQ(st.lit_share()[0], 0.25f);
+  EXPECT_EQ(st.lit_share()[1], 1.0f);
+  const DiscScales d = DiscScales::of(s, 100, st.lit_share());
+  EXPECT_EQ(d.large, radius_scale(s, 100));
+  EXPECT_EQ(d.small, radius_scale(s, 25));
+  EXPECT_EQ(DiscScales::of(s, 100, {0, 0}).large, 1.0f);
+  s.radius_policy = RadiusPolicy::kPerPixel;
+  EXPECT_EQ(radius_scale(s, 100), d.large);  // the image's own value: the shared schedule's
+}
+
+// With few photons per iteration (64 into a 32x32 box) a pixel's discs receive some in only part
+// of its iterations, and under the per-pixel policy its radii shrink with those: the mean radius
+// over the pixels stays above the shared schedule's, never above the first iteration's, and the
+// image still agrees with path's block by block (within the first iteration's radius's edge bias,
+// the largest a pixel keeps) and in its mean within 4.5 sigma. A share counted from iterations
+// that are not the pixel's, or radii that grow, would show in the blocks.
+TEST(Bpm, PerPixelRadiiShrinkWithThePhotonsFoundAndConvergeToPath) {
+  LoadedScene ls = load(cornell());
+  const Film ref = render_with(ls, "path", 2048).film;
+  BpmSettings s = small_batches(0);
+  s.photons_per_iteration = 64;
+  s.radius_policy = RadiusPolicy::kPerPixel;
+  const Iterations c = render_seeds(ls, 8, 60, s);
+  const nlohmann::json& scales = c.last.details["eye"]["radius_scale_mean"];
+  const double large = scales["large"].get<double>(), shared = scales["shared"].get<double>();
+  const BlockStats mc = image_mean(c), mr = block_stats(ref, 32)[0];
+  std::printf("mean radius scale %.3f, shared %.3f; mean %.5f, path %.5f (sigma %.5f)\n", large,
+              shared, mc.mean, mr.mean, std::sqrt(mc.var + mr.var));
+  EXPECT_EQ(c.last.details["settings"]["radius_policy"], "perpixel");
+  EXPECT_GT(large, 1.05 * shared);
+  EXPECT_LE(large, 1.0);
+  expect_blocks_agree(c, ref, 8, edge_bias(s, 1, 8), "perpixel");
   EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var));
 }
 

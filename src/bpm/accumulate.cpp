@@ -27,6 +27,37 @@ void add_moments(const Spectrum& L, const Spectrum& photon_L, const Spectrum& od
   m[PixelMoments::kCount] += 1;
 }
 
+// A pixel's backward photons' shares (in place of their sums, by accumulate_iteration) summed:
+// its photon part, its bias and the odd photons' part; and whether a small disc, and another,
+// received light.
+struct PixelShares {
+  Spectrum photon_L, bias, odd_L;
+  bool small_lit = false, large_lit = false;
+};
+
+// `at`: the pixel's backward photons by place (PixelSums::by_place), summed in the maps' order.
+PixelShares pixel_shares(const BackwardMaps& maps, const LightPassResult& light, const uint32_t* at,
+                         size_t places) {
+  // In the maps' order (an insertion sort of a few).
+  uint32_t found[kMaxBackwardPhotonsPerPath];
+  size_t n = 0;
+  for (size_t k = 0; k < places; ++k) {
+    const uint32_t g = at[k];
+    if (g == PixelSums::kNone) continue;
+    size_t i = n++;
+    for (; i > 0 && found[i - 1] > g; --i) found[i] = found[i - 1];
+    found[i] = g;
+  }
+  PixelShares s;
+  for (size_t k = 0; k < n; ++k) {
+    (maps.photons[found[k]].small_disc() ? s.small_lit : s.large_lit) = true;
+    s.photon_L += light.flux[found[k]];
+    s.bias += light.flux_inner[found[k]];
+    s.odd_L += light.flux_odd[found[k]];
+  }
+  return s;
+}
+
 }  // namespace
 
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
@@ -77,25 +108,12 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
       for (int x = 0; x < w; ++x) {
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
-        // In the maps' order (an insertion sort of a few).
-        uint32_t found[kMaxBackwardPhotonsPerPath];
-        size_t n = 0;
-        for (size_t k = 0; k < places; ++k) {
-          const uint32_t g = at[p * places + k];
-          if (g == PixelSums::kNone) continue;
-          size_t i = n++;
-          for (; i > 0 && found[i - 1] > g; --i) found[i] = found[i - 1];
-          found[i] = g;
-        }
-        Spectrum photon_L, bias, odd_L;
-        for (size_t k = 0; k < n; ++k) {
-          photon_L += light.flux[found[k]];
-          bias += light.flux_inner[found[k]];
-          odd_L += light.flux_odd[found[k]];
-        }
+        const PixelShares sh = pixel_shares(maps, light, at.data() + p * places, places);
+        const Spectrum &photon_L = sh.photon_L, &bias = sh.bias;
+        eye.round_stats[p].add_lit(sh.small_lit, sh.large_lit);
         Spectrum L = eye.radiance[p] + photon_L;
         if (moments && L.is_finite())
-          add_moments(L, photon_L, odd_L, light.emitted, eye.direct_samples[p],
+          add_moments(L, photon_L, sh.odd_L, light.emitted, eye.direct_samples[p],
                       moments->data() + PixelMoments::kValues * size_t(p), &eye.round_stats[p]);
         if (settings.debias)
           L -= bias;

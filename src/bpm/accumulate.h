@@ -18,7 +18,8 @@ namespace bpm {
 // estimate, or with `debias` is taken from it. When `estimates` is given (2 per pixel), each
 // sampled pixel's estimate (the mean over its wavelengths) is added to its first and 1 to its
 // second. Where the pixel sees emission, the estimate less its emission part goes to its round
-// statistics (EyePixels::round_stats).
+// statistics (EyePixels::round_stats), and so does whether its small and its other discs received
+// light (SampleStats::add_lit).
 //
 // The light pass's sums are used up: afterwards flux[g] and flux_inner[g] hold backward photon g's
 // parts of its pixel's estimate and bias (its shares), where it received light.

@@ -70,6 +70,10 @@ struct BackwardPhoton {
     return e;
   }
 
+  // Whether its radius is the small one, k0 footprints: a first vertex's disc for caustic light
+  // alone (bpm/eye_pass.h); every other is k1 footprints.
+  bool small_disc() const { return diffuse_index == 0 && accepts == kAcceptsCaustic; }
+
   // Sort key that fixes the order of backward photons whatever thread stored them (an eye path
   // stores fewer than 16: kMaxBackwardPhotonsPerPath).
   uint64_t key() const { return (uint64_t(pixel) << 4) | place; }

@@ -337,14 +337,19 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
 bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, int it,
                          const RenderControl& control) {
   const auto t = Clock::now();
+  // Under the per-pixel policy each pixel scales the first iteration's radii (DiscScales).
+  const bool per_pixel = s_.radius_policy == RadiusPolicy::kPerPixel;
+  const float shared = per_pixel ? 1.0f : scale;
   EyePassParams ep{&wm,
                    s_.diffuse_depth,
                    opt_.max_depth,
-                   s_.k0 * scale,
-                   s_.k1 * scale,
+                   s_.k0 * shared,
+                   s_.k1 * shared,
                    s_.emission_samples,
                    s_.direct_samples,
-                   s_.radius * scale,
+                   s_.radius * shared,
+                   per_pixel ? &s_ : nullptr,
+                   it,
                    medium_min_length_,
                    caustics_,
                    s_.normal_cos,
@@ -355,8 +360,9 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    combined(),
                    double(photons_),
                    s_.split_coats};
-  // Where the first vertices' discs are probed: near edges, within this iteration's radii.
-  near_edges_.mark(s_.k0 * scale, s_.k1 * scale);
+  // Where the first vertices' discs are probed: near edges, within this iteration's radii (the
+  // first iteration's, the largest, under the per-pixel policy).
+  near_edges_.mark(s_.k0 * shared, s_.k1 * shared);
   const bool complete = run_eye_pass(scene_, ep, camera_, masks_, control, pass, it, &eye_,
                                      {thread_lists_, eye_counters_});
   tot_.eye_s += since(t);
@@ -485,6 +491,7 @@ void BpmRender::set_sample_counts() {
     if (combined() == CombineAt::kChosen)
       eye_.continue_level[p] =
           uint8_t(continue_level(st, n, std::max(0.0, variance), cost_sum_.base_rays()));
+    eye_.lit_share[p] = st.lit_share();
   }
 }
 
@@ -677,6 +684,22 @@ RenderStats BpmRender::finish(RenderStats stats) {
     double sum = 0;
     for (uint8_t level : eye_.continue_level) sum += std::ldexp(1.0, -int(level));
     tot_.continue_probability = n_pixels_ > 0 ? sum / double(n_pixels_) : -1;
+  }
+  if (s_.radius_policy == RadiusPolicy::kPerPixel && stats.passes > 0) {
+    const int last = opt_.first_iteration + stats.passes - 1;
+    // Over the pixels whose discs of the kind have received photons.
+    double sum[2] = {0, 0}, n[2] = {0, 0};
+    for (const std::array<float, 2>& share : eye_.lit_share) {
+      const DiscScales d = DiscScales::of(s_, last, share);
+      for (int k = 0; k < 2; ++k)
+        if (share[size_t(k)] > 0) {
+          sum[k] += k == 0 ? d.small : d.large;
+          n[k] += 1;
+        }
+    }
+    tot_.small_scale_mean = n[0] > 0 ? sum[0] / n[0] : -1;
+    tot_.large_scale_mean = n[1] > 0 ? sum[1] / n[1] : -1;
+    tot_.shared_scale = radius_scale(s_, last);
   }
   stats.details = to_json(tot_, s_, stats.passes, n_pixels_);
   return stats;

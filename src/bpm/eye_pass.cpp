@@ -18,16 +18,18 @@ namespace {
 
 // A backward photon at diffuse vertex v (the diffuse-th of its path) that accepts `accepts`.
 // Caustic light at the first diffuse vertex is gathered over the small radius (k0); everything
-// gathered at a later vertex, and indirect light anywhere, over the large one (k1).
+// gathered at a later vertex, and indirect light anywhere, over the large one (k1); each times the
+// pixel's scale for its kind.
 BackwardPhoton backward_photon_at(const PathVertex& v, const PathState& s, const EyePassParams& prm,
-                                  PixelFootprint footprint, uint32_t pixel, int depth, int diffuse,
-                                  uint8_t accepts) {
+                                  PixelFootprint footprint, DiscScales scales, uint32_t pixel,
+                                  int depth, int diffuse, uint8_t accepts) {
   BackwardPhoton bp;
   bp.p = v.sp.p;
   const bool small = diffuse == 1 && accepts == kAcceptsCaustic;
   const float length = v.medium >= 0 ? std::max(s.length, prm.medium_min_length) : s.length;
   bp.radius =
-      prm.world_radius > 0 ? prm.world_radius : footprint.at(length) * (small ? prm.k0 : prm.k1);
+      (prm.world_radius > 0 ? prm.world_radius : footprint.at(length) * (small ? prm.k0 : prm.k1)) *
+      (small ? scales.small : scales.large);
   bp.ng = v.sp.ng;
   bp.ns = v.sp.ns;
   bp.uv = v.sp.uv;
@@ -48,6 +50,7 @@ struct EyePath {
   const RenderScene& scene;
   const EyePassParams& prm;
   PixelFootprint footprint;
+  DiscScales scales;
   uint32_t pixel;
   uint8_t near_edge;
   Rng& rng;
@@ -82,8 +85,8 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
                                         const DiscProbes& larger, double* merge_density,
                                         uint8_t continue_level) {
   const EyePassParams& prm = path.prm;
-  BackwardPhoton bp =
-      backward_photon_at(v, s, prm, path.footprint, path.pixel, depth, diffuse, accepts);
+  BackwardPhoton bp = backward_photon_at(v, s, prm, path.footprint, path.scales, path.pixel, depth,
+                                         diffuse, accepts);
   if (bp.radius <= 0 || s.beta.is_black()) return {};
   bp.combined = merge_density != nullptr;
   bp.continue_level = merge_density ? continue_level : 0;
@@ -139,7 +142,8 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
     store(kAcceptsCaustic | kAcceptsIndirect, {});
   } else {
     const DiscProbes larger = store(kAcceptsIndirect, {});  // r1 > r0: the larger disc first
-    store(kAcceptsCaustic, prm.k0 < prm.k1 ? larger : DiscProbes{});
+    const bool smaller = prm.k0 * path.scales.small < prm.k1 * path.scales.large;
+    store(kAcceptsCaustic, smaller ? larger : DiscProbes{});
   }
 }
 
@@ -434,14 +438,14 @@ inline EyeVertexChoice choose_or_split(const EyePath& path, const PathVertex& v,
                                              uint32_t pixel, Rng& rng, ObjectPhotonLists& out,
                                              EyeCounters& counters, bool emission_only,
                                              uint8_t near_edge, float flight_u, int direct_samples,
-                                             int continue_level) {
+                                             int continue_level, DiscScales scales) {
   int stored = 0, splits = 0;
   double direct_variance = -1;
   EyeContinuation continued;
   const int direct = std::clamp(direct_samples, 1, std::max(1, prm.direct_samples));
-  const EyePath path{
-      scene,  prm,    footprint, pixel,           near_edge,      rng,      out, counters,
-      stored, splits, direct,    direct_variance, continue_level, continued};
+  const EyePath path{scene,    prm,      footprint, scales, pixel,  near_edge,       rng,
+                     out,      counters, stored,    splits, direct, direct_variance, continue_level,
+                     continued};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;
@@ -613,12 +617,16 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             }
             ++ec.pixels;
             CameraSample cs = camera.sample(pass_index, pixel);
+            const DiscScales scales =
+                prm.pixel_radii
+                    ? DiscScales::of(*prm.pixel_radii, prm.iteration, px->lit_share[pixel])
+                    : DiscScales{};
             // Where the camera's ray scatters in a medium, stratified over the pixel's iterations.
             EyeRadiance r =
                 trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
                                false, prm.near_edges ? prm.near_edges->at(pixel) : 3,
                                flights ? camera.stream_uniform(pass_index, pixel) : -1.0f,
-                               px->direct_samples[pixel], px->continue_level[pixel]);
+                               px->direct_samples[pixel], px->continue_level[pixel], scales);
             px->round_stats[pixel].add_direct_variance(r.direct_variance);
             px->round_stats[pixel].add_continuation(r.continued);
             px->filter_weight[pixel] = cs.filter_weight;

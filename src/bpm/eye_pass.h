@@ -29,7 +29,8 @@ struct EyePassParams {
   int diffuse_depth = 1;
   int max_depth = 5;
   // Radii in pixel footprints (the camera ray's PixelFootprint at the vertex's path length):
-  // k0 and k1 times radius_scale(iteration).
+  // k0 and k1 times radius_scale(iteration), or with pixel_radii the first iteration's, which each
+  // pixel scales by its own schedule (DiscScales).
   float k0 = 0, k1 = 0;
   // At most this many camera samples per iteration for emission seen before the first diffuse
   // vertex (emitter edges, lights behind glass): cheap paths that end at that vertex, averaged
@@ -40,8 +41,12 @@ struct EyePassParams {
   // EyePixels::direct_samples of them.
   int direct_samples = 1;
   // When positive, every backward photon's radius in world units instead of the per-length radii
-  // (BpmSettings::radius, times the iteration's radius scale).
+  // (BpmSettings::radius, times the iteration's radius scale as k0 and k1 are).
   float world_radius = 0;
+  // With RadiusPolicy::kPerPixel, the settings whose schedule each pixel follows at its own pace
+  // (DiscScales::of), and the iteration's index; null: the radii above are the iteration's.
+  const PhotonSettings* pixel_radii = nullptr;
+  int iteration = 0;
   // In a scattering medium the radii are never those of a shorter path than this
   // (photons/medium_radius.h).
   float medium_min_length = 0;
@@ -124,6 +129,22 @@ struct EyeRadiance {
   EyeContinuation continued;
 };
 
+// What a pixel's radii are scaled by in an iteration, its small discs' (k0) and the others' (k1):
+// 1 where the radii above are already the iteration's. Under RadiusPolicy::kPerPixel a pixel
+// follows the progressive schedule counted in the iterations that brought its discs photons: at
+// iteration i, the schedule's scale at i times the share of its iterations so far in which a disc
+// of the kind received one (EyePixels::lit_share). Where photons reach every iteration that is
+// the shared schedule; where they seldom do, the radius shrinks as seldom, as progressive photon
+// mapping's per-point radii shrink with the photons found (Hachisuka et al. 2008), so that a dim
+// pixel's estimate keeps the photons its noise needs and a bright one's still sharpens.
+struct DiscScales {
+  float small = 1, large = 1;
+  static DiscScales of(const PhotonSettings& s, int iteration, const std::array<float, 2>& share) {
+    return {radius_scale_at(s, double(iteration) * share[0]),
+            radius_scale_at(s, double(iteration) * share[1])};
+  }
+};
+
 // Traces one eye path for `pixel`; returns the radiance the eye pass itself accounts for and
 // appends the path's backward photons to out[object] (radii: k0 or k1 footprints). With
 // emission_only the path ends at its first diffuse vertex and stores nothing: only `emission` is
@@ -133,27 +154,36 @@ struct EyeRadiance {
 // (PathState::flight_u). direct_samples: the samples of direct light at the last diffuse vertex
 // of a surface, at most params.direct_samples. continue_level: with CombineAt::kChosen, the path
 // goes on from a last vertex whose gathered lobes are not glossy with the probability
-// 2^-continue_level (EyeRadiance::continued).
+// 2^-continue_level (EyeRadiance::continued). scales: the pixel's DiscScales.
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, CameraRay ray,
                            PixelFootprint footprint, uint32_t pixel, Rng& rng,
                            ObjectPhotonLists& out, EyeCounters& counters,
                            bool emission_only = false, uint8_t near_edge = 3, float flight_u = -1,
-                           int direct_samples = 1, int continue_level = 0);
+                           int direct_samples = 1, int continue_level = 0, DiscScales scales = {});
 
 // A pixel's statistics for its extra samples, over the iterations: of emission seen before the
 // first diffuse vertex (per camera sample) and of the rest of its estimate (per iteration), for
 // the emission samples (counts, sums and sums of squares of means over the wavelengths); the sum
 // of 1 / the direct samples it took per estimate (the estimates' own moments are PixelMoments,
 // bpm/accumulate.h) and the sample variances of its direct light at one vertex, for the direct
-// samples; and what its continuations brought (EyeContinuation), for their probability.
+// samples; and what its continuations brought (EyeContinuation), for their probability; and in
+// how many of its iterations its discs received photons, for its radii (DiscScales).
 template <class T>
 struct SampleStats {
-  static constexpr int kValues = 15;
+  static constexpr int kValues = 18;
   // Where each group starts in v: count, sum and sum of squares for the first two; then the sum
   // of 1 / direct samples over the estimates, and the count and sum of direct variances; then the
   // iterations whose path met a vertex where the continuation is chosen, the sum and squares of
-  // what the continuations added there, and of those taken the count, squares and rays.
-  enum : int { kEmission = 0, kRest = 3, kInverseSamples = 6, kDirect = 7, kContinued = 9 };
+  // what the continuations added there, and of those taken the count, squares and rays; then the
+  // iterations accumulated, and those in which a small disc, and another disc, received photons.
+  enum : int {
+    kEmission = 0,
+    kRest = 3,
+    kInverseSamples = 6,
+    kDirect = 7,
+    kContinued = 9,
+    kLit = 15
+  };
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
   void add_emission(double x) { add(kEmission, x); }
@@ -170,6 +200,17 @@ struct SampleStats {
     v[kContinued + 3] += T(c.taken);
     v[kContinued + 4] += T(c.squares);
     v[kContinued + 5] += T(c.rays);
+  }
+  void add_lit(bool small, bool large) {
+    v[kLit] += 1;
+    v[kLit + 1] += T(small);
+    v[kLit + 2] += T(large);
+  }
+  // The shares of the iterations in which the small and the other discs received photons: 1
+  // before any is known.
+  std::array<float, 2> lit_share() const {
+    if (!(v[kLit] > 0)) return {1, 1};
+    return {float(v[kLit + 1] / v[kLit]), float(v[kLit + 2] / v[kLit])};
   }
   T emission_n() const { return v[kEmission]; }
   T rest_n() const { return v[kRest]; }
@@ -243,6 +284,9 @@ struct EyePixels {
   // from a last vertex whose gathered lobes are not glossy (continue_level, set at the end of each
   // round).
   std::vector<uint8_t> continue_level;
+  // Under RadiusPolicy::kPerPixel, the shares of the pixel's iterations so far in which its small
+  // and its other discs received photons (SampleStats::lit_share, set at the end of each round).
+  std::vector<std::array<float, 2>> lit_share;
   // The pixels' statistics for their extra samples (the emission ones only of pixels that see
   // emission): of every round so far, and of this round (summed over processes at its end).
   std::vector<SampleStats<double>> sample_stats;
@@ -258,6 +302,7 @@ struct EyePixels {
         emission_part(n, 0.0f),
         direct_samples(n, 2),
         continue_level(n, 0),
+        lit_share(n, {1.0f, 1.0f}),
         sample_stats(n),
         round_stats(n) {}
 };

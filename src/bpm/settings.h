@@ -9,6 +9,9 @@
 namespace bpm {
 
 struct BpmSettings : PhotonSettings {
+  // bpm's radii shrink per pixel, with the iterations that brought its discs photons (DiscScales,
+  // bpm/eye_pass.h; docs/MEASUREMENTS.md, "Radii per pixel").
+  BpmSettings() { radius_policy = RadiusPolicy::kPerPixel; }
   // D of DESIGN.md: diffuse vertices an eye path passes before its last backward photon (0..3).
   // 0 by default: at equal time its error is lower than with 1 on every scene of bench/equal_time
   // (docs/MEASUREMENTS.md, "Diffuse depth").

@@ -42,33 +42,36 @@ double ratio(double a, double b) { return b > 0 ? a / b : 0.0; }
 nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
   uint64_t backward_rays = t.eye.rays.camera_rays + t.eye.rays.bounce_rays;
   double backward_photons = double(t.eye.backward_photons);
-  return {{"camera_rays", t.eye.rays.camera_rays},
-          {"bounce_rays", t.eye.rays.bounce_rays},
-          {"shadow_rays", t.eye.rays.shadow_rays},
-          {"probe_rays", t.eye.rays.probe_rays},
-          // The extra camera samples of emission (EyePixels::emission_samples) and their rays
-          // (counted among the camera, bounce and shadow rays).
-          {"emission_samples", t.eye.emission_samples},
-          {"emission_sample_rays", t.eye.emission_rays},
-          // The samples of direct light beyond the first at last vertices
-          // (EyePixels::direct_samples) and their rays (among the bounce and shadow rays).
-          {"direct_samples", t.eye.direct_samples},
-          {"direct_sample_rays", t.eye.direct_rays},
-          // Eye paths that went on past their last diffuse vertex (--estimators combined) and
-          // their rays (among the bounce and shadow rays).
-          {"continued_paths", t.eye.continued},
-          {"continuation_rays", t.eye.continuation_rays},
-          {"continue_probability_mean", t.continue_probability},
-          {"backward_photons", t.eye.backward_photons},
-          // The paper's Table 1 counts per ray traced from the camera with all its continuations
-          // (an eye path); per segment counts every camera and bounce ray.
-          {"backward_photons_per_backward_ray",
-           ratio(backward_photons, double(t.eye.rays.camera_rays))},
-          {"backward_photons_per_backward_segment", ratio(backward_photons, double(backward_rays))},
-          {"backward_photons_per_pixel_iteration",
-           ratio(backward_photons, double(iterations) * double(pixels))},
-          // The probes run after the light pass (disc_shares.h): their time with the eye pass's.
-          {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s + t.probe_s)}};
+  return {
+      {"camera_rays", t.eye.rays.camera_rays},
+      {"bounce_rays", t.eye.rays.bounce_rays},
+      {"shadow_rays", t.eye.rays.shadow_rays},
+      {"probe_rays", t.eye.rays.probe_rays},
+      // The extra camera samples of emission (EyePixels::emission_samples) and their rays
+      // (counted among the camera, bounce and shadow rays).
+      {"emission_samples", t.eye.emission_samples},
+      {"emission_sample_rays", t.eye.emission_rays},
+      // The samples of direct light beyond the first at last vertices
+      // (EyePixels::direct_samples) and their rays (among the bounce and shadow rays).
+      {"direct_samples", t.eye.direct_samples},
+      {"direct_sample_rays", t.eye.direct_rays},
+      // Eye paths that went on past their last diffuse vertex (--estimators combined) and
+      // their rays (among the bounce and shadow rays).
+      {"continued_paths", t.eye.continued},
+      {"continuation_rays", t.eye.continuation_rays},
+      {"continue_probability_mean", t.continue_probability},
+      {"radius_scale_mean",
+       {{"small", t.small_scale_mean}, {"large", t.large_scale_mean}, {"shared", t.shared_scale}}},
+      {"backward_photons", t.eye.backward_photons},
+      // The paper's Table 1 counts per ray traced from the camera with all its continuations
+      // (an eye path); per segment counts every camera and bounce ray.
+      {"backward_photons_per_backward_ray",
+       ratio(backward_photons, double(t.eye.rays.camera_rays))},
+      {"backward_photons_per_backward_segment", ratio(backward_photons, double(backward_rays))},
+      {"backward_photons_per_pixel_iteration",
+       ratio(backward_photons, double(iterations) * double(pixels))},
+      // The probes run after the light pass (disc_shares.h): their time with the eye pass's.
+      {"rays_per_second", ratio(double(t.eye.rays.total()), t.eye_s + t.probe_s)}};
 }
 
 nlohmann::json light_json(const BpmTotals& t, int iterations) {

@@ -9,7 +9,10 @@
 
 namespace bpm {
 
-enum class RadiusPolicy { kFixed, kProgressive };
+// How radii shrink over the iterations: not at all; all pixels alike, by Knaus and Zwicker's
+// schedule; or each pixel by that schedule counted in the iterations whose photons reached it
+// (bpm only: EyePixels::lit_share).
+enum class RadiusPolicy { kFixed, kProgressive, kPerPixel };
 
 // Where bpm combines its photon merges with the eye path's continuation (photons/merge_weights.h):
 // nowhere (the partition), at last diffuse vertices whose gathered lobes include a glossy one
@@ -55,7 +58,20 @@ struct PhotonSettings {
 };
 
 inline const char* to_string(RadiusPolicy p) {
-  return p == RadiusPolicy::kFixed ? "fixed" : "progressive";
+  switch (p) {
+    case RadiusPolicy::kFixed:
+      return "fixed";
+    case RadiusPolicy::kProgressive:
+      return "progressive";
+    case RadiusPolicy::kPerPixel:
+      break;
+  }
+  return "perpixel";
+}
+inline std::optional<RadiusPolicy> parse_radius_policy(const std::string& s) {
+  for (RadiusPolicy p : {RadiusPolicy::kFixed, RadiusPolicy::kProgressive, RadiusPolicy::kPerPixel})
+    if (s == to_string(p)) return p;
+  return std::nullopt;
 }
 
 inline const char* to_string(CombineAt c) {
@@ -84,8 +100,13 @@ inline std::optional<CombineAt> parse_combine_at(const std::string& s) {
 // work, the same at every resolution (docs/MEASUREMENTS.md, "Photons per iteration").
 int photons_for(const PhotonSettings& s, size_t pixels);
 
-// Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first.
+// Radius scale (not squared) of iteration i (0-based) under the policy: 1 for the first. The
+// per-pixel policy's pixels follow the progressive schedule at a fractional iteration
+// (radius_scale_at); its value for the image as a whole is the progressive one.
 float radius_scale(const PhotonSettings& s, int iteration);
+// The progressive schedule at iteration t >= 0, not necessarily whole: its squared scale
+// interpolated linearly between the whole iterations around t (radius_scale's at whole t).
+float radius_scale_at(const PhotonSettings& s, double t);
 
 // Reads k0, k1, radiuspolicy, alpha, discprobes and photonsperiteration (pbrt-v4 sppm's name) from
 // an Integrator line; a bad value is an error at its place in the file.
