@@ -1436,6 +1436,34 @@ TEST(Bpm, EmissionSampleCountBalancesVarianceAndCost) {
   EXPECT_EQ(emission_sample_count(stats({2, 2, 2}, {1, 1, 1}), 9.0, 8), 1);
 }
 
+// Pixels within twice the filter's radius of one whose statistics of emission are known, and
+// without statistics of their own (none, or a first sight of emission), take the most emission
+// samples of those pixels; a pixel with statistics keeps its count; beyond the reach, one sample.
+TEST(Bpm, EmissionSamplesLentToPixelsWithinTheFiltersReach) {
+  const int w = 11, h = 9;
+  EyePixels px(size_t(w) * h);
+  auto at = [w](int x, int y) { return size_t(y) * w + size_t(x); };
+  auto measure = [&](int x, int y, int count) {
+    px.sees_emission[at(x, y)] = 1;
+    px.sample_stats[at(x, y)].add_emission(0);
+    px.sample_stats[at(x, y)].add_emission(2);
+    px.emission_samples[at(x, y)] = uint16_t(count);
+  };
+  measure(4, 4, 6);
+  measure(7, 4, 2);
+  px.sees_emission[at(4, 5)] = 1;  // seen once: no statistics yet
+  px.sample_stats[at(4, 5)].add_emission(2);
+  lend_emission_samples(w, h, Vec2(1.5f, 1.5f), &px);  // reach: 3 pixels
+  EXPECT_EQ(px.emission_samples[at(4, 4)], 6);
+  EXPECT_EQ(px.emission_samples[at(7, 4)], 2);  // its own, measured
+  EXPECT_EQ(px.emission_samples[at(4, 5)], 6);
+  EXPECT_EQ(px.emission_samples[at(1, 1)], 6);
+  EXPECT_EQ(px.emission_samples[at(4, 7)], 6);
+  EXPECT_EQ(px.emission_samples[at(9, 4)], 2);  // 5 from the first, 2 from the second
+  EXPECT_EQ(px.emission_samples[at(0, 0)], 1);  // 4 from the first
+  EXPECT_EQ(px.emission_samples[at(4, 8)], 1);
+}
+
 // Direct light at the last diffuse vertex takes up to EyePassParams::direct_samples samples in
 // pixels where it varies: a floor under a large, near light with a blocker that casts a
 // penumbra, and nothing else, so that nearly all of a pixel's variance is its direct light's. The

@@ -482,6 +482,10 @@ void BpmRender::set_sample_counts() {
     eye_.emission_samples[p] =
         eye_.sees_emission[p] ? uint16_t(emission_sample_count(st, emission, s_.emission_samples))
                               : 1;
+  }
+  lend_emission_samples(film_->width(), film_->height(), ls_.filter.radius, &eye_);
+  for (size_t p = 0; p < n_pixels_; ++p) {
+    const SampleStats<double>& st = eye_.sample_stats[p];
     // The pixel's estimates: their count and sample variance, from its moments.
     const double* m = moments_sum_.data() + PixelMoments::kValues * p;
     const double n = m[PixelMoments::kCount], sum = m[PixelMoments::kSum];

@@ -557,6 +557,30 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
   return int(std::clamp(std::round(e), 1.0, double(max_samples)));
 }
 
+void lend_emission_samples(int w, int h, Vec2 filter_radius, EyePixels* px) {
+  const int rx = int(std::ceil(2 * filter_radius.x)), ry = int(std::ceil(2 * filter_radius.y));
+  auto measured = [px](size_t p) {
+    return px->sees_emission[p] && px->sample_stats[p].emission_n() >= 2;
+  };
+  std::vector<uint16_t> lent(size_t(w) * size_t(h), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = size_t(y) * size_t(w) + size_t(x);
+        if (measured(p)) continue;
+        uint16_t most = 0;
+        for (int v = std::max(0, y - ry); v <= std::min(h - 1, y + ry); ++v)
+          for (int u = std::max(0, x - rx); u <= std::min(w - 1, x + rx); ++u) {
+            const size_t q = size_t(v) * size_t(w) + size_t(u);
+            if (measured(q)) most = std::max(most, px->emission_samples[q]);
+          }
+        lent[p] = most;
+      }
+  });
+  for (size_t p = 0; p < lent.size(); ++p)
+    if (lent[p] > 1) px->emission_samples[p] = lent[p];
+}
+
 int direct_sample_count(const SampleStats<double>& s, double estimates, double estimate_variance,
                         double cost_ratio, int max_samples) {
   if (max_samples <= 1) return 1;
@@ -637,7 +661,7 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
                               px->sees_emission[pixel] ? &px->round_stats[pixel] : nullptr);
             px->radiance[pixel] = r.total + (emission - r.emission);
             px->emission_part[pixel] = emission.average();
-            if (!r.emission.is_black()) px->saw_emission[pixel] = 1;
+            if (!r.emission.is_black() || !emission.is_black()) px->saw_emission[pixel] = 1;
             const auto t1 = Clock::now();
             px->cost_ns[pixel] = float(std::chrono::duration<double, std::nano>(t1 - t0).count());
             t0 = t1;

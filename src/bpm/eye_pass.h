@@ -241,6 +241,16 @@ struct SampleStats {
 // samples, then max_samples while the cost ratio is unknown (negative).
 int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples);
 
+// A pixel's camera samples land within its filter's radius of its centre, so a pixel whose centre
+// lies within twice that radius (`filter_radius`, in pixels) of one that saw emission may see it
+// too: an emitter's edge, or a small bright emitter that its samples reach a few times in a
+// thousand. Until it has two samples of emission in its own statistics, such a pixel takes the
+// most emission samples (EyePixels::emission_samples) of the pixels about it that have; else its
+// first sight of a small emitter may wait for most of the render, with one sample an iteration
+// where its neighbours take several. Pixels with statistics keep their own counts.
+struct EyePixels;
+void lend_emission_samples(int width, int height, Vec2 filter_radius, EyePixels* pixels);
+
 // Samples of direct light per iteration at a pixel's last diffuse vertex, by the same balance:
 // V_direct is the mean sample variance of direct light at one vertex (what more samples there
 // average away), V_rest what remains of the variance of the pixel's estimate per iteration (its
