@@ -37,6 +37,10 @@ SCENES = {
     "underwater": "scenes/underwater.pbrt",
     "volumetric-caustic": "../shared/scenes/volumetric-caustic/scene-v4.pbrt",
     "coffee": "../shared/scenes/coffee/scene-v4.pbrt",
+    "killeroo-simple": "../shared/scenes/killeroo-simple/killeroo-simple.pbrt",
+    "veach-mis": "../shared/scenes/veach-mis/scene-v4.pbrt",
+    "staircase2": "../shared/scenes/staircase2/scene-v4-standin.pbrt",
+    "spot-facets": "scenes/spot-facets.pbrt",
 }
 # Each default with its value and the values tried beside it (keyword arguments of bpm.render).
 CANDIDATES = {
