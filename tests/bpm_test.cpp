@@ -965,10 +965,13 @@ TEST(RadiusPolicy, PerPixelScalesFollowTheScheduleAtTheLitShare) {
   for (int k = 0; k < 8; ++k) st.add_lit(k % 4 == 0, true);
   EXPECT_EQ(st.lit_share()[0], 0.25f);
   EXPECT_EQ(st.lit_share()[1], 1.0f);
-  const DiscScales d = DiscScales::of(s, 100, st.lit_share());
+  const DiscScales d = DiscScales::of(s, 100, 0, st.lit_share());
   EXPECT_EQ(d.large, radius_scale(s, 100));
   EXPECT_EQ(d.small, radius_scale(s, 25));
-  EXPECT_EQ(DiscScales::of(s, 100, {0, 0}).large, 1.0f);
+  EXPECT_EQ(DiscScales::of(s, 100, 0, {0, 0}).large, 1.0f);
+  // A render that starts at iteration 40 counts those before it as lit.
+  EXPECT_EQ(DiscScales::of(s, 100, 40, {0, 0}).large, radius_scale(s, 40));
+  EXPECT_EQ(DiscScales::of(s, 100, 40, {0.5f, 1}).small, radius_scale(s, 70));
   s.radius_policy = RadiusPolicy::kPerPixel;
   EXPECT_EQ(radius_scale(s, 100), d.large);  // the image's own value: the shared schedule's
 }
@@ -1437,7 +1440,7 @@ TEST(Bpm, EmissionSampleCountBalancesVarianceAndCost) {
 }
 
 // Pixels within twice the filter's radius of one whose statistics of emission are known, and
-// without statistics of their own (none, or a first sight of emission), take the most emission
+// without statistics of their own (none, or fewer than two estimates), take the most emission
 // samples of those pixels; a pixel with statistics keeps its count; beyond the reach, one sample.
 TEST(Bpm, EmissionSamplesLentToPixelsWithinTheFiltersReach) {
   const int w = 11, h = 9;
@@ -1445,14 +1448,18 @@ TEST(Bpm, EmissionSamplesLentToPixelsWithinTheFiltersReach) {
   auto at = [w](int x, int y) { return size_t(y) * w + size_t(x); };
   auto measure = [&](int x, int y, int count) {
     px.sees_emission[at(x, y)] = 1;
-    px.sample_stats[at(x, y)].add_emission(0);
-    px.sample_stats[at(x, y)].add_emission(2);
+    for (double v : {0.0, 2.0}) {
+      px.sample_stats[at(x, y)].add_emission(v);
+      px.sample_stats[at(x, y)].add_rest(v);
+    }
     px.emission_samples[at(x, y)] = uint16_t(count);
   };
   measure(4, 4, 6);
   measure(7, 4, 2);
-  px.sees_emission[at(4, 5)] = 1;  // seen once: no statistics yet
+  px.sees_emission[at(4, 5)] = 1;  // seen in a round of one iteration: no statistics yet
   px.sample_stats[at(4, 5)].add_emission(2);
+  px.sample_stats[at(4, 5)].add_emission(0);
+  px.sample_stats[at(4, 5)].add_rest(1);
   lend_emission_samples(w, h, Vec2(1.5f, 1.5f), &px);  // reach: 3 pixels
   EXPECT_EQ(px.emission_samples[at(4, 4)], 6);
   EXPECT_EQ(px.emission_samples[at(7, 4)], 2);  // its own, measured

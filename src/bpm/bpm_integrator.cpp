@@ -70,13 +70,15 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 }
 
 // Memory (base/memory.h). Per pixel, what the eye pass (with the edges and near-edge marks of the
-// disc probes, and the sample statistics with their copy at the end of a round), the masks,
+// disc probes, the sample statistics with their copy at the end of a round, and the radii's
+// shares), the masks,
 // the emission guide and the photon count's moments (the round's, its copy at the end of a round
 // and the merged) keep.
-constexpr double kPixelBytes =
-    sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + 2 * sizeof(uint16_t) +
-    sizeof(float) + 3 * sizeof(SampleStats<double>) + sizeof(double) + sizeof(uint32_t) +
-    sizeof(float) + sizeof(uint16_t) + 3 * PixelMoments::kValues * sizeof(double);
+constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) +
+                               2 * sizeof(uint16_t) + sizeof(float) +
+                               3 * sizeof(SampleStats<double>) + sizeof(double) + sizeof(uint32_t) +
+                               sizeof(float) + sizeof(uint16_t) +
+                               3 * PixelMoments::kValues * sizeof(double) + 2 * sizeof(float);
 
 // What the extra samples of emission and of direct light cost against whole iterations
 // (emission_sample_count, direct_sample_count), in rays: all the rays the iterations cast and the
@@ -350,6 +352,7 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    s_.radius * shared,
                    per_pixel ? &s_ : nullptr,
                    it,
+                   opt_.first_iteration,
                    medium_min_length_,
                    caustics_,
                    s_.normal_cos,
@@ -694,7 +697,7 @@ RenderStats BpmRender::finish(RenderStats stats) {
     // Over the pixels whose discs of the kind have received photons.
     double sum[2] = {0, 0}, n[2] = {0, 0};
     for (const std::array<float, 2>& share : eye_.lit_share) {
-      const DiscScales d = DiscScales::of(s_, last, share);
+      const DiscScales d = DiscScales::of(s_, last, opt_.first_iteration, share);
       for (int k = 0; k < 2; ++k)
         if (share[size_t(k)] > 0) {
           sum[k] += k == 0 ? d.small : d.large;

@@ -141,7 +141,8 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
   } else if (diffuse > 1 || prm.world_radius > 0 || prm.k0 == prm.k1) {
     store(kAcceptsCaustic | kAcceptsIndirect, {});
   } else {
-    const DiscProbes larger = store(kAcceptsIndirect, {});  // r1 > r0: the larger disc first
+    // The disc of r1 first (the larger, unless the pixel's scales make r0 larger).
+    const DiscProbes larger = store(kAcceptsIndirect, {});
     const bool smaller = prm.k0 * path.scales.small < prm.k1 * path.scales.large;
     store(kAcceptsCaustic, smaller ? larger : DiscProbes{});
   }
@@ -559,8 +560,10 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
 
 void lend_emission_samples(int w, int h, Vec2 filter_radius, EyePixels* px) {
   const int rx = int(std::ceil(2 * filter_radius.x)), ry = int(std::ceil(2 * filter_radius.y));
+  // As emission_sample_count: its own count once both parts have two samples.
   auto measured = [px](size_t p) {
-    return px->sees_emission[p] && px->sample_stats[p].emission_n() >= 2;
+    const SampleStats<double>& s = px->sample_stats[p];
+    return px->sees_emission[p] && s.emission_n() >= 2 && s.rest_n() >= 2;
   };
   std::vector<uint16_t> lent(size_t(w) * size_t(h), 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
@@ -642,9 +645,9 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
             ++ec.pixels;
             CameraSample cs = camera.sample(pass_index, pixel);
             const DiscScales scales =
-                prm.pixel_radii
-                    ? DiscScales::of(*prm.pixel_radii, prm.iteration, px->lit_share[pixel])
-                    : DiscScales{};
+                prm.pixel_radii ? DiscScales::of(*prm.pixel_radii, prm.iteration,
+                                                 prm.first_iteration, px->lit_share[pixel])
+                                : DiscScales{};
             // Where the camera's ray scatters in a medium, stratified over the pixel's iterations.
             EyeRadiance r =
                 trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,

@@ -44,9 +44,10 @@ struct EyePassParams {
   // (BpmSettings::radius, times the iteration's radius scale as k0 and k1 are).
   float world_radius = 0;
   // With RadiusPolicy::kPerPixel, the settings whose schedule each pixel follows at its own pace
-  // (DiscScales::of), and the iteration's index; null: the radii above are the iteration's.
+  // (DiscScales::of), the iteration's index and that of the render's first; null: the radii above
+  // are the iteration's.
   const PhotonSettings* pixel_radii = nullptr;
-  int iteration = 0;
+  int iteration = 0, first_iteration = 0;
   // In a scattering medium the radii are never those of a shorter path than this
   // (photons/medium_radius.h).
   float medium_min_length = 0;
@@ -132,16 +133,21 @@ struct EyeRadiance {
 // What a pixel's radii are scaled by in an iteration, its small discs' (k0) and the others' (k1):
 // 1 where the radii above are already the iteration's. Under RadiusPolicy::kPerPixel a pixel
 // follows the progressive schedule counted in the iterations that brought its discs photons: at
-// iteration i, the schedule's scale at i times the share of its iterations so far in which a disc
-// of the kind received one (EyePixels::lit_share). Where photons reach every iteration that is
-// the shared schedule; where they seldom do, the radius shrinks as seldom, as progressive photon
-// mapping's per-point radii shrink with the photons found (Hachisuka et al. 2008), so that a dim
-// pixel's estimate keeps the photons its noise needs and a bright one's still sharpens.
+// iteration i, the schedule's scale at i times the share of its sampled iterations so far in which
+// a disc of the kind received one (EyePixels::lit_share). A render whose first iteration is a > 0
+// (IntegratorOptions::first_iteration) counts the iterations before it as lit: a + (i - a) share,
+// so that with every share 1 it is the shared schedule, whatever a. Where photons reach every
+// iteration that is the shared schedule; where they seldom do, the radius shrinks as seldom, as
+// progressive photon mapping's per-point radii shrink with the photons found (Hachisuka et al.
+// 2008), so that a dim pixel's estimate keeps the photons its noise needs and a bright one's still
+// sharpens.
 struct DiscScales {
   float small = 1, large = 1;
-  static DiscScales of(const PhotonSettings& s, int iteration, const std::array<float, 2>& share) {
-    return {radius_scale_at(s, double(iteration) * share[0]),
-            radius_scale_at(s, double(iteration) * share[1])};
+  static DiscScales of(const PhotonSettings& s, int iteration, int first,
+                       const std::array<float, 2>& share) {
+    const double rest = double(iteration - first);
+    return {radius_scale_at(s, first + rest * share[0]),
+            radius_scale_at(s, first + rest * share[1])};
   }
 };
 

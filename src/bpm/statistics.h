@@ -32,9 +32,10 @@ struct BpmTotals {
   // With --estimators auto: the mean over the pixels of their probability of going on from a last
   // vertex that is not glossy (EyePixels::continue_level; -1 otherwise).
   double continue_probability = -1;
-  // With --radius-policy perpixel: the means of the small and the other discs' radius scales in
-  // the last iteration (DiscScales) over the pixels whose discs of the kind received photons (-1
-  // where none did, or under another policy), beside the shared schedule's.
+  // With --radius-policy perpixel: the means of the small and the other discs' radius scales at
+  // the last iteration with the shares of the render's end (DiscScales) over the pixels whose discs
+  // of the kind received photons (-1 where none did, or under another policy), beside the shared
+  // schedule's.
   double small_scale_mean = -1, large_scale_mean = -1, shared_scale = -1;
   double photon_share = -1, photons_best = 0, variance = 0, photon_variance = 0;
 

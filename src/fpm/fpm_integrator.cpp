@@ -117,9 +117,7 @@ FpmSettings checked_settings(const FpmSettings& settings, size_t n_pixels) {
   if (s.photons_per_iteration <= 0)
     throw Error("fpm: --photons (file: photonsperiteration) must be positive");
   if (s.knn < 0) throw Error("fpm: --knn (file: knn) must not be negative");
-  // Both methods read one set of photon settings (bpm's default included); fpm keeps no statistics
-  // per pixel, and follows the shared schedule that bpm's pixels follow at their own pace.
-  if (s.radius_policy == RadiusPolicy::kPerPixel) s.radius_policy = RadiusPolicy::kProgressive;
+  s.radius_policy = fpm_radius_policy(s.radius_policy);
   return s;
 }
 

@@ -20,4 +20,10 @@ FpmSettings fpm_settings_from_file(const SceneEntity& integrator);
 // The settings as the JSON record prints them (also a checkpoint's identity).
 nlohmann::json settings_json(const FpmSettings& s);
 
+// The radius policy fpm runs: bpm's per-pixel one (which both methods read from one set of photon
+// settings) is the shared schedule here, since fpm keeps no statistics per pixel.
+inline RadiusPolicy fpm_radius_policy(RadiusPolicy p) {
+  return p == RadiusPolicy::kPerPixel ? RadiusPolicy::kProgressive : p;
+}
+
 }  // namespace bpm

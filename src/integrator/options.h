@@ -39,7 +39,8 @@ struct IntegratorOptions {
   int spp = 16;             // passes (iterations for the photon integrators)
   int first_iteration = 0;  // index of the first pass: random streams and radii follow it, so
                             // passes [a, b) rendered apart estimate the same image (the same
-                            // pixels exactly, unless bpm's guide learnt from earlier passes)
+                            // pixels exactly, unless bpm's guide, sample counts or per-pixel
+                            // radii learnt from earlier passes)
   double time_limit_s = 0;  // 0: none
   int threads = 0;          // 0: all hardware threads
   uint64_t seed = 0;

@@ -1,6 +1,7 @@
 // The outer loop every integrator shares (sections 3 and 4 of the paper): passes (path) or
-// iterations (bpm, fpm), each a complete, unbiased estimate of the image (bpm's emission guide
-// learns from the earlier ones; nothing else links them), until a budget
+// iterations (bpm, fpm), each a complete, unbiased estimate of the image (of its radius-blurred
+// image for the photon methods; bpm's emission guide, its pixels' sample counts and per-pixel
+// radii follow what the earlier ones measured, and nothing else links them), until a budget
 // ends the render: a pass count, time, the requested accuracy, or an interrupt. RenderControl
 // decides when to stop, which pixels a pass samples (adaptive sampling), prints progress and
 // writes checkpoints; the integrator only renders one pass into the film.

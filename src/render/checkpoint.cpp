@@ -60,6 +60,7 @@ nlohmann::json render_identity(const std::vector<std::string>& scene_files, cons
   if (opt.integrator == "fpm") {
     FpmSettings s = opt.fpm;
     s.photons_per_iteration = photons_for(s, pixels);
+    s.radius_policy = fpm_radius_policy(s.radius_policy);
     settings = settings_json(s);
   }
   return {{"scene", scene_files.empty() ? "" : scene_files.front()},

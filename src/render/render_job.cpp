@@ -132,7 +132,13 @@ RenderOptions render_options(const RenderRequest& a, const LoadedScene& ls,
     if (a.k0 > 0) p->k0 = a.k0;
     if (a.k1 > 0) p->k1 = a.k1;
     if (a.alpha > 0) p->alpha = a.alpha;
-    if (!a.radius_policy.empty()) p->radius_policy = *parse_radius_policy(a.radius_policy);
+    if (!a.radius_policy.empty()) {
+      const std::optional<RadiusPolicy> policy = parse_radius_policy(a.radius_policy);
+      if (!policy)
+        throw Error("--radius-policy must be fixed, progressive or perpixel, not \"" +
+                    a.radius_policy + "\"");
+      p->radius_policy = *policy;
+    }
     if (a.photons > 0) p->photons_per_iteration = a.photons;
     if (!a.bias_model.empty())
       p->bias_model = a.bias_model == "r2" ? BiasModel::kSquare : BiasModel::kSquareAndLinear;
