@@ -560,27 +560,28 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
 
 void lend_emission_samples(int w, int h, Vec2 filter_radius, EyePixels* px) {
   const int rx = int(std::ceil(2 * filter_radius.x)), ry = int(std::ceil(2 * filter_radius.y));
-  // As emission_sample_count: its own count once both parts have two samples.
-  auto measured = [px](size_t p) {
+  // Each pixel's own count where it has its statistics (as emission_sample_count: both parts have
+  // two samples), else 0.
+  const size_t n = size_t(w) * size_t(h);
+  std::vector<uint16_t> own(n, 0), lent(n, 0);
+  for (size_t p = 0; p < n; ++p) {
     const SampleStats<double>& s = px->sample_stats[p];
-    return px->sees_emission[p] && s.emission_n() >= 2 && s.rest_n() >= 2;
-  };
-  std::vector<uint16_t> lent(size_t(w) * size_t(h), 0);
+    if (px->sees_emission[p] && s.emission_n() >= 2 && s.rest_n() >= 2)
+      own[p] = px->emission_samples[p];
+  }
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y < r.end(); ++y)
       for (int x = 0; x < w; ++x) {
         const size_t p = size_t(y) * size_t(w) + size_t(x);
-        if (measured(p)) continue;
+        if (own[p]) continue;
         uint16_t most = 0;
         for (int v = std::max(0, y - ry); v <= std::min(h - 1, y + ry); ++v)
-          for (int u = std::max(0, x - rx); u <= std::min(w - 1, x + rx); ++u) {
-            const size_t q = size_t(v) * size_t(w) + size_t(u);
-            if (measured(q)) most = std::max(most, px->emission_samples[q]);
-          }
+          for (int u = std::max(0, x - rx); u <= std::min(w - 1, x + rx); ++u)
+            most = std::max(most, own[size_t(v) * size_t(w) + size_t(u)]);
         lent[p] = most;
       }
   });
-  for (size_t p = 0; p < lent.size(); ++p)
+  for (size_t p = 0; p < n; ++p)
     if (lent[p] > 1) px->emission_samples[p] = lent[p];
 }
 
