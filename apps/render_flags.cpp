@@ -233,6 +233,15 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
       ->check(CLI::IsMember({"partition", "glossy", "combined", "auto"}))
       ->group(kBpm);
   render
+      ->add_option("--camera-connections", ra.camera_connections,
+                   "on (default): caustic photons that land where the camera sees them are also "
+                   "joined to the camera, and each such light path is weighed between that and the "
+                   "merge at the pixels' first vertices by multiple importance sampling; off: the "
+                   "merges alone; alone: the connections alone, a check (pinhole perspective "
+                   "cameras, scenes without media; file: string cameraconnections)")
+      ->check(CLI::IsMember({"on", "off", "alone"}))
+      ->group(kBpm);
+  render
       ->add_flag("--no-coat-split", ra.no_coat_split,
                  "At a coated surface where gathering would end the eye path, take its coat or "
                  "its base by chance instead of both (file: bool splitcoats false)")

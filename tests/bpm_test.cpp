@@ -1124,6 +1124,57 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
   expect_bpm_converges(ls, render_with(ls, "path", 4096).film, 5);
 }
 
+// Light tracing to the camera (bpm/camera_connections.h): caustic photons landing where the
+// camera sees them are joined to it and spread over the pixels by the filter (a gaussian here, one
+// of the tabulated filters), each such path weighed against the merge at the pixels' first
+// vertices. With the connections alone (the merges' weight 0), with both, and with the merges
+// alone the caustic agrees with path's block by block, and so does the image's mean: a wrong
+// connection shows with `alone`, weights that do not sum to one with `on`. On a coated floor at
+// D = 1 the eye path gathers at its first vertex by chance, which both sides' weights count.
+TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
+  struct Case {
+    std::string name, floor;
+    int diffuse_depth;
+  };
+  const std::string diffuse = "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]";
+  for (const Case& k :
+       {Case{"diffuse floor", diffuse, 0},
+        Case{
+            "coated floor",
+            "Material \"coateddiffuse\" \"rgb reflectance\" [0.75 0.75 0.75] \"float roughness\" 0",
+            1}}) {
+    // The light moved aside, as in the absorbing variant, so that the caustic falls where the
+    // camera sees it directly.
+    std::string scene = caustic_scene();
+    const std::string light = quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true);
+    scene.replace(scene.find(light), light.size(), quad(1.3f, 0.1f, 1.7f, 0.5f, 2.0f, true));
+    scene.replace(scene.find("PixelFilter \"box\""), 17, "PixelFilter \"gaussian\"");
+    scene.replace(scene.find(diffuse), diffuse.size(), k.floor);
+    LoadedScene ls = load(scene);
+    const Film ref = render_with(ls, "path", 4096).film;
+    const BlockStats mr = block_stats(ref, 32)[0];
+    for (CameraConnectionMode mode :
+         {CameraConnectionMode::kAlone, CameraConnectionMode::kOn, CameraConnectionMode::kOff}) {
+      BpmSettings s = small_batches(k.diffuse_depth);
+      s.camera_connections = mode;
+      const Iterations its = render_iterations(ls, "bpm", 96, 7, s);
+      const std::string what =
+          k.name + ", D=" + std::to_string(k.diffuse_depth) + ", connections " + to_string(mode);
+      expect_blocks_agree(its, ref, 8, edge_bias(s, 96, 8), what);
+      const BlockStats m = image_mean(its);
+      std::printf("%s: mean %.5f, path %.5f (sigma %.5f)\n", what.c_str(), m.mean, mr.mean,
+                  std::sqrt(m.var + mr.var));
+      EXPECT_NEAR(m.mean, mr.mean, 4.5 * std::sqrt(m.var + mr.var)) << what;
+      const auto& light = its.last.details["light"];
+      EXPECT_EQ(light["camera_connections"], mode != CameraConnectionMode::kOff) << what;
+      if (mode == CameraConnectionMode::kOff)
+        EXPECT_EQ(light["camera_hits"].get<uint64_t>(), 0u) << what;
+      else
+        EXPECT_GT(light["camera_hits"].get<uint64_t>(), 20u) << what;
+    }
+  }
+}
+
 // The light pass's own variance (from the two halves of its photons, bpm/photon_count.h) falls as
 // 1 / N, and it is the part of an iteration's variance that four times the photons take away:
 // with N and 4N photons (fixed counts, unguided: the guide learns faster from more photons) an

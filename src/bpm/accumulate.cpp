@@ -108,7 +108,12 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
       for (int x = 0; x < w; ++x) {
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
-        const PixelShares sh = pixel_shares(maps, light, at.data() + p * places, places);
+        PixelShares sh = pixel_shares(maps, light, at.data() + p * places, places);
+        if (!light.camera.empty()) {  // camera connections (camera_connections.h)
+          const float norm = float(1.0 / double(light.emitted));
+          sh.photon_L += light.camera[p] * norm;
+          sh.odd_L += light.camera_odd[p] * norm;
+        }
         const Spectrum &photon_L = sh.photon_L, &bias = sh.bias;
         eye.round_stats[p].add_lit(sh.small_lit, sh.large_lit);
         Spectrum L = eye.radiance[p] + photon_L;

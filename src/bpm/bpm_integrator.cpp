@@ -1,6 +1,7 @@
 #include "bpm/bpm_integrator.h"
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <cmath>
@@ -162,6 +163,10 @@ class BpmRender {
   CombineAt combined() const { return scene_.media.empty() ? s_.combine : CombineAt::kNowhere; }
   // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
   double reserve_memory() const;
+  // The camera connections as the settings ask and the scene allows, and each pixel's radius for
+  // caustic light at a first vertex in iteration it (camera_connections.h).
+  CameraConnections camera_connections() const;
+  void set_caustic_radii(int it, float scale);
 
   const LoadedScene& ls_;
   const RenderScene& scene_;
@@ -211,6 +216,9 @@ class BpmRender {
   // media).
   std::unique_ptr<MediumSpheres> medium_spheres_;
   float medium_min_length_;  // photons/medium_radius.h
+  // Caustic photons joined to the camera (off where the settings, the camera or the scene rule
+  // them out).
+  CameraConnections connections_;
 };
 
 const char* const kMemoryAdvice =
@@ -265,6 +273,7 @@ BpmRender::BpmRender(const LoadedScene& ls, const IntegratorOptions& opt,
               ? median_surface_distance(scene_, camera_.camera(), film->width(), film->height())
               : 0) {
   pixel_sums_.places = photons_per_path(s_, scene_);
+  connections_ = camera_connections();
   LightCounters light_exemplar;
   light_exemplar.observer = opt.light_ray_observer;
   light_.counters = tbb::enumerable_thread_specific<LightCounters>(light_exemplar);
@@ -297,6 +306,39 @@ double BpmRender::reserve_memory() const {
   return fixed_bytes;
 }
 
+CameraConnections BpmRender::camera_connections() const {
+  CameraConnections cc;
+  // Only a pinhole sees the connections' point, and without media they need no transmittance.
+  if (!opt_.image || !caustics_ || !scene_.media.empty() || !camera_.camera().projects()) return cc;
+  cc.mode = s_.camera_connections;
+  cc.camera = &camera_.camera();
+  cc.filter = &camera_.filter();
+  cc.width = film_->width();
+  cc.height = film_->height();
+  cc.caustic_radius.assign(cc.on() ? n_pixels_ : 0, 0.0f);
+  cc.world = s_.radius > 0;
+  // The first vertex takes both parts of a material where gathering ends the path there
+  // (choose_or_split, bpm/eye_pass.cpp).
+  cc.gather_by_chance = !(s_.diffuse_depth == 0 && s_.split_coats);
+  return cc;
+}
+
+// As backward_photon_at (bpm/eye_pass.cpp) makes them: at D = 0 the first vertex's caustic disc
+// is the small one unless the radii are in world units or k0 = k1 (one disc for all light, of r1);
+// at D > 0 it is the small one.
+void BpmRender::set_caustic_radii(int it, float scale) {
+  const bool small = s_.diffuse_depth > 0 || !(s_.radius > 0 || s_.k0 == s_.k1);
+  const float base = s_.radius > 0
+                         ? s_.radius
+                         : (small ? s_.k0 : s_.k1) * camera_.camera().footprint({0, 0}).spread;
+  const bool per_pixel = s_.radius_policy == RadiusPolicy::kPerPixel;
+  tbb::parallel_for(size_t(0), n_pixels_, [&](size_t p) {
+    const DiscScales d = per_pixel ? DiscScales::of(s_, it, opt_.first_iteration, eye_.lit_share[p])
+                                   : DiscScales{scale, scale};
+    connections_.caustic_radius[p] = base * (small ? d.small : d.large);
+  });
+}
+
 // Fig. 3: one iteration, an independent estimate of the image.
 PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   const int it = opt_.first_iteration + pass;  // the index random streams and radii follow
@@ -320,6 +362,10 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
                std::any_of(maps_.photons.begin(), maps_.photons.end(),
                            [](const BackwardPhoton& bp) { return bp.combined; });
   lp.merge_photons = double(photons_);
+  if (connections_.on()) {
+    set_caustic_radii(it, scale);
+    lp.camera = &connections_;
+  }
   if (sensors_) {
     sensors_->set_scale(scale);
     sensor_sums_.clear();
@@ -450,7 +496,7 @@ void BpmRender::accumulate(const WavelengthMaterials& wm, int it) {
 PassResult BpmRender::progress() const {
   PassResult r;
   for (const EyeCounters& c : eye_counters_) r.rays += c.rays.total();
-  for (const LightCounters& c : light_.counters) r.rays += c.light_rays;
+  for (const LightCounters& c : light_.counters) r.rays += c.light_rays + c.camera_rays;
   char text[128];
   std::snprintf(text, sizeof text, "  %zu backward photons  coverage %.2f%s", maps_.photons.size(),
                 light_result_.coverage,
@@ -472,7 +518,8 @@ std::pair<ExtraSampleCost, ExtraSampleCost> BpmRender::round_cost() const {
     now.v[C::kDirectSamples] += double(c.direct_samples);
     now.v[C::kDirectRays] += double(c.direct_rays);
   }
-  for (const LightCounters& c : light_.counters) now.v[C::kRays] += double(c.light_rays);
+  for (const LightCounters& c : light_.counters)
+    now.v[C::kRays] += double(c.light_rays + c.camera_rays);
   for (size_t k = 0; k < now.v.size(); ++k) round.v[k] += now.v[k] - counted_.v[k];
   return {round, now};
 }
@@ -595,7 +642,7 @@ PassWork BpmRender::work_now() const {
     w.v[PassWork::kBackwardPhotons] += double(c.backward_photons);
   }
   for (const LightCounters& c : light_.counters) {
-    w.v[PassWork::kLightRays] += double(c.light_rays);
+    w.v[PassWork::kLightRays] += double(c.light_rays + c.camera_rays);
     w.v[PassWork::kQueries] += double(c.queries);
     w.v[PassWork::kBeams] += double(c.beams);
     w.v[PassWork::kEntries] += double(c.entries);
@@ -687,6 +734,7 @@ RenderStats BpmRender::finish(RenderStats stats) {
   stats.rays = tot_.eye.rays;
   stats.light_rays = tot_.light.light_rays;
   tot_.photons_last = photons_;
+  tot_.camera_connections = connections_.on();
   if (combined() == CombineAt::kChosen) {
     double sum = 0;
     for (uint8_t level : eye_.continue_level) sum += std::ldexp(1.0, -int(level));

@@ -77,6 +77,10 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
     if (bp.combined && h.merge_factor > 0) value *= combined_merge_weight(bp, m, h, prm);
+    if (prm.camera && h.cls == PhotonClass::kCaustic && merges_against_camera(*prm.camera, bp)) {
+      value *= merge_weight_against_camera(*prm.camera, bp, m);
+      if (value.is_black()) return;
+    }
     score += add_entry(bp, g, length_squared(h.p - bp.p), value, h.photon, prm, owner, out);
   };
   // The backward photons found are fetched in groups before any is used: each record is likely a
@@ -145,6 +149,20 @@ struct GroupTrace {
   bool scored;  // the emissions are recorded for the guide's scores
 };
 
+// A caustic photon's hit joined to the camera (camera_connections.h), on a surface that is not a
+// curve (where eye paths never gather).
+void connect_hit_to_camera(const RenderScene& scene, const CameraConnections& camera,
+                           const WavelengthMaterials& wm, const PhotonHit& h, bool odd,
+                           LightCounters& lc, std::vector<CameraHit>& hits) {
+  const Object& object = scene.objects[size_t(h.object)];
+  if (std::holds_alternative<Curves>(object.shape)) return;
+  Material storage;
+  const Material& m = wm.at(object.material, texture_context(h.sp), storage);
+  const size_t before = hits.size();
+  connect_to_camera(scene, camera, m, h.sp, h.wi, h.flux, odd, wm.wl, &lc.camera_rays, hits);
+  lc.camera_hits += hits.size() - before;
+}
+
 // Traces chunk c of the group, recording its photons' hits and emissions and its counters.
 void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   const RenderScene& scene = g.scene;
@@ -165,6 +183,9 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   crossings.clear();
   std::vector<PendingBeam>& beams = buf->beams[size_t(c)];
   beams.clear();
+  std::vector<CameraHit>& camera_hits = buf->camera_hits[size_t(c)];
+  camera_hits.clear();
+  const CameraConnections* camera = g.prm.camera;
   const bool media = g.prm.medium_spheres && !g.prm.medium_spheres->empty();
   const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
   const uint64_t last = std::min(first + kPhotonsPerChunk, g.count);
@@ -185,6 +206,8 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     // A backward photon adds at least one eye vertex; direct photons are never used
     // (next-event estimation counts direct light).
     auto on_hit = [&](const PhotonHit& h) {
+      if (camera && h.cls == PhotonClass::kCaustic && h.medium < 0)
+        connect_hit_to_camera(scene, *camera, *g.prm.materials, h, photon & 1, lc, camera_hits);
       // Photons in media reach the spheres there by their beams (on_beam).
       if (h.cls == PhotonClass::kDirect || h.medium >= 0 || !maps.has_photons(h.object)) return;
       ++lc.queries;
@@ -279,6 +302,7 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->chunk_counters.resize(size_t(n_chunks));
     buf->crossings.resize(size_t(n_chunks));
     buf->beams.resize(size_t(n_chunks));
+    buf->camera_hits.resize(size_t(n_chunks));
   }
   const GroupTrace g{
       scene, maps, prm, seed, pass_index, first_photon, count, guide, guide && prm.pixel_weight};
@@ -401,8 +425,10 @@ class StageClock {
 
 // The arrays keep their memory from the last iteration (fresh pages cost a fault each), and
 // only the flags are cleared: the sums of a backward photon are set at its first entry.
-void reset_result(size_t n_bp, LightPassResult& res) {
+void reset_result(size_t n_bp, size_t n_pixels, LightPassResult& res) {
   res.reached.assign(n_bp, 0);
+  res.camera.assign(n_pixels, Spectrum());
+  res.camera_odd.assign(n_pixels, Spectrum());
   res.flux.resize(n_bp);
   res.flux_inner.resize(n_bp);
   res.flux_quarter.resize(n_bp);
@@ -413,6 +439,22 @@ void reset_result(size_t n_bp, LightPassResult& res) {
   res.coverage = 0;
   res.trace_s = res.gather_s = res.apply_s = 0;
   res.peak_entry_bytes = 0;
+}
+
+// The camera connections of the first `chunks` chunks spread over the pixels: in parallel over
+// bands of rows, each band taking the hits chunk by chunk in order, so that every pixel adds its
+// shares in one order whatever the threads.
+void add_camera_hits(const CameraConnections& cc, int chunks, const LightPassBuffers& buf,
+                     LightPassResult& res) {
+  constexpr int kRows = 8;
+  tbb::parallel_for(0, (cc.height + kRows - 1) / kRows, [&](int band) {
+    const int row0 = band * kRows, row1 = std::min(cc.height, row0 + kRows);
+    const float reach = cc.filter->settings().radius.y + 0.5f;
+    for (int c = 0; c < chunks; ++c)
+      for (const CameraHit& hit : buf.camera_hits[size_t(c)])
+        if (hit.raster.y + reach >= float(row0) && hit.raster.y - reach <= float(row1))
+          spread_to_pixels(cc, hit, row0, row1, res.camera.data(), res.camera_odd.data());
+  });
 }
 
 // Rounds of gather and apply over the sorted hits: one, unless the entries reach the memory
@@ -556,7 +598,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   const size_t n_bp = maps.photons.size();
   BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
   LightPassResult& res = *out;
-  reset_result(n_bp, res);
+  reset_result(n_bp, prm.camera ? prm.camera->caustic_radius.size() : 0, res);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   const GroupSize group = group_size(n_bp);
@@ -574,6 +616,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     res.emitted += tr.kept;
     if (prm.sensor_sums)
       for (int c = 0; c < tr.chunks; ++c) prm.sensor_sums->add(buf->crossings[size_t(c)]);
+    if (prm.camera) add_camera_hits(*prm.camera, tr.chunks, *buf, res);
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
     gather_and_apply(maps, prm, masks, buf, res, clock);

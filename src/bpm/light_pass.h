@@ -17,6 +17,7 @@
 
 #include "base/rng.h"
 #include "bpm/backward_maps.h"
+#include "bpm/camera_connections.h"
 #include "bpm/masks.h"
 #include "bpm/medium_spheres.h"
 #include "bpm/settings.h"
@@ -73,6 +74,9 @@ struct LightPassParams {
   // each merge at a backward photon whose eye path went on is weighed, with N = merge_photons.
   bool combine = false;
   double merge_photons = 0;
+  // Caustic photons joined to the camera (bpm/camera_connections.h), their merges at the discs
+  // seen directly weighed against that. Null: none.
+  const CameraConnections* camera = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -118,6 +122,7 @@ struct LightPassBuffers {
   std::vector<std::vector<EmittedPhoton>> emitted;                  // [chunk]
   std::vector<std::vector<SensorCrossing>> crossings;               // [chunk], with sensors
   std::vector<std::vector<PendingBeam>> beams;                      // [chunk], with medium spheres
+  std::vector<std::vector<CameraHit>> camera_hits;                  // [chunk], with connections
   std::vector<std::vector<std::vector<PhotonEntry>>> beam_entries;  // [chunk][slot]
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
@@ -134,9 +139,11 @@ struct LightPassResult {
   std::vector<Spectrum> flux_inner;    // the same over the entries of its inner half (inner())
   std::vector<Spectrum> flux_quarter;  // and of its inner quarter (quarter())
   std::vector<Spectrum> flux_odd;      // and over the entries of the odd photons (odd())
-  uint64_t emitted = 0;                // photons emitted, N of eq. (2)
-  bool cut = false;                    // a stop request ended the pass before all its photons
-  int batches = 0;  // gather rounds: one per group, more where the memory limit split one
+  // Per pixel, with camera connections: the sum of their shares of it, and of the odd photons'.
+  std::vector<Spectrum> camera, camera_odd;
+  uint64_t emitted = 0;  // photons emitted, N of eq. (2)
+  bool cut = false;      // a stop request ended the pass before all its photons
+  int batches = 0;       // gather rounds: one per group, more where the memory limit split one
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;
   // Seconds, every part of the pass in one of them: tracing the photons (emission, rays,

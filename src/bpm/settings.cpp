@@ -5,6 +5,25 @@
 
 namespace bpm {
 
+const char* to_string(CameraConnectionMode m) {
+  switch (m) {
+    case CameraConnectionMode::kOff:
+      return "off";
+    case CameraConnectionMode::kOn:
+      return "on";
+    case CameraConnectionMode::kAlone:
+      return "alone";
+  }
+  return "?";
+}
+
+std::optional<CameraConnectionMode> parse_camera_connections(const std::string& s) {
+  for (CameraConnectionMode m :
+       {CameraConnectionMode::kOff, CameraConnectionMode::kOn, CameraConnectionMode::kAlone})
+    if (s == to_string(m)) return m;
+  return std::nullopt;
+}
+
 BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   BpmSettings b;
   const ParamSet& ps = in.params;
@@ -34,6 +53,11 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
              "must be \"partition\", \"glossy\", \"combined\" or \"auto\"", in.loc);
   b.combine = *parse_combine_at(estimators);
   b.split_coats = ps.get_bool("splitcoats", b.split_coats);
+  const std::string connections =
+      ps.get_string("cameraconnections", to_string(b.camera_connections));
+  ps.require("cameraconnections", parse_camera_connections(connections).has_value(),
+             "must be \"on\", \"off\" or \"alone\"", in.loc);
+  b.camera_connections = *parse_camera_connections(connections);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
@@ -61,7 +85,8 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"direct_samples", s.direct_samples},
           {"split_in_media", s.split_in_media},
           {"estimators", to_string(s.combine)},
-          {"split_coats", s.split_coats}};
+          {"split_coats", s.split_coats},
+          {"camera_connections", to_string(s.camera_connections)}};
 }
 
 }  // namespace bpm

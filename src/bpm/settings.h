@@ -2,11 +2,21 @@
 // line and the command line, and printed in the run's JSON record.
 #pragma once
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "photons/settings.h"
 #include "scene/parsed_scene.h"
 
 namespace bpm {
+
+// Light tracing to the camera for caustic light seen directly (bpm/camera_connections.h). kOn:
+// the connections and the merges at the discs seen directly, each path weighed between them;
+// kAlone: the connections count those paths in full and the merges not at all (a check of the
+// connections' estimate: the image must not change); kOff: the merges alone (the paper's method).
+enum class CameraConnectionMode : uint8_t { kOff, kOn, kAlone };
+const char* to_string(CameraConnectionMode m);
+std::optional<CameraConnectionMode> parse_camera_connections(const std::string& s);
 
 struct BpmSettings : PhotonSettings {
   // bpm's radii shrink per pixel, with the iterations that brought its discs photons (DiscScales,
@@ -50,6 +60,8 @@ struct BpmSettings : PhotonSettings {
   // with its weight divided by the chance (EyePassParams::split_coats): a coated floor seen from
   // the camera no longer carries the noise of that choice.
   bool split_coats = true;
+  // Caustic photons joined to the camera where it sees them (CameraConnectionMode).
+  CameraConnectionMode camera_connections = CameraConnectionMode::kOn;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"

@@ -88,6 +88,9 @@ nlohmann::json light_json(const BpmTotals& t, int iterations) {
       {"entries", t.light.entries},
       {"beams", t.light.beams},
       {"cut_off_rays", t.light.cut_off_rays},
+      {"camera_connections", t.camera_connections},
+      {"camera_rays", t.light.camera_rays},
+      {"camera_hits", t.light.camera_hits},
       {"photons_per_iteration_last", t.photons_last},
       // bpm/photon_count.h: the relative variance of an iteration and of its light pass alone
       // (means over pixels), the light pass's share, and the balanced photon count N*.

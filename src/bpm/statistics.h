@@ -38,6 +38,9 @@ struct BpmTotals {
   // schedule's.
   double small_scale_mean = -1, large_scale_mean = -1, shared_scale = -1;
   double photon_share = -1, photons_best = 0, variance = 0, photon_variance = 0;
+  // Whether caustic photons were joined to the camera (camera_connections.h): the setting, where
+  // the camera and the scene allow it.
+  bool camera_connections = false;
 
   // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.
   void add_maps(const BackwardMaps& maps);

@@ -19,6 +19,7 @@ float equirectangular_pixel_solid_angle(float y, int width, int height) {
 
 Camera::Camera(const CameraSettings& s, const Raster& r)
     : world_from_camera_(s.world_from_camera),
+      camera_from_world_(s.world_from_camera.inverse()),
       projection_(s.projection),
       lens_radius_(s.lens_radius),
       focal_distance_(s.focal_distance),
@@ -26,6 +27,8 @@ Camera::Camera(const CameraSettings& s, const Raster& r)
       height_(r.full_height),
       crop_x0_(float(r.x0)),
       crop_y0_(float(r.y0)),
+      crop_width_(float(r.width)),
+      crop_height_(float(r.height)),
       lens_(s.lens),
       medium_(s.medium) {
   const int width = r.full_width, height = r.full_height;
@@ -62,6 +65,34 @@ Camera::Camera(const CameraSettings& s, const Raster& r)
       pixel_angle_ = lens_->pixel_spread();
       break;
   }
+  // Rigid (a mirror allowed): solid angles in camera space are the world's.
+  const Vec3 ax = world_from_camera_.vector(Vec3(1, 0, 0)),
+             ay = world_from_camera_.vector(Vec3(0, 1, 0)),
+             az = world_from_camera_.vector(Vec3(0, 0, 1));
+  const bool rigid = std::fabs(length(ax) - 1) < 1e-4f && std::fabs(length(ay) - 1) < 1e-4f &&
+                     std::fabs(length(az) - 1) < 1e-4f && std::fabs(dot(ax, ay)) < 1e-4f &&
+                     std::fabs(dot(ay, az)) < 1e-4f && std::fabs(dot(az, ax)) < 1e-4f;
+  projects_ = projection_ == Projection::kPerspective && lens_radius_ == 0 && rigid;
+}
+
+std::optional<Camera::ProjectedPoint> Camera::project(Vec3 p, float margin) const {
+  if (!projects_) return std::nullopt;
+  const Vec3 c = camera_from_world_.point(p);
+  if (!(c.z > 0)) return std::nullopt;
+  // The point on the plane z = 1, and the screen coordinates generate_ray_full inverts.
+  const float qx = c.x / c.z, qy = c.y / c.z;
+  const float sx = qx / tan_half_, sy = qy / tan_half_;
+  const Vec2 full{(sx - x0_) / (x1_ - x0_) * float(width_),
+                  (y1_ - sy) / (y1_ - y0_) * float(height_)};
+  const Vec2 raster{full.x - crop_x0_, full.y - crop_y0_};
+  if (!(raster.x > -margin && raster.y > -margin && raster.x < crop_width_ + margin &&
+        raster.y < crop_height_ + margin))
+    return std::nullopt;
+  // A pixel is dx tan_half by dy tan_half on the plane z = 1 (pixel_angle_ squared), and a patch
+  // of the plane at q subtends its area times cos^3 of the angle to the axis: 1 / |q|^3.
+  const float q2 = 1 + qx * qx + qy * qy;
+  const float per_solid_angle = q2 * std::sqrt(q2) / (pixel_angle_ * pixel_angle_);
+  return ProjectedPoint{raster, per_solid_angle, world_from_camera_.point(Vec3(0, 0, 0))};
 }
 
 // pbrt-v4's spherical directions, with its y and z swapped: +y up.

@@ -4,6 +4,7 @@
 // down +x, a quarter across down +z).
 #pragma once
 #include <memory>
+#include <optional>
 
 #include "base/ray.h"
 #include "base/transform.h"
@@ -64,17 +65,30 @@ class Camera {
   PixelFootprint footprint(Vec2 p_full) const;
   // The width of a pixel's footprint at world point p seen directly.
   float footprint_at(Vec3 p) const;
+  // Where world point p lands on a pinhole perspective camera's image: its position in pixels of
+  // the image rendered (the crop's), the image's area in square pixels per unit of solid angle
+  // about the ray to p (du/domega), and the pinhole. Nothing for the other cameras (a lens, a
+  // non-rigid camera transform included), behind the camera, or more than `margin` pixels off the
+  // image (light tracing to the camera, bpm/camera_connections.h).
+  struct ProjectedPoint {
+    Vec2 raster;
+    float pixels_per_solid_angle;
+    Vec3 pinhole;
+  };
+  std::optional<ProjectedPoint> project(Vec3 p, float margin) const;
+  bool projects() const { return projects_; }
   Projection projection() const { return projection_; }
 
  private:
   Vec3 camera_direction(Vec2 p_full) const;  // spherical cameras
-  Transform world_from_camera_;
+  Transform world_from_camera_, camera_from_world_;
   Projection projection_;
   float lens_radius_, focal_distance_;
   float x0_, x1_, y0_, y1_;  // screen window
   float tan_half_;
   int width_, height_;  // the full raster
-  float crop_x0_, crop_y0_;
+  float crop_x0_, crop_y0_, crop_width_, crop_height_;
+  bool projects_ = false;  // project() applies: a pinhole perspective camera, rigid transform
   float pixel_angle_ = 0;  // sqrt of the pixel's solid angle (perspective, equal-area)
   float pixel_width_ = 0;  // sqrt of the pixel's area in world units (orthographic)
   std::shared_ptr<const LensSystem> lens_;

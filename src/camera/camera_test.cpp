@@ -83,5 +83,47 @@ TEST(Camera, EqualAreaPixelsSubtendEqualSolidAngles) {
   }
 }
 
+// A pinhole perspective camera (mirrored, turned and moved, a crop of a larger raster) projects
+// points along its rays back to the raster positions they came from, with the pixel area per
+// solid angle that neighbouring rays span; a lens, or a point behind it, does not project.
+TEST(Camera, PerspectiveProjectionInvertsTheRaysAndTheirSolidAngles) {
+  CameraSettings s = settings(Projection::kPerspective);
+  s.fov_degrees = 50;
+  s.world_from_camera = Transform::translate(Vec3(0.5f, -1, 2)) *
+                        Transform::rotate(30, normalize(Vec3(1, 2, 0.5f))) *
+                        Transform::scale(Vec3(-1, 1, 1));
+  const Raster raster{30, 20, 64, 48, 10, 7};
+  const Camera camera(s, raster);
+  ASSERT_TRUE(camera.projects());
+  Rng rng(41);
+  for (int q = 0; q < 50; ++q) {
+    const Vec2 u{rng.uniform() * 30, rng.uniform() * 20};
+    const Ray r = camera.generate_ray(u, {0.5f, 0.5f}).ray;
+    const auto p = camera.project(r.o + r.d * (0.5f + 5 * rng.uniform()), 0);
+    ASSERT_TRUE(p);
+    EXPECT_NEAR(p->raster.x, u.x, 2e-3f);
+    EXPECT_NEAR(p->raster.y, u.y, 2e-3f);
+    EXPECT_NEAR(length(p->pinhole - r.o), 0, 1e-5f);
+    // The solid angle of the rays through a small square about u (two triangles of directions).
+    const float h = 0.05f;
+    auto dir = [&](float dx, float dy) {
+      return camera.generate_ray({u.x + dx, u.y + dy}, {0.5f, 0.5f}).ray.d;
+    };
+    const Vec3 a = dir(-h, -h), b = dir(h, -h), c = dir(h, h), d = dir(-h, h);
+    const double omega = 0.5 * (length(cross(b - a, c - a)) + length(cross(c - a, d - a)));
+    EXPECT_NEAR(p->pixels_per_solid_angle * omega / (4 * h * h), 1.0, 1e-2);
+  }
+  const Ray centre = camera.generate_ray({15, 10}, {0.5f, 0.5f}).ray;
+  EXPECT_FALSE(camera.project(centre.o - centre.d, 0));  // behind
+  EXPECT_FALSE(camera.project(camera.generate_ray({-3, 10}, {0.5f, 0.5f}).ray.o +
+                                  camera.generate_ray({-3, 10}, {0.5f, 0.5f}).ray.d,
+                              2));  // 3 pixels off with a margin of 2
+  EXPECT_TRUE(camera.project(camera.generate_ray({-1, 10}, {0.5f, 0.5f}).ray.o +
+                                 camera.generate_ray({-1, 10}, {0.5f, 0.5f}).ray.d,
+                             2));
+  s.lens_radius = 0.01f;
+  EXPECT_FALSE(Camera(s, raster).project(centre.o + centre.d, 0));
+}
+
 }  // namespace
 }  // namespace bpm

@@ -95,6 +95,31 @@ FilterSample Filter::sample(Vec2 u) const {
   return {p, pdf > 0 ? f / pdf : 0};
 }
 
+int Filter::cell_of(Vec2 offset) const {
+  const int cx =
+      std::clamp(int((offset.x + s_.radius.x) / (2 * s_.radius.x) * float(nx_)), 0, nx_ - 1);
+  const int cy =
+      std::clamp(int((offset.y + s_.radius.y) / (2 * s_.radius.y) * float(ny_)), 0, ny_ - 1);
+  return cy * nx_ + cx;
+}
+
+float Filter::sample_density(Vec2 offset) const {
+  const float rx = s_.radius.x, ry = s_.radius.y;
+  if (std::fabs(offset.x) > rx || std::fabs(offset.y) > ry) return 0;
+  if (s_.type == FilterType::kBox) return 1 / (4 * rx * ry);
+  if (s_.type == FilterType::kTriangle) return evaluate(offset) / (rx * rx * ry * ry);
+  const float cell_area = (2 * rx / float(nx_)) * (2 * ry / float(ny_));
+  return cells_.pmf(cell_of(offset)) / cell_area;
+}
+
+float Filter::normalized(Vec2 offset) const {
+  const float rx = s_.radius.x, ry = s_.radius.y;
+  if (std::fabs(offset.x) > rx || std::fabs(offset.y) > ry) return 0;
+  if (s_.type == FilterType::kBox || s_.type == FilterType::kTriangle)
+    return sample_density(offset);
+  return integral_ != 0 ? values_[size_t(cell_of(offset))] / integral_ : 0;
+}
+
 std::string Filter::name() const {
   switch (s_.type) {
     case FilterType::kBox:

@@ -30,10 +30,18 @@ class Filter {
   explicit Filter(const FilterSettings& s);
   float evaluate(Vec2 p) const;
   FilterSample sample(Vec2 u) const;
+  // The density over offsets (per square pixel) that sample() draws from: f / integral(f) for
+  // the box and the triangle, the tabulated |f| / its integral for the others.
+  float sample_density(Vec2 offset) const;
+  // What one sample's weight averages with, per square pixel: f / integral(f) (the tabulated f
+  // for the filters sampled from their table), so that a value spread by it over the offsets
+  // adds to a pixel what camera samples weighted by sample() add in expectation.
+  float normalized(Vec2 offset) const;
   const FilterSettings& settings() const { return s_; }
   std::string name() const;
 
  private:
+  int cell_of(Vec2 offset) const;  // the tabulated cell holding offset (inside the radius)
   FilterSettings s_;
   // Tabulated |f| for filters without an analytic sampler.
   int nx_ = 0, ny_ = 0;

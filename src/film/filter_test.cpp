@@ -107,6 +107,41 @@ TEST_P(FilterTest, WeightedSamplesAverageTheTestFunction) {
   }
 }
 
+// sample_density is the density sample() draws from, and normalized what a weighted sample
+// averages with: both integrate to 1 over the filter's square, and each sample's weight is
+// normalized / sample_density times one constant (1 for the analytic samplers, the tabulated
+// integral for the others).
+TEST_P(FilterTest, DensitiesIntegrateToOneAndMatchTheSamplesWeights) {
+  const FilterCase& fc = GetParam();
+  Filter filter(fc.settings);
+  const double rx = fc.settings.radius.x, ry = fc.settings.radius.y;
+  const int k = 512;
+  double density = 0, normalized = 0;
+  for (int y = 0; y < k; ++y)
+    for (int x = 0; x < k; ++x) {
+      const Vec2 o{float(-rx + (x + 0.5) * 2 * rx / k), float(-ry + (y + 0.5) * 2 * ry / k)};
+      density += filter.sample_density(o) * (4 * rx * ry) / (k * k);
+      normalized += filter.normalized(o) * (4 * rx * ry) / (k * k);
+    }
+  EXPECT_NEAR(density, 1.0, 2e-3) << fc.name;
+  EXPECT_NEAR(normalized, 1.0, 2e-3) << fc.name;
+  EXPECT_EQ(filter.sample_density({float(rx) * 1.01f, 0}), 0.0f);
+  Rng rng(stream_key(79, uint64_t(fc.settings.type), 0));
+  double constant = 0;
+  for (int q = 0; q < 20000; ++q) {
+    const FilterSample s = filter.sample({rng.uniform(), rng.uniform()});
+    const float n = filter.normalized(s.offset), d = filter.sample_density(s.offset);
+    ASSERT_GT(d, 0) << fc.name;
+    if (n == 0) continue;
+    const double c = double(s.weight) * d / n;
+    if (constant == 0) constant = c;
+    ASSERT_NEAR(c, constant, 1e-4 * constant) << fc.name;
+  }
+  if (fc.analytic) {
+    EXPECT_NEAR(constant, 1.0, 1e-4) << fc.name;
+  }
+}
+
 // The analytic samplers draw offsets with density exactly f / integral(f): the mean and second
 // moment of the offset along each axis are those of the 1D factor.
 TEST(FilterSampling, TriangleMoments) {

@@ -113,6 +113,7 @@ class CameraSampler {
     return float(bits >> 8) * 0x1p-24f;
   }
   const Camera& camera() const { return camera_; }
+  const Filter& filter() const { return filter_; }
 
  private:
   Camera camera_;

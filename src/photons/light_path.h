@@ -83,6 +83,9 @@ struct LightCounters {
   uint64_t beams = 0;    // photon beams gathered at the spheres in media (bpm)
   // Rays that tested whether a photon is cut off from a backward photon (photon_cut_off; bpm).
   uint64_t cut_off_rays = 0;
+  // Shadow rays that tried to join caustic photons to the camera, and those that reached it
+  // (bpm/camera_connections.h).
+  uint64_t camera_rays = 0, camera_hits = 0;
   RayObserver* observer = nullptr;
   void add(const LightCounters& o) {
     photons += o.photons;
@@ -92,6 +95,8 @@ struct LightCounters {
     entries += o.entries;
     beams += o.beams;
     cut_off_rays += o.cut_off_rays;
+    camera_rays += o.camera_rays;
+    camera_hits += o.camera_hits;
   }
 };
 

@@ -36,7 +36,8 @@ struct RenderRequest {
   bool no_disc_probes = false;
   bool no_equiangular = false;
   bool split_in_media = false;
-  std::string estimators;  // bpm: "partition", "glossy", "combined" or "auto"
+  std::string estimators;          // bpm: "partition", "glossy", "combined" or "auto"
+  std::string camera_connections;  // bpm: "on", "off" or "alone"
   bool no_coat_split = false;
   bool debias = false;
   std::string bias_model;
