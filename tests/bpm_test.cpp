@@ -294,6 +294,15 @@ std::string caustic_scene(bool absorbing = false, const std::string& eta = "\"fl
   return s;
 }
 
+// The caustic scene with its light moved aside, as in the absorbing variant, so that the caustic
+// falls where the camera sees it directly (camera connections, bpm/camera_connections.h).
+std::string caustic_in_view_scene() {
+  std::string scene = caustic_scene();
+  const std::string light = quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true);
+  scene.replace(scene.find(light), light.size(), quad(1.3f, 0.1f, 1.7f, 0.5f, 2.0f, true));
+  return scene;
+}
+
 // A furnace without edges: the camera inside a sphere whose inner surface emits Le and reflects
 // diffusely with albedo rho. Every point sees radiance sum_{k=0}^{maxdepth} rho^k Le (pbrt-v4's
 // depth rule), most of it (58% at D = 0) through photons, so a wrong flux, depth count or class
@@ -1130,36 +1139,47 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
 // vertices. With the connections alone (the merges' weight 0), with both, and with the merges
 // alone the caustic agrees with path's block by block, and so does the image's mean: a wrong
 // connection shows with `alone`, weights that do not sum to one with `on`. On a coated floor at
-// D = 1 the eye path gathers at its first vertex by chance, which both sides' weights count.
+// D = 1, or at D = 0 without the coat split, the eye path gathers at its first vertex by chance,
+// which both sides' weights count; with k0 = k1 the caustic disc is the one of r1; the mitchell
+// filter's samples carry weights of either sign; on a rough dispersive floor the connection keeps
+// the hero wavelength as the eye path does.
 TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
   struct Case {
-    std::string name, floor;
+    std::string name, floor, filter;
     int diffuse_depth;
+    bool split_coats = true, one_radius = false;
   };
-  const std::string diffuse = "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]";
-  for (const Case& k :
-       {Case{"diffuse floor", diffuse, 0},
-        Case{
-            "coated floor",
-            "Material \"coateddiffuse\" \"rgb reflectance\" [0.75 0.75 0.75] \"float roughness\" 0",
-            1}}) {
-    // The light moved aside, as in the absorbing variant, so that the caustic falls where the
-    // camera sees it directly.
-    std::string scene = caustic_scene();
-    const std::string light = quad(-0.2f, 0.1f, 0.2f, 0.5f, 2.5f, true);
-    scene.replace(scene.find(light), light.size(), quad(1.3f, 0.1f, 1.7f, 0.5f, 2.0f, true));
-    scene.replace(scene.find("PixelFilter \"box\""), 17, "PixelFilter \"gaussian\"");
+  const std::string diffuse = "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]",
+                    coated =
+                        "Material \"coateddiffuse\" \"rgb reflectance\" [0.75 0.75 0.75] "
+                        "\"float roughness\" 0";
+  const std::vector<Case> cases = {
+      {"diffuse floor", diffuse, "gaussian", 0},
+      {"coated floor", coated, "gaussian", 1},
+      {"coated floor, chosen", coated, "gaussian", 0, false},
+      {"diffuse floor, k0 = k1", diffuse, "mitchell", 0, true, true},
+      {"rough dispersive floor",
+       "Material \"dielectric\" \"spectrum eta\" \"glass-F11\" \"float roughness\" 0.3", "box", 0}};
+  for (const Case& k : cases) {
+    std::string scene = caustic_in_view_scene();
+    scene.replace(scene.find("PixelFilter \"box\""), 17, "PixelFilter \"" + k.filter + "\"");
     scene.replace(scene.find(diffuse), diffuse.size(), k.floor);
     LoadedScene ls = load(scene);
     const Film ref = render_with(ls, "path", 4096).film;
     const BlockStats mr = block_stats(ref, 32)[0];
-    for (CameraConnectionMode mode :
-         {CameraConnectionMode::kAlone, CameraConnectionMode::kOn, CameraConnectionMode::kOff}) {
+    // The first two cases also run the merges alone; the others, the connections' variants.
+    std::vector<CameraConnectionMode> modes = {CameraConnectionMode::kAlone,
+                                               CameraConnectionMode::kOn};
+    if (&k - cases.data() < 2) modes.push_back(CameraConnectionMode::kOff);
+    for (CameraConnectionMode mode : modes) {
       BpmSettings s = small_batches(k.diffuse_depth);
       s.camera_connections = mode;
+      s.split_coats = k.split_coats;
+      if (k.one_radius) s.k1 = s.k0;  // one disc, narrow enough to keep the caustic sharp
       const Iterations its = render_iterations(ls, "bpm", 96, 7, s);
-      const std::string what =
-          k.name + ", D=" + std::to_string(k.diffuse_depth) + ", connections " + to_string(mode);
+      const std::string what = k.name + " (" + k.filter +
+                               "), D=" + std::to_string(k.diffuse_depth) + ", connections " +
+                               to_string(mode);
       expect_blocks_agree(its, ref, 8, edge_bias(s, 96, 8), what);
       const BlockStats m = image_mean(its);
       std::printf("%s: mean %.5f, path %.5f (sigma %.5f)\n", what.c_str(), m.mean, mr.mean,
@@ -1937,6 +1957,13 @@ TEST(Bpm, SameImageWithOneAndTwoThreads) {
     EXPECT_EQ(a.rgb, b.rgb) << (centres ? "centre tree" : "sphere tree");
     EXPECT_NE(a.rgb, c.rgb);
   }
+  // Camera connections spread over the pixels in bands of rows, with weights found by whichever
+  // thread needs them first.
+  ls = load(caustic_in_view_scene());
+  const BpmSettings s = small_batches(0);
+  const RenderRun a = render_with(ls, "bpm", 4, 1, 9, s), b = render_with(ls, "bpm", 4, 2, 9, s);
+  EXPECT_GT(a.stats.details["light"]["camera_hits"].get<uint64_t>(), 100u);
+  EXPECT_EQ(a.film.image().rgb, b.film.image().rgb) << "camera connections";
 }
 
 // A scene whose materials have no traced lobe has no caustics: bpm makes no backward photons that

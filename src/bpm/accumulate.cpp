@@ -63,7 +63,8 @@ PixelShares pixel_shares(const BackwardMaps& maps, const LightPassResult& light,
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                           EyePixels* eye_pixels, const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
-                          std::vector<double>* estimates, std::vector<double>* moments) {
+                          std::vector<double>* estimates, std::vector<double>* moments,
+                          float mean_filter_weight) {
   const int w = film->width(), h = film->height();
   LightPassResult& light = *light_sums;
   EyePixels& eye = *eye_pixels;
@@ -110,7 +111,12 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         if (!eye.sampled[p]) continue;
         PixelShares sh = pixel_shares(maps, light, at.data() + p * places, places);
         if (!light.camera.empty()) {  // camera connections (camera_connections.h)
-          const float norm = float(1.0 / double(light.emitted));
+          // The film weighs the whole estimate by the pixel's sample's filter weight, whose mean
+          // the connections' shares already hold: divided out, so that a filter with negative
+          // lobes (weights of either sign) does not flip them at random.
+          const float w = eye.filter_weight[p];
+          const float norm =
+              float(1.0 / double(light.emitted)) * (w != 0 ? mean_filter_weight / w : 1.0f);
           sh.photon_L += light.camera[p] * norm;
           sh.odd_L += light.camera_odd[p] * norm;
         }

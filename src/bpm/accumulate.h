@@ -46,10 +46,12 @@ struct PixelMoments {
 // round statistics 1 / the direct samples it took (SampleStats::add_direct_taken). The
 // photon part's variance over the light pass is (A - B)^2, A and B the parts that the photons of
 // even and of odd index brought (LightPassResult::flux_odd): two independent halves of the pass.
+// mean_filter_weight: what the pixels' camera samples' filter weights average
+// (Filter::mean_weight), for the camera connections' sums (LightPassResult::camera).
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums, EyePixels* eye,
                           const Wavelengths& wl, float max_component_value,
                           const PhotonSettings& settings, Film* film, PixelSums* sums,
                           std::vector<double>* estimates = nullptr,
-                          std::vector<double>* moments = nullptr);
+                          std::vector<double>* moments = nullptr, float mean_filter_weight = 1);
 
 }  // namespace bpm

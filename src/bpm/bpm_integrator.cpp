@@ -74,12 +74,12 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 // disc probes, the sample statistics with their copy at the end of a round, and the radii's
 // shares), the masks,
 // the emission guide and the photon count's moments (the round's, its copy at the end of a round
-// and the merged) keep.
-constexpr double kPixelBytes = sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) +
-                               2 * sizeof(uint16_t) + sizeof(float) +
-                               3 * sizeof(SampleStats<double>) + sizeof(double) + sizeof(uint32_t) +
-                               sizeof(float) + sizeof(uint16_t) +
-                               3 * PixelMoments::kValues * sizeof(double) + 2 * sizeof(float);
+// and the merged) keep, and the camera connections' two sums and radius.
+constexpr double kPixelBytes =
+    sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + 2 * sizeof(uint16_t) +
+    sizeof(float) + 3 * sizeof(SampleStats<double>) + sizeof(double) + sizeof(uint32_t) +
+    sizeof(float) + sizeof(uint16_t) + 3 * PixelMoments::kValues * sizeof(double) +
+    2 * sizeof(float) + 2 * sizeof(Spectrum) + sizeof(float);
 
 // What the extra samples of emission and of direct light cost against whole iterations
 // (emission_sample_count, direct_sample_count), in rays: all the rays the iterations cast and the
@@ -296,7 +296,8 @@ double BpmRender::reserve_memory() const {
   const double fixed_bytes =
       double(film_->bytes()) + double(n_pixels_) * kPixelBytes +
       light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),
-                           n_pixels_ * size_t(photons_per_path(s_, scene_)));
+                           n_pixels_ * size_t(photons_per_path(s_, scene_)),
+                           s_.camera_connections != CameraConnectionMode::kOff);
   check_memory(
       "bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) + " (up to " +
           std::to_string(photons_per_path(s_, scene_)) +
@@ -364,7 +365,7 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
   lp.merge_photons = double(photons_);
   if (connections_.on()) {
     set_caustic_radii(it, scale);
-    lp.camera = &connections_;
+    weigh_merges_against_camera(maps_, connections_, &lp);
   }
   if (sensors_) {
     sensors_->set_scale(scale);
@@ -440,7 +441,9 @@ bool BpmRender::build_maps(int pass, const RenderControl& control, LightPassPara
     // backward photons (counted by their number, not the lists' capacities, which depend on
     // how the threads shared the pixels: a budget decision must not).
     const double list_bytes = double(maps_.photons.size() * sizeof(BackwardPhoton));
-    const double used = fixed_bytes_ + maps_bytes(maps_, *lp) + list_bytes;
+    // With camera connections, a weight per backward photon (weigh_merges_against_camera).
+    const double used = fixed_bytes_ + maps_bytes(maps_, *lp) + list_bytes +
+                        (connections_.on() ? double(maps_.photons.size() * sizeof(float)) : 0.0);
     // Over the budget (the estimate before the first iteration assumed typical trees and no
     // textured materials): an error in the first iteration, which has nothing to keep; later,
     // the render ends with the iterations so far and says why.
@@ -481,7 +484,8 @@ void BpmRender::accumulate(const WavelengthMaterials& wm, int it) {
   tot_.probe_s += since(t);
   t = Clock::now();
   accumulate_iteration(maps_, &light_result_, &eye_, wm.wl, ls_.film.max_component_value, s_, film_,
-                       &pixel_sums_, guide_.empty() ? nullptr : &estimate_new_, &moments_new_);
+                       &pixel_sums_, guide_.empty() ? nullptr : &estimate_new_, &moments_new_,
+                       camera_.filter().mean_weight());
   tot_.accumulate_s += since(t);
   // The iteration's work, counted once it joined the image (a dropped one's goes with the next).
   const PassWork now = work_now();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/color.h"
 #include "integrator/direct_light.h"
 #include "photons/density.h"
 
@@ -28,8 +29,9 @@ double merge_area_density(const CameraConnections& cc, uint32_t pixel, float pix
 }  // namespace
 
 void connect_to_camera(const RenderScene& scene, const CameraConnections& cc, const Material& m,
-                       const SurfacePoint& sp, Vec3 wi, const Spectrum& flux, bool odd,
-                       const Wavelengths& wl, uint64_t* rays, std::vector<CameraHit>& out) {
+                       const SurfacePoint& sp, Vec3 wi, const Spectrum& flux, bool hero_only,
+                       bool odd, const Wavelengths& wl, uint64_t* rays,
+                       std::vector<CameraHit>& out) {
   const Vec2 radius = cc.filter->settings().radius;
   const auto proj = cc.camera->project(sp.p, std::max(radius.x, radius.y));
   if (!proj) return;
@@ -39,7 +41,10 @@ void connect_to_camera(const RenderScene& scene, const CameraConnections& cc, co
   const Vec3 wo = to_camera / std::sqrt(d2);
   const float cos_y = std::fabs(dot(sp.ng, wo));
   if (cos_y == 0) return;
-  const Spectrum value = photon_contribution(m, sp.ng, sp.ns, wo, wi, flux);
+  // A dispersive material holds the hero wavelength's index for every channel (materials/
+  // material.cpp): there the path goes on at the hero alone, scaled once (hero_join_factor).
+  Spectrum value = photon_contribution(m, sp.ng, sp.ns, wo, wi, flux);
+  if (!hero_only && material_is_dispersive(m)) value = hero_wavelength_only(value);
   if (value.is_black()) return;
   ++*rays;
   const Vec3 origin = offset_origin(sp.p, sp.ng, wo, sp.error);
@@ -51,9 +56,15 @@ void connect_to_camera(const RenderScene& scene, const CameraConnections& cc, co
   // r^2 / d^2 (world units).
   const float chance =
       cc.mode == CameraConnectionMode::kOn ? gather_chance(cc, m, sp.ns, wo) : 0.0f;
-  const float merge = float(chance * kPi * proj->pixels_per_solid_angle * cos_y /
-                            (cc.world ? double(d2) : 1.0));
+  const float merge =
+      float(chance * kPi * proj->pixels_per_solid_angle * cos_y / (cc.world ? double(d2) : 1.0));
   out.push_back({proj->raster, merge, seen * value * importance, odd});
+}
+
+std::pair<int, int> rows_reached(const CameraConnections& cc, const CameraHit& hit) {
+  const float r = cc.filter->settings().radius.y, y = hit.raster.y;
+  return {std::max(0, int(std::ceil(y - 0.5f - r))),
+          std::min(cc.height - 1, int(std::floor(y - 0.5f + r)))};
 }
 
 void spread_to_pixels(const CameraConnections& cc, const CameraHit& hit, int row0, int row1,
@@ -61,8 +72,8 @@ void spread_to_pixels(const CameraConnections& cc, const CameraHit& hit, int row
   const Vec2 radius = cc.filter->settings().radius, u = hit.raster;
   const int x0 = std::max(0, int(std::ceil(u.x - 0.5f - radius.x))),
             x1 = std::min(cc.width - 1, int(std::floor(u.x - 0.5f + radius.x))),
-            y0 = std::max(row0, int(std::ceil(u.y - 0.5f - radius.y))),
-            y1 = std::min(row1 - 1, int(std::floor(u.y - 0.5f + radius.y)));
+            y0 = std::max(row0, rows_reached(cc, hit).first),
+            y1 = std::min(row1 - 1, rows_reached(cc, hit).second);
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       const Vec2 offset{u.x - (float(x) + 0.5f), u.y - (float(y) + 0.5f)};

@@ -15,6 +15,7 @@
 // entry, photons/density.h).
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "base/spectrum.h"
@@ -52,10 +53,16 @@ struct CameraHit {
 };
 
 // Joins a caustic photon's hit at sp (on a surface of material m, not a curve) to the camera:
-// appends it to `out` if the camera sees the point. Counts its shadow ray in *rays.
+// appends it to `out` if the camera sees the point. hero_only: the photon keeps its hero
+// wavelength alone; at a dispersive material the connection does (as the eye path does there,
+// keep_hero_wavelength_at). Counts its shadow ray in *rays.
 void connect_to_camera(const RenderScene& scene, const CameraConnections& cc, const Material& m,
-                       const SurfacePoint& sp, Vec3 wi, const Spectrum& flux, bool odd,
-                       const Wavelengths& wl, uint64_t* rays, std::vector<CameraHit>& out);
+                       const SurfacePoint& sp, Vec3 wi, const Spectrum& flux, bool hero_only,
+                       bool odd, const Wavelengths& wl, uint64_t* rays,
+                       std::vector<CameraHit>& out);
+
+// The rows of the image a hit's filter reaches: [first, last].
+std::pair<int, int> rows_reached(const CameraConnections& cc, const CameraHit& hit);
 
 // Adds hit's share of each pixel whose filter reaches it, in rows [row0, row1), to sums (and to
 // odd_sums for an odd photon's), both per pixel of the image.

@@ -54,6 +54,20 @@ float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const P
   return merge_weight(h.merge_factor, p, density);
 }
 
+// The weight of backward photon g's merges of caustic photons against the camera connections
+// (weigh_merges_against_camera): found once, by whichever thread needs it first (they all find
+// the same).
+float camera_merge_weight(const LightPassParams& prm, uint32_t g, const BackwardPhoton& bp,
+                          const Material& m) {
+  std::atomic_ref<float> known(prm.camera_weights[g]);
+  float w = known.load(std::memory_order_relaxed);
+  if (w >= 0) return w;
+  w = merges_against_camera(*prm.camera, bp) ? merge_weight_against_camera(*prm.camera, bp, m)
+                                             : 1.0f;
+  known.store(w, std::memory_order_relaxed);
+  return w;
+}
+
 // Adds the entries of one diffuse hit (its query was counted when it was recorded). Returns the
 // sum of the entries' contributions to their pixels (per unit of 1 / N), each times the pixel's
 // weight, when prm.pixel_weight is set.
@@ -77,8 +91,8 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
     if (bp.combined && h.merge_factor > 0) value *= combined_merge_weight(bp, m, h, prm);
-    if (prm.camera && h.cls == PhotonClass::kCaustic && merges_against_camera(*prm.camera, bp)) {
-      value *= merge_weight_against_camera(*prm.camera, bp, m);
+    if (prm.camera && h.cls == PhotonClass::kCaustic) {
+      value *= camera_merge_weight(prm, g, bp, m);
       if (value.is_black()) return;
     }
     score += add_entry(bp, g, length_squared(h.p - bp.p), value, h.photon, prm, owner, out);
@@ -121,6 +135,12 @@ void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm) {
   });
 }
 
+void weigh_merges_against_camera(const BackwardMaps& maps, const CameraConnections& camera,
+                                 LightPassParams* prm) {
+  prm->camera = &camera;
+  prm->camera_weights.assign(maps.photons.size(), -1.0f);
+}
+
 namespace {
 
 // Bytes the entry lists of one chunk hold.
@@ -159,7 +179,8 @@ void connect_hit_to_camera(const RenderScene& scene, const CameraConnections& ca
   Material storage;
   const Material& m = wm.at(object.material, texture_context(h.sp), storage);
   const size_t before = hits.size();
-  connect_to_camera(scene, camera, m, h.sp, h.wi, h.flux, odd, wm.wl, &lc.camera_rays, hits);
+  connect_to_camera(scene, camera, m, h.sp, h.wi, h.flux, h.hero_only, odd, wm.wl, &lc.camera_rays,
+                    hits);
   lc.camera_hits += hits.size() - before;
 }
 
@@ -399,12 +420,16 @@ GroupSize group_size(size_t backward_photons) {
   return {hits / 2, hits};
 }
 
-double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons) {
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons, bool camera) {
   // The kept chunks' hits with their lists' spare capacity, and a chunk per thread traced past
   // them or kept from an earlier group (max_depth + 1 hits per photon at most); the emissions.
+  // A camera connection is made at a caustic photon's hit in view, most of which are also hits
+  // recorded: counted as many as those.
   const GroupSize g = group_size(backward_photons);
-  return double(kHitBytes) * (2.0 * double(g.hits) + 2.0 * double(threads) * kPhotonsPerChunk *
-                                                         double(std::max(max_depth, 0) + 1)) +
+  const double per_hit =
+      double(kHitBytes) + (camera ? double(sizeof(CameraHit) + sizeof(CameraHit*)) : 0.0);
+  return per_hit * (2.0 * double(g.hits) +
+                    2.0 * double(threads) * kPhotonsPerChunk * double(std::max(max_depth, 0) + 1)) +
          2.0 * double(g.photons) * sizeof(EmittedPhoton);
 }
 
@@ -441,19 +466,25 @@ void reset_result(size_t n_bp, size_t n_pixels, LightPassResult& res) {
   res.peak_entry_bytes = 0;
 }
 
-// The camera connections of the first `chunks` chunks spread over the pixels: in parallel over
-// bands of rows, each band taking the hits chunk by chunk in order, so that every pixel adds its
-// shares in one order whatever the threads.
-void add_camera_hits(const CameraConnections& cc, int chunks, const LightPassBuffers& buf,
+// The camera connections of the first `chunks` chunks spread over the pixels: listed per band of
+// rows that their filters reach (chunk by chunk in order), then each band in parallel adds its
+// hits in that order, so that every pixel's sum does not depend on the threads.
+void add_camera_hits(const CameraConnections& cc, int chunks, LightPassBuffers& buf,
                      LightPassResult& res) {
   constexpr int kRows = 8;
-  tbb::parallel_for(0, (cc.height + kRows - 1) / kRows, [&](int band) {
-    const int row0 = band * kRows, row1 = std::min(cc.height, row0 + kRows);
-    const float reach = cc.filter->settings().radius.y + 0.5f;
-    for (int c = 0; c < chunks; ++c)
-      for (const CameraHit& hit : buf.camera_hits[size_t(c)])
-        if (hit.raster.y + reach >= float(row0) && hit.raster.y - reach <= float(row1))
-          spread_to_pixels(cc, hit, row0, row1, res.camera.data(), res.camera_odd.data());
+  std::vector<std::vector<const CameraHit*>>& bands = buf.camera_bands;
+  bands.resize(size_t((cc.height + kRows - 1) / kRows));
+  for (auto& b : bands) b.clear();
+  for (int c = 0; c < chunks; ++c)
+    for (const CameraHit& hit : buf.camera_hits[size_t(c)]) {
+      const auto [first, last] = rows_reached(cc, hit);
+      for (int b = first / kRows; b <= last / kRows && first <= last; ++b)
+        bands[size_t(b)].push_back(&hit);
+    }
+  tbb::parallel_for(0, int(bands.size()), [&](int b) {
+    const int row0 = b * kRows, row1 = std::min(cc.height, row0 + kRows);
+    for (const CameraHit* hit : bands[size_t(b)])
+      spread_to_pixels(cc, *hit, row0, row1, res.camera.data(), res.camera_odd.data());
   });
 }
 

@@ -75,12 +75,22 @@ struct LightPassParams {
   bool combine = false;
   double merge_photons = 0;
   // Caustic photons joined to the camera (bpm/camera_connections.h), their merges at the discs
-  // seen directly weighed against that. Null: none.
+  // seen directly weighed against that: per backward photon, the weight of its merges of caustic
+  // photons, or -1 until it is needed (weigh_merges_against_camera; the gather's threads set it
+  // through atomic references). Null: none.
   const CameraConnections* camera = nullptr;
+  mutable std::vector<float> camera_weights{};
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
 void resolve_photon_materials(const BackwardMaps& maps, LightPassParams* prm);
+
+// Sets prm->camera, and prm->camera_weights to "not yet known" for each backward photon of maps:
+// the gather finds a weight the first time a caustic photon reaches its backward photon
+// (merge_weight_against_camera where merges_against_camera, else 1), so that an iteration whose
+// caustic photons land nowhere in view costs nothing.
+void weigh_merges_against_camera(const BackwardMaps& maps, const CameraConnections& camera,
+                                 LightPassParams* prm);
 
 // A diffuse hit of a photon, waiting for its gather.
 struct PendingHit {
@@ -123,6 +133,7 @@ struct LightPassBuffers {
   std::vector<std::vector<SensorCrossing>> crossings;               // [chunk], with sensors
   std::vector<std::vector<PendingBeam>> beams;                      // [chunk], with medium spheres
   std::vector<std::vector<CameraHit>> camera_hits;                  // [chunk], with connections
+  std::vector<std::vector<const CameraHit*>> camera_bands;          // [band of 8 rows]
   std::vector<std::vector<std::vector<PhotonEntry>>> beam_entries;  // [chunk][slot]
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
@@ -165,8 +176,10 @@ struct GroupSize {
 };
 GroupSize group_size(size_t backward_photons);
 constexpr uint64_t kHitBytes = sizeof(PendingHit) + sizeof(PendingHit*);
-// What the light pass's hits may take with at most `backward_photons`, for the memory budget.
-double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons);
+// What the light pass's hits (and with `camera`, its camera connections) may take with at most
+// `backward_photons`, for the memory budget.
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons,
+                            bool camera = false);
 // Hits per gather chunk.
 constexpr int kHitsPerGather = 1024;
 

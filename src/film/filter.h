@@ -37,6 +37,9 @@ class Filter {
   // for the filters sampled from their table), so that a value spread by it over the offsets
   // adds to a pixel what camera samples weighted by sample() add in expectation.
   float normalized(Vec2 offset) const;
+  // What sample()'s weights average: 1 for the box and the triangle, the tabulated f's integral
+  // for the others.
+  float mean_weight() const { return values_.empty() ? 1.0f : integral_; }
   const FilterSettings& settings() const { return s_; }
   std::string name() const;
 
