@@ -242,6 +242,16 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
       ->check(CLI::IsMember({"on", "off", "alone"}))
       ->group(kBpm);
   render
+      ->add_option("--vertex-connections", ra.vertex_connections,
+                   "on: each photon's vertex on a surface with gathered lobes is also joined by a "
+                   "shadow ray to the last diffuse vertex of a pixel's eye path drawn at random, "
+                   "and each such light path is weighed between that, the merge and the eye "
+                   "path's continuation by multiple importance sampling; off (default): not; "
+                   "alone: the connections take the merges' share, a check (scenes without media; "
+                   "file: string vertexconnections)")
+      ->check(CLI::IsMember({"on", "off", "alone"}))
+      ->group(kBpm);
+  render
       ->add_flag("--no-coat-split", ra.no_coat_split,
                  "At a coated surface where gathering would end the eye path, take its coat or "
                  "its base by chance instead of both (file: bool splitcoats false)")

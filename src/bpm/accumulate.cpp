@@ -120,6 +120,11 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
           sh.photon_L += light.camera[p] * norm;
           sh.odd_L += light.camera_odd[p] * norm;
         }
+        if (!light.vertex.empty()) {  // vertex connections (vertex_connections.h)
+          const float norm = float(1.0 / double(light.emitted));
+          sh.photon_L += light.vertex[p] * norm;
+          sh.odd_L += light.vertex_odd[p] * norm;
+        }
         const Spectrum &photon_L = sh.photon_L, &bias = sh.bias;
         eye.round_stats[p].add_lit(sh.small_lit, sh.large_lit);
         Spectrum L = eye.radiance[p] + photon_L;

@@ -48,7 +48,11 @@ struct BackwardPhoton {
   // Its disc may be cut, and is probed after the light pass if it gathers light
   // (bpm/disc_shares.h); until then disc_found and disc_cut are 0, a share of 1.
   uint8_t probes_pending : 1 = 0;
-  bool hero_only;          // the eye path keeps its hero wavelength alone (PathState)
+  uint8_t hero_only : 1;  // the eye path keeps its hero wavelength alone (PathState)
+  // The one backward photon of its eye path that photons' vertices are joined to (vertex
+  // connections, bpm/vertex_connections.h): the first that accepts indirect light on a surface
+  // where paths are combined.
+  uint8_t vertex_target : 1 = 0;
   uint8_t disc_cut = 0;    // the disc probes that found no surface (photons/disc_probes.h)
   uint8_t disc_found = 0;  // and those that found some
   uint8_t place = 0;       // its rank among its eye path's backward photons, in storing order

@@ -161,6 +161,10 @@ class BpmRender {
   void choose_photons();
   // Combined estimators run: asked for, in a scene without media (photons/merge_weights.h).
   CombineAt combined() const { return scene_.media.empty() ? s_.combine : CombineAt::kNowhere; }
+  // Vertex connections run: asked for, with an image, in a scene without media.
+  bool vertex_connections() const {
+    return s_.vertex_connections != ConnectionMode::kOff && opt_.image && scene_.media.empty();
+  }
   // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
   double reserve_memory() const;
   // The camera connections as the settings ask and the scene allows, and each pixel's radius for
@@ -219,6 +223,7 @@ class BpmRender {
   // Caustic photons joined to the camera (off where the settings, the camera or the scene rule
   // them out).
   CameraConnections connections_;
+  VertexConnections vertex_;  // this iteration's targets (vertex_connections.h)
 };
 
 const char* const kMemoryAdvice =
@@ -297,7 +302,7 @@ double BpmRender::reserve_memory() const {
       double(film_->bytes()) + double(n_pixels_) * kPixelBytes +
       light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),
                            n_pixels_ * size_t(photons_per_path(s_, scene_)),
-                           s_.camera_connections != CameraConnectionMode::kOff);
+                           s_.camera_connections != ConnectionMode::kOff);
   check_memory(
       "bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) + " (up to " +
           std::to_string(photons_per_path(s_, scene_)) +
@@ -363,6 +368,11 @@ PassResult BpmRender::iteration(int pass, const RenderControl& control) {
                std::any_of(maps_.photons.begin(), maps_.photons.end(),
                            [](const BackwardPhoton& bp) { return bp.combined; });
   lp.merge_photons = double(photons_);
+  if (vertex_connections()) {
+    find_vertex_targets(maps_, n_pixels_, double(photons_), &vertex_);
+    vertex_.alone = s_.vertex_connections == ConnectionMode::kAlone;
+    lp.vertex = &vertex_;
+  }
   if (connections_.on()) {
     set_caustic_radii(it, scale);
     weigh_merges_against_camera(maps_, connections_, &lp);
@@ -409,7 +419,8 @@ bool BpmRender::eye_pass(const WavelengthMaterials& wm, float scale, int pass, i
                    s_.split_in_media,
                    combined(),
                    double(photons_),
-                   s_.split_coats};
+                   s_.split_coats,
+                   vertex_connections() ? double(n_pixels_) : 0.0};
   // Where the first vertices' discs are probed: near edges, within this iteration's radii (the
   // first iteration's, the largest, under the per-pixel policy).
   near_edges_.mark(s_.k0 * shared, s_.k1 * shared);
@@ -500,7 +511,8 @@ void BpmRender::accumulate(const WavelengthMaterials& wm, int it) {
 PassResult BpmRender::progress() const {
   PassResult r;
   for (const EyeCounters& c : eye_counters_) r.rays += c.rays.total();
-  for (const LightCounters& c : light_.counters) r.rays += c.light_rays + c.camera_rays;
+  for (const LightCounters& c : light_.counters)
+    r.rays += c.light_rays + c.camera_rays + c.vertex_rays;
   char text[128];
   std::snprintf(text, sizeof text, "  %zu backward photons  coverage %.2f%s", maps_.photons.size(),
                 light_result_.coverage,
@@ -523,7 +535,7 @@ std::pair<ExtraSampleCost, ExtraSampleCost> BpmRender::round_cost() const {
     now.v[C::kDirectRays] += double(c.direct_rays);
   }
   for (const LightCounters& c : light_.counters)
-    now.v[C::kRays] += double(c.light_rays + c.camera_rays);
+    now.v[C::kRays] += double(c.light_rays + c.camera_rays + c.vertex_rays);
   for (size_t k = 0; k < now.v.size(); ++k) round.v[k] += now.v[k] - counted_.v[k];
   return {round, now};
 }
@@ -646,7 +658,7 @@ PassWork BpmRender::work_now() const {
     w.v[PassWork::kBackwardPhotons] += double(c.backward_photons);
   }
   for (const LightCounters& c : light_.counters) {
-    w.v[PassWork::kLightRays] += double(c.light_rays + c.camera_rays);
+    w.v[PassWork::kLightRays] += double(c.light_rays + c.camera_rays + c.vertex_rays);
     w.v[PassWork::kQueries] += double(c.queries);
     w.v[PassWork::kBeams] += double(c.beams);
     w.v[PassWork::kEntries] += double(c.entries);
@@ -739,6 +751,7 @@ RenderStats BpmRender::finish(RenderStats stats) {
   stats.light_rays = tot_.light.light_rays;
   tot_.photons_last = photons_;
   tot_.camera_connections = connections_.on();
+  tot_.vertex_connections = vertex_connections();
   if (combined() == CombineAt::kChosen) {
     double sum = 0;
     for (uint8_t level : eye_.continue_level) sum += std::ldexp(1.0, -int(level));

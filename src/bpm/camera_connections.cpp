@@ -72,8 +72,7 @@ void connect_to_camera(const RenderScene& scene, const CameraConnections& cc, co
   if (seen.is_black()) return;
   // The importance of the point to the image, per square pixel of the filter's offsets.
   const float importance = view->proj.pixels_per_solid_angle * view->cos_y / view->d2;
-  const float chance =
-      cc.mode == CameraConnectionMode::kOn ? gather_chance(cc, m, sp.ns, wo) : 0.0f;
+  const float chance = cc.mode == ConnectionMode::kOn ? gather_chance(cc, m, sp.ns, wo) : 0.0f;
   out.push_back(
       {view->proj.raster, merge_factor(cc, chance, *view), seen * value * importance, odd});
 }
@@ -107,7 +106,7 @@ void spread_to_pixels(const CameraConnections& cc, const CameraHit& hit, int row
 
 float merge_weight_against_camera(const CameraConnections& cc, const BackwardPhoton& bp,
                                   const Material& m) {
-  if (cc.mode == CameraConnectionMode::kAlone) return 0;
+  if (cc.mode == ConnectionMode::kAlone) return 0;
   const Vec2 radius = cc.filter->settings().radius;
   const auto view = view_from_camera(cc, bp.p, bp.ng, std::max(radius.x, radius.y) + 1);
   if (!view) return 1;  // not seen through the pinhole (numerical accident): no connection made it

@@ -30,7 +30,7 @@ namespace bpm {
 
 // What the light pass needs to connect photons to the camera in one iteration.
 struct CameraConnections {
-  CameraConnectionMode mode = CameraConnectionMode::kOff;
+  ConnectionMode mode = ConnectionMode::kOff;
   const Camera* camera = nullptr;
   const Filter* filter = nullptr;
   int width = 0, height = 0;  // the image rendered
@@ -41,7 +41,7 @@ struct CameraConnections {
   // The eye path chose by chance between the parts of a material at its first vertex (with
   // probability 1 - bsdf_traced_part_probability of gathering); false where it takes both.
   bool gather_by_chance = false;
-  bool on() const { return mode != CameraConnectionMode::kOff; }
+  bool on() const { return mode != ConnectionMode::kOff; }
 };
 
 // A caustic photon joined to the camera, before it is spread over the pixels (spread_to_pixels).

@@ -62,6 +62,7 @@ struct EyePath {
   double& direct_variance;  // of those samples, where there are two or more (EyeRadiance)
   int continue_level;       // EyePixels::continue_level
   EyeContinuation& continued;
+  bool& targeted;  // a backward photon of this path is the vertex connections' target
 };
 
 // Direct light at v by next-event estimation, shared by MIS with the BSDF sample that goes on.
@@ -91,6 +92,11 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
   bp.combined = merge_density != nullptr;
   bp.continue_level = merge_density ? continue_level : 0;
   bp.place = uint8_t(path.stored++);
+  // The vertex connections' target: the path's first backward photon for indirect light where
+  // paths are combined (vertex_connections.h).
+  if (prm.vertex_pixels > 0 && !path.targeted && (accepts & kAcceptsIndirect) && v.medium < 0 &&
+      combinable_vertex(v))
+    bp.vertex_target = path.targeted = true;
   if (v.medium >= 0) {  // after the objects' lists, one per medium
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
     ++path.counters.backward_photons;
@@ -185,7 +191,17 @@ struct Continuation {
   Vec3 prev_p, prev_n;
   double pdf_prev = 0;
   double cos_prev = 0, d2 = 1;  // |cos| at the vertex before toward e_j; their squared distance
+  // Where x is the vertex connections' target: 1 / (pi r^2 P), so that their density over the
+  // merge's is vertex_scale / A(x) (vertex_connections.h), with A(x) the photon's density of x
+  // from e_1 (a_x, known from j = 2 on); else 0.
+  double vertex_scale = 0, a_x = 0;
 };
+
+// The merge's term of a continued path's weight with the vertex connections' added: both over the
+// continuation's density, a_x the photon's density of x from e_1.
+inline double merge_and_connection(double merge, const Continuation& c, double a_x) {
+  return c.vertex_scale > 0 && a_x > 0 ? merge * (1 + c.vertex_scale / a_x) : merge;
+}
 
 // At e_j (v), next-event estimation of an area light, weighed against the BSDF sample that could
 // find it and the merge at x.
@@ -216,7 +232,8 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
   const double merge =
       c.ratio * a_prev *
       area_density(emission_density(scene, li, ls->n_light, ls->wi), ls->p_light, v.sp.p, v.sp.ng);
-  const double w = b_light / (b_light + b_bsdf + merge);
+  const double others = merge_and_connection(merge, c, c.a_x > 0 ? c.a_x : a_prev);
+  const double w = b_light / (b_light + b_bsdf + others);
   if (!std::isfinite(w)) return {};
   return s.beta * f * ls->radiance * float(w / (double(sample->pmf) * ls->pdf_solid_angle));
 }
@@ -230,13 +247,15 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
 // gathers with (EyeVertexChoice). Past x each path is weighed by the share of it that photons
 // draw through gathered lobes (bsdf_gathered_probability: 1 but at split coats).
 inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, BsdfPart part,
-                                  PathState s, int depth, double merge_density) {
+                                  PathState s, int depth, double merge_density,
+                                  double vertex_scale) {
   const RenderScene& scene = path.scene;
   const WavelengthMaterials& wm = *path.prm.materials;
   PathCounters& rays = path.counters.rays;
   const uint64_t rays_before = rays.total();
   ++path.counters.continued;
   Continuation c{merge_density, x.sp.p, x.sp.ng};
+  c.vertex_scale = vertex_scale;
   Spectrum L;
   const PathVertex* at = &x;
   PathVertex vertices[2];  // e_j and e_(j-1) in turn (a vertex is not copied)
@@ -260,8 +279,10 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
       if (path.rng.uniform() < q) break;
       s.beta = beta / (1 - q);
       // A of e_(j-2) (x at j = 2), from e_(j-1) = v, arriving from e_j.
-      c.ratio *= double(g) * bsdf_pdf(v.m(), bs->wi, v.wo_local, TransportMode::kImportance) *
-                 c.cos_prev / c.d2;
+      const double a = double(g) * bsdf_pdf(v.m(), bs->wi, v.wo_local, TransportMode::kImportance) *
+                       c.cos_prev / c.d2;
+      c.ratio *= a;
+      if (j == 2) c.a_x = a;
     } else {
       s.beta = beta;
     }
@@ -291,7 +312,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
       const double b_light = light_sample_density(scene, li, c.prev_p, e.sp.p, e.sp.ng);
       const double merge =
           c.ratio * emission_density(scene, li, e.sp.ng, d / float(len)) * c.cos_prev / c.d2;
-      const double w = b_bsdf / (b_bsdf + b_light + merge);
+      const double w = b_bsdf / (b_bsdf + b_light + merge_and_connection(merge, c, c.a_x));
       if (!Le.is_black() && std::isfinite(w)) L += s.beta * Le * float(w);
     }
     // Paths of j vertices between the light and x: within the merge's depth.
@@ -328,15 +349,23 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
     level = path.continue_level;
   }
   double merge_density = 0;
+  const bool targeted_before = path.targeted;
   store_backward_photons(path, v, s, depth, diffuse, last, go_on ? &merge_density : nullptr,
                          uint8_t(level));
   if (!go_on) return last;
+  // The target of the vertex connections stored here: their density over the merge's is
+  // 1 / (pi r^2 P A(x)), pi r^2 = merge_density / N.
+  const double vertex_scale =
+      path.targeted && !targeted_before && merge_density > 0
+          ? path.prm.merge_photons / (merge_density * path.prm.vertex_pixels)
+          : 0.0;
   if (chosen_here) path.continued.at_vertex = true;
   // Taken with the probability q: its density q B against the merge's, its light over q.
   const double q = std::ldexp(1.0, -level);
   if (level > 0 && !(path.rng.uniform() < q)) return last;
   const uint64_t rays = path.counters.rays.total();
-  const Spectrum c = continue_eye_path(path, v, choice.part, s, depth, merge_density / q);
+  const Spectrum c =
+      continue_eye_path(path, v, choice.part, s, depth, merge_density / q, vertex_scale);
   L += c / float(q);
   if (chosen_here) path.continued.add(c.average(), q, path.counters.rays.total() - rays);
   return last;
@@ -443,10 +472,11 @@ inline EyeVertexChoice choose_or_split(const EyePath& path, const PathVertex& v,
   int stored = 0, splits = 0;
   double direct_variance = -1;
   EyeContinuation continued;
+  bool targeted = false;
   const int direct = std::clamp(direct_samples, 1, std::max(1, prm.direct_samples));
-  const EyePath path{scene,    prm,      footprint, scales, pixel,  near_edge,       rng,
-                     out,      counters, stored,    splits, direct, direct_variance, continue_level,
-                     continued};
+  const EyePath path{
+      scene,    prm,    footprint, scales, pixel,           near_edge,      rng,       out,
+      counters, stored, splits,    direct, direct_variance, continue_level, continued, targeted};
   if (ray.weight == 0) return {};
   PathState s{ray.ray, Spectrum(ray.weight), ray.medium};
   s.rng = &rng;

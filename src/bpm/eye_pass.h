@@ -74,6 +74,10 @@ struct EyePassParams {
   // At the first vertex of a material with both parts (BsdfPart) where gathering would end the
   // path, it takes both parts instead of one by chance (BpmSettings::split_coats).
   bool split_coats = true;
+  // Vertex connections (bpm/vertex_connections.h): the pixels they draw from (0: none). The first
+  // backward photon of an eye path that accepts indirect light where paths are combined is their
+  // target, and its merges and continuation are weighed against them.
+  double vertex_pixels = 0;
 };
 
 struct EyeCounters {

@@ -38,20 +38,29 @@ float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, u
   return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
 }
 
-// The weight of merging photon hit h at backward photon bp, whose eye path went on from it
-// (photons/merge_weights.h): the eye's BSDF density there of the photon's direction against the
-// merge's pi r^2 N.
-float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const PendingHit& h,
-                            const LightPassParams& prm) {
-  const Frame frame = Frame::from_z(bp.ns);
-  const Vec3 wo = frame.to_local(bp.wo);
-  // The lobes the eye path gathered with at x (choose_eye_vertex).
-  const BsdfPart part =
-      bsdf_traced_part_probability(m, wo) == 0 ? BsdfPart::kAll : BsdfPart::kGathered;
-  const float p = bsdf_pdf(m, wo, frame.to_local(h.wi), TransportMode::kRadiance, part);
-  const double density =
-      std::ldexp(kPi * double(bp.radius) * bp.radius * prm.merge_photons, bp.continue_level);
-  return merge_weight(h.merge_factor, p, density);
+// The weight of merging photon hit h (whose path may be combined) at backward photon g: against
+// the eye path's continuation where it went on from there (photons/merge_weights.h: the eye's BSDF
+// density there of the photon's direction against the merge's pi r^2 N), and against the vertex
+// connections where g is their target (bpm/vertex_connections.h).
+float combined_merge_weight(uint32_t g, const BackwardPhoton& bp, const Material& m,
+                            const PendingHit& h, const LightPassParams& prm) {
+  double others = 0;
+  if (bp.combined) {
+    const Frame frame = Frame::from_z(bp.ns);
+    const Vec3 wo = frame.to_local(bp.wo);
+    // The lobes the eye path gathered with at x (choose_eye_vertex).
+    const BsdfPart part =
+        bsdf_traced_part_probability(m, wo) == 0 ? BsdfPart::kAll : BsdfPart::kGathered;
+    const float p = bsdf_pdf(m, wo, frame.to_local(h.wi), TransportMode::kRadiance, part);
+    const double density =
+        std::ldexp(kPi * double(bp.radius) * bp.radius * prm.merge_photons, bp.continue_level);
+    others += double(h.merge_factor) * p / density;
+  }
+  if (prm.vertex && bp.vertex_target && h.arrival > 0 && prm.vertex->target[bp.pixel] == g) {
+    if (prm.vertex->alone) return 0;
+    others += connection_over_merge(bp.radius, prm.vertex->pixels, h.arrival);
+  }
+  return float(1 / (1 + others));
 }
 
 // The weight of backward photon g's merges of caustic photons against the camera connections
@@ -90,7 +99,10 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, h.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
-    if (bp.combined && h.merge_factor > 0) value *= combined_merge_weight(bp, m, h, prm);
+    if (h.merge_factor > 0) {
+      value *= combined_merge_weight(g, bp, m, h, prm);
+      if (value.is_black()) return;
+    }
     if (prm.camera && h.cls == PhotonClass::kCaustic) {
       value *= camera_merge_weight(prm, g, bp, m);
       if (value.is_black()) return;
@@ -184,6 +196,32 @@ void connect_hit_to_camera(const RenderScene& scene, const CameraConnections& ca
   lc.camera_hits += hits.size() - before;
 }
 
+// Domain separation of the streams that draw the pixels of vertex connections.
+constexpr uint64_t kVertexStream = 0x766572746578ull;
+
+// A photon's vertex joined to the target of a pixel drawn at random (vertex_connections.h), from
+// a stream keyed by the photon and its bounces.
+void connect_hit_to_eye_vertex(const GroupTrace& g, uint64_t photon, const PhotonHit& h, bool odd,
+                               LightCounters& lc, std::vector<VertexHit>& out) {
+  const VertexConnections& vc = *g.prm.vertex;
+  Rng rng(stream_key(g.seed ^ kVertexStream, uint64_t(g.pass_index), photon, uint64_t(h.bounces)));
+  const uint32_t pixel =
+      uint32_t(std::min(vc.pixels - 1, std::floor(double(rng.uniform()) * vc.pixels)));
+  const uint32_t target = vc.target[pixel];
+  if (target == VertexConnections::kNone) return;
+  const BackwardPhoton& bp = g.maps.photons[target];
+  const WavelengthMaterials& wm = *g.prm.materials;
+  Material storage;
+  const Material& m_z =
+      wm.at(g.scene.objects[size_t(h.object)].material, texture_context(h.sp), storage);
+  const Material& m_x =
+      g.prm.photon_materials.empty() ? wm.materials[bp.material] : g.prm.photon_materials[target];
+  const size_t before = out.size();
+  connect_to_eye_vertex(g.scene, vc, h, m_z, bp, pixel, m_x, g.prm.max_depth, odd, &lc.vertex_rays,
+                        out);
+  lc.vertex_hits += out.size() - before;
+}
+
 // Traces chunk c of the group, recording its photons' hits and emissions and its counters.
 void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   const RenderScene& scene = g.scene;
@@ -207,6 +245,8 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   std::vector<CameraHit>& camera_hits = buf->camera_hits[size_t(c)];
   camera_hits.clear();
   const CameraConnections* camera = g.prm.camera;
+  std::vector<VertexHit>& vertex_hits = buf->vertex_hits[size_t(c)];
+  vertex_hits.clear();
   const bool media = g.prm.medium_spheres && !g.prm.medium_spheres->empty();
   const uint64_t first = uint64_t(c) * kPhotonsPerChunk;
   const uint64_t last = std::min(first + kPhotonsPerChunk, g.count);
@@ -229,13 +269,16 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     auto on_hit = [&](const PhotonHit& h) {
       if (camera && h.cls == PhotonClass::kCaustic && h.medium < 0)
         connect_hit_to_camera(scene, *camera, *g.prm.materials, h, photon & 1, lc, camera_hits);
+      if (g.prm.vertex && h.mis)
+        connect_hit_to_eye_vertex(g, g.first_photon + k, h, photon & 1, lc, vertex_hits);
       // Photons in media reach the spheres there by their beams (on_beam).
       if (h.cls == PhotonClass::kDirect || h.medium >= 0 || !maps.has_photons(h.object)) return;
       ++lc.queries;
       const uint32_t bucket = maps.bucket_of(h.object, h.cls, h.sp.p);
       if (bucket == BackwardMaps::kNoBucket) return;
       hits.push_back({h.sp.p, h.sp.ng, h.wi, h.flux, bucket, photon, h.object, int16_t(h.bounces),
-                      h.cls, h.hero_only, 0.0f, h.merge_factor});
+                      h.cls, h.hero_only, 0.0f, h.merge_factor,
+                      h.mis ? h.mis->arrival_density() : 0.0f});
     };
     // Direct beams are never used either (next-event estimation in the medium).
     auto on_beam = [&](const PhotonBeam& b) {
@@ -247,7 +290,7 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
     trace_light_path(
         scene, *g.prm.materials, g.prm.max_depth, 1, e, rng, lc, on_hit,
         SensorSegments(scene, sensors, g.prm.materials->wl, crossings, g.prm.max_depth), on_beam,
-        g.prm.combine);
+        g.prm.combine || g.prm.vertex);
     if (g.scored) emitted.push_back({e.cell, e.weight});
   }
   buf->hits[size_t(c)].swap(hits);
@@ -324,6 +367,7 @@ TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
     buf->crossings.resize(size_t(n_chunks));
     buf->beams.resize(size_t(n_chunks));
     buf->camera_hits.resize(size_t(n_chunks));
+    buf->vertex_hits.resize(size_t(n_chunks));
   }
   const GroupTrace g{
       scene, maps, prm, seed, pass_index, first_photon, count, guide, guide && prm.pixel_weight};
@@ -450,10 +494,12 @@ class StageClock {
 
 // The arrays keep their memory from the last iteration (fresh pages cost a fault each), and
 // only the flags are cleared: the sums of a backward photon are set at its first entry.
-void reset_result(size_t n_bp, size_t n_pixels, LightPassResult& res) {
+void reset_result(size_t n_bp, size_t n_pixels, size_t n_vertex_pixels, LightPassResult& res) {
   res.reached.assign(n_bp, 0);
   res.camera.assign(n_pixels, Spectrum());
   res.camera_odd.assign(n_pixels, Spectrum());
+  res.vertex.assign(n_vertex_pixels, Spectrum());
+  res.vertex_odd.assign(n_vertex_pixels, Spectrum());
   res.flux.resize(n_bp);
   res.flux_inner.resize(n_bp);
   res.flux_quarter.resize(n_bp);
@@ -486,6 +532,16 @@ void add_camera_hits(const CameraConnections& cc, int chunks, LightPassBuffers& 
     for (const CameraHit* hit : bands[size_t(b)])
       spread_to_pixels(cc, *hit, row0, row1, res.camera.data(), res.camera_odd.data());
   });
+}
+
+// The vertex connections of the first `chunks` chunks added to their pixels' sums, chunk by chunk
+// in order.
+void add_vertex_hits(int chunks, const LightPassBuffers& buf, LightPassResult& res) {
+  for (int c = 0; c < chunks; ++c)
+    for (const VertexHit& hit : buf.vertex_hits[size_t(c)]) {
+      res.vertex[hit.pixel] += hit.value;
+      if (hit.odd) res.vertex_odd[hit.pixel] += hit.value;
+    }
 }
 
 // Rounds of gather and apply over the sorted hits: one, unless the entries reach the memory
@@ -629,7 +685,8 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
   const size_t n_bp = maps.photons.size();
   BPM_CHECK(n_bp <= PhotonEntry::kIndexMask);  // the memory budget refuses far fewer
   LightPassResult& res = *out;
-  reset_result(n_bp, prm.camera ? prm.camera->caustic_radius.size() : 0, res);
+  reset_result(n_bp, prm.camera ? prm.camera->caustic_radius.size() : 0,
+               prm.vertex ? prm.vertex->target.size() : 0, res);
   // A stop request (interrupt, time budget) ends the pass at a chunk boundary: N of eq. (2) is
   // then the photons emitted so far.
   const GroupSize group = group_size(n_bp);
@@ -648,6 +705,7 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     if (prm.sensor_sums)
       for (int c = 0; c < tr.chunks; ++c) prm.sensor_sums->add(buf->crossings[size_t(c)]);
     if (prm.camera) add_camera_hits(*prm.camera, tr.chunks, *buf, res);
+    if (prm.vertex) add_vertex_hits(tr.chunks, *buf, res);
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
     gather_and_apply(maps, prm, masks, buf, res, clock);

@@ -21,6 +21,7 @@
 #include "bpm/masks.h"
 #include "bpm/medium_spheres.h"
 #include "bpm/settings.h"
+#include "bpm/vertex_connections.h"
 #include "photons/light_path.h"
 #include "photons/sensor_discs.h"
 #include "scene/render_scene.h"
@@ -80,6 +81,9 @@ struct LightPassParams {
   // through atomic references). Null: none.
   const CameraConnections* camera = nullptr;
   mutable std::vector<float> camera_weights{};
+  // Photons' vertices joined to eye vertices (bpm/vertex_connections.h), and the merges at the
+  // targets weighed against that. Null: none.
+  const VertexConnections* vertex = nullptr;
 };
 
 // Fills prm->photon_materials for the backward photons of maps when a material is textured.
@@ -104,6 +108,7 @@ struct PendingHit {
   bool hero_only;
   float score = 0;         // set by the gather: the hit's part of its photon's score for the guide
   float merge_factor = 0;  // PhotonHit's
+  float arrival = 0;       // PhotonMis::arrival_density, with vertex connections
 };
 
 // A beam of a photon through a scattering medium (PhotonBeam), waiting for its gather.
@@ -134,6 +139,7 @@ struct LightPassBuffers {
   std::vector<std::vector<PendingBeam>> beams;                      // [chunk], with medium spheres
   std::vector<std::vector<CameraHit>> camera_hits;                  // [chunk], with connections
   std::vector<std::vector<const CameraHit*>> camera_bands;          // [band of 8 rows]
+  std::vector<std::vector<VertexHit>> vertex_hits;                  // [chunk], with connections
   std::vector<std::vector<std::vector<PhotonEntry>>> beam_entries;  // [chunk][slot]
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
@@ -152,6 +158,8 @@ struct LightPassResult {
   std::vector<Spectrum> flux_odd;      // and over the entries of the odd photons (odd())
   // Per pixel, with camera connections: the sum of their shares of it, and of the odd photons'.
   std::vector<Spectrum> camera, camera_odd;
+  // Per pixel, with vertex connections: the sum of their values, and of the odd photons'.
+  std::vector<Spectrum> vertex, vertex_odd;
   uint64_t emitted = 0;  // photons emitted, N of eq. (2)
   bool cut = false;      // a stop request ended the pass before all its photons
   int batches = 0;       // gather rounds: one per group, more where the memory limit split one

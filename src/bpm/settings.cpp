@@ -5,21 +5,20 @@
 
 namespace bpm {
 
-const char* to_string(CameraConnectionMode m) {
+const char* to_string(ConnectionMode m) {
   switch (m) {
-    case CameraConnectionMode::kOff:
+    case ConnectionMode::kOff:
       return "off";
-    case CameraConnectionMode::kOn:
+    case ConnectionMode::kOn:
       return "on";
-    case CameraConnectionMode::kAlone:
+    case ConnectionMode::kAlone:
       return "alone";
   }
   return "?";
 }
 
-std::optional<CameraConnectionMode> parse_camera_connections(const std::string& s) {
-  for (CameraConnectionMode m :
-       {CameraConnectionMode::kOff, CameraConnectionMode::kOn, CameraConnectionMode::kAlone})
+std::optional<ConnectionMode> parse_connection_mode(const std::string& s) {
+  for (ConnectionMode m : {ConnectionMode::kOff, ConnectionMode::kOn, ConnectionMode::kAlone})
     if (s == to_string(m)) return m;
   return std::nullopt;
 }
@@ -55,9 +54,13 @@ BpmSettings bpm_settings_from_file(const SceneEntity& in) {
   b.split_coats = ps.get_bool("splitcoats", b.split_coats);
   const std::string connections =
       ps.get_string("cameraconnections", to_string(b.camera_connections));
-  ps.require("cameraconnections", parse_camera_connections(connections).has_value(),
+  ps.require("cameraconnections", parse_connection_mode(connections).has_value(),
              "must be \"on\", \"off\" or \"alone\"", in.loc);
-  b.camera_connections = *parse_camera_connections(connections);
+  b.camera_connections = *parse_connection_mode(connections);
+  const std::string vertex = ps.get_string("vertexconnections", to_string(b.vertex_connections));
+  ps.require("vertexconnections", parse_connection_mode(vertex).has_value(),
+             "must be \"on\", \"off\" or \"alone\"", in.loc);
+  b.vertex_connections = *parse_connection_mode(vertex);
   b.emission_samples = ps.get_int("emissionsamples", b.emission_samples);
   ps.require("emissionsamples", b.emission_samples >= 1 && b.emission_samples <= 1024,
              "must be in 1..1024", in.loc);
@@ -86,7 +89,8 @@ nlohmann::json settings_json(const BpmSettings& s) {
           {"split_in_media", s.split_in_media},
           {"estimators", to_string(s.combine)},
           {"split_coats", s.split_coats},
-          {"camera_connections", to_string(s.camera_connections)}};
+          {"camera_connections", to_string(s.camera_connections)},
+          {"vertex_connections", to_string(s.vertex_connections)}};
 }
 
 }  // namespace bpm

@@ -10,13 +10,14 @@
 
 namespace bpm {
 
-// Light tracing to the camera for caustic light seen directly (bpm/camera_connections.h). kOn:
-// the connections and the merges at the discs seen directly, each path weighed between them;
-// kAlone: the connections count those paths in full and the merges not at all (a check of the
-// connections' estimate: the image must not change); kOff: the merges alone (the paper's method).
-enum class CameraConnectionMode : uint8_t { kOff, kOn, kAlone };
-const char* to_string(CameraConnectionMode m);
-std::optional<CameraConnectionMode> parse_camera_connections(const std::string& s);
+// Light tracing to the camera for caustic light seen directly (bpm/camera_connections.h), and
+// vertex connections (bpm/vertex_connections.h). kOn: the connections and the merges that make
+// the same paths, each path weighed between them; kAlone: the connections count those paths in
+// full (the merges' share included) and the merges not at all (a check of the connections'
+// estimate: the image must not change); kOff: the merges alone (the paper's method).
+enum class ConnectionMode : uint8_t { kOff, kOn, kAlone };
+const char* to_string(ConnectionMode m);
+std::optional<ConnectionMode> parse_connection_mode(const std::string& s);
 
 struct BpmSettings : PhotonSettings {
   // bpm's radii shrink per pixel, with the iterations that brought its discs photons (DiscScales,
@@ -60,8 +61,12 @@ struct BpmSettings : PhotonSettings {
   // with its weight divided by the chance (EyePassParams::split_coats): a coated floor seen from
   // the camera no longer carries the noise of that choice.
   bool split_coats = true;
-  // Caustic photons joined to the camera where it sees them (CameraConnectionMode).
-  CameraConnectionMode camera_connections = CameraConnectionMode::kOn;
+  // Caustic photons joined to the camera where it sees them (ConnectionMode).
+  ConnectionMode camera_connections = ConnectionMode::kOn;
+  // Photons' vertices joined to the last diffuse vertex of a pixel's eye path drawn at random
+  // (vertex connection, bpm/vertex_connections.h), each path weighed between that, the merge and
+  // the continuation.
+  ConnectionMode vertex_connections = ConnectionMode::kOff;
 };
 
 // bpm's parameters on the file's Integrator line (an "fpm" line takes the same ones; an "sppm"

@@ -91,6 +91,9 @@ nlohmann::json light_json(const BpmTotals& t, int iterations) {
       {"camera_connections", t.camera_connections},
       {"camera_rays", t.light.camera_rays},
       {"camera_hits", t.light.camera_hits},
+      {"vertex_connections", t.vertex_connections},
+      {"vertex_rays", t.light.vertex_rays},
+      {"vertex_hits", t.light.vertex_hits},
       {"photons_per_iteration_last", t.photons_last},
       // bpm/photon_count.h: the relative variance of an iteration and of its light pass alone
       // (means over pixels), the light pass's share, and the balanced photon count N*.

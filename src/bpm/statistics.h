@@ -41,6 +41,8 @@ struct BpmTotals {
   // Whether caustic photons were joined to the camera (camera_connections.h): the setting, where
   // the camera and the scene allow it.
   bool camera_connections = false;
+  // Whether photons' vertices were joined to eye vertices (vertex_connections.h).
+  bool vertex_connections = false;
 
   // Sizes of one iteration's maps and, for sphere trees, how often a sphere is stored.
   void add_maps(const BackwardMaps& maps);

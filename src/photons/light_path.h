@@ -86,6 +86,9 @@ struct LightCounters {
   // Shadow rays that tried to join caustic photons to the camera, and those that reached it
   // (bpm/camera_connections.h).
   uint64_t camera_rays = 0, camera_hits = 0;
+  // Shadow rays that tried to join photons' vertices to eye vertices, and those that got through
+  // (bpm/vertex_connections.h).
+  uint64_t vertex_rays = 0, vertex_hits = 0;
   RayObserver* observer = nullptr;
   void add(const LightCounters& o) {
     photons += o.photons;
@@ -97,6 +100,8 @@ struct LightCounters {
     cut_off_rays += o.cut_off_rays;
     camera_rays += o.camera_rays;
     camera_hits += o.camera_hits;
+    vertex_rays += o.vertex_rays;
+    vertex_hits += o.vertex_hits;
   }
 };
 
@@ -128,6 +133,9 @@ struct PhotonHit {
   int medium = -1;  // a point where the photon scatters in this medium (object -1, sp.p only)
   // PhotonMis::merge_factor where the light path is traced for combined estimators; else 0.
   float merge_factor = 0;
+  // The photon's products (photons/merge_weights.h) where its path so far may be combined; else
+  // null.
+  const PhotonMis* mis = nullptr;
 };
 
 // A straight piece of a photon's path, from ray.o along ray.d up to t_max (in units of ray.d; kInf
@@ -317,7 +325,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     if (bounces <= hit_depth && (in_medium || !vertex_all_traced(v))) {
       ++counters.diffuse_hits;
       on_hit(PhotonHit{in_medium ? -1 : v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only,
-                       in_medium ? v.medium : -1, mis ? mis->merge_factor() : 0.0f});
+                       in_medium ? v.medium : -1, mis ? mis->merge_factor() : 0.0f,
+                       mis && mis->on() && !in_medium ? mis : nullptr});
     }
     if (bounces + 1 > depth) break;
     if (in_medium) {

@@ -52,6 +52,8 @@ void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
   r_ /= std::fabs(double(dot(v.sp.ng, d))) / (len * d2);
   seg_cos_ = std::fabs(double(dot(prev_n_, d))) / len;
   seg_d2_ = d2;
+  k_ = k;
+  arrival_ = k == 1 ? 0.0 : a_ * std::fabs(double(dot(v.sp.ng, d))) / (len * d2);
   if (k == 1) b0_ = light_sample_density(scene, light_, v.sp.p, y_, n_y_);
   if (!combinable_vertex(v) || !std::isfinite(r_)) on_ = false;
 }
@@ -78,6 +80,7 @@ void PhotonMis::scatter(const PathVertex& v, Vec3 wi, bool traced, int k) {
     return;
   }
   r_ *= b / a;
+  a_ = a;
   prev_ = v.sp.p;
   prev_n_ = v.sp.ng;
 }

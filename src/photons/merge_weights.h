@@ -72,11 +72,23 @@ class PhotonMis {
   // 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density at x of the photon's
   // direction. 0: not combined (the merge counts the path in full).
   float merge_factor() const { return on_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
+  // Whether the path so far may be combined.
+  bool on() const { return on_; }
+  // A of the vertex just arrived at (k >= 2): the adjoint BSDF's density at the vertex before, of
+  // the way here, as an area density here; 0 at the first vertex or when not combined.
+  float arrival_density() const { return on_ ? float(arrival_) : 0.0f; }
+  // For a connection from the vertex just arrived at, z_k, to an eye vertex (vertex connections):
+  // B0 .. B(k-1) over A0 .. Ak, given eye_pdf, the eye's BSDF density at z_k, arriving from the eye
+  // vertex, of the way toward where the photon came from.
+  double connection_ratio(double eye_pdf) const {
+    return r_ * (eye_pdf * seg_cos_ / seg_d2_ + (k_ == 1 ? b0_ : 0.0));
+  }
 
  private:
   bool on_ = false;
   double r_ = 0, b0_ = 0;
-  int light_ = -1;
+  double a_ = 0, arrival_ = 0;  // the solid-angle A of the last scatter; the area A of the arrival
+  int light_ = -1, k_ = 0;
   Vec3 y_, n_y_;                     // the light's point and normal
   Vec3 prev_, prev_n_;               // the vertex before the current one, and its geometric normal
   double seg_cos_ = 0, seg_d2_ = 1;  // |cos| at prev toward the current vertex, squared distance

@@ -123,7 +123,9 @@ RenderOptions render_options(const RenderRequest& a, const LoadedScene& ls,
   if (a.split_in_media) opt.bpm.split_in_media = true;
   if (!a.estimators.empty()) opt.bpm.combine = *parse_combine_at(a.estimators);
   if (!a.camera_connections.empty())
-    opt.bpm.camera_connections = *parse_camera_connections(a.camera_connections);
+    opt.bpm.camera_connections = *parse_connection_mode(a.camera_connections);
+  if (!a.vertex_connections.empty())
+    opt.bpm.vertex_connections = *parse_connection_mode(a.vertex_connections);
   if (a.no_coat_split) opt.bpm.split_coats = false;
   if (a.no_disc_probes) opt.bpm.disc_probes = opt.fpm.disc_probes = false;
   if (a.emission_samples > 0) opt.bpm.emission_samples = a.emission_samples;

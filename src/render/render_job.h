@@ -38,6 +38,7 @@ struct RenderRequest {
   bool split_in_media = false;
   std::string estimators;          // bpm: "partition", "glossy", "combined" or "auto"
   std::string camera_connections;  // bpm: "on", "off" or "alone"
+  std::string vertex_connections;  // bpm: "on", "off" or "alone"
   bool no_coat_split = false;
   bool debias = false;
   std::string bias_model;
