@@ -1168,10 +1168,9 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
     const Film ref = render_with(ls, "path", 4096).film;
     const BlockStats mr = block_stats(ref, 32)[0];
     // The first two cases also run the merges alone; the others, the connections' variants.
-    std::vector<CameraConnectionMode> modes = {CameraConnectionMode::kAlone,
-                                               CameraConnectionMode::kOn};
-    if (&k - cases.data() < 2) modes.push_back(CameraConnectionMode::kOff);
-    for (CameraConnectionMode mode : modes) {
+    std::vector<ConnectionMode> modes = {ConnectionMode::kAlone, ConnectionMode::kOn};
+    if (&k - cases.data() < 2) modes.push_back(ConnectionMode::kOff);
+    for (ConnectionMode mode : modes) {
       BpmSettings s = small_batches(k.diffuse_depth);
       s.camera_connections = mode;
       s.split_coats = k.split_coats;
@@ -1186,11 +1185,60 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
                   std::sqrt(m.var + mr.var));
       EXPECT_NEAR(m.mean, mr.mean, 4.5 * std::sqrt(m.var + mr.var)) << what;
       const auto& light = its.last.details["light"];
-      EXPECT_EQ(light["camera_connections"], mode != CameraConnectionMode::kOff) << what;
-      if (mode == CameraConnectionMode::kOff)
+      EXPECT_EQ(light["camera_connections"], mode != ConnectionMode::kOff) << what;
+      if (mode == ConnectionMode::kOff)
         EXPECT_EQ(light["camera_hits"].get<uint64_t>(), 0u) << what;
       else
         EXPECT_GT(light["camera_hits"].get<uint64_t>(), 20u) << what;
+    }
+  }
+}
+
+// Vertex connections (bpm/vertex_connections.h): photons' vertices joined to the last diffuse
+// vertex of a random pixel's eye path, each such path weighed against the merge there and the eye
+// path's continuation. Between two wide parallel planes (a floor seen from the camera, a ceiling
+// with a small light: no corners, where a connection alone would be heavy-tailed) every indirect
+// path may be combined: with the connections alone the merges take nothing (no entries) and the
+// image still agrees with path's block by block and in its mean; with both it agrees too, with the
+// continuation by chance (auto) and without it (partition). In the box, with its corners, both
+// together: a wrong weight shows as a bias there. The merges alone are the other tests'.
+TEST(Bpm, VertexConnectionsCountEachPathOnce) {
+  std::string planes = header(32, 6, "0.5 0.4 -0.3  0.5 0 0.5  0 1 0", 60);
+  planes += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [20 20 20]\n" +
+            quad(0.4f, 0.4f, 0.6f, 0.6f, 0.55f, true) + "AttributeEnd\n";
+  planes +=
+      "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]\n" + quad(-3, -3, 4, 4, 0, false);
+  planes +=
+      "Material \"diffuse\" \"rgb reflectance\" [0.8 0.5 0.3]\n" + quad(-3, -3, 4, 4, 0.6f, true);
+  struct Case {
+    std::string name, scene;
+    ConnectionMode mode;
+    CombineAt combine;
+  };
+  const std::vector<Case> cases = {
+      {"planes, alone, auto", planes, ConnectionMode::kAlone, CombineAt::kChosen},
+      {"planes, alone, partition", planes, ConnectionMode::kAlone, CombineAt::kNowhere},
+      {"planes, on, partition", planes, ConnectionMode::kOn, CombineAt::kNowhere},
+      {"box, on, auto", cornell(), ConnectionMode::kOn, CombineAt::kChosen},
+      {"box, on, combined", cornell(), ConnectionMode::kOn, CombineAt::kEverywhere}};
+  for (const Case& k : cases) {
+    LoadedScene ls = load(k.scene);
+    const Film ref = render_with(ls, "path", 4096).film;
+    const BlockStats mr = block_stats(ref, 32)[0];
+    BpmSettings s = small_batches(0);
+    s.vertex_connections = k.mode;
+    s.combine = k.combine;
+    const Iterations its = render_seeds(ls, 6, 40, s);
+    expect_blocks_agree(its, ref, 8, edge_bias(s, 40, 8), k.name);
+    const BlockStats m = image_mean(its);
+    std::printf("%s: mean %.5f, path %.5f (sigma %.5f)\n", k.name.c_str(), m.mean, mr.mean,
+                std::sqrt(m.var + mr.var));
+    EXPECT_NEAR(m.mean, mr.mean, 4.5 * std::sqrt(m.var + mr.var)) << k.name;
+    const auto& light = its.last.details["light"];
+    EXPECT_EQ(light["vertex_connections"], true) << k.name;
+    EXPECT_GT(light["vertex_hits"].get<uint64_t>(), 1000u) << k.name;
+    if (k.mode == ConnectionMode::kAlone) {
+      EXPECT_EQ(light["entries"].get<uint64_t>(), 0u) << k.name;
     }
   }
 }
@@ -1964,6 +2012,13 @@ TEST(Bpm, SameImageWithOneAndTwoThreads) {
   const RenderRun a = render_with(ls, "bpm", 4, 1, 9, s), b = render_with(ls, "bpm", 4, 2, 9, s);
   EXPECT_GT(a.stats.details["light"]["camera_hits"].get<uint64_t>(), 100u);
   EXPECT_EQ(a.film.image().rgb, b.film.image().rgb) << "camera connections";
+  // Vertex connections, added to their pixels chunk by chunk.
+  ls = load(cornell());
+  BpmSettings v = small_batches(0);
+  v.vertex_connections = ConnectionMode::kOn;
+  const RenderRun va = render_with(ls, "bpm", 4, 1, 9, v), vb = render_with(ls, "bpm", 4, 2, 9, v);
+  EXPECT_GT(va.stats.details["light"]["vertex_hits"].get<uint64_t>(), 100u);
+  EXPECT_EQ(va.film.image().rgb, vb.film.image().rgb) << "vertex connections";
 }
 
 // A scene whose materials have no traced lobe has no caustics: bpm makes no backward photons that

@@ -299,7 +299,8 @@ TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   std::string text = kTinyScene;
   text.replace(text.find("WorldBegin"), 0,
                "Integrator \"bpm\" \"integer diffusedepth\" 2 \"float k0\" 0.5 \"integer "
-               "photonsperiteration\" 1500 \"integer emissionsamples\" 3\n");
+               "photonsperiteration\" 1500 \"integer emissionsamples\" 3 \"string "
+               "vertexconnections\" \"on\"\n");
   std::string scene = write("s.pbrt", text);
   CliRun r = run("render " + scene + " -q --spp 1 --k0 0.75 -o " + (dir_ / "out.exr").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -309,6 +310,7 @@ TEST_F(Cli, BpmSettingsComeFromTheSceneFileAndFlagsOverrideThem) {
   EXPECT_EQ(rec["bpm"]["settings"]["k0"], 0.75);
   EXPECT_EQ(rec["bpm"]["settings"]["photons_per_iteration"], 1500);
   EXPECT_EQ(rec["bpm"]["settings"]["emission_samples"], 3);
+  EXPECT_EQ(rec["bpm"]["settings"]["vertex_connections"], "on");
   EXPECT_EQ(rec["bpm"]["light"]["photons"].get<uint64_t>(), 1500u);
 }
 
@@ -380,6 +382,13 @@ TEST_F(Cli, BadBpmSettingsAreErrors) {
   EXPECT_NE(run("render " + good + " --integrator bpm --radius-policy wild").exit_code, 0);
   EXPECT_NE(run("render " + good + " --integrator bpm --photons 0").exit_code, 0);
   EXPECT_NE(run("render " + good + " --integrator bpm --emission-samples 0").exit_code, 0);
+  EXPECT_NE(run("render " + good + " --integrator bpm --vertex-connections maybe").exit_code, 0);
+  text = kTinyScene;
+  text.replace(text.find("WorldBegin"), 0,
+               "Integrator \"bpm\" \"string vertexconnections\" \"sometimes\"\n");
+  r = run("render " + write("bad2.pbrt", text) + " -q -o " + (dir_ / "out.exr").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("vertexconnections"), std::string::npos) << r.err;
   // The photon methods' error estimate needs whole streams of iterations in each M-image.
   r = run("render " + good + " -q --integrator fpm --m-images 3 -o " + (dir_ / "m.exr").string());
   EXPECT_EQ(r.exit_code, 1);

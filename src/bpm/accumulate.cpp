@@ -58,6 +58,26 @@ PixelShares pixel_shares(const BackwardMaps& maps, const LightPassResult& light,
   return s;
 }
 
+// Pixel p's sums of camera and vertex connections (camera_connections.h, vertex_connections.h)
+// added to its shares, per photon emitted. filter_weight: its camera sample's.
+void add_connections(const LightPassResult& light, float filter_weight, float mean_filter_weight,
+                     size_t p, PixelShares* sh) {
+  const float per_photon = float(1.0 / double(light.emitted));
+  if (!light.camera.empty()) {
+    // The film weighs the whole estimate by the pixel's sample's filter weight, whose mean the
+    // camera connections' shares already hold: divided out, so that a filter with negative lobes
+    // (weights of either sign) does not flip them at random.
+    const float norm =
+        per_photon * (filter_weight != 0 ? mean_filter_weight / filter_weight : 1.0f);
+    sh->photon_L += light.camera[p] * norm;
+    sh->odd_L += light.camera_odd[p] * norm;
+  }
+  if (!light.vertex.empty()) {  // made at the pixel's own eye vertex, weighed as its merges
+    sh->photon_L += light.vertex[p] * per_photon;
+    sh->odd_L += light.vertex_odd[p] * per_photon;
+  }
+}
+
 }  // namespace
 
 void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
@@ -110,21 +130,7 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
         uint32_t p = uint32_t(y) * uint32_t(w) + uint32_t(x);
         if (!eye.sampled[p]) continue;
         PixelShares sh = pixel_shares(maps, light, at.data() + p * places, places);
-        if (!light.camera.empty()) {  // camera connections (camera_connections.h)
-          // The film weighs the whole estimate by the pixel's sample's filter weight, whose mean
-          // the connections' shares already hold: divided out, so that a filter with negative
-          // lobes (weights of either sign) does not flip them at random.
-          const float w = eye.filter_weight[p];
-          const float norm =
-              float(1.0 / double(light.emitted)) * (w != 0 ? mean_filter_weight / w : 1.0f);
-          sh.photon_L += light.camera[p] * norm;
-          sh.odd_L += light.camera_odd[p] * norm;
-        }
-        if (!light.vertex.empty()) {  // vertex connections (vertex_connections.h)
-          const float norm = float(1.0 / double(light.emitted));
-          sh.photon_L += light.vertex[p] * norm;
-          sh.odd_L += light.vertex_odd[p] * norm;
-        }
+        add_connections(light, eye.filter_weight[p], mean_filter_weight, p, &sh);
         const Spectrum &photon_L = sh.photon_L, &bias = sh.bias;
         eye.round_stats[p].add_lit(sh.small_lit, sh.large_lit);
         Spectrum L = eye.radiance[p] + photon_L;

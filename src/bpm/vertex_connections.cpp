@@ -44,15 +44,17 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
     hero_only = true;
   }
   if (leaving.is_black()) return;
-  Spectrum value = photon_contribution(m_x, bp.ng, bp.ns, bp.wo, -w, leaving * (cos_z * cos_x / d2));
+  Spectrum value =
+      photon_contribution(m_x, bp.ng, bp.ns, bp.wo, -w, leaving * (cos_z * cos_x / d2));
   value *= hero_join_factor(bp.hero_only, hero_only);
   if (value.is_black()) return;
   // The densities (vertex_connections.h): the merge's over the connection's, and the
   // continuation's where the eye path went on from x.
   const Frame fz = Frame::from_z(h.sp.ns);
   const Vec3 wo_z = fz.to_local(h.wi), wx_z = fz.to_local(w);
-  const double a_x = double(bsdf_gathered_probability(m_z, wo_z, wx_z, TransportMode::kImportance)) *
-                     bsdf_pdf(m_z, wo_z, wx_z, TransportMode::kImportance) * cos_x / d2;
+  const double a_x =
+      double(bsdf_gathered_probability(m_z, wo_z, wx_z, TransportMode::kImportance)) *
+      bsdf_pdf(m_z, wo_z, wx_z, TransportMode::kImportance) * cos_x / d2;
   if (!(a_x > 0)) return;
   const double merge = 1 / connection_over_merge(bp.radius, vc.pixels, a_x);
   double others = merge;

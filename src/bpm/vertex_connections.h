@@ -28,7 +28,8 @@ struct VertexConnections {
   std::vector<uint32_t> target;
   double pixels = 0;   // P: the pixels a connection draws from, each with probability 1 / P
   double photons = 0;  // N: the photons per iteration the merges' densities count
-  // The connections take the merges' share of their paths, the merges none (ConnectionMode::kAlone).
+  // The connections take the merges' share of their paths, the merges none
+  // (ConnectionMode::kAlone).
   bool alone = false;
   bool on() const { return pixels > 0; }
 };
@@ -52,8 +53,9 @@ inline double connection_over_merge(double r, double pixels, double a_x) {
 }
 
 // Joins photon hit h (h.mis set: the path may be combined; on a surface of material m_z) to
-// backward photon bp (a target; its material m_x), within max_depth scattering events: appends
-// the connection to `out` where nothing stands between. Counts its shadow ray in *rays.
+// backward photon bp (the target of `pixel`; its material m_x), within max_depth scattering
+// events: appends the connection to `out` where nothing stands between. Counts its shadow ray in
+// *rays.
 void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc,
                            const PhotonHit& h, const Material& m_z, const BackwardPhoton& bp,
                            uint32_t pixel, const Material& m_x, int max_depth, bool odd,
