@@ -1199,9 +1199,10 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
 // path's continuation. Between two wide parallel planes (a floor seen from the camera, a ceiling
 // with a small light: no corners, where a connection alone would be heavy-tailed) every indirect
 // path may be combined: with the connections alone the merges take nothing (no entries) and the
-// image still agrees with path's block by block and in its mean; with both it agrees too, with the
-// continuation by chance (auto) and without it (partition). In the box, with its corners, both
-// together: a wrong weight shows as a bias there. The merges alone are the other tests'.
+// image still agrees with path's block by block and in its mean, also under a coated ceiling;
+// with both it agrees too, with the continuation by chance (auto) and without it (partition). In
+// the box, with its corners, both together: a wrong weight shows as a bias there. The merges
+// alone are the other tests'.
 TEST(Bpm, VertexConnectionsCountEachPathOnce) {
   std::string planes = header(32, 6, "0.5 0.4 -0.3  0.5 0 0.5  0 1 0", 60);
   planes += "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [20 20 20]\n" +
@@ -1210,6 +1211,13 @@ TEST(Bpm, VertexConnectionsCountEachPathOnce) {
       "Material \"diffuse\" \"rgb reflectance\" [0.7 0.7 0.7]\n" + quad(-3, -3, 4, 4, 0, false);
   planes +=
       "Material \"diffuse\" \"rgb reflectance\" [0.8 0.5 0.3]\n" + quad(-3, -3, 4, 4, 0.6f, true);
+  // A coated ceiling (a glossy coat rough enough to be gathered): the photons' vertices there join
+  // x through the coat's walk table, evaluated in the photon's order.
+  std::string coated = planes;
+  const std::string ceiling = "Material \"diffuse\" \"rgb reflectance\" [0.8 0.5 0.3]";
+  coated.replace(coated.find(ceiling), ceiling.size(),
+                 "Material \"coateddiffuse\" \"rgb reflectance\" [0.8 0.5 0.3] \"float "
+                 "roughness\" 0.3");
   struct Case {
     std::string name, scene;
     ConnectionMode mode;
@@ -1217,6 +1225,8 @@ TEST(Bpm, VertexConnectionsCountEachPathOnce) {
   };
   const std::vector<Case> cases = {
       {"planes, alone, auto", planes, ConnectionMode::kAlone, CombineAt::kChosen},
+      {"planes with a coated ceiling, alone, partition", coated, ConnectionMode::kAlone,
+       CombineAt::kNowhere},
       {"planes, alone, partition", planes, ConnectionMode::kAlone, CombineAt::kNowhere},
       {"planes, on, partition", planes, ConnectionMode::kOn, CombineAt::kNowhere},
       {"box, on, auto", cornell(), ConnectionMode::kOn, CombineAt::kChosen},

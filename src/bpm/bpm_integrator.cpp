@@ -74,12 +74,14 @@ void update_pixel_weights(const std::vector<double>& sum, const std::vector<uint
 // disc probes, the sample statistics with their copy at the end of a round, and the radii's
 // shares), the masks,
 // the emission guide and the photon count's moments (the round's, its copy at the end of a round
-// and the merged) keep, and the camera connections' two sums and radius.
+// and the merged) keep, and the camera connections' two sums and radius; with vertex
+// connections, their two sums and target (kVertexPixelBytes).
 constexpr double kPixelBytes =
     sizeof(Spectrum) + 2 * sizeof(float) + 4 * sizeof(uint8_t) + 2 * sizeof(uint16_t) +
     sizeof(float) + 3 * sizeof(SampleStats<double>) + sizeof(double) + sizeof(uint32_t) +
     sizeof(float) + sizeof(uint16_t) + 3 * PixelMoments::kValues * sizeof(double) +
     2 * sizeof(float) + 2 * sizeof(Spectrum) + sizeof(float);
+constexpr double kVertexPixelBytes = 2 * sizeof(Spectrum) + sizeof(uint32_t);
 
 // What the extra samples of emission and of direct light cost against whole iterations
 // (emission_sample_count, direct_sample_count), in rays: all the rays the iterations cast and the
@@ -299,10 +301,11 @@ double BpmRender::reserve_memory() const {
                 std::to_string(PhotonEntry::kIndexMask) +
                 "): lower --resolution or --diffuse-depth");
   const double fixed_bytes =
-      double(film_->bytes()) + double(n_pixels_) * kPixelBytes +
+      double(film_->bytes()) +
+      double(n_pixels_) * (kPixelBytes + (vertex_connections() ? kVertexPixelBytes : 0.0)) +
       light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),
                            n_pixels_ * size_t(photons_per_path(s_, scene_)),
-                           s_.camera_connections != ConnectionMode::kOff);
+                           s_.camera_connections != ConnectionMode::kOff, vertex_connections());
   check_memory(
       "bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) + " (up to " +
           std::to_string(photons_per_path(s_, scene_)) +

@@ -56,7 +56,8 @@ float combined_merge_weight(uint32_t g, const BackwardPhoton& bp, const Material
         std::ldexp(kPi * double(bp.radius) * bp.radius * prm.merge_photons, bp.continue_level);
     others += double(h.merge_factor) * p / density;
   }
-  if (prm.vertex && bp.vertex_target && h.arrival > 0 && prm.vertex->target[bp.pixel] == g) {
+  if (prm.vertex && bp.vertex_target && h.arrival > 0 && bp.pixel < prm.vertex->target.size() &&
+      prm.vertex->target[bp.pixel] == g) {
     if (prm.vertex->alone) return 0;
     others += connection_over_merge(bp.radius, prm.vertex->pixels, h.arrival);
   }
@@ -99,9 +100,9 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     Spectrum value = photon_contribution(m, h.ng, bp.ns, bp.wo, h.wi, h.flux);
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
-    if (h.merge_factor > 0) {
+    if (h.merge_factor > 0 || h.arrival > 0) {
       value *= combined_merge_weight(g, bp, m, h, prm);
-      if (value.is_black()) return;
+      if (prm.vertex && value.is_black()) return;
     }
     if (prm.camera && h.cls == PhotonClass::kCaustic) {
       value *= camera_merge_weight(prm, g, bp, m);
@@ -205,8 +206,9 @@ void connect_hit_to_eye_vertex(const GroupTrace& g, uint64_t photon, const Photo
                                LightCounters& lc, std::vector<VertexHit>& out) {
   const VertexConnections& vc = *g.prm.vertex;
   Rng rng(stream_key(g.seed ^ kVertexStream, uint64_t(g.pass_index), photon, uint64_t(h.bounces)));
-  const uint32_t pixel =
-      uint32_t(std::min(vc.pixels - 1, std::floor(double(rng.uniform()) * vc.pixels)));
+  // Uniform over the P pixels for any P below 2^32 (the top 32 bits of a 32-by-32-bit product: at
+  // most one draw in 2^32 / P apart between pixels).
+  const uint32_t pixel = uint32_t((uint64_t(rng.next_u32()) * uint64_t(vc.target.size())) >> 32);
   const uint32_t target = vc.target[pixel];
   if (target == VertexConnections::kNone) return;
   const BackwardPhoton& bp = g.maps.photons[target];
@@ -464,17 +466,20 @@ GroupSize group_size(size_t backward_photons) {
   return {hits / 2, hits};
 }
 
-double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons, bool camera) {
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons, bool camera,
+                            bool vertex) {
   // The kept chunks' hits with their lists' spare capacity, and a chunk per thread traced past
   // them or kept from an earlier group (max_depth + 1 hits per photon at most); the emissions.
   // A camera connection is made at a caustic photon's hit in view, most of which are also hits
-  // recorded: counted as many as those.
+  // recorded: counted as many as those. A vertex connection is made at most once per hit,
+  // recorded or not (a photon's first hit is not): counted as many as the hits and the photons.
   const GroupSize g = group_size(backward_photons);
-  const double per_hit =
-      double(kHitBytes) + (camera ? double(sizeof(CameraHit) + sizeof(CameraHit*)) : 0.0);
+  const double per_hit = double(kHitBytes) +
+                         (camera ? double(sizeof(CameraHit) + sizeof(CameraHit*)) : 0.0) +
+                         (vertex ? double(sizeof(VertexHit)) : 0.0);
   return per_hit * (2.0 * double(g.hits) +
                     2.0 * double(threads) * kPhotonsPerChunk * double(std::max(max_depth, 0) + 1)) +
-         2.0 * double(g.photons) * sizeof(EmittedPhoton);
+         2.0 * double(g.photons) * (sizeof(EmittedPhoton) + (vertex ? sizeof(VertexHit) : 0));
 }
 
 namespace {

@@ -184,10 +184,10 @@ struct GroupSize {
 };
 GroupSize group_size(size_t backward_photons);
 constexpr uint64_t kHitBytes = sizeof(PendingHit) + sizeof(PendingHit*);
-// What the light pass's hits (and with `camera`, its camera connections) may take with at most
-// `backward_photons`, for the memory budget.
+// What the light pass's hits (and with `camera` and `vertex`, its camera and vertex connections)
+// may take with at most `backward_photons`, for the memory budget.
 double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons,
-                            bool camera = false);
+                            bool camera = false, bool vertex = false);
 // Hits per gather chunk.
 constexpr int kHitsPerGather = 1024;
 

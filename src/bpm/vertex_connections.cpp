@@ -35,9 +35,17 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
   const float cos_z = std::fabs(dot(h.sp.ng, w)), cos_x = std::fabs(dot(bp.ng, w));
   if (cos_z == 0 || cos_x == 0) return;
   // The photon's light leaving z toward x through the gathered lobes, as a photon that went there
-  // would carry it (scatter_photon_at_surface) with the density of its direction replaced by that
-  // of x's area; then what x's backward photon makes of it (a merge's entry).
-  Spectrum leaving = photon_contribution(m_z, h.sp.ng, h.sp.ns, w, h.wi, h.flux);
+  // would carry it (scatter_photon_at_surface: the adjoint BSDF, whose order matters where a
+  // material is not reciprocal, with the shading normal's correction) with the density of its
+  // direction replaced by that of x's area; then what x's backward photon makes of it (a merge's
+  // entry).
+  const Frame fz = Frame::from_z(h.sp.ns);
+  const Vec3 wo_z = fz.to_local(h.wi), wx_z = fz.to_local(w);
+  const float cos_in = std::fabs(dot(h.wi, h.sp.ng));
+  if (cos_in == 0) return;
+  Spectrum leaving = h.flux *
+                     bsdf_f(m_z, wo_z, wx_z, TransportMode::kImportance, BsdfPart::kGathered) *
+                     (std::fabs(wo_z.z) / cos_in);
   bool hero_only = h.hero_only;
   if (!hero_only && material_is_dispersive(m_z)) {
     leaving = hero_wavelength_only(leaving);
@@ -50,8 +58,6 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
   if (value.is_black()) return;
   // The densities (vertex_connections.h): the merge's over the connection's, and the
   // continuation's where the eye path went on from x.
-  const Frame fz = Frame::from_z(h.sp.ns);
-  const Vec3 wo_z = fz.to_local(h.wi), wx_z = fz.to_local(w);
   const double a_x =
       double(bsdf_gathered_probability(m_z, wo_z, wx_z, TransportMode::kImportance)) *
       bsdf_pdf(m_z, wo_z, wx_z, TransportMode::kImportance) * cos_x / d2;
