@@ -38,12 +38,12 @@ float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, u
   return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
 }
 
-// The weight of merging photon hit h (whose path may be combined) at backward photon g: against
+// The weight of merging photon hit h (whose path may be combined) at backward photon bp: against
 // the eye path's continuation where it went on from there (photons/merge_weights.h: the eye's BSDF
 // density there of the photon's direction against the merge's pi r^2 N), and against the vertex
-// connections where g is their target (bpm/vertex_connections.h).
-float combined_merge_weight(uint32_t g, const BackwardPhoton& bp, const Material& m,
-                            const PendingHit& h, const LightPassParams& prm) {
+// connections where bp is their target (bpm/vertex_connections.h).
+float combined_merge_weight(const BackwardPhoton& bp, const Material& m, const PendingHit& h,
+                            const LightPassParams& prm) {
   double others = 0;
   if (bp.combined) {
     const Frame frame = Frame::from_z(bp.ns);
@@ -56,10 +56,9 @@ float combined_merge_weight(uint32_t g, const BackwardPhoton& bp, const Material
         std::ldexp(kPi * double(bp.radius) * bp.radius * prm.merge_photons, bp.continue_level);
     others += double(h.merge_factor) * p / density;
   }
-  if (prm.vertex && bp.vertex_target && h.arrival > 0 && bp.pixel < prm.vertex->target.size() &&
-      prm.vertex->target[bp.pixel] == g) {
+  if (prm.vertex && bp.vertex_target && h.arrival > 0) {
     if (prm.vertex->alone) return 0;
-    others += connection_over_merge(bp.radius, prm.vertex->pixels, h.arrival);
+    others += connection_over_merge(bp.radius, prm.vertex->pixels(), h.arrival);
   }
   return float(1 / (1 + others));
 }
@@ -101,7 +100,7 @@ float gather_at_hit(const BackwardMaps& maps, const LightPassParams& prm,
     if (value.is_black()) return;
     value *= hero_join_factor(bp.hero_only, h.hero_only);
     if (h.merge_factor > 0 || h.arrival > 0) {
-      value *= combined_merge_weight(g, bp, m, h, prm);
+      value *= combined_merge_weight(bp, m, h, prm);
       if (prm.vertex && value.is_black()) return;
     }
     if (prm.camera && h.cls == PhotonClass::kCaustic) {

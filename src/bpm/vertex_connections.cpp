@@ -12,7 +12,6 @@ namespace bpm {
 
 void find_vertex_targets(const BackwardMaps& maps, size_t pixels, double photons,
                          VertexConnections* vc) {
-  vc->pixels = double(pixels);
   vc->photons = photons;
   vc->target.assign(pixels, VertexConnections::kNone);
   // An eye path marks one backward photon at most, so each pixel's slot is written once.
@@ -62,7 +61,7 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
       double(bsdf_gathered_probability(m_z, wo_z, wx_z, TransportMode::kImportance)) *
       bsdf_pdf(m_z, wo_z, wx_z, TransportMode::kImportance) * cos_x / d2;
   if (!(a_x > 0)) return;
-  const double merge = 1 / connection_over_merge(bp.radius, vc.pixels, a_x);
+  const double merge = 1 / connection_over_merge(bp.radius, vc.pixels(), a_x);
   double others = merge;
   if (bp.combined) {
     const Frame fx = Frame::from_z(bp.ns);
@@ -73,14 +72,14 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
     const double b_x =
         double(bsdf_pdf(m_x, wo_x, fx.to_local(-w), TransportMode::kRadiance, part)) * cos_z / d2;
     const double b_z = bsdf_pdf(m_z, wx_z, wo_z, TransportMode::kRadiance);
-    others += std::ldexp(vc.pixels / vc.photons, -int(bp.continue_level)) *
+    others += std::ldexp(vc.pixels() / vc.photons, -int(bp.continue_level)) *
               h.mis->connection_ratio(b_z) * b_x;
   }
   const double weight = vc.alone ? (1 + merge) / (1 + others) : 1 / (1 + others);
   if (!(weight > 0) || !std::isfinite(weight)) return;
   ++*rays;
   if (scene.occluded(offset_origin(h.sp.p, h.sp.ng, w, h.sp.error), bp.p)) return;
-  out.push_back({pixel, bp.tau * value * float(vc.pixels * weight), odd});
+  out.push_back({pixel, bp.tau * value * float(vc.pixels() * weight), odd});
 }
 
 }  // namespace bpm

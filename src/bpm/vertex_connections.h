@@ -24,14 +24,14 @@ namespace bpm {
 // What the light pass needs to join photons' vertices to eye vertices in one iteration.
 struct VertexConnections {
   static constexpr uint32_t kNone = ~0u;
-  // Per pixel, the index in the maps of its backward photon marked vertex_target, or kNone.
+  // Per pixel of the image (P of them, each drawn with probability 1 / P), the index in the maps
+  // of its backward photon marked vertex_target, or kNone.
   std::vector<uint32_t> target;
-  double pixels = 0;   // P: the pixels a connection draws from, each with probability 1 / P
   double photons = 0;  // N: the photons per iteration the merges' densities count
   // The connections take the merges' share of their paths, the merges none
   // (ConnectionMode::kAlone).
   bool alone = false;
-  bool on() const { return pixels > 0; }
+  double pixels() const { return double(target.size()); }
 };
 
 // Sets vc's targets from the backward photons of maps marked vertex_target, for an image of

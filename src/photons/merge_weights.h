@@ -94,12 +94,4 @@ class PhotonMis {
   double seg_cos_ = 0, seg_d2_ = 1;  // |cos| at prev toward the current vertex, squared distance
 };
 
-// The merge's weight at a backward photon whose eye path went on (BackwardPhoton::combined):
-// factor (PhotonMis::merge_factor), p the eye's BSDF density (radiance transport) at x of the
-// photon's direction, merge_density = pi r^2 N.
-inline float merge_weight(float factor, float p, double merge_density) {
-  if (factor == 0) return 1;
-  return float(1 / (1 + double(factor) * double(p) / merge_density));
-}
-
 }  // namespace bpm
