@@ -928,6 +928,58 @@ TEST(Bpm, CombinedEstimatorsConvergeToPath) {
   }
 }
 
+// A point-like light's paths are combined as an area light's (merge_weights.h): the delta of its
+// position, in A0 and in B0 alike, is left out of both sides' densities, and no BSDF sample finds
+// it. In the test box lit by a spot light under its ceiling, aimed at the floor, and a point light
+// beside it: with few photons over narrow discs the combined image agrees with path's block by
+// block and in its mean within 4.5 sigma, and its pixels' error falls below the partition's; with
+// the vertex connections alone (partition) the merges at their targets count nothing and the
+// image agrees with path's too. A side that left such paths out, or counted them in full, would be
+// a share of the indirect light off.
+TEST(Bpm, CombinedEstimatorsCountPointLightPathsOnce) {
+  std::string scene = cornell();
+  const std::string area = "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [15 15 15]\n" +
+                           quad(0.35f, 0.35f, 0.65f, 0.65f, 0.999f, true) + "AttributeEnd\n";
+  ASSERT_NE(scene.find(area), std::string::npos);
+  scene.replace(scene.find(area), area.size(),
+                "LightSource \"spot\" \"rgb I\" [2 2 2] \"point3 from\" [0.5 0.95 0.5] \"point3 "
+                "to\" [0.5 0 0.5] \"float coneangle\" 50 \"float conedeltaangle\" 10\n"
+                "LightSource \"point\" \"rgb I\" [0.3 0.3 0.3] \"point3 from\" [0.2 0.9 0.3]\n");
+  LoadedScene ls = load(scene);
+  const Film ref = render_with(ls, "path", 2048).film;
+  const BlockStats mr = block_stats(ref, 32)[0];
+  BpmSettings partition = small_batches(0);
+  partition.photons_per_iteration = 64;
+  partition.k1 = 1;
+  partition.combine = CombineAt::kNowhere;
+  BpmSettings combined = partition;
+  combined.combine = CombineAt::kEverywhere;
+  const Iterations c = render_iterations(ls, "bpm", 512, 5, combined);
+  const Iterations p = render_iterations(ls, "bpm", 96, 5, partition);
+  expect_blocks_agree(c, ref, 8, edge_bias(combined, 96, 8), "combined");
+  EXPECT_GT(c.last.details["eye"]["continued_paths"].get<double>(), 0.0);
+  const double ec = pixel_rms_error(c, ref.image()), ep = pixel_rms_error(p, ref.image());
+  const BlockStats mc = image_mean(c);
+  std::printf(
+      "point-like lights: pixel RMS error combined %.4f, partition %.4f; mean %.5f, path "
+      "%.5f (sigma %.5f)\n",
+      ec, ep, mc.mean, mr.mean, std::sqrt(mc.var + mr.var));
+  EXPECT_LT(ec, 0.75 * ep) << "combined " << ec << ", partition " << ep;
+  EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var));
+
+  BpmSettings alone = small_batches(0);
+  alone.vertex_connections = ConnectionMode::kAlone;
+  alone.combine = CombineAt::kNowhere;
+  const Iterations v = render_seeds(ls, 6, 40, alone);
+  expect_blocks_agree(v, ref, 8, edge_bias(alone, 40, 8), "vertex connections alone");
+  const BlockStats mv = image_mean(v);
+  std::printf("vertex connections alone: mean %.5f, path %.5f (sigma %.5f)\n", mv.mean, mr.mean,
+              std::sqrt(mv.var + mr.var));
+  EXPECT_NEAR(mv.mean, mr.mean, 4.5 * std::sqrt(mv.var + mr.var));
+  EXPECT_GT(v.last.details["light"]["vertex_hits"].get<uint64_t>(), 1000u);
+  EXPECT_EQ(v.last.details["light"]["entries"].get<uint64_t>(), 0u);
+}
+
 // With --estimators auto the eye path goes on from a last vertex that is not glossy with a
 // probability each pixel chooses (continue_level): its light over the probability, its density
 // times it in the weights on both sides. With many photons over wide discs the merges take nearly

@@ -203,15 +203,15 @@ inline double merge_and_connection(double merge, const Continuation& c, double a
   return c.vertex_scale > 0 && a_x > 0 ? merge * (1 + c.vertex_scale / a_x) : merge;
 }
 
-// At e_j (v), next-event estimation of an area light, weighed against the BSDF sample that could
-// find it and the merge at x.
+// At e_j (v), next-event estimation of an area or point-like light, weighed against the BSDF
+// sample that could find it (an area light) and the merge at x.
 inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v, const PathState& s,
                                        const Continuation& c) {
   const RenderScene& scene = path.scene;
   const auto sample = sample_light_at(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local,
                                       *path.prm.materials, path.rng, path.counters.rays);
-  // Other lights than area lights are not combined: the merge's.
-  if (!sample || !std::holds_alternative<AreaLight>(scene.lights[size_t(sample->light)])) return {};
+  // Distant and infinite lights are not combined: the merge's.
+  if (!sample || !combinable_light(scene.lights[size_t(sample->light)])) return {};
   const int li = sample->light;
   const LightLiSample* ls = &sample->ls;
   const Vec3 wi_local = sample->wi_local;
@@ -221,6 +221,8 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
       bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
   if (!(g > 0)) return {};
   f *= g;
+  // A point-like light: next-event estimation's density and the emission's without their
+  // position's delta, and none for the BSDF sample (n_light is zero).
   const double b_light = light_sample_density(scene, li, v.sp.p, ls->p_light, ls->n_light);
   const double b_bsdf =
       area_density(bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance), v.sp.p,
@@ -231,7 +233,7 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
                         c.cos_prev / c.d2;
   const double merge =
       c.ratio * a_prev *
-      area_density(emission_density(scene, li, ls->n_light, ls->wi), ls->p_light, v.sp.p, v.sp.ng);
+      area_density(emission_density(scene, li, ls->n_light, -ls->wi), ls->p_light, v.sp.p, v.sp.ng);
   const double others = merge_and_connection(merge, c, c.a_x > 0 ? c.a_x : a_prev);
   const double w = b_light / (b_light + b_bsdf + others);
   if (!std::isfinite(w)) return {};
@@ -240,7 +242,7 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
 
 // Indirect light at the last diffuse vertex x by the eye path's continuation (combined
 // estimators, photons/merge_weights.h): BSDF samples from x on, through vertices with gathered
-// lobes only, each finding area lights by next-event estimation and by its BSDF sample, every
+// lobes only, each finding lights by next-event estimation and by its BSDF sample, every
 // path weighed against the merge at x's backward photon, whose density is merge_density
 // (pi r^2 N; 0: none). The continuation goes on by Russian roulette on its change of
 // throughput. depth: x's scattering events, as the backward photon's eye_depth; part: the lobes x

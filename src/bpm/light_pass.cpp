@@ -341,6 +341,10 @@ TraceResult keep_prefix(const std::vector<uint8_t>& ran, int workers, uint64_t c
     for (size_t c = size_t(kept) + size_t(workers); c < buf->hits.size(); ++c) {
       std::vector<PendingHit>().swap(buf->hits[c]);
       std::vector<EmittedPhoton>().swap(buf->emitted[c]);
+      std::vector<SensorCrossing>().swap(buf->crossings[c]);
+      std::vector<PendingBeam>().swap(buf->beams[c]);
+      std::vector<CameraHit>().swap(buf->camera_hits[c]);
+      std::vector<VertexHit>().swap(buf->vertex_hits[c]);
     }
   LightCounters& total = buf->counters.local();
   for (int c = 0; c < kept; ++c) total.add(buf->chunk_counters[size_t(c)]);

@@ -192,6 +192,10 @@ std::optional<LightLeSample> light_sample_le(const Light& l, const Shape* shape,
                                              Vec2 u_dir, const SceneBoundsInfo& bounds,
                                              const Wavelengths& wl,
                                              const Spectrum* spectrum = nullptr);
+// The solid-angle density with which light_sample_le sends a point-like light's photon (point,
+// spot, goniometric, projection) along the unit world direction w, its position being a delta;
+// nullopt for lights that are not point-like.
+std::optional<float> point_light_pdf_le(const Light& l, Vec3 w);
 // Total emitted power as a colour (the light's RGB times its geometric factor), used by the
 // power light sampler.
 Rgb light_power(const Light& l, const SceneBoundsInfo& bounds);

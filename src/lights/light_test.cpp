@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "base/chi2_test_util.h"
 #include "base/rng.h"
@@ -811,6 +812,52 @@ TEST(GoniometricAndProjectionLights, MeanFluxIsTheIntegratedIntensity) {
   // The projection light's RGB power, which "power" normalises, is the same integral.
   Rgb prgb = light_power(Light(p), kBounds);
   EXPECT_GT(prgb.luminance(), 0);
+}
+
+// The density of a point-like light's photon directions (point_light_pdf_le, which the combined
+// estimators weigh its paths by) is the one light_sample_le draws with: each photon's flux is
+// the intensity toward its direction over that density, and the density integrates to one over
+// the sphere (it is zero outside a spot light's cone, beside a projection light's frame). Lights
+// with an area or at infinity have none.
+TEST(LightSampleLe, PointLikeLightsDensityIsTheSampledOne) {
+  const GoniometricLight g = make_goniometric();
+  const ProjectionLight p = make_projection(8, 4, 70);
+  const SpotLight spot = make_spot();
+  auto intensity = [&](const Light& l, Vec3 w) {
+    if (std::holds_alternative<PointLight>(l)) return kLs;
+    if (std::holds_alternative<SpotLight>(l))
+      return spot.intensity.sample(kWl) * spot_falloff(spot, spot.frame.to_local(w));
+    if (std::holds_alternative<GoniometricLight>(l)) return light_intensity(g, w, kWl);
+    return light_intensity(p, w, kWl);
+  };
+  for (const auto& [light, name] :
+       {std::pair{Light(PointLight{Vec3(1, 2, 3), kL}), "point"}, std::pair{Light(spot), "spot"},
+        std::pair{Light(g), "goniometric"}, std::pair{Light(p), "projection"}}) {
+    Rng rng(stream_key(43, std::string(name).size()));
+    // A direction on a texel's edge may read the texel beside it: count the agreements.
+    int photons = 0, agree = 0;
+    for (int k = 0; k < 20000; ++k) {
+      auto s = light_sample_le(light, nullptr, {rng.uniform(), rng.uniform()},
+                               {rng.uniform(), rng.uniform()}, kBounds, kWl);
+      if (!s) continue;
+      const std::optional<float> pdf = point_light_pdf_le(light, s->direction);
+      ASSERT_TRUE(pdf.has_value()) << name;
+      ++photons;
+      const Spectrum I = intensity(light, s->direction);
+      agree += I[0] > 0 && std::fabs(s->flux[0] * *pdf / I[0] - 1) < 2e-3f;
+    }
+    EXPECT_GT(photons, 19000) << name;
+    EXPECT_GE(agree, photons - photons / 1000) << name;
+    MeanAccumulator total;
+    for (int k = 0; k < 200000; ++k) {
+      const Vec3 w = sample_uniform_sphere({rng.uniform(), rng.uniform()});
+      total.add(double(*point_light_pdf_le(light, w)) / kUniformSpherePdfSolidAngle);
+    }
+    expect_mean(total, 1.0, 1e-6, name);
+  }
+  EXPECT_FALSE(point_light_pdf_le(Light(DistantLight{Vec3(0, 1, 0), kL}), Vec3(0, -1, 0)));
+  EXPECT_FALSE(point_light_pdf_le(Light(UniformInfiniteLight{kL}), Vec3(0, -1, 0)));
+  EXPECT_EQ(*point_light_pdf_le(Light(spot), -spot.frame.n), 0.0f);
 }
 
 // Photon emission: the mean flux weight of light_sample_le is the light's power (what the photon

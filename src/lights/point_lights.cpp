@@ -1,6 +1,7 @@
 // Point-like lights: point, spot (pbrt-v4 PointLight, SpotLight), and the image-modulated
 // goniometric and projection lights (pbrt-v4 GoniometricLight, ProjectionLight).
 #include <cmath>
+#include <variant>
 #include <vector>
 
 #include "base/sampling.h"
@@ -241,5 +242,25 @@ std::optional<LightLeSample> sample_le_of(const ProjectionLight& l, const Shape*
 }
 
 Rgb power_of(const ProjectionLight& l, const SceneBoundsInfo&) { return l.power_rgb; }
+
+// The densities of the sample_le_of above: uniform over the sphere (point) or the cone out to
+// cos_falloff_end (spot); the image's distribution over the equal-area square, whose area is
+// 4 pi steradians (goniometric), or over the projected frame (projection).
+std::optional<float> point_light_pdf_le(const Light& light, Vec3 w) {
+  if (std::holds_alternative<PointLight>(light)) return kUniformSpherePdfSolidAngle;
+  if (const auto* l = std::get_if<SpotLight>(&light))
+    return spot_falloff(*l, l->frame.to_local(w)) > 0
+               ? uniform_cone_pdf_solid_angle(l->cos_falloff_end)
+               : 0.0f;
+  if (const auto* l = std::get_if<GoniometricLight>(&light)) {
+    const Vec3 wl = swap_yz(normalize(l->world_from_light.inverse().vector(w)));
+    return l->distribution.pdf(equal_area_sphere_to_square(wl)) / (4 * kPi);
+  }
+  if (const auto* l = std::get_if<ProjectionLight>(&light)) {
+    const auto uv = projection_uv(*l, w);
+    return uv ? l->distribution.pdf(*uv) / projection_solid_angle_per_area(*l, *uv) : 0.0f;
+  }
+  return std::nullopt;
+}
 
 }  // namespace bpm

@@ -1,6 +1,7 @@
 #include "photons/merge_weights.h"
 
 #include <cmath>
+#include <variant>
 
 namespace bpm {
 
@@ -9,24 +10,34 @@ bool combinable_vertex(const PathVertex& v) {
          !std::holds_alternative<PhongMaterial>(v.m());
 }
 
+bool combinable_light(const Light& l) {
+  return std::holds_alternative<AreaLight>(l) ||
+         (light_is_delta(l) && !std::holds_alternative<DistantLight>(l));
+}
+
 double emission_density(const RenderScene& scene, int light, Vec3 n, Vec3 w) {
-  const auto* area = std::get_if<AreaLight>(&scene.lights[size_t(light)]);
+  const Light& l = scene.lights[size_t(light)];
+  const double pmf = double(scene.light_distribution.pmf(light));
+  // A point-like light: its direction's density alone (its position's delta left out).
+  if (const auto pdf = point_light_pdf_le(l, w)) return pmf * double(*pdf);
+  const auto* area = std::get_if<AreaLight>(&l);
   if (!area || !(area->area > 0)) return 0;
   // Cosine-weighted about the normal (sample_le_of); a two-sided light picks its side first.
   const double side = area->two_sided ? 0.5 : 1.0;
-  return double(scene.light_distribution.pmf(light)) / double(area->area) * side *
-         std::fabs(double(dot(n, w))) * kInvPi;
+  return pmf / double(area->area) * side * std::fabs(double(dot(n, w))) * kInvPi;
 }
 
 double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n) {
   const Light& l = scene.lights[size_t(light)];
-  if (!std::holds_alternative<AreaLight>(l)) return 0;
+  const double pmf = double(scene.light_distribution.pmf(light));
+  if (!combinable_light(l)) return 0;
+  // A point-like light: its delta left out, as emission_density leaves out its own.
+  if (!std::holds_alternative<AreaLight>(l)) return pmf;
   const Vec3 d = y - p;
   const float len = length(d);
   if (!(len > 0)) return 0;
-  const double pdf = double(scene.light_distribution.pmf(light)) *
-                     double(light_pdf_li(l, scene.light_shape(l), p, d / len, y, n));
-  return area_density(pdf, p, y, n);
+  return area_density(pmf * double(light_pdf_li(l, scene.light_shape(l), p, d / len, y, n)), p, y,
+                      n);
 }
 
 void PhotonMis::start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w) {

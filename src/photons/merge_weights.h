@@ -17,8 +17,9 @@
 //                                                 the sum of the two)
 // The emission densities are the unguided ones (lights by power, uniform points, cosine
 // directions): guided emission changes the photons' weights, not what they are weighed against.
-// Only paths whose light is an area light and whose vertices z all have gathered lobes only (on a
-// surface, not a curve) are combined; every other path stays the merge's alone, and the
+// Only paths whose light is an area light or point-like (combinable_light; a point-like light's
+// position is a delta that both sides leave out) and whose vertices z all have gathered lobes only
+// (on a surface, not a curve) are combined; every other path stays the merge's alone, and the
 // continuation leaves it out. Both passes compute the same products, each from its own end of the
 // path, so that the weights of a path sum to one.
 #pragma once
@@ -28,6 +29,11 @@
 #include "scene/render_scene.h"
 
 namespace bpm {
+
+// Whether a combined path may start on l: an area light, or a point-like one (point, spot,
+// goniometric, projection), whose position's delta both sides leave out of their densities (it
+// cancels in every ratio) and which no BSDF sample finds.
+bool combinable_light(const Light& l);
 
 // Whether a combined path may pass through v: a surface (not a curve) with gathered lobes, not
 // Phong's (whose sampling is not reciprocal). Where a coat splits (BsdfPart), only the share of
@@ -45,13 +51,15 @@ inline double area_density(double pdf_solid_angle, Vec3 from, Vec3 to, Vec3 n_to
   return pdf_solid_angle * std::fabs(double(dot(n_to, d))) / (d2 * std::sqrt(d2));
 }
 
-// A0 times the solid-angle density of A1 for area light `light` (unguided emission: the light by
-// power, a uniform point, a cosine-weighted direction): the density of emitting along the unit
-// direction w from a point of geometric normal n; 0 for other lights.
+// A0 times the solid-angle density of A1 for light `light` (unguided emission: the light by
+// power; on an area light a uniform point and a cosine-weighted direction): the density of
+// emitting along the unit direction w from a point of geometric normal n; for a point-like light
+// the light's and its direction's alone; 0 for other lights.
 double emission_density(const RenderScene& scene, int light, Vec3 n, Vec3 w);
 
 // B0 by next-event estimation from p (sample_direct_light: the light by power, then its own
-// sampling) of the point y on area light `light`, of geometric normal n: an area density.
+// sampling) of the point y on area light `light`, of geometric normal n: an area density; for a
+// point-like light the light's density alone.
 double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n);
 
 // The running products of a photon's path (the light pass's side): after its k-th vertex z_k,
@@ -59,8 +67,8 @@ double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y,
 // it leaves one; merge_factor() is what a merge at a backward photon needs of it.
 class PhotonMis {
  public:
-  // The photon leaves area light `light` at y, of geometric normal n, along the unit direction w.
-  // Any other light: not combined.
+  // The photon leaves light `light` at y, of geometric normal n (zero for a point-like light),
+  // along the unit direction w. A light that combinable_light refuses: not combined.
   void start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w);
   // The photon arrives at its k-th vertex v (k from 1).
   void arrive(const RenderScene& scene, const PathVertex& v, int k);
