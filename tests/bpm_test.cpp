@@ -928,23 +928,18 @@ TEST(Bpm, CombinedEstimatorsConvergeToPath) {
   }
 }
 
-// A point-like light's paths are combined as an area light's (merge_weights.h): the delta of its
-// position, in A0 and in B0 alike, is left out of both sides' densities, and no BSDF sample finds
-// it. In the test box lit by a spot light under its ceiling, aimed at the floor, and a point light
-// beside it: with few photons over narrow discs the combined image agrees with path's block by
-// block and in its mean within 4.5 sigma, and its pixels' error falls below the partition's; with
-// the vertex connections alone (partition) the merges at their targets count nothing and the
-// image agrees with path's too. A side that left such paths out, or counted them in full, would be
-// a share of the indirect light off.
-TEST(Bpm, CombinedEstimatorsCountPointLightPathsOnce) {
+// The test box with its ceiling light replaced by `lights`, rendered by path and by bpm with few
+// photons over narrow discs: the combined image agrees with path's block by block and in its mean
+// within 4.5 sigma, and its pixels' error falls below the partition's; with the vertex connections
+// alone (partition) the merges at their targets count nothing and the image agrees with path's
+// too. A side that left the lights' paths out, or counted them in full, would be a share of the
+// indirect light off.
+void expect_lights_combined_once(const std::string& lights, const char* what) {
   std::string scene = cornell();
   const std::string area = "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [15 15 15]\n" +
                            quad(0.35f, 0.35f, 0.65f, 0.65f, 0.999f, true) + "AttributeEnd\n";
   ASSERT_NE(scene.find(area), std::string::npos);
-  scene.replace(scene.find(area), area.size(),
-                "LightSource \"spot\" \"rgb I\" [2 2 2] \"point3 from\" [0.5 0.95 0.5] \"point3 "
-                "to\" [0.5 0 0.5] \"float coneangle\" 50 \"float conedeltaangle\" 10\n"
-                "LightSource \"point\" \"rgb I\" [0.3 0.3 0.3] \"point3 from\" [0.2 0.9 0.3]\n");
+  scene.replace(scene.find(area), area.size(), lights);
   LoadedScene ls = load(scene);
   const Film ref = render_with(ls, "path", 2048).film;
   const BlockStats mr = block_stats(ref, 32)[0];
@@ -961,9 +956,8 @@ TEST(Bpm, CombinedEstimatorsCountPointLightPathsOnce) {
   const double ec = pixel_rms_error(c, ref.image()), ep = pixel_rms_error(p, ref.image());
   const BlockStats mc = image_mean(c);
   std::printf(
-      "point-like lights: pixel RMS error combined %.4f, partition %.4f; mean %.5f, path "
-      "%.5f (sigma %.5f)\n",
-      ec, ep, mc.mean, mr.mean, std::sqrt(mc.var + mr.var));
+      "%s: pixel RMS error combined %.4f, partition %.4f; mean %.5f, path %.5f (sigma %.5f)\n",
+      what, ec, ep, mc.mean, mr.mean, std::sqrt(mc.var + mr.var));
   EXPECT_LT(ec, 0.75 * ep) << "combined " << ec << ", partition " << ep;
   EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var));
 
@@ -973,11 +967,36 @@ TEST(Bpm, CombinedEstimatorsCountPointLightPathsOnce) {
   const Iterations v = render_seeds(ls, 6, 40, alone);
   expect_blocks_agree(v, ref, 8, edge_bias(alone, 40, 8), "vertex connections alone");
   const BlockStats mv = image_mean(v);
-  std::printf("vertex connections alone: mean %.5f, path %.5f (sigma %.5f)\n", mv.mean, mr.mean,
-              std::sqrt(mv.var + mr.var));
+  std::printf("%s, vertex connections alone: mean %.5f, path %.5f (sigma %.5f)\n", what, mv.mean,
+              mr.mean, std::sqrt(mv.var + mr.var));
   EXPECT_NEAR(mv.mean, mr.mean, 4.5 * std::sqrt(mv.var + mr.var));
   EXPECT_GT(v.last.details["light"]["vertex_hits"].get<uint64_t>(), 1000u);
   EXPECT_EQ(v.last.details["light"]["entries"].get<uint64_t>(), 0u);
+}
+
+// A point-like light's paths are combined as an area light's (merge_weights.h): the delta of its
+// position, in A0 and in B0 alike, is left out of both sides' densities, and no BSDF sample finds
+// it. The test box lit by a spot light under its ceiling, aimed at the floor, and a point light
+// beside it.
+TEST(Bpm, CombinedEstimatorsCountPointLightPathsOnce) {
+  expect_lights_combined_once(
+      "LightSource \"spot\" \"rgb I\" [2 2 2] \"point3 from\" [0.5 0.95 0.5] \"point3 to\" [0.5 0 "
+      "0.5] \"float coneangle\" 50 \"float conedeltaangle\" 10\n"
+      "LightSource \"point\" \"rgb I\" [0.3 0.3 0.3] \"point3 from\" [0.2 0.9 0.3]\n",
+      "point-like lights");
+}
+
+// Paths from lights at infinity are combined too: both sides count the light's end in the
+// direction's measure (the photon's entry disc turned into an area density at its first vertex;
+// a distant light's direction a delta both leave out; the sky found by next-event estimation and
+// by the BSDF samples that escape). The test box, open at its front, lit through it by a uniform
+// sky and a distant light.
+TEST(Bpm, CombinedEstimatorsCountPathsFromLightsAtInfinityOnce) {
+  expect_lights_combined_once(
+      "LightSource \"infinite\" \"rgb L\" [0.8 0.8 0.8]\n"
+      "LightSource \"distant\" \"rgb L\" [3 3 3] \"point3 from\" [0.5 2 -1] \"point3 to\" [0.5 0 "
+      "0.6]\n",
+      "lights at infinity");
 }
 
 // With --estimators auto the eye path goes on from a last vertex that is not glossy with a

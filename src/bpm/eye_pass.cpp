@@ -203,16 +203,45 @@ inline double merge_and_connection(double merge, const Continuation& c, double a
   return c.vertex_scale > 0 && a_x > 0 ? merge * (1 + c.vertex_scale / a_x) : merge;
 }
 
-// At e_j (v), next-event estimation of an area or point-like light, weighed against the BSDF
-// sample that could find it (an area light) and the merge at x.
+// The weight of light found by the BSDF sample that left e_(j-1) (c.prev_p): the point y of
+// light `li` (normal n; for a light at infinity, a point far along the sample's direction),
+// weighed against next-event estimation there and the merge at x.
+inline double found_light_weight(const RenderScene& scene, const Continuation& c, int li, Vec3 y,
+                                 Vec3 n) {
+  const Light& light = scene.lights[size_t(li)];
+  const Vec3 d = y - c.prev_p;
+  const float len = length(d);
+  if (!(len > 0)) return 0;
+  const double b_bsdf = light_end_density(light, c.pdf_prev, c.prev_p, y, n);
+  const double b_light = light_sample_density(scene, li, c.prev_p, y, n);
+  const double merge = c.ratio * emission_density(scene, li, y, n, -d / len, c.prev_p, c.prev_n);
+  return b_bsdf / (b_bsdf + b_light + merge_and_connection(merge, c, c.a_x));
+}
+
+// The environment lights found by the BSDF sample that left e_(j-1) and escaped along dir, weighed
+// as found_light_weight says.
+inline Spectrum found_environment(const RenderScene& scene, const Continuation& c, Vec3 dir,
+                                  const Wavelengths& wl) {
+  Spectrum L;
+  const Vec3 far = c.prev_p + dir * (2 * scene.bounds_info.radius);
+  for (const int li : scene.infinite_lights) {
+    const Spectrum Le = environment_radiance(scene.lights[size_t(li)], dir, wl);
+    const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, far, Vec3());
+    if (std::isfinite(w) && w > 0) L += Le * float(w);
+  }
+  return L;
+}
+
+// At e_j (v), next-event estimation of a light, weighed against the BSDF sample that could find
+// it (an area or environment light) and the merge at x.
 inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v, const PathState& s,
                                        const Continuation& c) {
   const RenderScene& scene = path.scene;
   const auto sample = sample_light_at(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local,
                                       *path.prm.materials, path.rng, path.counters.rays);
-  // Distant and infinite lights are not combined: the merge's.
-  if (!sample || !combinable_light(scene.lights[size_t(sample->light)])) return {};
+  if (!sample) return {};
   const int li = sample->light;
+  const Light& light = scene.lights[size_t(li)];
   const LightLiSample* ls = &sample->ls;
   const Vec3 wi_local = sample->wi_local;
   Spectrum f = sample->f;
@@ -221,19 +250,19 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
       bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
   if (!(g > 0)) return {};
   f *= g;
-  // A point-like light: next-event estimation's density and the emission's without their
-  // position's delta, and none for the BSDF sample (n_light is zero).
+  // A delta light: next-event estimation's density and the emission's without their delta, and
+  // none for the BSDF sample.
   const double b_light = light_sample_density(scene, li, v.sp.p, ls->p_light, ls->n_light);
   const double b_bsdf =
-      area_density(bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance), v.sp.p,
-                   ls->p_light, ls->n_light);
+      light_end_density(light, bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance),
+                        v.sp.p, ls->p_light, ls->n_light);
   // The photon's densities: the light's point and direction, e_j from there, e_(j-1) from e_j.
   const double a_prev = double(g) *
                         bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kImportance) *
                         c.cos_prev / c.d2;
   const double merge =
       c.ratio * a_prev *
-      area_density(emission_density(scene, li, ls->n_light, -ls->wi), ls->p_light, v.sp.p, v.sp.ng);
+      emission_density(scene, li, ls->p_light, ls->n_light, -ls->wi, v.sp.p, v.sp.ng);
   const double others = merge_and_connection(merge, c, c.a_x > 0 ? c.a_x : a_prev);
   const double w = b_light / (b_light + b_bsdf + others);
   if (!std::isfinite(w)) return {};
@@ -297,6 +326,8 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     PathVertex& e = vertices[j & 1];
     Spectrum none;
     const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, EmitterWeight::none(), none);
+    if (end == StepEnd::kEscaped && j > 1)
+      L += s.beta * found_environment(scene, c, s.ray.d, wm.wl);
     if (end != StepEnd::kVertex) break;
     const Vec3 d = e.sp.p - c.prev_p;
     c.d2 = double(length_squared(d));
@@ -310,12 +341,8 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     if (j > 1 && li >= 0) {
       const Spectrum Le = area_light_radiance(std::get<AreaLight>(scene.lights[size_t(li)]),
                                               e.sp.ng, e.sp.uv, -s.ray.d, wm.wl);
-      const double b_bsdf = c.pdf_prev * cos_here / c.d2;
-      const double b_light = light_sample_density(scene, li, c.prev_p, e.sp.p, e.sp.ng);
-      const double merge =
-          c.ratio * emission_density(scene, li, e.sp.ng, d / float(len)) * c.cos_prev / c.d2;
-      const double w = b_bsdf / (b_bsdf + b_light + merge_and_connection(merge, c, c.a_x));
-      if (!Le.is_black() && std::isfinite(w)) L += s.beta * Le * float(w);
+      const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, e.sp.p, e.sp.ng);
+      if (std::isfinite(w) && w > 0) L += s.beta * Le * float(w);
     }
     // Paths of j vertices between the light and x: within the merge's depth.
     if (depth + j > path.prm.max_depth || !combinable_vertex(e) || e.wo_local.z == 0) break;

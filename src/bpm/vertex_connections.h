@@ -1,14 +1,14 @@
 // Vertex connection (Georgiev et al. 2012; docs/METHOD.md, "Vertex connections"): a photon's
-// vertex z on a surface with gathered lobes, reached through such vertices only from an area or a
-// point-like light (a path that may be combined, photons/merge_weights.h), is joined by a shadow
-// ray to the last diffuse vertex x of the eye path of a pixel drawn uniformly from the image's P
-// pixels (that eye path's target backward photon, BackwardPhoton::vertex_target). The light path
-// y0 .. z, x is then made three ways, each weighed by its density over the sum (the balance
-// heuristic): the connection, with density N / P A0 .. Am per iteration (N photons, z = z_m); the
-// merge at x, N A0 .. A(m+1) pi r^2; the eye path's continuation from x, 2^-level B0 .. Bm.
-// Against the merge the connection's density is 1 / (pi r^2 P A(m+1)), A(m+1) the adjoint BSDF's
-// density at z of the way to x as an area density at x: the merge, the continuation
-// (continue_eye_path) and the connection each add that term.
+// vertex z on a surface with gathered lobes, reached through such vertices only (a path that may
+// be combined, photons/merge_weights.h), is joined by a shadow ray to the last diffuse vertex x of
+// the eye path of a pixel drawn uniformly from the image's P pixels (that eye path's target
+// backward photon, BackwardPhoton::vertex_target). The light path y0 .. z, x is then made three
+// ways, each weighed by its density over the sum (the balance heuristic): the connection, with
+// density N / P A0 .. Am per iteration (N photons, z = z_m); the merge at x, N A0 .. A(m+1)
+// pi r^2; the eye path's continuation from x, 2^-level B0 .. Bm. Against the merge the
+// connection's density is 1 / (pi r^2 P A(m+1)), A(m+1) the adjoint BSDF's density at z of the
+// way to x as an area density at x: the merge, the continuation (continue_eye_path) and the
+// connection each add that term.
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -10,44 +10,64 @@ bool combinable_vertex(const PathVertex& v) {
          !std::holds_alternative<PhongMaterial>(v.m());
 }
 
-bool combinable_light(const Light& l) {
-  return std::holds_alternative<AreaLight>(l) ||
-         (light_is_delta(l) && !std::holds_alternative<DistantLight>(l));
+namespace {
+// The area of the disc through which photons from a light at infinity enter (infinite_lights.cpp).
+double entry_disc_area(const RenderScene& scene) {
+  const double r = double(scene.bounds_info.radius);
+  return kPi * r * r;
 }
+}  // namespace
 
-double emission_density(const RenderScene& scene, int light, Vec3 n, Vec3 w) {
+double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w, Vec3 p,
+                        Vec3 n_p) {
   const Light& l = scene.lights[size_t(light)];
   const double pmf = double(scene.light_distribution.pmf(light));
-  // A point-like light: its direction's density alone (its position's delta left out).
-  if (const auto pdf = point_light_pdf_le(l, w)) return pmf * double(*pdf);
-  const auto* area = std::get_if<AreaLight>(&l);
-  if (!area || !(area->area > 0)) return 0;
-  // Cosine-weighted about the normal (sample_le_of); a two-sided light picks its side first.
-  const double side = area->two_sided ? 0.5 : 1.0;
-  return pmf / double(area->area) * side * std::fabs(double(dot(n, w))) * kInvPi;
+  if (light_is_infinite(l)) {
+    // A point of the entry disc (uniform, perpendicular to w) and w itself: the disc's area density
+    // is |cos| at p over its area; w's density is a delta for a distant light (left out, as in
+    // light_sample_density), the environment's own sampling's otherwise.
+    const double dir = light_is_delta(l) ? 1.0 : double(light_pdf_li(l, nullptr, p, -w, y, Vec3()));
+    return pmf * dir * std::fabs(double(dot(n_p, w))) / entry_disc_area(scene);
+  }
+  double a = 0;  // A0 times A1's solid-angle density at y
+  if (const auto pdf = point_light_pdf_le(l, w)) {
+    // A point-like light: its direction's density alone (its position's delta left out).
+    a = pmf * double(*pdf);
+  } else if (const auto* area = std::get_if<AreaLight>(&l); area && area->area > 0) {
+    // Cosine-weighted about the normal (sample_le_of); a two-sided light picks its side first.
+    const double side = area->two_sided ? 0.5 : 1.0;
+    a = pmf / double(area->area) * side * std::fabs(double(dot(n, w))) * kInvPi;
+  }
+  return area_density(a, y, p, n_p);
+}
+
+double light_end_density(const Light& l, double pdf_solid_angle, Vec3 p, Vec3 y, Vec3 n) {
+  if (light_is_delta(l)) return 0;
+  if (light_is_infinite(l)) return pdf_solid_angle;
+  return area_density(pdf_solid_angle, p, y, n);
 }
 
 double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n) {
   const Light& l = scene.lights[size_t(light)];
   const double pmf = double(scene.light_distribution.pmf(light));
-  if (!combinable_light(l)) return 0;
-  // A point-like light: its delta left out, as emission_density leaves out its own.
-  if (!std::holds_alternative<AreaLight>(l)) return pmf;
+  // A point-like or distant light: its delta left out, as emission_density leaves out its own.
+  if (light_is_delta(l)) return pmf;
   const Vec3 d = y - p;
   const float len = length(d);
   if (!(len > 0)) return 0;
-  return area_density(pmf * double(light_pdf_li(l, scene.light_shape(l), p, d / len, y, n)), p, y,
-                      n);
+  return light_end_density(l, pmf * double(light_pdf_li(l, scene.light_shape(l), p, d / len, y, n)),
+                           p, y, n);
 }
 
 void PhotonMis::start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w) {
-  const double e = emission_density(scene, light, n, w);
-  on_ = e > 0;
-  if (!on_) return;
-  r_ = 1 / e;
+  const Light& l = scene.lights[size_t(light)];
+  on_ = true;
   light_ = light;
   y_ = prev_ = y;
   n_y_ = prev_n_ = n;
+  w_ = w;
+  at_infinity_ = light_is_infinite(l);
+  delta_ = light_is_delta(l);
 }
 
 void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
@@ -59,13 +79,28 @@ void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
     return;
   }
   const double len = std::sqrt(d2);
-  // The area part of A_k, and the segment's cosine at its start for B_(k-1).
-  r_ /= std::fabs(double(dot(v.sp.ng, d))) / (len * d2);
-  seg_cos_ = std::fabs(double(dot(prev_n_, d))) / len;
-  seg_d2_ = d2;
+  const double to_area = std::fabs(double(dot(v.sp.ng, d))) / (len * d2);
   k_ = k;
-  arrival_ = k == 1 ? 0.0 : a_ * std::fabs(double(dot(v.sp.ng, d))) / (len * d2);
-  if (k == 1) b0_ = light_sample_density(scene, light_, v.sp.p, y_, n_y_);
+  if (k == 1) {
+    // A0 A1 as an area density here; B0 from here.
+    r_ = 1 / emission_density(scene, light_, y_, n_y_, w_, v.sp.p, v.sp.ng);
+    b0_ = light_sample_density(scene, light_, v.sp.p, y_, n_y_);
+    arrival_ = 0;
+  } else {
+    // The area part of A_k.
+    r_ /= to_area;
+    arrival_ = a_ * to_area;
+  }
+  // The segment's factor for B_(k-1): the eye's solid-angle density at v toward the vertex before,
+  // turned into that vertex's measure (a light at infinity: the direction itself; none for a
+  // delta light, which no BSDF sample finds).
+  if (k == 1 && at_infinity_) {
+    seg_cos_ = delta_ ? 0.0 : 1.0;
+    seg_d2_ = 1;
+  } else {
+    seg_cos_ = std::fabs(double(dot(prev_n_, d))) / len;
+    seg_d2_ = d2;
+  }
   if (!combinable_vertex(v) || !std::isfinite(r_)) on_ = false;
 }
 

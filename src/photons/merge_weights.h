@@ -12,16 +12,18 @@
 //                                                 keeps the weights summing to one), N photons per
 //                                                 iteration
 //   continuation:  B0 B1 ... Bm                    the eye's: zm from x, z(k-1) from zk by the
-//   BSDF,
-//                                                 y0 by next-event estimation or by the BSDF (B0 is
-//                                                 the sum of the two)
+//                                                 BSDF, y0 by next-event estimation or by the BSDF
+//                                                 (B0 is the sum of the two)
 // The emission densities are the unguided ones (lights by power, uniform points, cosine
 // directions): guided emission changes the photons' weights, not what they are weighed against.
-// Only paths whose light is an area light or point-like (combinable_light; a point-like light's
-// position is a delta that both sides leave out) and whose vertices z all have gathered lobes only
-// (on a surface, not a curve) are combined; every other path stays the merge's alone, and the
-// continuation leaves it out. Both passes compute the same products, each from its own end of the
-// path, so that the weights of a path sum to one.
+// Every light combines: an area light's point is an area density; a point-like light's position
+// (point, spot, goniometric, projection) is a delta that both sides leave out, and no BSDF sample
+// finds it; a light at infinity starts its path with a direction, in whose solid-angle measure
+// both sides count y0 (the photon's entry disc's density turned into an area density at z1), the
+// direction of a distant light again a delta left out. Only paths whose vertices z all have
+// gathered lobes only (on a surface, not a curve) are combined; every other path stays the
+// merge's alone, and the continuation leaves it out. Both passes compute the same products, each
+// from its own end of the path, so that the weights of a path sum to one.
 #pragma once
 #include <cmath>
 
@@ -29,11 +31,6 @@
 #include "scene/render_scene.h"
 
 namespace bpm {
-
-// Whether a combined path may start on l: an area light, or a point-like one (point, spot,
-// goniometric, projection), whose position's delta both sides leave out of their densities (it
-// cancels in every ratio) and which no BSDF sample finds.
-bool combinable_light(const Light& l);
 
 // Whether a combined path may pass through v: a surface (not a curve) with gathered lobes, not
 // Phong's (whose sampling is not reciprocal). Where a coat splits (BsdfPart), only the share of
@@ -51,15 +48,22 @@ inline double area_density(double pdf_solid_angle, Vec3 from, Vec3 to, Vec3 n_to
   return pdf_solid_angle * std::fabs(double(dot(n_to, d))) / (d2 * std::sqrt(d2));
 }
 
-// A0 times the solid-angle density of A1 for light `light` (unguided emission: the light by
-// power; on an area light a uniform point and a cosine-weighted direction): the density of
-// emitting along the unit direction w from a point of geometric normal n; for a point-like light
-// the light's and its direction's alone; 0 for other lights.
-double emission_density(const RenderScene& scene, int light, Vec3 n, Vec3 w);
+// A0 A1 as an area density at p (of geometric normal n_p): the density of unguided emission (the
+// light by power; on an area light a uniform point and a cosine-weighted direction) of leaving
+// light `light` at y (geometric normal n, zero without a surface) along the unit direction w and
+// arriving at p; for a point-like light without its position's delta; for a light at infinity
+// the entry disc's density at p times that of the direction (a distant light's left out).
+double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w, Vec3 p,
+                        Vec3 n_p);
+
+// A solid-angle density at p of the direction toward the point y (normal n) of light l, in the
+// measure in which both sides count y: an area density at y; a light at infinity's direction
+// itself; 0 for a delta light (no BSDF sample finds it).
+double light_end_density(const Light& l, double pdf_solid_angle, Vec3 p, Vec3 y, Vec3 n);
 
 // B0 by next-event estimation from p (sample_direct_light: the light by power, then its own
-// sampling) of the point y on area light `light`, of geometric normal n: an area density; for a
-// point-like light the light's density alone.
+// sampling) of the point y (normal n) on light `light`, in light_end_density's measure; for a
+// delta light (point-like or distant) the light's probability alone.
 double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n);
 
 // The running products of a photon's path (the light pass's side): after its k-th vertex z_k,
@@ -67,8 +71,8 @@ double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y,
 // it leaves one; merge_factor() is what a merge at a backward photon needs of it.
 class PhotonMis {
  public:
-  // The photon leaves light `light` at y, of geometric normal n (zero for a point-like light),
-  // along the unit direction w. A light that combinable_light refuses: not combined.
+  // The photon leaves light `light` at y, of geometric normal n (zero without a surface), along
+  // the unit direction w.
   void start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w);
   // The photon arrives at its k-th vertex v (k from 1).
   void arrive(const RenderScene& scene, const PathVertex& v, int k);
@@ -97,7 +101,8 @@ class PhotonMis {
   double r_ = 0, b0_ = 0;
   double a_ = 0, arrival_ = 0;  // the solid-angle A of the last scatter; the area A of the arrival
   int light_ = -1, k_ = 0;
-  Vec3 y_, n_y_;                     // the light's point and normal
+  Vec3 y_, n_y_, w_;  // the light's point and normal, the emission's direction
+  bool at_infinity_ = false, delta_ = false;
   Vec3 prev_, prev_n_;               // the vertex before the current one, and its geometric normal
   double seg_cos_ = 0, seg_d2_ = 1;  // |cos| at prev toward the current vertex, squared distance
 };
