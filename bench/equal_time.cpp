@@ -7,7 +7,7 @@
 // Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
 // (references by bpm), lamp-room, room2, shelf-room, kitchen, fog (reference by path),
 // spot-lens-fog, underwater (references by bpm), smoke (a uniformgrid medium; reference by path),
-// the Cornell box
+// courtyard (sky and sun over a large ground; reference by path), the Cornell box
 // (../shared's at 256x256 when present, else ours) and, when ../shared has them, the staircase2
 // stand-in at 256x256 and other shared scenes (references by path), and volumetric-caustic at
 // 256x256 (reference by bpm). In scenes with media pbrt-v4 renders with volpath and bdpt (its path
@@ -73,6 +73,7 @@ std::vector<SceneEntry> default_scenes() {
       {"spot-lens-fog", ours + "spot-lens-fog.pbrt", "bpm"},
       {"underwater", ours + "underwater.pbrt", "bpm"},
       {"smoke", ours + "smoke.pbrt", "path"},
+      {"courtyard", ours + "courtyard.pbrt", "path"},
   };
   if (fs::exists(shared_cornell))
     s.push_back({"cornell-box", shared_cornell.lexically_normal().string(), "path", "256x256"});
