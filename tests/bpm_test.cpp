@@ -999,6 +999,15 @@ TEST(Bpm, CombinedEstimatorsCountPathsFromLightsAtInfinityOnce) {
       "lights at infinity");
 }
 
+// The same for an environment image, whose direction density is its own sampling's (a gradient
+// with two bright patches of a few texels: one lights the box through its open front).
+TEST(Bpm, CombinedEstimatorsCountPathsFromAnEnvironmentImageOnce) {
+  const std::string exr = test::write_environment_exr("bpm_combined_env", 16, 16);
+  expect_lights_combined_once("LightSource \"infinite\" \"string filename\" \"" + exr + "\"\n",
+                              "environment image");
+  std::filesystem::remove(exr);
+}
+
 // With --estimators auto the eye path goes on from a last vertex that is not glossy with a
 // probability each pixel chooses (continue_level): its light over the probability, its density
 // times it in the weights on both sides. With many photons over wide discs the merges take nearly

@@ -16,6 +16,7 @@ namespace {
 
 using test::load;
 using test::render_film;
+using test::write_environment_exr;
 
 // A convex diffuse object under a uniform environment L sees L over its whole hemisphere, so it
 // reflects exactly rho * L; the background shows L.
@@ -328,34 +329,6 @@ TEST(Integrators, AlphaMasksLetLightThrough) {
       EXPECT_NEAR(sum_diff, 0, 4 * std::sqrt(sum_var) + 1e-3) << c.name << " " << integrator;
     }
   }
-}
-
-// An environment image written to a temporary EXR: a dim gradient, a bright patch in the upper
-// hemisphere of the light's frame and a brighter one below it.
-std::string write_environment_exr(const std::string& name, int width, int height) {
-  Image env;
-  env.width = width;
-  env.height = height;
-  env.rgb.resize(size_t(width) * height * 3);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      float* t = &env.rgb[(size_t(y) * width + x) * 3];
-      t[0] = 0.3f + 0.4f * x / width;
-      t[1] = 0.2f + 0.3f * y / height;
-      t[2] = 0.5f;
-    }
-  auto patch = [&](int x0, int y0, float v) {
-    for (int y = y0; y < y0 + 2; ++y)
-      for (int x = x0; x < x0 + 2; ++x)
-        for (int c = 0; c < 3; ++c) env.rgb[(size_t(y) * width + x) * 3 + c] = v;
-  };
-  patch(width / 2 + 1, height / 2 - 3,
-        30);                  // upper hemisphere (near the square's centre, or the top rows)
-  patch(0, height - 2, 100);  // lower hemisphere (a corner, or the bottom rows)
-  std::filesystem::path path =
-      std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".exr");
-  write_exr(path.string(), env);
-  return path.string();
 }
 
 // A diffuse plane (rho = 0.5) facing the light's +z under an environment image normalised by

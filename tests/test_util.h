@@ -1,12 +1,14 @@
 // Helpers shared by the scene-level tests.
 #pragma once
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <string>
 
 #include "film/film.h"
+#include "film/image_io.h"
 #include "render/renderer.h"
 #include "scene/flatten.h"
 #include "scene/parsed_scene.h"
@@ -80,6 +82,34 @@ Translate 0 0.4 0.4
 Shape "sphere" "float radius" 0.4
 AttributeEnd
 )";
+}
+
+// An environment image written to a temporary EXR: a dim gradient, a bright patch in the upper
+// hemisphere of the light's frame and a brighter one below it.
+inline std::string write_environment_exr(const std::string& name, int width, int height) {
+  Image env;
+  env.width = width;
+  env.height = height;
+  env.rgb.resize(size_t(width) * height * 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float* t = &env.rgb[(size_t(y) * width + x) * 3];
+      t[0] = 0.3f + 0.4f * x / width;
+      t[1] = 0.2f + 0.3f * y / height;
+      t[2] = 0.5f;
+    }
+  auto patch = [&](int x0, int y0, float v) {
+    for (int y = y0; y < y0 + 2; ++y)
+      for (int x = x0; x < x0 + 2; ++x)
+        for (int c = 0; c < 3; ++c) env.rgb[(size_t(y) * width + x) * 3 + c] = v;
+  };
+  patch(width / 2 + 1, height / 2 - 3,
+        30);                  // upper hemisphere (near the square's centre, or the top rows)
+  patch(0, height - 2, 100);  // lower hemisphere (a corner, or the bottom rows)
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".exr");
+  write_exr(path.string(), env);
+  return path.string();
 }
 
 // The folder with the public scenes and pbrt-v4 references, or "" when absent.
