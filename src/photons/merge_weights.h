@@ -80,7 +80,9 @@ class PhotonMis {
   // not.
   void scatter(const PathVertex& v, Vec3 wi, bool traced, int k);
   // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
-  // the vertex before over the squared distance, so that the merge's weight is
+  // the vertex before over the squared distance (the factor that turns the eye's solid-angle
+  // density into the measure of that vertex; merges start at the second), so that the merge's
+  // weight is
   // 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density at x of the photon's
   // direction. 0: not combined (the merge counts the path in full).
   float merge_factor() const { return on_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
@@ -103,8 +105,10 @@ class PhotonMis {
   int light_ = -1, k_ = 0;
   Vec3 y_, n_y_, w_;  // the light's point and normal, the emission's direction
   bool at_infinity_ = false, delta_ = false;
-  Vec3 prev_, prev_n_;               // the vertex before the current one, and its geometric normal
-  double seg_cos_ = 0, seg_d2_ = 1;  // |cos| at prev toward the current vertex, squared distance
+  Vec3 prev_, prev_n_;  // the vertex before the current one, and its geometric normal
+  // |cos| at prev toward the current vertex and their squared distance; from a light at infinity
+  // to the first vertex 1 and 1 (the direction's own measure; 0 and 1 for a distant light).
+  double seg_cos_ = 0, seg_d2_ = 1;
 };
 
 }  // namespace bpm
