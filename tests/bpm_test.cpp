@@ -1785,6 +1785,40 @@ TEST(Bpm, ContinueLevelBalancesVarianceAndCost) {
   EXPECT_EQ(continue_level(SampleStats<double>{}, 10, v, 100), 0);
 }
 
+// A pixel whose own few continuations found nothing borrows its neighbours' (the rare light they
+// found) and goes on more often; the rest of its statistics stay its own.
+TEST(Bpm, ContinueLevelCountsTheNeighboursContinuations) {
+  constexpr int w = 4, h = 3;
+  constexpr int c = SampleStats<double>::kContinued;
+  std::vector<SampleStats<double>> stats(w * h);
+  for (size_t p = 0; p < stats.size(); ++p) {
+    stats[p].v[c] = 100;
+    stats[p].v[c + 3] = 6;      // continuations taken
+    stats[p].v[c + 5] = 6 * 4;  // 4 rays each
+    stats[p].v[0] = double(p);  // another statistic, kept per pixel
+  }
+  // Pixel (1, 1) found no light; one neighbour (2, 2) found some, another pixel far off (3, 0)
+  // too. Sums of X / q and of X^2: one continuation of light 2 at q = 1/16.
+  const size_t lone = 1 * w + 1, near = 2 * w + 2, far = 0 * w + 3;
+  for (size_t p : {near, far}) {
+    stats[p].v[c + 1] = 32;
+    stats[p].v[c + 2] = 32 * 32;
+    stats[p].v[c + 4] = 4;
+  }
+  const SampleStats<double> s = with_neighbours_continuations(stats, w, h, lone);
+  EXPECT_EQ(s.v[c + 3], 9 * 6);
+  EXPECT_EQ(s.v[c + 4], 4);  // the neighbour's, not the far pixel's
+  EXPECT_EQ(s.v[c + 5], 9 * 6 * 4);
+  EXPECT_EQ(s.v[c], 900);
+  EXPECT_EQ(s.v[0], double(lone));
+  // At the image's corner, four pixels.
+  EXPECT_EQ(with_neighbours_continuations(stats, w, h, 0).v[c + 3], 4 * 6);
+  // Alone the pixel would take the least probability; with its neighbours a larger one.
+  const double v = 1;
+  EXPECT_EQ(continue_level(stats[lone], 10, v, 4), kMaxContinueLevel);
+  EXPECT_LT(continue_level(s, 10, v, 4), kMaxContinueLevel);
+}
+
 // pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon
 // count; sppm's default of -1 photons (one per pixel) keeps ours; a negative radius is an error.
 TEST(BpmSettings, SppmLineGivesDepth0ItsRadiusAndItsPhotons) {

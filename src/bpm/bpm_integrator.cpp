@@ -562,8 +562,9 @@ void BpmRender::set_sample_counts() {
     eye_.direct_samples[p] =
         uint16_t(direct_sample_count(st, n, std::max(0.0, variance), direct, s_.direct_samples));
     if (combined() == CombineAt::kChosen)
-      eye_.continue_level[p] =
-          uint8_t(continue_level(st, n, std::max(0.0, variance), cost_sum_.base_rays()));
+      eye_.continue_level[p] = uint8_t(continue_level(
+          with_neighbours_continuations(eye_.sample_stats, film_->width(), film_->height(), p), n,
+          std::max(0.0, variance), cost_sum_.base_rays()));
     eye_.lit_share[p] = st.lit_share();
   }
 }
