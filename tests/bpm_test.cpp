@@ -1786,8 +1786,9 @@ TEST(Bpm, ContinueLevelBalancesVarianceAndCost) {
 }
 
 // A pixel whose own few continuations found nothing borrows its neighbours' (the rare light they
-// found) and goes on more often; the rest of its statistics stay its own.
-TEST(Bpm, ContinueLevelCountsTheNeighboursContinuations) {
+// found) and goes on more often; so with its direct light's variance; the rest of its statistics
+// stay its own.
+TEST(Bpm, RareStatisticsCountThePixelsNeighbours) {
   constexpr int w = 4, h = 3;
   constexpr int c = SampleStats<double>::kContinued;
   std::vector<SampleStats<double>> stats(w * h);
@@ -1805,14 +1806,23 @@ TEST(Bpm, ContinueLevelCountsTheNeighboursContinuations) {
     stats[p].v[c + 2] = 32 * 32;
     stats[p].v[c + 4] = 4;
   }
-  const SampleStats<double> s = with_neighbours_continuations(stats, w, h, lone);
+  const SampleStats<double> s = with_neighbours_rare(stats, w, h, lone);
   EXPECT_EQ(s.v[c + 3], 9 * 6);
   EXPECT_EQ(s.v[c + 4], 4);  // the neighbour's, not the far pixel's
   EXPECT_EQ(s.v[c + 5], 9 * 6 * 4);
   EXPECT_EQ(s.v[c], 900);
   EXPECT_EQ(s.v[0], double(lone));
+  // The direct light's variances too (count and sum), not the pixel's own 1 / samples.
+  constexpr int d = SampleStats<double>::kDirect;
+  stats[near].v[d] = 3;
+  stats[near].v[d + 1] = 6;
+  stats[near].v[SampleStats<double>::kInverseSamples] = 5;
+  const SampleStats<double> sd = with_neighbours_rare(stats, w, h, lone);
+  EXPECT_EQ(sd.v[d], 3);
+  EXPECT_EQ(sd.direct_variance(), 2);
+  EXPECT_EQ(sd.v[SampleStats<double>::kInverseSamples], 0);
   // At the image's corner, four pixels.
-  EXPECT_EQ(with_neighbours_continuations(stats, w, h, 0).v[c + 3], 4 * 6);
+  EXPECT_EQ(with_neighbours_rare(stats, w, h, 0).v[c + 3], 4 * 6);
   // Alone the pixel would take the least probability; with its neighbours a larger one.
   const double v = 1;
   EXPECT_EQ(continue_level(stats[lone], 10, v, 4), kMaxContinueLevel);

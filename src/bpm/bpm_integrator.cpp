@@ -559,12 +559,13 @@ void BpmRender::set_sample_counts() {
     const double* m = moments_sum_.data() + PixelMoments::kValues * p;
     const double n = m[PixelMoments::kCount], sum = m[PixelMoments::kSum];
     const double variance = n < 2 ? 0.0 : (m[PixelMoments::kSquares] - sum * sum / n) / (n - 1);
-    eye_.direct_samples[p] =
-        uint16_t(direct_sample_count(st, n, std::max(0.0, variance), direct, s_.direct_samples));
+    const SampleStats<double> pooled =
+        with_neighbours_rare(eye_.sample_stats, film_->width(), film_->height(), p);
+    eye_.direct_samples[p] = uint16_t(
+        direct_sample_count(pooled, n, std::max(0.0, variance), direct, s_.direct_samples));
     if (combined() == CombineAt::kChosen)
-      eye_.continue_level[p] = uint8_t(continue_level(
-          with_neighbours_continuations(eye_.sample_stats, film_->width(), film_->height(), p), n,
-          std::max(0.0, variance), cost_sum_.base_rays()));
+      eye_.continue_level[p] =
+          uint8_t(continue_level(pooled, n, std::max(0.0, variance), cost_sum_.base_rays()));
     eye_.lit_share[p] = st.lit_share();
   }
 }

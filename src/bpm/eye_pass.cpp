@@ -675,16 +675,20 @@ int continue_level(const SampleStats<double>& s, double estimates, double estima
   return int(std::clamp(std::round(-std::log2(q)), 0.0, double(kMaxContinueLevel)));
 }
 
-SampleStats<double> with_neighbours_continuations(const std::vector<SampleStats<double>>& stats,
-                                                  int width, int height, size_t p) {
-  constexpr size_t kFirst = SampleStats<double>::kContinued, kLast = SampleStats<double>::kLit;
-  SampleStats<double> s = stats[p];
-  for (size_t k = kFirst; k < kLast; ++k) s.v[k] = 0;
+SampleStats<double> with_neighbours_rare(const std::vector<SampleStats<double>>& stats, int width,
+                                         int height, size_t p) {
+  using S = SampleStats<double>;
+  // The direct variances' count and sum; the continuations' six values.
+  constexpr size_t kPooled[] = {S::kDirect,        S::kDirect + 1,    S::kContinued,
+                                S::kContinued + 1, S::kContinued + 2, S::kContinued + 3,
+                                S::kContinued + 4, S::kContinued + 5};
+  S s = stats[p];
+  for (size_t k : kPooled) s.v[k] = 0;
   const int px = int(p % size_t(width)), py = int(p / size_t(width));
   for (int y = std::max(0, py - 1); y <= std::min(height - 1, py + 1); ++y)
     for (int x = std::max(0, px - 1); x <= std::min(width - 1, px + 1); ++x) {
-      const SampleStats<double>& n = stats[size_t(y) * size_t(width) + size_t(x)];
-      for (size_t k = kFirst; k < kLast; ++k) s.v[k] += n.v[k];
+      const S& n = stats[size_t(y) * size_t(width) + size_t(x)];
+      for (size_t k : kPooled) s.v[k] += n.v[k];
     }
   return s;
 }

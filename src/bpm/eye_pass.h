@@ -283,14 +283,16 @@ constexpr int kMaxContinueLevel = 4;
 int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
                    double base_rays);
 
-// Pixel p's statistics (of a width x height image) with those of its continuations summed over it
-// and its eight neighbours, for continue_level. The light a continuation finds is often rare and
-// bright (from an open floor, a wall that its BSDF samples seldom reach), so that a pixel's own
-// few continuations at a small q tend to miss it: its E[X^2] then reads too small, its q falls
-// further and it takes still fewer. Its neighbours see nearly the same scene around them; nine
-// pixels' continuations estimate E[X^2] and c from nine times as many.
-SampleStats<double> with_neighbours_continuations(const std::vector<SampleStats<double>>& stats,
-                                                  int width, int height, size_t p);
+// Pixel p's statistics (of a width x height image) with those of its direct light's variance and
+// of its continuations summed over it and its eight neighbours, for direct_sample_count and
+// continue_level; the rest its own. What these measure is often rare: the light a continuation
+// finds (a wall that BSDF samples from an open floor seldom reach), a shadow's edge that one of a
+// pixel's direct samples crosses now and then. A pixel's own few samples tend to miss it, so that
+// its figure reads too small, and the rule then gives it fewer samples still (one direct sample
+// measures no variance at all). Its neighbours see nearly the same scene around them: nine pixels'
+// samples estimate it from nine times as many.
+SampleStats<double> with_neighbours_rare(const std::vector<SampleStats<double>>& stats, int width,
+                                         int height, size_t p);
 
 // What the eye pass leaves per pixel for the accumulation (stage 4) and the masks.
 struct EyePixels {
