@@ -1821,8 +1821,10 @@ TEST(Bpm, RareStatisticsCountThePixelsNeighbours) {
   EXPECT_EQ(sd.v[d], 3);
   EXPECT_EQ(sd.direct_variance(), 2);
   EXPECT_EQ(sd.v[SampleStats<double>::kInverseSamples], 0);
-  // At the image's corner, four pixels.
-  EXPECT_EQ(with_neighbours_rare(stats, w, h, 0).v[c + 3], 4 * 6);
+  // At the image's corners, four pixels; at an edge, six.
+  for (size_t corner : {size_t(0), size_t(w - 1), size_t(w * h - w), size_t(w * h - 1)})
+    EXPECT_EQ(with_neighbours_rare(stats, w, h, corner).v[c + 3], 4 * 6) << corner;
+  EXPECT_EQ(with_neighbours_rare(stats, w, h, 1).v[c + 3], 6 * 6);
   // Alone the pixel would take the least probability; with its neighbours a larger one.
   const double v = 1;
   EXPECT_EQ(continue_level(stats[lone], 10, v, 4), kMaxContinueLevel);

@@ -290,7 +290,8 @@ int continue_level(const SampleStats<double>& s, double estimates, double estima
 // pixel's direct samples crosses now and then. A pixel's own few samples tend to miss it, so that
 // its figure reads too small, and the rule then gives it fewer samples still (one direct sample
 // measures no variance at all). Its neighbours see nearly the same scene around them: nine pixels'
-// samples estimate it from nine times as many.
+// samples (six at an edge, four at a corner) estimate it from that many times as many. Pooled are
+// the sums themselves, so that a pooled variance also holds the spread between the pixels' means.
 SampleStats<double> with_neighbours_rare(const std::vector<SampleStats<double>>& stats, int width,
                                          int height, size_t p);
 
