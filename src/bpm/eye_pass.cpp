@@ -157,19 +157,22 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
 // Direct light at the last diffuse vertex, where the path ends: the mean of path.direct_samples
 // samples, each next-event estimation and a BSDF sample that only looks for the light, shared by
 // MIS (none where every light is a point or a direction: those next-event estimation counts in
-// full). The samples beyond the first are counted apart, and the sample variance of two or more
-// goes to path.direct_variance.
+// full). Where the eye path went on from v, its first BSDF sample is the first sample's
+// (`first_found`: the light it found, weighed so). The samples beyond the first are counted
+// apart, and the sample variance of two or more goes to path.direct_variance.
 inline Spectrum direct_light_at_last(const EyePath& path, const PathVertex& v, const PathState& s,
-                                     BsdfPart part) {
+                                     BsdfPart part, const Spectrum* first_found) {
   const int n = path.direct_samples;
   uint64_t first_rays = 0;  // the rays counted after the first sample
   Spectrum sum;
   double mean = 0, m2 = 0;  // Welford's running mean and squared deviations
   for (int k = 0; k < n; ++k) {
     if (k == 1) first_rays = path.counters.rays.total();
-    const Spectrum d = direct_light_at(path, v, s, part) +
-                       direct_light_by_bsdf(path.scene, *path.prm.materials, v, s, part, path.rng,
-                                            path.counters.rays);
+    const Spectrum d =
+        direct_light_at(path, v, s, part) +
+        (k == 0 && first_found ? *first_found
+                               : direct_light_by_bsdf(path.scene, *path.prm.materials, v, s, part,
+                                                      path.rng, path.counters.rays));
     sum += d;
     const double x = d.average(), delta = x - mean;
     mean += delta / (k + 1);
@@ -269,6 +272,24 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
   return s.beta * f * ls->radiance * float(w / (double(sample->pmf) * ls->pdf_solid_angle));
 }
 
+// Past e_1 (j > 1), at e_(j-1) = v left along wi with the throughput `beta`: the photons' gathered
+// share at v, arriving from e_j, then Russian roulette on the change of throughput; false where the
+// path ends, else s.beta and c updated (c.ratio times A of e_(j-2), x at j = 2, from v).
+inline bool survives_past(const PathVertex& v, Vec3 wi, Spectrum beta, int j, Rng& rng,
+                          PathState& s, Continuation& c) {
+  const float g = bsdf_gathered_probability(v.m(), wi, v.wo_local, TransportMode::kImportance);
+  if (!(g > 0)) return false;
+  beta *= g;
+  const float q = std::fmax(0.0f, 1 - beta.max_component() / s.beta.max_component());
+  if (rng.uniform() < q) return false;
+  s.beta = beta / (1 - q);
+  const double a =
+      double(g) * bsdf_pdf(v.m(), wi, v.wo_local, TransportMode::kImportance) * c.cos_prev / c.d2;
+  c.ratio *= a;
+  if (j == 2) c.a_x = a;
+  return true;
+}
+
 // Indirect light at the last diffuse vertex x by the eye path's continuation (combined
 // estimators, photons/merge_weights.h): BSDF samples from x on, through vertices with gathered
 // lobes only, each finding lights by next-event estimation and by its BSDF sample, every
@@ -276,10 +297,17 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
 // (pi r^2 N; 0: none). The continuation goes on by Russian roulette on its change of
 // throughput. depth: x's scattering events, as the backward photon's eye_depth; part: the lobes x
 // gathers with (EyeVertexChoice). Past x each path is weighed by the share of it that photons
-// draw through gathered lobes (bsdf_gathered_probability: 1 but at split coats).
+// draw through gathered lobes (bsdf_gathered_probability: 1 but at split coats). Its first BSDF
+// sample is also the first of x's direct samples: the light it finds goes to first.found, weighed
+// as direct_light_by_bsdf weighs it, and first.shared says whether that sample would have cast
+// the ray itself (the ray is then the direct light's, not the continuation's, in its cost).
+struct FirstSample {
+  Spectrum found;
+  bool shared = false;
+};
 inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, BsdfPart part,
-                                  PathState s, int depth, double merge_density,
-                                  double vertex_scale) {
+                                  PathState s, int depth, double merge_density, double vertex_scale,
+                                  FirstSample& first) {
   const RenderScene& scene = path.scene;
   const WavelengthMaterials& wm = *path.prm.materials;
   PathCounters& rays = path.counters.rays;
@@ -297,35 +325,30 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     const Vec2 u{path.rng.uniform(), path.rng.uniform()};
     const BsdfPart lobes = j == 1 ? part : BsdfPart::kAll;
     const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, lobes);
-    if (!bs || bs->is_specular() || (j == 1 && bs->is_traced())) break;
-    Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
-    if (j > 1) {
-      // The photons' gathered share at v, arriving from e_j; then Russian roulette on the change
-      // of throughput.
-      const float g =
-          bsdf_gathered_probability(v.m(), bs->wi, v.wo_local, TransportMode::kImportance);
-      if (!(g > 0)) break;
-      beta *= g;
-      const float q = std::fmax(0.0f, 1 - beta.max_component() / s.beta.max_component());
-      if (path.rng.uniform() < q) break;
-      s.beta = beta / (1 - q);
-      // A of e_(j-2) (x at j = 2), from e_(j-1) = v, arriving from e_j.
-      const double a = double(g) * bsdf_pdf(v.m(), bs->wi, v.wo_local, TransportMode::kImportance) *
-                       c.cos_prev / c.d2;
-      c.ratio *= a;
-      if (j == 2) c.a_x = a;
-    } else {
+    if (!bs || bs->is_specular()) break;
+    // At x a traced lobe's sample only looks for the light, as the direct sample's would.
+    const bool look_only = j == 1 && bs->is_traced();
+    if (look_only && !scene.bsdf_finds_lights) break;
+    const Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+    if (j == 1)
       s.beta = beta;
-    }
+    else if (!survives_past(v, bs->wi, beta, j, path.rng, s, c))
+      break;
     if (s.beta.is_black() || !s.beta.is_finite()) break;
     c.pdf_prev = bsdf_pdf(v.m(), v.wo_local, bs->wi, TransportMode::kRadiance, lobes);
     c.prev_p = v.sp.p;
     c.prev_n = v.sp.ng;
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+    EmitterWeight found = EmitterWeight::none();
+    if (j == 1 && scene.bsdf_finds_lights) {
+      found = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+      first.shared = scene.may_reach_emitter(s.ray);
+    }
     ++rays.bounce_rays;
     PathVertex& e = vertices[j & 1];
     Spectrum none;
-    const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, EmitterWeight::none(), none);
+    const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, found, j == 1 ? first.found : none);
+    if (look_only) break;
     if (end == StepEnd::kEscaped && j > 1)
       L += s.beta * found_environment(scene, c, s.ray.d, wm.wl);
     if (end != StepEnd::kVertex) break;
@@ -364,9 +387,16 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
                                      Spectrum& L) {
   bool last = diffuse == path.prm.diffuse_depth + 1;
   // Direct light: before the last vertex shared by MIS with the BSDF sample that continues the
-  // path.
-  L += last ? direct_light_at_last(path, v, s, choice.part)
-            : direct_light_at(path, v, s, choice.part);
+  // path; at the last, once it is known whether the path goes on (the first direct sample's BSDF
+  // sample is then the continuation's).
+  if (!last) L += direct_light_at(path, v, s, choice.part);
+  FirstSample first;
+  bool continued = false;
+  const auto direct_at_last = [&] {
+    if (last)
+      L += direct_light_at_last(path, v, s, choice.part, continued ? &first.found : nullptr);
+    return last;
+  };
   const CombineAt at = path.prm.combine;
   bool go_on = last && at != CombineAt::kNowhere && combinable_vertex(v);
   // Where the gathered lobes are not glossy: with kChosen the pixel's probability
@@ -381,7 +411,7 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   const bool targeted_before = path.targeted;
   store_backward_photons(path, v, s, depth, diffuse, last, go_on ? &merge_density : nullptr,
                          uint8_t(level));
-  if (!go_on) return last;
+  if (!go_on) return direct_at_last();
   // The target of the vertex connections stored here: their density over the merge's is
   // 1 / (pi r^2 P A(x)), pi r^2 = merge_density / N.
   const double vertex_scale =
@@ -391,13 +421,15 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   if (chosen_here) path.continued.at_vertex = true;
   // Taken with the probability q: its density q B against the merge's, its light over q.
   const double q = std::ldexp(1.0, -level);
-  if (level > 0 && !(path.rng.uniform() < q)) return last;
+  if (level > 0 && !(path.rng.uniform() < q)) return direct_at_last();
   const uint64_t rays = path.counters.rays.total();
   const Spectrum c =
-      continue_eye_path(path, v, choice.part, s, depth, merge_density / q, vertex_scale);
+      continue_eye_path(path, v, choice.part, s, depth, merge_density / q, vertex_scale, first);
+  continued = true;
   L += c / float(q);
-  if (chosen_here) path.continued.add(c.average(), q, path.counters.rays.total() - rays);
-  return last;
+  if (chosen_here)
+    path.continued.add(c.average(), q, path.counters.rays.total() - rays - (first.shared ? 1 : 0));
+  return direct_at_last();
 }
 
 // The diffuse-th diffuse vertex, inside a scattering medium: direct light by next-event
