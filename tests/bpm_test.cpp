@@ -32,6 +32,7 @@
 #include <string>
 
 #include "base/error.h"
+#include "bpm/accumulate.h"
 #include "bpm/eye_pass.h"
 #include "bpm/light_pass.h"
 #include "camera/camera.h"
@@ -1646,6 +1647,34 @@ TEST(Bpm, EmissionSampleCountBalancesVarianceAndCost) {
   EXPECT_EQ(emission_sample_count(even, 0.0, 8), 1);  // an extra sample costs a whole iteration
   EXPECT_EQ(emission_sample_count(stats({0, 2, 0, 2}, {1, 1, 1}), 9.0, 8), 8);
   EXPECT_EQ(emission_sample_count(stats({2, 2, 2}, {1, 1, 1}), 9.0, 8), 1);
+}
+
+// The rate of iterations each pixel's error asks for: its relative error over the 90th
+// percentile's (ten pixels of mean 1 and standard errors 1 .. 10: the tenth is the reference), -1
+// for a pixel with one estimate; and the extra samples that follow it.
+TEST(Bpm, ExtraSamplesFollowTheRateThatAPixelsErrorAsksFor) {
+  std::vector<double> moments;
+  for (int i = 0; i < 10; ++i) {
+    // Four estimates of mean 1 whose sample variance is 4 (i + 1)^2: standard error i + 1.
+    const double a = 1 - 2 * (i + 1) * std::sqrt(0.75), b = 1 + 2 * (i + 1) * std::sqrt(0.75);
+    moments.insert(moments.end(), {2 * a + 2 * b, 2 * a * a + 2 * b * b, 0, 0, 4});
+  }
+  moments.insert(moments.end(), {1, 1, 0, 0, 1});
+  const std::vector<float> asked = asked_pass_rates(moments);
+  ASSERT_EQ(asked.size(), 11u);
+  for (int i = 0; i < 10; ++i) EXPECT_NEAR(asked[size_t(i)], 0.1 * (i + 1), 1e-5) << i;
+  EXPECT_EQ(asked[10], -1.0f);
+  // At or above the floor (0.1), unknown: the count as it is; below it, in proportion, at least 1.
+  EXPECT_EQ(at_asked_rate(8, 0.5f, 0.1f, false), 8);
+  EXPECT_EQ(at_asked_rate(8, 3.0f, 0.1f, false), 8);
+  EXPECT_EQ(at_asked_rate(8, -1.0f, 0.1f, false), 8);
+  EXPECT_EQ(at_asked_rate(8, 0.05f, 0.1f, false), 4);
+  EXPECT_EQ(at_asked_rate(8, 0.001f, 0.1f, false), 1);
+  // Emission alone: what the error asks for beyond one an iteration, within [1, count].
+  EXPECT_EQ(at_asked_rate(8, 0.3f, 0.1f, true), 1);
+  EXPECT_EQ(at_asked_rate(8, 2.6f, 0.1f, true), 3);
+  EXPECT_EQ(at_asked_rate(8, 20.0f, 0.1f, true), 8);
+  EXPECT_EQ(at_asked_rate(8, -1.0f, 0.1f, true), 8);
 }
 
 // Pixels within twice the filter's radius of one whose statistics of emission are known, and

@@ -152,4 +152,34 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
   });
 }
 
+std::vector<float> asked_pass_rates(const std::vector<double>& moments) {
+  const size_t n = moments.size() / PixelMoments::kValues;
+  std::vector<double> mean(n, 0.0), error(n, -1.0);  // error < 0: fewer than two estimates
+  double image_mean = 0;
+  for (size_t p = 0; p < n; ++p) {
+    const double* m = moments.data() + PixelMoments::kValues * p;
+    const double count = m[PixelMoments::kCount], sum = m[PixelMoments::kSum];
+    if (count < 2) continue;
+    mean[p] = std::fabs(sum / count);
+    const double variance =
+        std::max(0.0, (m[PixelMoments::kSquares] - sum * sum / count) / (count - 1));
+    error[p] = std::sqrt(variance / count);
+    image_mean += mean[p] / double(n);
+  }
+  std::vector<double> relative;
+  std::vector<double> rel(n, -1.0);
+  for (size_t p = 0; p < n; ++p)
+    if (error[p] >= 0)
+      relative.push_back(rel[p] = error[p] / (mean[p] + 0.01 * image_mean + 1e-12));
+  std::vector<float> asked(n, -1.0f);
+  if (relative.empty()) return asked;
+  const size_t k = std::min(relative.size() - 1, size_t(0.9 * double(relative.size())));
+  std::nth_element(relative.begin(), relative.begin() + ptrdiff_t(k), relative.end());
+  const double ref = relative[k];
+  if (!(ref > 0)) return asked;
+  for (size_t p = 0; p < n; ++p)
+    if (rel[p] >= 0) asked[p] = float(rel[p] / ref);
+  return asked;
+}
+
 }  // namespace bpm

@@ -546,10 +546,18 @@ std::pair<ExtraSampleCost, ExtraSampleCost> BpmRender::round_cost() const {
 void BpmRender::set_sample_counts() {
   const double emission = cost_sum_.ratio(ExtraSampleCost::kEmissionSamples),
                direct = cost_sum_.ratio(ExtraSampleCost::kDirectSamples);
+  // Under adaptive sampling the extra samples follow the rate of iterations each pixel's error
+  // asks for (at_asked_rate).
+  const std::vector<float> asked =
+      opt_.adaptive ? asked_pass_rates(moments_sum_) : std::vector<float>(n_pixels_, -1.0f);
+  const auto shared = [&](size_t p, int count, bool emission_alone = false) {
+    return uint16_t(at_asked_rate(count, asked[p], opt_.adaptive_floor, emission_alone));
+  };
   for (size_t p = 0; p < n_pixels_; ++p) {
     const SampleStats<double>& st = eye_.sample_stats[p];
     eye_.emission_samples[p] =
-        eye_.sees_emission[p] ? uint16_t(emission_sample_count(st, emission, s_.emission_samples))
+        eye_.sees_emission[p] ? shared(p, emission_sample_count(st, emission, s_.emission_samples),
+                                       st.rest_n() >= 2 && !(st.variance(st.kRest) > 0))
                               : 1;
   }
   lend_emission_samples(film_->width(), film_->height(), ls_.filter.radius, &eye_);
@@ -561,8 +569,8 @@ void BpmRender::set_sample_counts() {
     const double variance = n < 2 ? 0.0 : (m[PixelMoments::kSquares] - sum * sum / n) / (n - 1);
     const SampleStats<double> pooled =
         with_neighbours_rare(eye_.sample_stats, film_->width(), film_->height(), p);
-    eye_.direct_samples[p] = uint16_t(
-        direct_sample_count(pooled, n, std::max(0.0, variance), direct, s_.direct_samples));
+    eye_.direct_samples[p] = shared(
+        p, direct_sample_count(pooled, n, std::max(0.0, variance), direct, s_.direct_samples));
     if (combined() == CombineAt::kChosen)
       eye_.continue_level[p] =
           uint8_t(continue_level(pooled, n, std::max(0.0, variance), cost_sum_.base_rays()));

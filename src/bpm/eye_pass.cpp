@@ -649,6 +649,13 @@ int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int m
   return int(std::clamp(std::round(e), 1.0, double(max_samples)));
 }
 
+int at_asked_rate(int count, float asked, float floor, bool emission_alone) {
+  if (!(asked >= 0)) return count;
+  if (emission_alone) return int(std::clamp(std::round(asked), 1.0f, float(std::max(count, 1))));
+  if (!(floor > 0) || asked >= floor) return count;
+  return int(std::max(1.0f, std::round(float(count) * asked / floor)));
+}
+
 void lend_emission_samples(int w, int h, Vec2 filter_radius, EyePixels* px) {
   const int rx = int(std::ceil(2 * filter_radius.x)), ry = int(std::ceil(2 * filter_radius.y));
   // Each pixel's own count where it has its statistics (as emission_sample_count: both parts have

@@ -251,6 +251,17 @@ struct SampleStats {
 // samples, then max_samples while the cost ratio is unknown (negative).
 int emission_sample_count(const SampleStats<double>& s, double cost_ratio, int max_samples);
 
+// A pixel's count of extra samples (emission or direct, from the rules above) under adaptive
+// sampling, given the rate of iterations its error asks for (`asked`, asked_pass_rates in
+// bpm/accumulate.h; < 0: unknown, the count as it is) and the floor of its sampling probability.
+// The rules balance extra samples against the pixel's own iterations, whose rate its error sets;
+// where the floor samples it more often than that, it takes fewer in proportion (at least one).
+// A pixel whose estimate is its emission alone (`emission_alone`: the rest never varied; the sky,
+// a light against black) gains from extra samples nothing that more iterations of it would not
+// give at the same cost: it takes as many as its error asks for beyond one an iteration, which its
+// sampling probability (at most 1) cannot give, within [1, count].
+int at_asked_rate(int count, float asked, float floor, bool emission_alone);
+
 // A pixel's camera samples land within its filter's radius of its centre, so a pixel whose centre
 // lies within twice that radius (`filter_radius`, in pixels) of one that saw emission may see it
 // too: an emitter's edge, or a small bright emitter that its samples reach a few times in a
