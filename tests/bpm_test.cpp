@@ -1650,20 +1650,26 @@ TEST(Bpm, EmissionSampleCountBalancesVarianceAndCost) {
 }
 
 // The rate of iterations each pixel's error asks for: its relative error over the 90th
-// percentile's (ten pixels of mean 1 and standard errors 1 .. 10: the tenth is the reference), -1
-// for a pixel with one estimate; and the extra samples that follow it.
+// percentile's. Twenty pixels of means 1 .. 20 whose relative errors are 1 .. 20 times a unit
+// (the mean offset by 1% of the pixels' mean): the 19th is the reference, so pixel i asks for
+// (i + 1) / 19 (the largest would give / 20). A black pixel and one of three estimates: -1 (the
+// control samples the one every pass and waits four for the other). Then the extra samples that
+// follow the rate.
 TEST(Bpm, ExtraSamplesFollowTheRateThatAPixelsErrorAsksFor) {
   std::vector<double> moments;
-  for (int i = 0; i < 10; ++i) {
-    // Four estimates of mean 1 whose sample variance is 4 (i + 1)^2: standard error i + 1.
-    const double a = 1 - 2 * (i + 1) * std::sqrt(0.75), b = 1 + 2 * (i + 1) * std::sqrt(0.75);
-    moments.insert(moments.end(), {2 * a + 2 * b, 2 * a * a + 2 * b * b, 0, 0, 4});
+  const double offset = 0.01 * 10.5;  // 1% of the counted pixels' mean
+  for (int i = 0; i < 20; ++i) {
+    // Four estimates m - d, m - d, m + d, m + d: standard error d / sqrt(3).
+    const double m = i + 1, error = 0.01 * (i + 1) * (m + offset), d = error * std::sqrt(3.0);
+    moments.insert(moments.end(), {4 * m, 4 * m * m + 4 * d * d, 0, 0, 4});
   }
-  moments.insert(moments.end(), {1, 1, 0, 0, 1});
+  moments.insert(moments.end(), {0, 0, 0, 0, 5});
+  moments.insert(moments.end(), {3, 5, 0, 0, 3});
   const std::vector<float> asked = asked_pass_rates(moments);
-  ASSERT_EQ(asked.size(), 11u);
-  for (int i = 0; i < 10; ++i) EXPECT_NEAR(asked[size_t(i)], 0.1 * (i + 1), 1e-5) << i;
-  EXPECT_EQ(asked[10], -1.0f);
+  ASSERT_EQ(asked.size(), 22u);
+  for (int i = 0; i < 20; ++i) EXPECT_NEAR(asked[size_t(i)], (i + 1) / 19.0, 1e-5) << i;
+  EXPECT_EQ(asked[20], -1.0f);
+  EXPECT_EQ(asked[21], -1.0f);
   // At or above the floor (0.1), unknown: the count as it is; below it, in proportion, at least 1.
   EXPECT_EQ(at_asked_rate(8, 0.5f, 0.1f, false), 8);
   EXPECT_EQ(at_asked_rate(8, 3.0f, 0.1f, false), 8);

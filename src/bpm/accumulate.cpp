@@ -154,25 +154,28 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
 
 std::vector<float> asked_pass_rates(const std::vector<double>& moments) {
   const size_t n = moments.size() / PixelMoments::kValues;
-  std::vector<double> mean(n, 0.0), error(n, -1.0);  // error < 0: fewer than two estimates
-  double image_mean = 0;
+  // Each pixel's mean and the standard error of it, where it has the estimates adaptive
+  // sampling waits for and one of them was not black (-1: none).
+  std::vector<double> mean(n, 0.0), error(n, -1.0);
+  double mean_sum = 0;
+  size_t counted = 0;
   for (size_t p = 0; p < n; ++p) {
     const double* m = moments.data() + PixelMoments::kValues * p;
-    const double count = m[PixelMoments::kCount], sum = m[PixelMoments::kSum];
-    if (count < 2) continue;
+    const double count = m[PixelMoments::kCount], sum = m[PixelMoments::kSum],
+                 squares = m[PixelMoments::kSquares];
+    if (count < kWarmupPasses || !(squares > 0)) continue;
     mean[p] = std::fabs(sum / count);
-    const double variance =
-        std::max(0.0, (m[PixelMoments::kSquares] - sum * sum / count) / (count - 1));
+    const double variance = std::max(0.0, (squares - sum * sum / count) / (count - 1));
     error[p] = std::sqrt(variance / count);
-    image_mean += mean[p] / double(n);
+    mean_sum += mean[p];
+    ++counted;
   }
-  std::vector<double> relative;
-  std::vector<double> rel(n, -1.0);
-  for (size_t p = 0; p < n; ++p)
-    if (error[p] >= 0)
-      relative.push_back(rel[p] = error[p] / (mean[p] + 0.01 * image_mean + 1e-12));
   std::vector<float> asked(n, -1.0f);
-  if (relative.empty()) return asked;
+  if (counted == 0) return asked;
+  const double offset = 0.01 * mean_sum / double(counted) + 1e-12;  // as the control's
+  std::vector<double> rel(n, -1.0), relative;
+  for (size_t p = 0; p < n; ++p)
+    if (error[p] >= 0) relative.push_back(rel[p] = error[p] / (mean[p] + offset));
   const size_t k = std::min(relative.size() - 1, size_t(0.9 * double(relative.size())));
   std::nth_element(relative.begin(), relative.begin() + ptrdiff_t(k), relative.end());
   const double ref = relative[k];

@@ -54,10 +54,13 @@ void accumulate_iteration(const BackwardMaps& maps, LightPassResult* light_sums,
                           std::vector<double>* estimates = nullptr,
                           std::vector<double>* moments = nullptr, float mean_filter_weight = 1);
 
-// Per pixel, from its PixelMoments sums, the rate of iterations that its error asks for under
-// adaptive sampling (RenderControl): the relative error of its mean so far (over the mean plus 1%
-// of the image's) over the 90th percentile's. Adaptive sampling samples the pixel with that
-// probability, within [its floor, 1]; -1 where the pixel has fewer than two estimates.
+// Per pixel, from its PixelMoments sums, an estimate of the rate of iterations that its error
+// asks for under adaptive sampling (RenderControl samples a pixel with that probability, within
+// [its floor, 1]): the relative error of its mean so far (over the mean plus 1% of the pixels'
+// mean) over the 90th percentile's. The control's own figure weighs the film's three channels,
+// this one the mean over the wavelengths: colour noise counts less here. -1 where the pixel has
+// fewer estimates than the control waits for (kWarmupPasses) or all of them were black (the
+// control samples such a pixel every pass).
 std::vector<float> asked_pass_rates(const std::vector<double>& moments);
 
 }  // namespace bpm

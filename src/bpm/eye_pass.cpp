@@ -343,6 +343,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     if (j == 1 && scene.bsdf_finds_lights) {
       found = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
       first.shared = scene.may_reach_emitter(s.ray);
+      if (look_only && !first.shared) break;  // it can find no light: no ray, as the direct's
     }
     ++rays.bounce_rays;
     PathVertex& e = vertices[j & 1];

@@ -89,7 +89,7 @@ struct EyeCounters {
   // The extra samples of direct light beyond the first, and the rays they cast (in `rays` too).
   uint64_t direct_samples = 0, direct_rays = 0;
   // Eye paths that went on past their last diffuse vertex (combined estimators), and their rays
-  // (in `rays` too).
+  // (in `rays` too; the first, which the first direct sample shares, included).
   uint64_t continued = 0, continuation_rays = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);

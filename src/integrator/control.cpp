@@ -15,7 +15,6 @@ namespace bpm {
 namespace {
 constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
 // Passes before the error estimate is trusted (for the accuracy budget and adaptive sampling).
-constexpr int kWarmupPasses = 4;
 }  // namespace
 
 bool ends_round(int passes) {

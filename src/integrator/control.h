@@ -29,6 +29,9 @@ inline double since(Clock::time_point t) {
 
 struct IntegratorOptions;
 
+// The passes before adaptive sampling and the accuracy budget trust the error estimate.
+constexpr int kWarmupPasses = 4;
+
 // Passes are grouped into rounds. Within a round the passes are independent: the sampling
 // probabilities and what an integrator learns from its passes (bpm's guided emission) stay as
 // they were at the round's start; at its end what the round learnt is merged. A round is a
