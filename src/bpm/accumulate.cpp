@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <utility>
 
 #include "base/error.h"
 #include "integrator/progressive.h"
@@ -176,9 +177,7 @@ std::vector<float> asked_pass_rates(const std::vector<double>& moments) {
   std::vector<double> rel(n, -1.0), relative;
   for (size_t p = 0; p < n; ++p)
     if (error[p] >= 0) relative.push_back(rel[p] = error[p] / (mean[p] + offset));
-  const size_t k = std::min(relative.size() - 1, size_t(0.9 * double(relative.size())));
-  std::nth_element(relative.begin(), relative.begin() + ptrdiff_t(k), relative.end());
-  const double ref = relative[k];
+  const double ref = reference_relative_error(std::move(relative));
   if (!(ref > 0)) return asked;
   for (size_t p = 0; p < n; ++p)
     if (rel[p] >= 0) asked[p] = float(rel[p] / ref);

@@ -90,10 +90,7 @@ void RenderControl::update_probabilities() {
     rel[i] = float(error[i] / (value[i] + 0.01 * image_mean + 1e-12));
   });
   // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
-  std::vector<float> sorted = rel;
-  size_t k = std::min(n - 1, size_t(0.9 * double(n)));
-  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  float ref = sorted[k];
+  const float ref = reference_relative_error(rel);
   // A pixel whose passes have all been black has no error estimate: light may reach it by rare
   // paths (a small lit spot seen after two bounces) that the passes so far missed. Sampling it less
   // would leave it black far longer (unbiased, but heavily skewed), so it is sampled every pass.

@@ -10,6 +10,7 @@
 // pixel starves and the error estimate of every pixel stays alive; it is 1 for a pixel whose
 // passes have all been black, which has no error estimate at all.
 #pragma once
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -31,6 +32,15 @@ struct IntegratorOptions;
 
 // The passes before adaptive sampling and the accuracy budget trust the error estimate.
 constexpr int kWarmupPasses = 4;
+
+// The relative error that adaptive sampling measures pixels against: the 90th percentile of the
+// pixels' (non-empty `relative`), so that the noisiest tenth is sampled every pass.
+template <class T>
+T reference_relative_error(std::vector<T> relative) {
+  const size_t k = std::min(relative.size() - 1, size_t(0.9 * double(relative.size())));
+  std::nth_element(relative.begin(), relative.begin() + ptrdiff_t(k), relative.end());
+  return relative[k];
+}
 
 // Passes are grouped into rounds. Within a round the passes are independent: the sampling
 // probabilities and what an integrator learns from its passes (bpm's guided emission) stay as
