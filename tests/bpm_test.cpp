@@ -27,6 +27,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -1681,6 +1682,36 @@ TEST(Bpm, ExtraSamplesFollowTheRateThatAPixelsErrorAsksFor) {
   EXPECT_EQ(at_asked_rate(8, 2.6f, 0.1f, true), 3);
   EXPECT_EQ(at_asked_rate(8, 20.0f, 0.1f, true), 8);
   EXPECT_EQ(at_asked_rate(8, -1.0f, 0.1f, true), 8);
+}
+
+// The render passes the asked rates to the counts: a floor under a sky of a 5500 K blackbody,
+// whose colour makes each sky pixel's emission vary with its wavelengths while nothing else in
+// it does. Without adaptive sampling the rule gives such pixels the most emission samples; with
+// it, a sky pixel's error asks for few iterations, so it takes about one. Extra samples counted
+// per pixel and iteration that sampled the pixel (the film's pass counts).
+TEST(Bpm, AdaptiveSamplingGivesPixelsOfEmissionAloneTheSamplesTheirErrorAsksFor) {
+  LoadedScene ls = load(header(16, 5, "0 1 -3  0 1 0  0 1 0", 60) +
+                        "LightSource \"infinite\" \"blackbody L\" [5500]\n"
+                        "Material \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\n" +
+                        quad(-20, -4, 20, 40, 0, false));
+  const int iterations = 24;
+  auto per_sampled_pixel = [&](bool adaptive) {
+    Film film(ls.film.width, ls.film.height);
+    RenderOptions opt = test_options(ls, "bpm", iterations, 3, small_batches(0));
+    opt.adaptive = adaptive;
+    const RenderStats st = render(ls, opt, &film);
+    const std::vector<float> passes = film.pass_counts();
+    const double sampled = std::accumulate(passes.begin(), passes.end(), 0.0);
+    if (!adaptive) {
+      EXPECT_EQ(sampled, double(passes.size()) * iterations);
+    }
+    return st.details["eye"]["emission_samples"].get<double>() / sampled;
+  };
+  const double uniform = per_sampled_pixel(false), adaptive = per_sampled_pixel(true);
+  std::printf("extra emission samples per sampled pixel and iteration: %.3f, adaptive %.3f\n",
+              uniform, adaptive);
+  EXPECT_GT(uniform, 1.0);
+  EXPECT_LT(adaptive, 0.5 * uniform);
 }
 
 // Pixels within twice the filter's radius of one whose statistics of emission are known, and
