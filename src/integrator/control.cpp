@@ -14,7 +14,6 @@
 namespace bpm {
 namespace {
 constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
-// Passes before the error estimate is trusted (for the accuracy budget and adaptive sampling).
 }  // namespace
 
 bool ends_round(int passes) {
