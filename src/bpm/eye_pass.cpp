@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
@@ -192,12 +193,26 @@ inline Spectrum direct_light_at_last(const EyePath& path, const PathVertex& v, c
 struct Continuation {
   double ratio;
   Vec3 prev_p, prev_n;
-  double pdf_prev = 0;
+  double pdf_prev = 0;  // for a delta lobe the probability of choosing it
+  // The vertex before has traced lobes only (no next-event estimation there); one of e_1 ..
+  // e_(j-1) has gathered lobes (else the light found is a caustic at x, the merge's alone).
+  bool prev_traced = false, gathered = false;
   double cos_prev = 0, d2 = 1;  // |cos| at the vertex before toward e_j; their squared distance
   // Where x is the vertex connections' target: 1 / (pi r^2 P), so that their density over the
   // merge's is vertex_scale / A(x) (vertex_connections.h), with A(x) the photon's density of x
-  // from e_1 (a_x, known from j = 2 on); else 0.
+  // from e_1 (a_x, known from j = 2 on; infinite where e_1 is traced: no connection joins it);
+  // else 0.
   double vertex_scale = 0, a_x = 0;
+  // The path leaves e_(j-1) = v (traced: its lobes are all traced) by the sample bs of `lobes`.
+  void leave(const PathVertex& v, const BsdfSample& bs, BsdfPart lobes, bool traced, int j) {
+    pdf_prev = bs.is_specular()
+                   ? double(bs.pdf_solid_angle)
+                   : double(bsdf_pdf(v.m(), v.wo_local, bs.wi, TransportMode::kRadiance, lobes));
+    prev_traced = traced;
+    gathered = gathered || (j > 1 && !traced);
+    prev_p = v.sp.p;
+    prev_n = v.sp.ng;
+  }
 };
 
 // The merge's term of a continued path's weight with the vertex connections' added: both over the
@@ -216,7 +231,7 @@ inline double found_light_weight(const RenderScene& scene, const Continuation& c
   const float len = length(d);
   if (!(len > 0)) return 0;
   const double b_bsdf = light_end_density(light, c.pdf_prev, c.prev_p, y, n);
-  const double b_light = light_sample_density(scene, li, c.prev_p, y, n);
+  const double b_light = c.prev_traced ? 0.0 : light_sample_density(scene, li, c.prev_p, y, n);
   const double merge = c.ratio * emission_density(scene, li, y, n, -d / len, c.prev_p, c.prev_n);
   return b_bsdf / (b_bsdf + b_light + merge_and_connection(merge, c, c.a_x));
 }
@@ -272,31 +287,36 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
   return s.beta * f * ls->radiance * float(w / (double(sample->pmf) * ls->pdf_solid_angle));
 }
 
-// Past e_1 (j > 1), at e_(j-1) = v left along wi with the throughput `beta`: the photons' gathered
-// share at v, arriving from e_j, then Russian roulette on the change of throughput; false where the
-// path ends, else s.beta and c updated (c.ratio times A of e_(j-2), x at j = 2, from v).
-inline bool survives_past(const PathVertex& v, Vec3 wi, Spectrum beta, int j, Rng& rng,
+// Past e_1 (j > 1), at e_(j-1) = v left by the sample bs with the throughput `beta`: the photons'
+// gathered share at v, arriving from e_j (all of it where v's lobes are all traced), then Russian
+// roulette on the change of throughput; false where the path ends, else s.beta and c updated
+// (c.ratio times A of e_(j-2), x at j = 2, from v).
+inline bool survives_past(const PathVertex& v, const BsdfSample& bs, Spectrum beta, int j, Rng& rng,
                           PathState& s, Continuation& c) {
-  const float g = bsdf_gathered_probability(v.m(), wi, v.wo_local, TransportMode::kImportance);
+  const bool traced = bsdf_all_traced(v.m());
+  const float g =
+      traced ? 1.0f
+             : bsdf_gathered_probability(v.m(), bs.wi, v.wo_local, TransportMode::kImportance);
   if (!(g > 0)) return false;
   beta *= g;
   const float q = std::fmax(0.0f, 1 - beta.max_component() / s.beta.max_component());
   if (rng.uniform() < q) return false;
   s.beta = beta / (1 - q);
+  const float delta = bs.is_specular() ? bs.pdf_solid_angle : 0.0f;
   const double a =
-      double(g) * bsdf_pdf(v.m(), wi, v.wo_local, TransportMode::kImportance) * c.cos_prev / c.d2;
+      combined_density(v, bs.wi, v.wo_local, TransportMode::kImportance, delta) * c.cos_prev / c.d2;
   c.ratio *= a;
-  if (j == 2) c.a_x = a;
+  if (j == 2) c.a_x = traced ? std::numeric_limits<double>::infinity() : a;
   return true;
 }
 
 // Indirect light at the last diffuse vertex x by the eye path's continuation (combined
-// estimators, photons/merge_weights.h): BSDF samples from x on, through vertices with gathered
-// lobes only, each finding lights by next-event estimation and by its BSDF sample, every
-// path weighed against the merge at x's backward photon, whose density is merge_density
-// (pi r^2 N; 0: none). The continuation goes on by Russian roulette on its change of
-// throughput. depth: x's scattering events, as the backward photon's eye_depth; part: the lobes x
-// gathers with (EyeVertexChoice). Past x each path is weighed by the share of it that photons
+// estimators, photons/merge_weights.h): BSDF samples from x on, through combinable vertices, each
+// finding lights by next-event estimation (but where its lobes are all traced) and by its BSDF
+// sample, every path weighed against the merge at x's backward photon, whose density is
+// merge_density (pi r^2 N; 0: none). The continuation goes on by Russian roulette on its change
+// of throughput. depth: x's scattering events, as the backward photon's eye_depth; part: the lobes
+// x gathers with (EyeVertexChoice). Past x each path is weighed by the share of it that photons
 // draw through gathered lobes (bsdf_gathered_probability: 1 but at split coats). Its first BSDF
 // sample is also the first of x's direct samples: the light it finds goes to first.found, weighed
 // as direct_light_by_bsdf weighs it, and first.shared says whether that sample would have cast
@@ -325,19 +345,19 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     const Vec2 u{path.rng.uniform(), path.rng.uniform()};
     const BsdfPart lobes = j == 1 ? part : BsdfPart::kAll;
     const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, lobes);
-    if (!bs || bs->is_specular()) break;
+    // Past x a delta lobe is followed where every lobe is traced (not a coat's alone).
+    const bool traced = j > 1 && bsdf_all_traced(v.m());
+    if (!bs || (bs->is_specular() && !traced)) break;
     // At x a traced lobe's sample only looks for the light, as the direct sample's would.
     const bool look_only = j == 1 && bs->is_traced();
     if (look_only && !scene.bsdf_finds_lights) break;
     const Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (j == 1)
       s.beta = beta;
-    else if (!survives_past(v, bs->wi, beta, j, path.rng, s, c))
+    else if (!survives_past(v, *bs, beta, j, path.rng, s, c))
       break;
     if (s.beta.is_black() || !s.beta.is_finite()) break;
-    c.pdf_prev = bsdf_pdf(v.m(), v.wo_local, bs->wi, TransportMode::kRadiance, lobes);
-    c.prev_p = v.sp.p;
-    c.prev_n = v.sp.ng;
+    c.leave(v, *bs, lobes, traced, j);
     leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
     EmitterWeight found = EmitterWeight::none();
     if (j == 1 && scene.bsdf_finds_lights) {
@@ -350,7 +370,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     Spectrum none;
     const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, found, j == 1 ? first.found : none);
     if (look_only) break;
-    if (end == StepEnd::kEscaped && j > 1)
+    if (end == StepEnd::kEscaped && c.gathered)
       L += s.beta * found_environment(scene, c, s.ray.d, wm.wl);
     if (end != StepEnd::kVertex) break;
     const Vec3 d = e.sp.p - c.prev_p;
@@ -362,7 +382,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     // Emission found by v's BSDF sample (x's own is its direct light): a path of j - 1 vertices
     // between the light and x.
     const int li = scene.light_of_hit(e.hit);
-    if (j > 1 && li >= 0) {
+    if (c.gathered && li >= 0) {
       const Spectrum Le = area_light_radiance(std::get<AreaLight>(scene.lights[size_t(li)]),
                                               e.sp.ng, e.sp.uv, -s.ray.d, wm.wl);
       const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, e.sp.p, e.sp.ng);
@@ -373,7 +393,10 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     keep_hero_wavelength_at(e, s);
     c.ratio /= c.pdf_prev * cos_here / c.d2;  // B of e_j
     if (!std::isfinite(c.ratio)) break;
-    L += continued_light_sample(path, e, s, c);
+    if (bsdf_all_traced(e.m()))
+      ++path.counters.continued_traced;
+    else
+      L += continued_light_sample(path, e, s, c);
     at = &e;
   }
   path.counters.continuation_rays += rays.total() - rays_before;

@@ -91,6 +91,8 @@ struct EyeCounters {
   // Eye paths that went on past their last diffuse vertex (combined estimators), and their rays
   // (in `rays` too; the first, which the first direct sample shares, included).
   uint64_t continued = 0, continuation_rays = 0;
+  // The vertices with traced lobes only that continuations went through.
+  uint64_t continued_traced = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);
     backward_photons += o.backward_photons;
@@ -101,6 +103,7 @@ struct EyeCounters {
     direct_rays += o.direct_rays;
     continued += o.continued;
     continuation_rays += o.continuation_rays;
+    continued_traced += o.continued_traced;
   }
 };
 

@@ -59,6 +59,8 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
       // their rays (among the bounce and shadow rays).
       {"continued_paths", t.eye.continued},
       {"continuation_rays", t.eye.continuation_rays},
+      // The vertices with traced lobes only (glass, mirrors) that continuations went through.
+      {"continued_traced_vertices", t.eye.continued_traced},
       {"continue_probability_mean", t.continue_probability},
       {"radius_scale_mean",
        {{"small", t.small_scale_mean}, {"large", t.large_scale_mean}, {"shared", t.shared_scale}}},

@@ -243,7 +243,7 @@ inline std::optional<bool> scatter_photon_at_surface(const RenderScene& scene, c
   if (rng.uniform() < q) return std::nullopt;
   s.beta = bnew / (1 - q);
   if (s.beta.is_black() || !s.beta.is_finite()) return std::nullopt;
-  if (mis) mis->scatter(v, wi, bs->is_traced(), k);
+  if (mis) mis->scatter(v, *bs, wi, k);
   leave_vertex(scene, v, wi, s);
   return bs->is_traced() || v.on_curve;
 }

@@ -6,8 +6,22 @@
 namespace bpm {
 
 bool combinable_vertex(const PathVertex& v) {
-  return v.medium < 0 && !v.on_curve && v.material && !bsdf_all_traced(v.m()) &&
-         !std::holds_alternative<PhongMaterial>(v.m());
+  if (v.medium >= 0 || v.on_curve || !v.material) return false;
+  const Material& m = v.m();
+  if (bsdf_all_traced(m))
+    return std::holds_alternative<ConductorMaterial>(m) ||
+           std::holds_alternative<DielectricMaterial>(m) ||
+           std::holds_alternative<ThinDielectricMaterial>(m);
+  return !std::holds_alternative<PhongMaterial>(m);
+}
+
+double combined_density(const PathVertex& v, Vec3 from, Vec3 to, TransportMode mode,
+                        float delta_probability) {
+  if (delta_probability > 0) return delta_probability;
+  const Material& m = v.m();
+  const double g = bsdf_all_traced(m) ? 1.0 : double(bsdf_gathered_probability(m, from, to, mode));
+  if (!(g > 0)) return 0;
+  return g * double(bsdf_pdf(m, from, to, mode));
 }
 
 namespace {
@@ -84,12 +98,15 @@ void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
   if (k == 1) {
     // A0 A1 as an area density here; B0 from here.
     r_ = 1 / emission_density(scene, light_, y_, n_y_, w_, v.sp.p, v.sp.ng);
-    b0_ = light_sample_density(scene, light_, v.sp.p, y_, n_y_);
+    // No next-event estimation at a vertex whose lobes are all traced.
+    b0_ = v.material && bsdf_all_traced(v.m())
+              ? 0.0
+              : light_sample_density(scene, light_, v.sp.p, y_, n_y_);
     arrival_ = 0;
   } else {
-    // The area part of A_k.
+    // The area part of A_k; no vertex connection joins a traced vertex to this one.
     r_ /= to_area;
-    arrival_ = a_ * to_area;
+    arrival_ = last_traced_ ? 0.0 : a_ * to_area;
   }
   // The segment's factor for B_(k-1): the eye's solid-angle density at v toward the vertex before,
   // turned into that vertex's measure (a light at infinity: the direction itself; none for a
@@ -104,23 +121,28 @@ void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
   if (!combinable_vertex(v) || !std::isfinite(r_)) on_ = false;
 }
 
-void PhotonMis::scatter(const PathVertex& v, Vec3 wi, bool traced, int k) {
+void PhotonMis::scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int k) {
   if (!on_) return;
-  if (traced) {  // drawn through a traced lobe: the photon's alone
+  const bool all_traced = bsdf_all_traced(v.m());
+  if (bs.is_traced() && !all_traced) {  // through a split coat's traced part: the photon's alone
     on_ = false;
     return;
   }
   const Vec3 wi_local = v.frame.to_local(wi);
+  // A delta lobe's choice is as probable both ways (Fresnel's reflectance is the same from either
+  // side; a mirror has one lobe): its probability stands for both sides' densities, whose deltas
+  // cancel.
+  const float delta = bs.is_specular() ? bs.pdf_solid_angle : 0.0f;
   // A_(k+1)'s solid-angle density: the adjoint BSDF's at v, from where the photon came, through
   // the gathered part (where a coat splits, its share of the density).
-  const double g =
-      bsdf_gathered_probability(v.m(), v.wo_local, wi_local, TransportMode::kImportance);
-  const double a = g * bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kImportance);
+  const double a = combined_density(v, v.wo_local, wi_local, TransportMode::kImportance, delta);
   // B_(k-1): the eye's BSDF at v, arriving from wi, toward the vertex before (y0 when k = 1,
   // where next-event estimation's density joins it).
-  double b =
-      double(bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kRadiance)) * seg_cos_ / seg_d2_;
+  double b = (delta > 0 ? delta : bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kRadiance)) *
+             seg_cos_ / seg_d2_;
   if (k == 1) b += b0_;
+  last_traced_ = all_traced;
+  gathered_ = gathered_ || !all_traced;
   if (!(a > 0)) {
     on_ = false;
     return;

@@ -20,10 +20,13 @@
 // (point, spot, goniometric, projection) is a delta that both sides leave out, and no BSDF sample
 // finds it; a light at infinity starts its path with a direction, in whose solid-angle measure
 // both sides count y0 (the photon's entry disc's density turned into an area density at z1), the
-// direction of a distant light again a delta left out. Only paths whose vertices z all have
-// gathered lobes only (on a surface, not a curve) are combined; every other path stays the
-// merge's alone, and the continuation leaves it out. Both passes compute the same products, each
-// from its own end of the path, so that the weights of a path sum to one.
+// direction of a distant light again a delta left out. Paths whose vertices z are all on surfaces
+// (not curves) with gathered lobes, or with traced lobes only (a mirror, glass, a thin pane: the
+// eye path goes on through them as the photon does, without next-event estimation there), and at
+// least one of them gathered (a caustic at x stays the merge's), are combined; at a delta lobe
+// both sides count the probability of choosing it and leave its delta out. Every other path stays
+// the merge's alone, and the continuation leaves it out. Both passes compute the same products,
+// each from its own end of the path, so that the weights of a path sum to one.
 #pragma once
 #include <cmath>
 
@@ -33,11 +36,20 @@
 namespace bpm {
 
 // Whether a combined path may pass through v: a surface (not a curve) with gathered lobes, not
-// Phong's (whose sampling is not reciprocal). Where a coat splits (BsdfPart), only the share of
-// the light that the photon draws through the gathered part is combined: the photon's vertex then
-// counts in A with the density of that draw, and the continuation's path is weighed by the same
-// share (bsdf_gathered_probability); the share drawn through the coat stays the photon's alone.
+// Phong's (whose sampling is not reciprocal), or one whose lobes are all traced, but for a coat's
+// (whose density is only estimated). Where a coat splits (BsdfPart), only the share of the light
+// that the photon draws through the gathered part is combined: the photon's vertex then counts in
+// A with the density of that draw, and the continuation's path is weighed by the same share
+// (bsdf_gathered_probability); the share drawn through the coat stays the photon's alone.
 bool combinable_vertex(const PathVertex& v);
+
+// The photon's density (A), in the combined products, of a path through the combinable vertex v
+// leaving along `to` having arrived from `from` (local directions): the BSDF's through the
+// gathered part (times its share where a coat splits), the whole BSDF's where every lobe is
+// traced; for a delta lobe (delta_probability > 0, the sample's) the probability of choosing it,
+// its delta left out.
+double combined_density(const PathVertex& v, Vec3 from, Vec3 to, TransportMode mode,
+                        float delta_probability);
 
 // A solid-angle density at `from` of the direction to `to`, turned into an area density at `to`
 // (whose geometric normal is n_to).
@@ -76,20 +88,20 @@ class PhotonMis {
   void start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w);
   // The photon arrives at its k-th vertex v (k from 1).
   void arrive(const RenderScene& scene, const PathVertex& v, int k);
-  // It leaves v, its k-th vertex, along the world direction wi, drawn through a traced lobe or
-  // not.
-  void scatter(const PathVertex& v, Vec3 wi, bool traced, int k);
+  // It leaves v, its k-th vertex, along the world direction wi, drawn as the sample bs.
+  void scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int k);
   // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
   // the vertex before over the squared distance (the factor that turns the eye's solid-angle
   // density into the measure of that vertex; merges start at the second), so that the merge's
   // weight is
   // 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density at x of the photon's
   // direction. 0: not combined (the merge counts the path in full).
-  float merge_factor() const { return on_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
+  float merge_factor() const { return on_ && gathered_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
   // Whether the path so far may be combined.
   bool on() const { return on_; }
   // A of the vertex just arrived at (k >= 2): the adjoint BSDF's density at the vertex before, of
-  // the way here, as an area density here; 0 at the first vertex or when not combined.
+  // the way here, as an area density here; 0 at the first vertex, after a traced vertex (no
+  // connection joins one) or when not combined.
   float arrival_density() const { return on_ ? float(arrival_) : 0.0f; }
   // For a connection from the vertex just arrived at, z_k, to an eye vertex (vertex connections):
   // B0 .. B(k-1) over A0 .. Ak, given eye_pdf, the eye's BSDF density at z_k, arriving from the eye
@@ -100,6 +112,8 @@ class PhotonMis {
 
  private:
   bool on_ = false;
+  bool gathered_ = false;     // a vertex with gathered lobes left behind (not a caustic)
+  bool last_traced_ = false;  // the vertex before the current one has traced lobes only
   double r_ = 0, b0_ = 0;
   double a_ = 0, arrival_ = 0;  // the solid-angle A of the last scatter; the area A of the arrival
   int light_ = -1, k_ = 0;
