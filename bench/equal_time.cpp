@@ -4,8 +4,8 @@
 // figures; never fails.
 //   equal_time [--time S] [--scenes a,b] [--pbrt PATH] [--reference-time S] [--res WxH]
 //              [--integrators path,bpm,fpm] [--references-only]
-// Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box
-// (references by bpm), lamp-room, room2, shelf-room, kitchen, fog (reference by path),
+// Scenes: caustic-sphere, light-guides-inside, -outside, -side, prism, spot-facets, water-box,
+// window-room (references by bpm), lamp-room, room2, shelf-room, kitchen, fog (reference by path),
 // spot-lens-fog, underwater (references by bpm), smoke (a uniformgrid medium; reference by path),
 // courtyard (sky and sun over a large ground; reference by path), the Cornell box
 // (../shared's at 256x256 when present, else ours) and, when ../shared has them, the staircase2
@@ -65,6 +65,8 @@ std::vector<SceneEntry> default_scenes() {
       {"prism", ours + "prism.pbrt", "bpm"},
       {"spot-facets", ours + "spot-facets.pbrt", "bpm"},
       {"water-box", ours + "water-box.pbrt", "bpm"},
+      // A room lit by a sun and a sky through a glass pane (path cannot find the sun through it).
+      {"window-room", ours + "window-room.pbrt", "bpm"},
       {"lamp-room", ours + "lamp-room.pbrt", "path"},
       {"room2", ours + "room2.pbrt", "path"},
       {"shelf-room", ours + "shelf-room.pbrt", "path"},
