@@ -228,8 +228,8 @@ void add_bpm_options(CLI::App* render, RenderRequest& ra) {
                    "weighed between the photons and the continuation by multiple importance "
                    "sampling; glossy: combined where that vertex's gathered lobes include a glossy "
                    "one, partition elsewhere; auto (default): as glossy, and elsewhere combined "
-                   "with a probability each pixel chooses from its own variance and cost (scenes "
-                   "without media; file: string estimators)")
+                   "with a probability each pixel chooses from its own variance and cost (paths "
+                   "through scattering media stay the photons'; file: string estimators)")
       ->check(CLI::IsMember({"partition", "glossy", "combined", "auto"}))
       ->group(kBpm);
   render

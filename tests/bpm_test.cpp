@@ -1016,6 +1016,29 @@ TEST(Bpm, CombinedEstimatorsCountPathsThroughTracedLobesOnce) {
   EXPECT_GT(check.combined["eye"]["continued_traced_vertices"].get<double>(), 0.0);
 }
 
+// In a scene with a scattering medium the paths that cross no medium are combined, the others
+// stay the merges' (merge_weights.h): a photon stops its products where it enters the medium, and
+// the eye path's continuation counts nothing past a ray or a shadow ray through it. The test box
+// with a slab of thin fog under its light (an interface box around a homogeneous medium of optical
+// depth 0.5 across), which all light crosses: most of it unscattered, so that a continuation that
+// counted its next-event estimation through the fog as well as the merges would be about a third
+// too bright.
+TEST(Bpm, CombinedEstimatorsLeavePathsThroughScatteringMediaToTheMerges) {
+  std::string scene = cornell();
+  scene.insert(scene.find("WorldBegin"),
+               "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
+               "[0.3 0.3 0.3] \"rgb sigma_s\" [3 3 3]\n");
+  scene +=
+      "AttributeBegin\nMaterial \"interface\"\nMediumInterface \"fog\" \"\"\n"
+      "Shape \"trianglemesh\" \"integer indices\" [1 3 2 1 2 0 4 6 7 4 7 5 4 5 1 4 1 0 2 3 7 2 7 "
+      "6 2 6 4 2 4 0 1 5 7 1 7 3] \"point3 P\" [0.25 0.8 0.25  0.25 0.8 0.75  0.25 0.95 0.25  0.25 "
+      "0.95 0.75  0.75 0.8 0.25  0.75 0.8 0.75  0.75 0.95 0.25  0.75 0.95 0.75]\nAttributeEnd\n";
+  // Path's image is noisy in the fog (its pixels' error is left unchecked); the means agree within
+  // 4.5 sigma.
+  const CombinedCheck check = expect_combined_agrees_with_path(load(scene), "a slab of fog", false);
+  EXPECT_GT(check.combined["light"]["beams"].get<double>(), 0.0);
+}
+
 // A point-like light's paths are combined as an area light's (merge_weights.h): the delta of its
 // position, in A0 and in B0 alike, is left out of both sides' densities, and no BSDF sample finds
 // it. The test box lit by a spot light under its ceiling, aimed at the floor, and a point light

@@ -161,8 +161,9 @@ class BpmRender {
   // what the rounds learnt.
   PassWork work_now() const;
   void choose_photons();
-  // Combined estimators run: asked for, in a scene without media (photons/merge_weights.h).
-  CombineAt combined() const { return scene_.media.empty() ? s_.combine : CombineAt::kNowhere; }
+  // Combined estimators run as asked (photons/merge_weights.h: not on paths through scattering
+  // media).
+  CombineAt combined() const { return s_.combine; }
   // Vertex connections run: asked for, with an image, in a scene without media.
   bool vertex_connections() const {
     return s_.vertex_connections != ConnectionMode::kOff && opt_.image && scene_.media.empty();

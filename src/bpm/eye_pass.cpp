@@ -258,6 +258,8 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
   const auto sample = sample_light_at(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local,
                                       *path.prm.materials, path.rng, path.counters.rays);
   if (!sample) return {};
+  // Through a scattering medium: the photons' alone (merge_weights.h).
+  if (sample->through_scattering) return {};
   const int li = sample->light;
   const Light& light = scene.lights[size_t(li)];
   const LightLiSample* ls = &sample->ls;
@@ -368,8 +370,11 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     ++rays.bounce_rays;
     PathVertex& e = vertices[j & 1];
     Spectrum none;
-    const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, found, j == 1 ? first.found : none);
-    if (look_only) break;
+    bool scattering = false;  // the ray crossed a scattering medium: no path past it is combined
+    const StepEnd end =
+        next_eye_vertex(scene, wm, s, e, rays, found, j == 1 ? first.found : none, false, nullptr,
+                        [&](const Ray&, float, const Spectrum&) { scattering = true; });
+    if (look_only || scattering) break;
     if (end == StepEnd::kEscaped && c.gathered)
       L += s.beta * found_environment(scene, c, s.ray.d, wm.wl);
     if (end != StepEnd::kVertex) break;

@@ -9,9 +9,13 @@
 namespace bpm {
 
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
-                              bool infinite, const Wavelengths& wl) {
+                              bool infinite, const Wavelengths& wl, bool* scattering) {
+  const auto note = [&](int in) {
+    if (scattering && in >= 0 && scene.media[size_t(in)].scatters()) *scattering = true;
+  };
   if (!scene.occluded(origin, target)) {
     if (medium < 0) return Spectrum(1.0f);
+    note(medium);
     const Vec3 d = target - origin;
     const float len = length(d);
     return medium_transmittance(scene, medium, Ray{origin, d / len, kInf}, infinite ? kInf : len,
@@ -26,6 +30,7 @@ Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target
     if (!(len > 0)) return {};
     const Ray r{o, d / len, len * (1 - 1e-4f)};
     Hit h;
+    note(medium);
     if (!scene.intersect(r, &h)) {
       if (medium >= 0) T *= medium_transmittance(scene, medium, r, infinite ? kInf : len, wl);
       return T;
@@ -72,11 +77,12 @@ std::optional<LightSampleAt> sample_light_at(const RenderScene& scene, const Sur
     float len = length(d);
     counters.observer->shadow(Ray{origin, d / len, len * (1 - 1e-4f)});
   }
+  bool scattering = false;
   f *= shadow_transmittance(scene, origin, target,
                             medium_toward(scene, object, sp.ng, ls->wi, medium), ls->is_infinite,
-                            wl);
+                            wl, &scattering);
   if (f.is_black()) return std::nullopt;
-  return LightSampleAt{li, pmf, *ls, wi_local, f};
+  return LightSampleAt{li, pmf, *ls, wi_local, f, scattering};
 }
 
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,

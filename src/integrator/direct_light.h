@@ -15,20 +15,23 @@ namespace bpm {
 // segment: 0 when a surface that is not an interface stands between; through interface surfaces,
 // which shadow rays cross as pbrt-v4's cross medium boundaries, the product of each stretch's
 // medium transmittance, the medium changing at each. `infinite`: the target stands for a
-// direction, the last stretch infinitely long.
+// direction, the last stretch infinitely long. With `scattering`, *scattering is set where a
+// stretch lies in a scattering medium.
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
-                              bool infinite, const Wavelengths& wl);
+                              bool infinite, const Wavelengths& wl, bool* scattering = nullptr);
 
 // One sample for next-event estimation at sp: a light chosen by power (light, pmf), a point on it
 // by its own sampling (ls), and f, the BSDF of `part` times |cos| times the shadow ray's
 // transmittance (wi_local: the light's direction in `frame`). None where the light sends nothing
-// there or f is black. sample_direct_light weighs it; bpm's continuation weighs it otherwise.
+// there or f is black; through_scattering: the shadow ray crossed a scattering medium.
+// sample_direct_light weighs it; bpm's continuation weighs it otherwise.
 struct LightSampleAt {
   int light;
   float pmf;
   LightLiSample ls;
   Vec3 wi_local;
   Spectrum f;
+  bool through_scattering = false;
 };
 std::optional<LightSampleAt> sample_light_at(const RenderScene& scene, const SurfacePoint& sp,
                                              int object, int medium, const Material& m,

@@ -269,8 +269,8 @@ inline bool scatter_photon_in_medium(const RenderScene& scene, const PathVertex&
 // asks for. The path stops when neither wants more. In a scattering medium the photon scatters
 // where its free flight ends (by the phase function, a diffuse event), and on_beam(const
 // PhotonBeam&) is called for each of its ways through the medium after at most the bounces of a hit
-// reported. With `combine` (a scene without media), each hit carries its merge factor
-// (PhotonHit::merge_factor, photons/merge_weights.h).
+// reported. With `combine`, each hit carries its merge factor (PhotonHit::merge_factor,
+// photons/merge_weights.h).
 template <class OnHit, class OnSegment = NoSegments, class OnBeam = NoBeams>
 void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, int max_depth,
                       int min_eye_vertices, const EmissionDraw& e, Rng& rng,
@@ -297,6 +297,8 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     StepEnd end;
     const Spectrum beta_before = s.beta;
     auto beam = [&](const Ray& ray, float t_max, const Spectrum& flux) {
+      // Through a scattering medium no path is combined (merge_weights.h).
+      if (mis && scene.media[size_t(s.medium)].scatters()) mis->stop();
       if (bounces <= hit_depth)
         on_beam(PhotonBeam{ray, t_max, flux, s.medium, cls, bounces, s.hero_only});
     };

@@ -23,9 +23,11 @@
 // direction of a distant light again a delta left out. Paths whose vertices z are all on surfaces
 // (not curves) with gathered lobes, or with traced lobes only (a mirror, glass, a thin pane: the
 // eye path goes on through them as the photon does, without next-event estimation there), and at
-// least one of them gathered (a caustic at x stays the merge's), are combined; at a delta lobe
-// both sides count the probability of choosing it and leave its delta out. Every other path stays
-// the merge's alone, and the continuation leaves it out. Both passes compute the same products,
+// least one of them gathered (a caustic at x stays the merge's), and whose segments cross no
+// scattering medium (where a free flight's density and a shadow ray's transmittance would have to
+// be weighed), are combined; at a delta lobe both sides count the probability of choosing it and
+// leave its delta out. Every other path stays the merge's alone, and the continuation leaves it
+// out. Both passes compute the same products,
 // each from its own end of the path, so that the weights of a path sum to one.
 #pragma once
 #include <cmath>
@@ -90,6 +92,8 @@ class PhotonMis {
   void arrive(const RenderScene& scene, const PathVertex& v, int k);
   // It leaves v, its k-th vertex, along the world direction wi, drawn as the sample bs.
   void scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int k);
+  // It crosses a scattering medium: the path is the photon's alone from here.
+  void stop() { on_ = false; }
   // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
   // the vertex before over the squared distance (the factor that turns the eye's solid-angle
   // density into the measure of that vertex; merges start at the second), so that the merge's
