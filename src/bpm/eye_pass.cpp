@@ -205,9 +205,9 @@ struct Continuation {
   double vertex_scale = 0, a_x = 0;
   // The path leaves e_(j-1) = v (traced: its lobes are all traced) by the sample bs of `lobes`.
   void leave(const PathVertex& v, const BsdfSample& bs, BsdfPart lobes, bool traced, int j) {
-    pdf_prev = bs.is_specular()
-                   ? double(bs.pdf_solid_angle)
-                   : double(bsdf_pdf(v.m(), v.wo_local, bs.wi, TransportMode::kRadiance, lobes));
+    const float delta = delta_choice_probability(bs);
+    pdf_prev =
+        delta > 0 ? delta : bsdf_pdf(v.m(), v.wo_local, bs.wi, TransportMode::kRadiance, lobes);
     prev_traced = traced;
     gathered = gathered || (j > 1 && !traced);
     prev_p = v.sp.p;
@@ -289,13 +289,12 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
   return s.beta * f * ls->radiance * float(w / (double(sample->pmf) * ls->pdf_solid_angle));
 }
 
-// Past e_1 (j > 1), at e_(j-1) = v left by the sample bs with the throughput `beta`: the photons'
-// gathered share at v, arriving from e_j (all of it where v's lobes are all traced), then Russian
-// roulette on the change of throughput; false where the path ends, else s.beta and c updated
-// (c.ratio times A of e_(j-2), x at j = 2, from v).
-inline bool survives_past(const PathVertex& v, const BsdfSample& bs, Spectrum beta, int j, Rng& rng,
-                          PathState& s, Continuation& c) {
-  const bool traced = bsdf_all_traced(v.m());
+// Past e_1 (j > 1), at e_(j-1) = v (traced: its lobes are all traced) left by the sample bs with
+// the throughput `beta`: the photons' gathered share at v, arriving from e_j (all of it where
+// traced), then Russian roulette on the change of throughput; false where the path ends, else
+// s.beta and c updated (c.ratio times A of e_(j-2), x at j = 2, from v).
+inline bool survives_past(const PathVertex& v, bool traced, const BsdfSample& bs, Spectrum beta,
+                          int j, Rng& rng, PathState& s, Continuation& c) {
   const float g =
       traced ? 1.0f
              : bsdf_gathered_probability(v.m(), bs.wi, v.wo_local, TransportMode::kImportance);
@@ -304,9 +303,9 @@ inline bool survives_past(const PathVertex& v, const BsdfSample& bs, Spectrum be
   const float q = std::fmax(0.0f, 1 - beta.max_component() / s.beta.max_component());
   if (rng.uniform() < q) return false;
   s.beta = beta / (1 - q);
-  const float delta = bs.is_specular() ? bs.pdf_solid_angle : 0.0f;
-  const double a =
-      combined_density(v, bs.wi, v.wo_local, TransportMode::kImportance, delta) * c.cos_prev / c.d2;
+  const double a = combined_density(v, bs.wi, v.wo_local, TransportMode::kImportance,
+                                    delta_choice_probability(bs)) *
+                   c.cos_prev / c.d2;
   c.ratio *= a;
   if (j == 2) c.a_x = traced ? std::numeric_limits<double>::infinity() : a;
   return true;
@@ -356,7 +355,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     const Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
     if (j == 1)
       s.beta = beta;
-    else if (!survives_past(v, *bs, beta, j, path.rng, s, c))
+    else if (!survives_past(v, traced, *bs, beta, j, path.rng, s, c))
       break;
     if (s.beta.is_black() || !s.beta.is_finite()) break;
     c.leave(v, *bs, lobes, traced, j);

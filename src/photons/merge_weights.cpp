@@ -129,10 +129,7 @@ void PhotonMis::scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int 
     return;
   }
   const Vec3 wi_local = v.frame.to_local(wi);
-  // A delta lobe's choice is as probable both ways (Fresnel's reflectance is the same from either
-  // side; a mirror has one lobe): its probability stands for both sides' densities, whose deltas
-  // cancel.
-  const float delta = bs.is_specular() ? bs.pdf_solid_angle : 0.0f;
+  const float delta = delta_choice_probability(bs);
   // A_(k+1)'s solid-angle density: the adjoint BSDF's at v, from where the photon came, through
   // the gathered part (where a coat splits, its share of the density).
   const double a = combined_density(v, v.wo_local, wi_local, TransportMode::kImportance, delta);

@@ -53,6 +53,13 @@ bool combinable_vertex(const PathVertex& v);
 double combined_density(const PathVertex& v, Vec3 from, Vec3 to, TransportMode mode,
                         float delta_probability);
 
+// For a delta lobe's sample, the probability of choosing its lobe, which stands for both sides'
+// densities (a choice as probable both ways: Fresnel's reflectance is the same from either side,
+// a mirror has one lobe; the deltas cancel); 0 for any other sample.
+inline float delta_choice_probability(const BsdfSample& bs) {
+  return bs.is_specular() ? bs.pdf_solid_angle : 0.0f;
+}
+
 // A solid-angle density at `from` of the direction to `to`, turned into an area density at `to`
 // (whose geometric normal is n_to).
 inline double area_density(double pdf_solid_angle, Vec3 from, Vec3 to, Vec3 n_to) {
