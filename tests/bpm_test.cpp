@@ -1016,14 +1016,16 @@ TEST(Bpm, CombinedEstimatorsCountPathsThroughTracedLobesOnce) {
   EXPECT_GT(check.combined["eye"]["continued_traced_vertices"].get<double>(), 0.0);
 }
 
-// In a scene with a scattering medium the paths that cross no medium are combined, the others
-// stay the merges' (merge_weights.h): a photon stops its products where it enters the medium, and
-// the eye path's continuation counts nothing past a ray or a shadow ray through it. The test box
-// with a slab of thin fog under its light (an interface box around a homogeneous medium of optical
-// depth 0.5 across), which all light crosses: most of it unscattered, so that a continuation that
-// counted its next-event estimation through the fog as well as the merges would be about a third
-// too bright.
-TEST(Bpm, CombinedEstimatorsLeavePathsThroughScatteringMediaToTheMerges) {
+// Paths through scattering media are combined too (merge_weights.h): a segment's probability of
+// getting across is left out of both sides' products, but for next-event estimation's shadow ray,
+// whose density is divided by it; at a point where the path scatters in a medium, sigma_t stands
+// for |cos|, and the eye path goes on by the phase function with next-event estimation there.
+// The test box with a slab of thin fog under its light (an interface box around a homogeneous
+// medium of optical depth 0.5 across), which all light crosses: a path through the fog that both
+// the continuation and the merges counted in full, or weighed differently on the two sides, would
+// make the image bright or dark (a photon's next-event density left out where it first scattered
+// in the fog made it 5% bright, 13 sigma).
+TEST(Bpm, CombinedEstimatorsCountPathsThroughScatteringMediaOnce) {
   std::string scene = cornell();
   scene.insert(scene.find("WorldBegin"),
                "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" "
@@ -1037,6 +1039,8 @@ TEST(Bpm, CombinedEstimatorsLeavePathsThroughScatteringMediaToTheMerges) {
   // 4.5 sigma.
   const CombinedCheck check = expect_combined_agrees_with_path(load(scene), "a slab of fog", false);
   EXPECT_GT(check.combined["light"]["beams"].get<double>(), 0.0);
+  EXPECT_GT(check.combined["eye"]["continued_through_media"].get<double>(), 0.0);
+  EXPECT_GT(check.combined["eye"]["continued_medium_vertices"].get<double>(), 0.0);
 }
 
 // A point-like light's paths are combined as an area light's (merge_weights.h): the delta of its

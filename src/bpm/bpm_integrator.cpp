@@ -161,8 +161,7 @@ class BpmRender {
   // what the rounds learnt.
   PassWork work_now() const;
   void choose_photons();
-  // Combined estimators run as asked (photons/merge_weights.h: not on paths through scattering
-  // media).
+  // Combined estimators run as asked (photons/merge_weights.h).
   CombineAt combined() const { return s_.combine; }
   // Vertex connections run: asked for, with an image, in a scene without media.
   bool vertex_connections() const {

@@ -189,15 +189,21 @@ inline Spectrum direct_light_at_last(const EyePath& path, const PathVertex& v, c
 // Where the eye path goes on past its last diffuse vertex x (combined estimators,
 // photons/merge_weights.h): a vertex e_j, j from 1, with the running ratio of the merge's density
 // to the continuation's for the path so far (merge_density times A of x .. e_(j-2), over B of
-// e_1 .. e_j), the vertex before (e_0 = x) and the eye's BSDF density there of the way to e_j.
+// e_1 .. e_j), the vertex before (e_0 = x; on a surface or in a medium) and the eye's BSDF (or
+// phase) density there of the way to e_j.
 struct Continuation {
   double ratio;
-  Vec3 prev_p, prev_n;
+  DensityEnd prev;
   double pdf_prev = 0;  // for a delta lobe the probability of choosing it
   // The vertex before has traced lobes only (no next-event estimation there); one of e_1 ..
   // e_(j-1) has gathered lobes (else the light found is a caustic at x, the merge's alone).
   bool prev_traced = false, gathered = false;
-  double cos_prev = 0, d2 = 1;  // |cos| at the vertex before toward e_j; their squared distance
+  // |cos| (sigma in a medium: DensityEnd) at the vertex before toward e_j; their squared distance
+  double cos_prev = 0, d2 = 1;
+  // The probability that a free flight gets across the media between the vertex before and e_j
+  // (PathState::pass), which next-event estimation's density is divided by there: its
+  // shadow ray gets across for certain, where the BSDF sample and the photon get across with it.
+  double pass = 1;
   // Where x is the vertex connections' target: 1 / (pi r^2 P), so that their density over the
   // merge's is vertex_scale / A(x) (vertex_connections.h), with A(x) the photon's density of x
   // from e_1 (a_x, known from j = 2 on; infinite where e_1 is traced: no connection joins it);
@@ -210,8 +216,14 @@ struct Continuation {
         delta > 0 ? delta : bsdf_pdf(v.m(), v.wo_local, bs.wi, TransportMode::kRadiance, lobes);
     prev_traced = traced;
     gathered = gathered || (j > 1 && !traced);
-    prev_p = v.sp.p;
-    prev_n = v.sp.ng;
+    prev = {v.sp.p, v.sp.ng};
+  }
+  // It leaves the medium vertex v (of mean sigma_t `sigma`) by a phase sample of density `phase`.
+  void leave_medium(const PathVertex& v, float phase, double sigma) {
+    pdf_prev = phase;
+    prev_traced = false;
+    gathered = true;
+    prev = {v.sp.p, Vec3(), sigma};
   }
 };
 
@@ -227,12 +239,14 @@ inline double merge_and_connection(double merge, const Continuation& c, double a
 inline double found_light_weight(const RenderScene& scene, const Continuation& c, int li, Vec3 y,
                                  Vec3 n) {
   const Light& light = scene.lights[size_t(li)];
-  const Vec3 d = y - c.prev_p;
+  const Vec3 d = y - c.prev.p;
   const float len = length(d);
   if (!(len > 0)) return 0;
-  const double b_bsdf = light_end_density(light, c.pdf_prev, c.prev_p, y, n);
-  const double b_light = c.prev_traced ? 0.0 : light_sample_density(scene, li, c.prev_p, y, n);
-  const double merge = c.ratio * emission_density(scene, li, y, n, -d / len, c.prev_p, c.prev_n);
+  const double b_bsdf = light_end_density(light, c.pdf_prev, c.prev.p, y, n);
+  if (!(c.pass > 0)) return 0;
+  const double b_light =
+      c.prev_traced ? 0.0 : light_sample_density(scene, li, c.prev.p, y, n) / c.pass;
+  const double merge = c.ratio * emission_density(scene, li, y, n, -d / len, c.prev);
   return b_bsdf / (b_bsdf + b_light + merge_and_connection(merge, c, c.a_x));
 }
 
@@ -241,7 +255,7 @@ inline double found_light_weight(const RenderScene& scene, const Continuation& c
 inline Spectrum found_environment(const RenderScene& scene, const Continuation& c, Vec3 dir,
                                   const Wavelengths& wl) {
   Spectrum L;
-  const Vec3 far = c.prev_p + dir * (2 * scene.bounds_info.radius);
+  const Vec3 far = c.prev.p + dir * (2 * scene.bounds_info.radius);
   for (const int li : scene.infinite_lights) {
     const Spectrum Le = environment_radiance(scene.lights[size_t(li)], dir, wl);
     const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, far, Vec3());
@@ -250,43 +264,71 @@ inline Spectrum found_environment(const RenderScene& scene, const Continuation& 
   return L;
 }
 
-// At e_j (v), next-event estimation of a light, weighed against the BSDF sample that could find
-// it (an area or environment light) and the merge at x.
+// The weight of next-event estimation's sample of a light at e_j (`at`), against the BSDF (or
+// phase) sample that could find it (an area or environment light), of density eye_pdf there, and
+// the merge at x, whose photon leaves e_j toward e_(j-1) with the density photon_pdf.
+inline double continued_light_weight(const RenderScene& scene, const Continuation& c,
+                                     const LightSampleAt& sample, const DensityEnd& at,
+                                     double eye_pdf, double photon_pdf) {
+  const int li = sample.light;
+  const LightLiSample& ls = sample.ls;
+  // A delta light: next-event estimation's density and the emission's without their delta, and
+  // none for the BSDF sample.
+  const double b_light =
+      light_sample_density(scene, li, at.p, ls.p_light, ls.n_light) / double(sample.pass);
+  const double b_bsdf =
+      light_end_density(scene.lights[size_t(li)], eye_pdf, at.p, ls.p_light, ls.n_light);
+  // The photon's densities: the light's point and direction, e_j from there, e_(j-1) from e_j.
+  const double a_prev = photon_pdf * c.cos_prev / c.d2;
+  const double merge =
+      c.ratio * a_prev * emission_density(scene, li, ls.p_light, ls.n_light, -ls.wi, at);
+  const double others = merge_and_connection(merge, c, c.a_x > 0 ? c.a_x : a_prev);
+  return b_light / (b_light + b_bsdf + others);
+}
+
+// The light of next-event estimation's sample with its weight w, f its BSDF (or phase) times
+// transmittance.
+inline Spectrum weighted_light_sample(const EyePath& path, const PathState& s,
+                                      const LightSampleAt& sample, const Spectrum& f, double w) {
+  if (!std::isfinite(w)) return {};
+  if (sample.pass < 1) ++path.counters.continued_through_media;
+  return s.beta * f * sample.ls.radiance *
+         float(w / (double(sample.pmf) * sample.ls.pdf_solid_angle));
+}
+
+// At e_j (v, on a surface), next-event estimation of a light (continued_light_weight).
 inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v, const PathState& s,
                                        const Continuation& c) {
   const RenderScene& scene = path.scene;
   const auto sample = sample_light_at(scene, v.sp, v.object(), s.medium, v.m(), v.frame, v.wo_local,
                                       *path.prm.materials, path.rng, path.counters.rays);
-  if (!sample) return {};
-  // Through a scattering medium: the photons' alone (merge_weights.h).
-  if (sample->through_scattering) return {};
-  const int li = sample->light;
-  const Light& light = scene.lights[size_t(li)];
-  const LightLiSample* ls = &sample->ls;
+  if (!sample || !(sample->pass > 0)) return {};
   const Vec3 wi_local = sample->wi_local;
-  Spectrum f = sample->f;
   // The share a photon from the light would draw through v's gathered part (merge_weights.h).
   const float g =
       bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
   if (!(g > 0)) return {};
-  f *= g;
-  // A delta light: next-event estimation's density and the emission's without their delta, and
-  // none for the BSDF sample.
-  const double b_light = light_sample_density(scene, li, v.sp.p, ls->p_light, ls->n_light);
-  const double b_bsdf =
-      light_end_density(light, bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance),
-                        v.sp.p, ls->p_light, ls->n_light);
-  // The photon's densities: the light's point and direction, e_j from there, e_(j-1) from e_j.
-  const double a_prev = double(g) *
-                        bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kImportance) *
-                        c.cos_prev / c.d2;
-  const double merge =
-      c.ratio * a_prev *
-      emission_density(scene, li, ls->p_light, ls->n_light, -ls->wi, v.sp.p, v.sp.ng);
-  const double others = merge_and_connection(merge, c, c.a_x > 0 ? c.a_x : a_prev);
-  const double w = b_light / (b_light + b_bsdf + others);
-  if (!std::isfinite(w)) return {};
-  return s.beta * f * ls->radiance * float(w / (double(sample->pmf) * ls->pdf_solid_angle));
+  const double w = continued_light_weight(
+      scene, c, *sample, DensityEnd{v.sp.p, v.sp.ng},
+      bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance),
+      double(g) * bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kImportance));
+  return weighted_light_sample(path, s, *sample, sample->f * g, w);
+}
+
+// At e_j (v, in a medium of mean sigma_t `sigma` there), next-event estimation of a light
+// (continued_light_weight; the phase function's density is the same both ways).
+inline Spectrum continued_light_sample_in_medium(const EyePath& path, const PathVertex& v,
+                                                 const PathState& s, const Continuation& c,
+                                                 double sigma) {
+  const RenderScene& scene = path.scene;
+  const float g = scene.media[size_t(v.medium)].g;
+  const auto sample =
+      sample_light_in_medium(scene, v, g, *path.prm.materials, path.rng, path.counters.rays);
+  if (!sample || !(sample->pass > 0)) return {};
+  const double phase = henyey_greenstein(dot(-v.wo, sample->ls.wi), g);
+  const double w =
+      continued_light_weight(scene, c, *sample, DensityEnd{v.sp.p, Vec3(), sigma}, phase, phase);
+  return weighted_light_sample(path, s, *sample, sample->f, w);
 }
 
 // Past e_1 (j > 1), at e_(j-1) = v (traced: its lobes are all traced) left by the sample bs with
@@ -311,6 +353,115 @@ inline bool survives_past(const PathVertex& v, bool traced, const BsdfSample& bs
   return true;
 }
 
+// Past e_1, at e_(j-1) = v in a medium (of mean sigma_t `sigma` there), reached with the throughput
+// beta_flight before its free flight: Russian roulette on the change since (the medium's albedo),
+// as a photon's there, then a phase sample (its weight is 1; its density the same both ways,
+// which is also the photon's of e_(j-2) from v). False where the path ends, else s and c updated.
+inline bool leave_medium_vertex(const RenderScene& scene, const PathVertex& v, double sigma,
+                                const Spectrum& beta_flight, int j, Rng& rng, PathState& s,
+                                Continuation& c) {
+  const float q = std::fmax(0.0f, 1 - s.beta.max_component() / beta_flight.max_component());
+  if (rng.uniform() < q) return false;
+  s.beta /= 1 - q;
+  const PhaseSample ps = sample_phase(v, scene.media[size_t(v.medium)].g, rng);
+  const float phase = ps.emitter.pdf_bsdf;
+  if (!(phase > 0)) return false;
+  const double a = double(phase) * c.cos_prev / c.d2;
+  c.ratio *= a;
+  if (j == 2) c.a_x = a;
+  c.leave_medium(v, phase, sigma);
+  s.ray = Ray{v.sp.p, ps.wi, kInf};
+  return true;
+}
+
+// The continuation's first BSDF sample, which is also the first of x's direct samples
+// (continue_eye_path): the light it finds, and whether that sample would have cast its ray.
+struct FirstSample {
+  Spectrum found;
+  bool shared = false;
+};
+
+// At e_(j-1) = v on a surface (x where j = 1), the BSDF sample that leaves it toward e_j of the
+// lobes x gathers with (part) or of all, Russian roulette past x (survives_past), s.ray and c
+// updated. `found` is how the ray weighs the light it finds (at x: as the direct sample's), and
+// `look_only` whether the ray only looks for the light (a traced lobe at x). False where the path
+// ends.
+inline bool leave_surface_vertex(const EyePath& path, const PathVertex& v, int j, BsdfPart part,
+                                 PathState& s, Continuation& c, FirstSample& first,
+                                 EmitterWeight& found, bool& look_only) {
+  const RenderScene& scene = path.scene;
+  const float uc = path.rng.uniform();
+  const Vec2 u{path.rng.uniform(), path.rng.uniform()};
+  const BsdfPart lobes = j == 1 ? part : BsdfPart::kAll;
+  const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, lobes);
+  // Past x a delta lobe is followed where every lobe is traced (not a coat's alone).
+  const bool traced = j > 1 && bsdf_all_traced(v.m());
+  if (!bs || (bs->is_specular() && !traced)) return false;
+  // At x a traced lobe's sample only looks for the light, as the direct sample's would.
+  look_only = j == 1 && bs->is_traced();
+  if (look_only && !scene.bsdf_finds_lights) return false;
+  const Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
+  if (j == 1)
+    s.beta = beta;
+  else if (!survives_past(v, traced, *bs, beta, j, path.rng, s, c))
+    return false;
+  if (s.beta.is_black() || !s.beta.is_finite()) return false;
+  c.leave(v, *bs, lobes, traced, j);
+  leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+  if (j == 1 && scene.bsdf_finds_lights) {
+    found = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
+    first.shared = scene.may_reach_emitter(s.ray);
+    if (look_only && !first.shared) return false;  // it can find no light: no ray, as the direct's
+  }
+  return true;
+}
+
+// At e_j (e), where the continuation's ray ended (end), having left the vertex before (c.prev):
+// the light it found, weighed; then, where the path may go on from e_j (`vertices` scattering
+// events from the camera within maxdepth, a combinable vertex), B of e_j in c.ratio and
+// next-event estimation there. False where the path ends.
+inline bool arrive_at(const EyePath& path, const PathVertex& e, StepEnd end, int vertices,
+                      PathState& s, Continuation& c, Spectrum& L) {
+  const RenderScene& scene = path.scene;
+  const Wavelengths& wl = path.prm.materials->wl;
+  if (c.pass < 1 && end != StepEnd::kAbsorbed) ++path.counters.continued_through_media;
+  if (end == StepEnd::kEscaped && c.gathered)
+    L += s.beta * found_environment(scene, c, s.ray.d, wl);
+  const bool in_medium = end == StepEnd::kMedium;
+  if (end != StepEnd::kVertex && !in_medium) return false;
+  const DensityEnd here = density_end(scene, e, wl);
+  const Vec3 d = e.sp.p - c.prev.p;
+  c.d2 = double(length_squared(d));
+  if (!(c.d2 > 0)) return false;
+  const double len = std::sqrt(c.d2);
+  c.cos_prev = c.prev.factor(d, len);
+  // Emission found by the BSDF sample of e_(j-1) (x's own is its direct light): a path of j - 1
+  // vertices between the light and x.
+  const int li = in_medium ? -1 : scene.light_of_hit(e.hit);
+  if (c.gathered && li >= 0) {
+    const Spectrum Le = area_light_radiance(std::get<AreaLight>(scene.lights[size_t(li)]), e.sp.ng,
+                                            e.sp.uv, -s.ray.d, wl);
+    const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, e.sp.p, e.sp.ng);
+    if (std::isfinite(w) && w > 0) L += s.beta * Le * float(w);
+  }
+  // Paths of j vertices between the light and x: within the merge's depth.
+  if (vertices > path.prm.max_depth || !combinable_vertex(e)) return false;
+  if (!in_medium) {
+    if (e.wo_local.z == 0) return false;
+    keep_hero_wavelength_at(e, s);
+  }
+  c.ratio /= c.pdf_prev * here.factor(d, len) / c.d2;  // B of e_j
+  if (!std::isfinite(c.ratio)) return false;
+  if (in_medium) {
+    ++path.counters.continued_in_media;
+    L += continued_light_sample_in_medium(path, e, s, c, here.sigma);
+  } else if (bsdf_all_traced(e.m()))
+    ++path.counters.continued_traced;
+  else
+    L += continued_light_sample(path, e, s, c);
+  return true;
+}
+
 // Indirect light at the last diffuse vertex x by the eye path's continuation (combined
 // estimators, photons/merge_weights.h): BSDF samples from x on, through combinable vertices, each
 // finding lights by next-event estimation (but where its lobes are all traced) and by its BSDF
@@ -322,10 +473,6 @@ inline bool survives_past(const PathVertex& v, bool traced, const BsdfSample& bs
 // sample is also the first of x's direct samples: the light it finds goes to first.found, weighed
 // as direct_light_by_bsdf weighs it, and first.shared says whether that sample would have cast
 // the ray itself (the ray is then the direct light's, not the continuation's, in its cost).
-struct FirstSample {
-  Spectrum found;
-  bool shared = false;
-};
 inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, BsdfPart part,
                                   PathState s, int depth, double merge_density, double vertex_scale,
                                   FirstSample& first) {
@@ -334,73 +481,29 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
   PathCounters& rays = path.counters.rays;
   const uint64_t rays_before = rays.total();
   ++path.counters.continued;
-  Continuation c{merge_density, x.sp.p, x.sp.ng};
+  Continuation c{merge_density, DensityEnd{x.sp.p, x.sp.ng}};
   c.vertex_scale = vertex_scale;
   Spectrum L;
   const PathVertex* at = &x;
   PathVertex vertices[2];  // e_j and e_(j-1) in turn (a vertex is not copied)
+  Spectrum beta_flight;    // the throughput before the free flight that reached e_(j-1)
   for (int j = 1;; ++j) {
     const PathVertex& v = *at;
-    // The BSDF sample that leaves v: to e_j.
-    const float uc = path.rng.uniform();
-    const Vec2 u{path.rng.uniform(), path.rng.uniform()};
-    const BsdfPart lobes = j == 1 ? part : BsdfPart::kAll;
-    const auto bs = sample_bsdf(v, uc, u, TransportMode::kRadiance, lobes);
-    // Past x a delta lobe is followed where every lobe is traced (not a coat's alone).
-    const bool traced = j > 1 && bsdf_all_traced(v.m());
-    if (!bs || (bs->is_specular() && !traced)) break;
-    // At x a traced lobe's sample only looks for the light, as the direct sample's would.
-    const bool look_only = j == 1 && bs->is_traced();
-    if (look_only && !scene.bsdf_finds_lights) break;
-    const Spectrum beta = s.beta * bs->f * (std::fabs(bs->wi.z) / bs->pdf_solid_angle);
-    if (j == 1)
-      s.beta = beta;
-    else if (!survives_past(v, traced, *bs, beta, j, path.rng, s, c))
-      break;
-    if (s.beta.is_black() || !s.beta.is_finite()) break;
-    c.leave(v, *bs, lobes, traced, j);
-    leave_vertex(scene, v, v.frame.to_world(bs->wi), s);
+    bool look_only = false;
     EmitterWeight found = EmitterWeight::none();
-    if (j == 1 && scene.bsdf_finds_lights) {
-      found = EmitterWeight::mis(bs->mis_pdf, v.sp.p);
-      first.shared = scene.may_reach_emitter(s.ray);
-      if (look_only && !first.shared) break;  // it can find no light: no ray, as the direct's
+    if (v.medium >= 0) {
+      const double sigma = medium_mean_sigma_t(scene, v.medium, v.sp.p, wm.wl);
+      if (!leave_medium_vertex(scene, v, sigma, beta_flight, j, path.rng, s, c)) break;
+    } else if (!leave_surface_vertex(path, v, j, part, s, c, first, found, look_only)) {
+      break;
     }
     ++rays.bounce_rays;
     PathVertex& e = vertices[j & 1];
     Spectrum none;
-    bool scattering = false;  // the ray crossed a scattering medium: no path past it is combined
-    const StepEnd end =
-        next_eye_vertex(scene, wm, s, e, rays, found, j == 1 ? first.found : none, false, nullptr,
-                        [&](const Ray&, float, const Spectrum&) { scattering = true; });
-    if (look_only || scattering) break;
-    if (end == StepEnd::kEscaped && c.gathered)
-      L += s.beta * found_environment(scene, c, s.ray.d, wm.wl);
-    if (end != StepEnd::kVertex) break;
-    const Vec3 d = e.sp.p - c.prev_p;
-    c.d2 = double(length_squared(d));
-    if (!(c.d2 > 0)) break;
-    const double len = std::sqrt(c.d2);
-    c.cos_prev = std::fabs(double(dot(c.prev_n, d))) / len;
-    const double cos_here = std::fabs(double(dot(e.sp.ng, d))) / len;
-    // Emission found by v's BSDF sample (x's own is its direct light): a path of j - 1 vertices
-    // between the light and x.
-    const int li = scene.light_of_hit(e.hit);
-    if (c.gathered && li >= 0) {
-      const Spectrum Le = area_light_radiance(std::get<AreaLight>(scene.lights[size_t(li)]),
-                                              e.sp.ng, e.sp.uv, -s.ray.d, wm.wl);
-      const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, e.sp.p, e.sp.ng);
-      if (std::isfinite(w) && w > 0) L += s.beta * Le * float(w);
-    }
-    // Paths of j vertices between the light and x: within the merge's depth.
-    if (depth + j > path.prm.max_depth || !combinable_vertex(e) || e.wo_local.z == 0) break;
-    keep_hero_wavelength_at(e, s);
-    c.ratio /= c.pdf_prev * cos_here / c.d2;  // B of e_j
-    if (!std::isfinite(c.ratio)) break;
-    if (bsdf_all_traced(e.m()))
-      ++path.counters.continued_traced;
-    else
-      L += continued_light_sample(path, e, s, c);
+    beta_flight = s.beta;
+    const StepEnd end = next_eye_vertex(scene, wm, s, e, rays, found, j == 1 ? first.found : none);
+    c.pass = s.pass;
+    if (look_only || !arrive_at(path, e, end, depth + j, s, c, L)) break;
     at = &e;
   }
   path.counters.continuation_rays += rays.total() - rays_before;

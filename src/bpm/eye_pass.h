@@ -91,8 +91,9 @@ struct EyeCounters {
   // Eye paths that went on past their last diffuse vertex (combined estimators), and their rays
   // (in `rays` too; the first, which the first direct sample shares, included).
   uint64_t continued = 0, continuation_rays = 0;
-  // The vertices with traced lobes only that continuations went through.
-  uint64_t continued_traced = 0;
+  // The vertices with traced lobes only and the medium vertices that continuations went through,
+  // and their rays and shadow rays (with light to count) that got across a scattering medium.
+  uint64_t continued_traced = 0, continued_in_media = 0, continued_through_media = 0;
   void add(const EyeCounters& o) {
     rays.add(o.rays);
     backward_photons += o.backward_photons;
@@ -104,6 +105,8 @@ struct EyeCounters {
     continued += o.continued;
     continuation_rays += o.continuation_rays;
     continued_traced += o.continued_traced;
+    continued_in_media += o.continued_in_media;
+    continued_through_media += o.continued_through_media;
   }
 };
 

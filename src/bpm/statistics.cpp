@@ -61,6 +61,10 @@ nlohmann::json eye_json(const BpmTotals& t, int iterations, size_t pixels) {
       {"continuation_rays", t.eye.continuation_rays},
       // The vertices with traced lobes only (glass, mirrors) that continuations went through.
       {"continued_traced_vertices", t.eye.continued_traced},
+      // The points in media where they scattered.
+      {"continued_medium_vertices", t.eye.continued_in_media},
+      // Their rays and shadow rays (with light to count) that got across a scattering medium.
+      {"continued_through_media", t.eye.continued_through_media},
       {"continue_probability_mean", t.continue_probability},
       {"radius_scale_mean",
        {{"small", t.small_scale_mean}, {"large", t.large_scale_mean}, {"shared", t.shared_scale}}},

@@ -9,17 +9,20 @@
 namespace bpm {
 
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
-                              bool infinite, const Wavelengths& wl, bool* scattering) {
-  const auto note = [&](int in) {
-    if (scattering && in >= 0 && scene.media[size_t(in)].scatters()) *scattering = true;
+                              bool infinite, const Wavelengths& wl, float* pass) {
+  // A stretch of `length` along r in `in`: its transmittance; in a scattering medium its mean is
+  // the probability that a free flight gets across (next_vertex's PathState::pass).
+  const auto stretch = [&](int in, const Ray& r, float length) {
+    const Spectrum T = medium_transmittance(scene, in, r, length, wl);
+    if (pass && scene.media[size_t(in)].scatters()) *pass *= T.average();
+    return T;
   };
+  if (pass) *pass = 1;
   if (!scene.occluded(origin, target)) {
     if (medium < 0) return Spectrum(1.0f);
-    note(medium);
     const Vec3 d = target - origin;
     const float len = length(d);
-    return medium_transmittance(scene, medium, Ray{origin, d / len, kInf}, infinite ? kInf : len,
-                                wl);
+    return stretch(medium, Ray{origin, d / len, kInf}, infinite ? kInf : len);
   }
   if (!scene.has_interfaces) return {};
   Spectrum T(1.0f);
@@ -30,16 +33,15 @@ Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target
     if (!(len > 0)) return {};
     const Ray r{o, d / len, len * (1 - 1e-4f)};
     Hit h;
-    note(medium);
     if (!scene.intersect(r, &h)) {
-      if (medium >= 0) T *= medium_transmittance(scene, medium, r, infinite ? kInf : len, wl);
+      if (medium >= 0) T *= stretch(medium, r, infinite ? kInf : len);
       return T;
     }
     const Object& obj = scene.objects[size_t(h.object)];
     if (!std::holds_alternative<InterfaceMaterial>(scene.materials[size_t(obj.material)]))
       return {};
     const SurfacePoint sp = scene.surface(r, h);
-    if (medium >= 0) T *= medium_transmittance(scene, medium, r, h.t, wl);
+    if (medium >= 0) T *= stretch(medium, r, h.t);
     if (T.is_black()) return T;
     medium = medium_toward(scene, h.object, sp.ng, r.d, medium);
     o = offset_origin(sp.p, sp.ng, r.d, sp.error);
@@ -77,12 +79,12 @@ std::optional<LightSampleAt> sample_light_at(const RenderScene& scene, const Sur
     float len = length(d);
     counters.observer->shadow(Ray{origin, d / len, len * (1 - 1e-4f)});
   }
-  bool scattering = false;
+  float pass = 1;
   f *= shadow_transmittance(scene, origin, target,
                             medium_toward(scene, object, sp.ng, ls->wi, medium), ls->is_infinite,
-                            wl, &scattering);
+                            wl, &pass);
   if (f.is_black()) return std::nullopt;
-  return LightSampleAt{li, pmf, *ls, wi_local, f, scattering};
+  return LightSampleAt{li, pmf, *ls, wi_local, f, pass};
 }
 
 Spectrum sample_direct_light(const RenderScene& scene, const SurfacePoint& sp, int object,
@@ -204,11 +206,11 @@ float light_point_pdf(const Light& light) {
 
 }  // namespace
 
-Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVertex& v, float g,
-                                       const WavelengthMaterials& wm, Rng& rng,
-                                       PathCounters& counters) {
+std::optional<LightSampleAt> sample_light_in_medium(const RenderScene& scene, const PathVertex& v,
+                                                    float g, const WavelengthMaterials& wm,
+                                                    Rng& rng, PathCounters& counters) {
   const Wavelengths& wl = wm.wl;
-  if (scene.lights.empty()) return {};
+  if (scene.lights.empty()) return std::nullopt;
   float pmf;
   int li = scene.light_distribution.sample(rng.uniform(), &pmf);
   const Light& light = scene.lights[size_t(li)];
@@ -216,16 +218,33 @@ Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVerte
   const Vec3 p = v.sp.p;
   auto ls = light_sample_li(light, scene.light_shape(light), p, u, scene.bounds_info, wl,
                             wm.light_spectrum(li));
-  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return {};
+  if (!ls || ls->radiance.is_black() || ls->pdf_solid_angle == 0) return std::nullopt;
   const float phase = henyey_greenstein(dot(-v.wo, ls->wi), g);
-  if (!(phase > 0)) return {};
+  if (!(phase > 0)) return std::nullopt;
   ++counters.shadow_rays;
   const bool has_surface = length_squared(ls->n_light) > 0;
   const Vec3 target = has_surface
                           ? offset_origin(ls->p_light, ls->n_light, -ls->wi, ls->p_light_error)
                           : ls->p_light;
-  const Spectrum f = shadow_transmittance(scene, p, target, v.medium, ls->is_infinite, wl) * phase;
-  if (f.is_black()) return {};
+  float pass = 1;
+  const Spectrum f =
+      shadow_transmittance(scene, p, target, v.medium, ls->is_infinite, wl, &pass) * phase;
+  if (f.is_black()) return std::nullopt;
+  return LightSampleAt{li, pmf, *ls, ls->wi, f, pass};
+}
+
+Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVertex& v, float g,
+                                       const WavelengthMaterials& wm, Rng& rng,
+                                       PathCounters& counters) {
+  const auto s = sample_light_in_medium(scene, v, g, wm, rng, counters);
+  if (!s) return {};
+  const Light& light = scene.lights[size_t(s->light)];
+  const LightLiSample* ls = &s->ls;
+  const Spectrum& f = s->f;
+  const Vec3 p = v.sp.p;
+  const float phase = henyey_greenstein(dot(-v.wo, ls->wi), g);
+  const float pmf = s->pmf;
+  const Wavelengths& wl = wm.wl;
   const float p_light = pmf * ls->pdf_solid_angle;
   float share = ls->is_delta ? 1 : power_heuristic(p_light, phase);
   // The balance heuristic against sample_direct_light_along's density of the same light path.

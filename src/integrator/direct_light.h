@@ -15,15 +15,17 @@ namespace bpm {
 // segment: 0 when a surface that is not an interface stands between; through interface surfaces,
 // which shadow rays cross as pbrt-v4's cross medium boundaries, the product of each stretch's
 // medium transmittance, the medium changing at each. `infinite`: the target stands for a
-// direction, the last stretch infinitely long. With `scattering`, *scattering is set where a
-// stretch lies in a scattering medium.
+// direction, the last stretch infinitely long. With `pass`, *pass is the probability that a free
+// flight gets across the whole way (as PathState::pass: the product over the stretches in
+// scattering media of their mean transmittance).
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
-                              bool infinite, const Wavelengths& wl, bool* scattering = nullptr);
+                              bool infinite, const Wavelengths& wl, float* pass = nullptr);
 
 // One sample for next-event estimation at sp: a light chosen by power (light, pmf), a point on it
 // by its own sampling (ls), and f, the BSDF of `part` times |cos| times the shadow ray's
 // transmittance (wi_local: the light's direction in `frame`). None where the light sends nothing
-// there or f is black; through_scattering: the shadow ray crossed a scattering medium.
+// there or f is black; pass: the probability that a free flight would have got across the shadow
+// ray's way (shadow_transmittance), which bpm's continuation weighs next-event estimation by.
 // sample_direct_light weighs it; bpm's continuation weighs it otherwise.
 struct LightSampleAt {
   int light;
@@ -31,7 +33,7 @@ struct LightSampleAt {
   LightLiSample ls;
   Vec3 wi_local;
   Spectrum f;
-  bool through_scattering = false;
+  float pass = 1;
 };
 std::optional<LightSampleAt> sample_light_at(const RenderScene& scene, const SurfacePoint& sp,
                                              int object, int medium, const Material& m,
@@ -80,6 +82,11 @@ float sample_forced_medium_distance(const RenderScene& scene, int medium, const 
 Spectrum sample_direct_light_in_medium(const RenderScene& scene, const PathVertex& v, float g,
                                        const WavelengthMaterials& wm, Rng& rng,
                                        PathCounters& counters);
+// Its sample, unweighted (sample_light_at's at a medium vertex): wi_local is the light's world
+// direction, f the phase function's value times the shadow ray's transmittance.
+std::optional<LightSampleAt> sample_light_in_medium(const RenderScene& scene, const PathVertex& v,
+                                                    float g, const WavelengthMaterials& wm,
+                                                    Rng& rng, PathCounters& counters);
 
 // Direct light scattered toward the origin of a unit ray from anywhere on its first `length`
 // (kInf: without end) inside `medium`, per unit throughput at the ray's origin: a point drawn on a

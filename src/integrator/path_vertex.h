@@ -31,6 +31,12 @@ struct PathState {
   // caller draws the points where it scatters itself, along the pieces that in_medium reports
   // (bpm's forced medium vertices, bpm/eye_pass.cpp).
   bool cross_media = false;
+  // Set by next_vertex: the probability that its free flights got across the scattering media
+  // between the ray's origin and the vertex it reached (the mean over the wavelengths of each
+  // piece's transmittance, up to a medium vertex on the last; 1 where none was crossed). The
+  // combined estimators' weights divide next-event estimation's density by it
+  // (photons/merge_weights.h).
+  float pass = 1;
 };
 
 // The piece of a ray through a scattering medium on which a medium vertex was drawn: from ray.o
@@ -50,11 +56,11 @@ struct MediumPiece {
 struct PathVertex {
   Hit hit;
   SurfacePoint sp;
-  Vec3 wo;                   // toward where the path came from
-  int material_index;        // the object's material in RenderScene::materials
-  const Material* material;  // resolved at sp (textures, mixes) at the path's wavelengths
-  Material storage;          // holds the material when it had to be resolved at sp
-  Frame frame;               // shading frame
+  Vec3 wo;                             // toward where the path came from
+  int material_index = -1;             // the object's material in RenderScene::materials
+  const Material* material = nullptr;  // resolved at sp (textures, mixes) at the path's wavelengths
+  Material storage;                    // holds the material when it had to be resolved at sp
+  Frame frame;                         // shading frame
   Vec3 wo_local;
   bool on_curve = false;  // the surface is a curve (scene/curves.h)
   // A point inside a scattering medium (StepEnd::kMedium): sp.p is the point, wo the way back,
@@ -84,18 +90,25 @@ inline float flight_uniform(Rng& rng, float& preset) {
 // distance). The distance follows one wavelength's free flight, the wavelength drawn uniformly, and
 // the throughput is weighted by the mixture of all wavelengths' densities (one-sample MIS, the
 // balance heuristic: chromatic media stay unbiased at every wavelength): at a scattering point
-// beta *= sigma_s T(t) / p(t), past it beta *= T(distance) / P(t > distance). Returns the
-// scattering distance, or a negative value when the ray gets past.
+// beta *= sigma_s T(t) / p(t), past it beta *= T(distance) / P(t > distance); *pass is multiplied
+// by the mean transmittance up to the point or past the piece. Returns the scattering distance,
+// or a negative value when the ray gets past.
 inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sigma_s,
-                                    float distance, Rng& rng, float& preset_u, Spectrum& beta) {
+                                    float distance, Rng& rng, float& preset_u, Spectrum& beta,
+                                    float& pass) {
   constexpr int n = Spectrum::kChannels;
   const int j = std::min(int(rng.uniform() * n), n - 1);
   const float u = flight_uniform(rng, preset_u);
   const float t = sigma_t[j] > 0 ? -std::log1p(-u) / sigma_t[j] : kInf;
   if (t < distance) {
-    double p = 0;
-    for (int k = 0; k < n; ++k) p += sigma_t[k] * std::exp(-double(sigma_t[k]) * t);
+    double p = 0, T = 0;
+    for (int k = 0; k < n; ++k) {
+      const double e = std::exp(-double(sigma_t[k]) * t);
+      p += sigma_t[k] * e;
+      T += e;
+    }
     p /= n;
+    pass *= float(T / n);
     for (int k = 0; k < n; ++k)
       beta[k] *= float(sigma_s[k] * std::exp(-double(sigma_t[k]) * t) / p);
     return t;
@@ -107,16 +120,18 @@ inline float sample_medium_distance(const Spectrum& sigma_t, const Spectrum& sig
     P += T[k];
   }
   P /= n;
+  pass *= float(P);
   for (int k = 0; k < n; ++k) beta[k] *= float(T[k] / P);
   return -1;
 }
 
 // sample_medium_distance in an rgbgrid, whose sigma_t varies with the wavelength from point to
 // point: wavelength j's free flight drawn in its own optical depth, every wavelength weighted by
-// the mixture of their densities sigma_t(x) T(t). Returns the distance, or negative past it.
+// the mixture of their densities sigma_t(x) T(t); *pass as sample_medium_distance's. Returns the
+// distance, or negative past it.
 inline float sample_rgb_grid_flight(const RgbGrid& g, const Ray& unit, float distance,
                                     const Wavelengths& wl, Rng& rng, float& preset_u,
-                                    Spectrum& beta) {
+                                    Spectrum& beta, float& pass) {
   constexpr int n = Spectrum::kChannels;
   const int j = std::min(int(rng.uniform() * n), n - 1);
   const float tau = -std::log1p(-flight_uniform(rng, preset_u));
@@ -125,9 +140,14 @@ inline float sample_rgb_grid_flight(const RgbGrid& g, const Ray& unit, float dis
   if (t >= 0) {
     Spectrum a, s;
     g.coefficients(unit.o + unit.d * t, wl, &a, &s);
-    double p = 0;
-    for (int k = 0; k < n; ++k) p += (a[k] + s[k]) * std::exp(-double(depth[k]));
+    double p = 0, T = 0;
+    for (int k = 0; k < n; ++k) {
+      const double e = std::exp(-double(depth[k]));
+      p += (a[k] + s[k]) * e;
+      T += e;
+    }
     p /= n;
+    pass *= float(T / n);
     for (int k = 0; k < n; ++k)
       beta[k] = p > 0 ? float(beta[k] * s[k] * std::exp(-double(depth[k])) / p) : 0.0f;
     return t;
@@ -139,6 +159,7 @@ inline float sample_rgb_grid_flight(const RgbGrid& g, const Ray& unit, float dis
     P += T[k];
   }
   P /= n;
+  pass *= float(P);
   for (int k = 0; k < n; ++k) beta[k] = P > 0 ? float(beta[k] * T[k] / P) : 0.0f;
   return -1;
 }
@@ -161,6 +182,7 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
                     PathVertex& v, uint64_t& continuation_rays, RayObserver* observer,
                     OnSurface&& on_surface, InMedium&& in_medium = {}) {
   const Wavelengths& wl = materials.wl;
+  s.pass = 1;
   for (int guard = 0; guard < 10000; ++guard) {
     if (observer) observer->closest_hit(s.ray);
     v.hit = Hit();
@@ -174,17 +196,19 @@ StepEnd next_vertex(const RenderScene& scene, const WavelengthMaterials& materia
       in_medium(unit, distance, s.beta);
       float t = -1;
       if (m.rgb_grid) {
-        t = sample_rgb_grid_flight(*m.rgb_grid, unit, distance, wl, *s.rng, s.flight_u, s.beta);
+        t = sample_rgb_grid_flight(*m.rgb_grid, unit, distance, wl, *s.rng, s.flight_u, s.beta,
+                                   s.pass);
       } else {
         // The free flight in optical depth (density units), then as a distance (scene/medium.h).
         const Spectrum sigma_s = m.sigma_s.sample(wl), sigma_t = m.sigma_a.sample(wl) + sigma_s;
         const float tau = sample_medium_distance(sigma_t, sigma_s, m.depth(unit, 0, distance),
-                                                 *s.rng, s.flight_u, s.beta);
+                                                 *s.rng, s.flight_u, s.beta, s.pass);
         if (tau >= 0) t = m.distance_at_depth(unit, tau, distance);
       }
       if (t >= 0) {
         s.length += t;
         v.medium = s.medium;
+        v.material = nullptr;
         v.sp = SurfacePoint{};
         v.sp.p = s.ray.o + normalize(s.ray.d) * t;
         v.wo = -normalize(s.ray.d);

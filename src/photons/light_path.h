@@ -250,14 +250,18 @@ inline std::optional<bool> scatter_photon_at_surface(const RenderScene& scene, c
 
 // Scatters a photon at the medium point v: a phase-function sample (its weight is 1), Russian
 // roulette on the change of power since the last vertex, beta_before (the medium's albedo).
-// Returns false where the photon ends.
+// Returns false where the photon ends. With `mis`, its products follow it (v its k-th vertex).
 inline bool scatter_photon_in_medium(const RenderScene& scene, const PathVertex& v,
-                                     const Spectrum& beta_before, Rng& rng, PathState& s) {
+                                     const Spectrum& beta_before, Rng& rng, PathState& s,
+                                     PhotonMis* mis = nullptr, int k = 0) {
   const float q = std::fmax(0.0f, 1 - s.beta.max_component() / beta_before.max_component());
   if (rng.uniform() < q) return false;
   s.beta /= 1 - q;
   const Vec2 u{rng.uniform(), rng.uniform()};
-  s.ray = Ray{v.sp.p, sample_henyey_greenstein(-v.wo, scene.media[size_t(v.medium)].g, u), kInf};
+  const float g = scene.media[size_t(v.medium)].g;
+  const Vec3 wi = sample_henyey_greenstein(-v.wo, g, u);
+  if (mis) mis->scatter_in_medium(henyey_greenstein(dot(-v.wo, wi), g), k);
+  s.ray = Ray{v.sp.p, wi, kInf};
   return true;
 }
 
@@ -297,8 +301,6 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     StepEnd end;
     const Spectrum beta_before = s.beta;
     auto beam = [&](const Ray& ray, float t_max, const Spectrum& flux) {
-      // Through a scattering medium no path is combined (merge_weights.h).
-      if (mis && scene.media[size_t(s.medium)].scatters()) mis->stop();
       if (bounces <= hit_depth)
         on_beam(PhotonBeam{ray, t_max, flux, s.medium, cls, bounces, s.hero_only});
     };
@@ -321,18 +323,18 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
     }
     if (end != StepEnd::kVertex && end != StepEnd::kMedium) break;
     const bool in_medium = end == StepEnd::kMedium;
-    if (mis && !in_medium) mis->arrive(scene, v, bounces + 1);
+    if (mis) mis->arrive(scene, v, bounces + 1, s.pass, wm.wl);
     // A surface with gathered lobes (BsdfPart), or a point in a medium: the photon's estimate
     // there sees those alone.
     if (bounces <= hit_depth && (in_medium || !vertex_all_traced(v))) {
       ++counters.diffuse_hits;
       on_hit(PhotonHit{in_medium ? -1 : v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only,
-                       in_medium ? v.medium : -1, mis ? mis->merge_factor() : 0.0f,
+                       in_medium ? v.medium : -1, mis && !in_medium ? mis->merge_factor() : 0.0f,
                        mis && mis->on() && !in_medium ? mis : nullptr});
     }
     if (bounces + 1 > depth) break;
     if (in_medium) {
-      if (!scatter_photon_in_medium(scene, v, beta_before, rng, s)) break;
+      if (!scatter_photon_in_medium(scene, v, beta_before, rng, s, mis, bounces + 1)) break;
       all_specular = false;
     } else {
       const std::optional<bool> traced =

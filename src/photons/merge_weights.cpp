@@ -6,7 +6,8 @@
 namespace bpm {
 
 bool combinable_vertex(const PathVertex& v) {
-  if (v.medium >= 0 || v.on_curve || !v.material) return false;
+  if (v.medium >= 0) return true;
+  if (v.on_curve || !v.material) return false;
   const Material& m = v.m();
   if (bsdf_all_traced(m))
     return std::holds_alternative<ConductorMaterial>(m) ||
@@ -32,16 +33,17 @@ double entry_disc_area(const RenderScene& scene) {
 }
 }  // namespace
 
-double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w, Vec3 p,
-                        Vec3 n_p) {
+double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w,
+                        const DensityEnd& at) {
   const Light& l = scene.lights[size_t(light)];
   const double pmf = double(scene.light_distribution.pmf(light));
   if (light_is_infinite(l)) {
     // A point of the entry disc (uniform, perpendicular to w) and w itself: the disc's area density
-    // is |cos| at p over its area; w's density is a delta for a distant light (left out, as in
-    // light_sample_density), the environment's own sampling's otherwise.
-    const double dir = light_is_delta(l) ? 1.0 : double(light_pdf_li(l, nullptr, p, -w, y, Vec3()));
-    return pmf * dir * std::fabs(double(dot(n_p, w))) / entry_disc_area(scene);
+    // is |cos| (or sigma in a medium) there over its area; w's density is a delta for a distant
+    // light (left out, as in light_sample_density), the environment's own sampling's otherwise.
+    const double dir =
+        light_is_delta(l) ? 1.0 : double(light_pdf_li(l, nullptr, at.p, -w, y, Vec3()));
+    return pmf * dir * at.factor(w, 1) / entry_disc_area(scene);
   }
   double a = 0;  // A0 times A1's solid-angle density at y
   if (const auto pdf = point_light_pdf_le(l, w)) {
@@ -52,13 +54,13 @@ double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec
     const double side = area->two_sided ? 0.5 : 1.0;
     a = pmf / double(area->area) * side * std::fabs(double(dot(n, w))) * kInvPi;
   }
-  return area_density(a, y, p, n_p);
+  return area_density(a, y, at);
 }
 
 double light_end_density(const Light& l, double pdf_solid_angle, Vec3 p, Vec3 y, Vec3 n) {
   if (light_is_delta(l)) return 0;
   if (light_is_infinite(l)) return pdf_solid_angle;
-  return area_density(pdf_solid_angle, p, y, n);
+  return area_density(pdf_solid_angle, p, DensityEnd{y, n});
 }
 
 double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n) {
@@ -77,31 +79,37 @@ void PhotonMis::start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 
   const Light& l = scene.lights[size_t(light)];
   on_ = true;
   light_ = light;
-  y_ = prev_ = y;
-  n_y_ = prev_n_ = n;
+  y_ = y;
+  n_y_ = n;
+  prev_ = {y, n};
   w_ = w;
   at_infinity_ = light_is_infinite(l);
   delta_ = light_is_delta(l);
 }
 
-void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
+void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k, float pass,
+                       const Wavelengths& wl) {
   if (!on_) return;
-  const Vec3 d = v.sp.p - prev_;
+  here_ = density_end(scene, v, wl);
+  const Vec3 d = v.sp.p - prev_.p;
   const double d2 = double(length_squared(d));
   if (!(d2 > 0)) {
     on_ = false;
     return;
   }
   const double len = std::sqrt(d2);
-  const double to_area = std::fabs(double(dot(v.sp.ng, d))) / (len * d2);
+  const double to_area = here_.factor(d, len) / d2;
   k_ = k;
   if (k == 1) {
     // A0 A1 as an area density here; B0 from here.
-    r_ = 1 / emission_density(scene, light_, y_, n_y_, w_, v.sp.p, v.sp.ng);
-    // No next-event estimation at a vertex whose lobes are all traced.
+    r_ = 1 / emission_density(scene, light_, y_, n_y_, w_, here_);
+    // No next-event estimation at a vertex whose lobes are all traced. Its shadow ray gets
+    // across the media for certain (its transmittance is a weight), where the photon and the
+    // BSDF sample get across with the probability `pass`, which both count (and which the
+    // products leave out, as every later segment's, where it would cancel).
     b0_ = v.material && bsdf_all_traced(v.m())
               ? 0.0
-              : light_sample_density(scene, light_, v.sp.p, y_, n_y_);
+              : light_sample_density(scene, light_, v.sp.p, y_, n_y_) / double(pass);
     arrival_ = 0;
   } else {
     // The area part of A_k; no vertex connection joins a traced vertex to this one.
@@ -115,10 +123,10 @@ void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k) {
     seg_cos_ = delta_ ? 0.0 : 1.0;
     seg_d2_ = 1;
   } else {
-    seg_cos_ = std::fabs(double(dot(prev_n_, d))) / len;
+    seg_cos_ = prev_.factor(d, len);
     seg_d2_ = d2;
   }
-  if (!combinable_vertex(v) || !std::isfinite(r_)) on_ = false;
+  if (!combinable_vertex(v) || !std::isfinite(r_) || !std::isfinite(b0_)) on_ = false;
 }
 
 void PhotonMis::scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int k) {
@@ -146,8 +154,24 @@ void PhotonMis::scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int 
   }
   r_ *= b / a;
   a_ = a;
-  prev_ = v.sp.p;
-  prev_n_ = v.sp.ng;
+  prev_ = here_;
+}
+
+void PhotonMis::scatter_in_medium(float phase, int k) {
+  if (!on_) return;
+  // A_(k+1) is the phase function's density; B_(k-1) the same (Henyey-Greenstein depends on the
+  // angle alone), toward the vertex before, joined by next-event estimation's where k = 1.
+  double b = double(phase) * seg_cos_ / seg_d2_;
+  if (k == 1) b += b0_;
+  last_traced_ = false;
+  gathered_ = true;
+  if (!(phase > 0)) {
+    on_ = false;
+    return;
+  }
+  r_ *= b / double(phase);
+  a_ = phase;
+  prev_ = here_;
 }
 
 }  // namespace bpm

@@ -20,15 +20,19 @@
 // (point, spot, goniometric, projection) is a delta that both sides leave out, and no BSDF sample
 // finds it; a light at infinity starts its path with a direction, in whose solid-angle measure
 // both sides count y0 (the photon's entry disc's density turned into an area density at z1), the
-// direction of a distant light again a delta left out. Paths whose vertices z are all on surfaces
-// (not curves) with gathered lobes, or with traced lobes only (a mirror, glass, a thin pane: the
-// eye path goes on through them as the photon does, without next-event estimation there), and at
-// least one of them gathered (a caustic at x stays the merge's), and whose segments cross no
-// scattering medium (where a free flight's density and a shadow ray's transmittance would have to
-// be weighed), are combined; at a delta lobe both sides count the probability of choosing it and
-// leave its delta out. Every other path stays the merge's alone, and the continuation leaves it
-// out. Both passes compute the same products,
-// each from its own end of the path, so that the weights of a path sum to one.
+// direction of a distant light again a delta left out. Paths whose vertices z are points in
+// scattering media or on surfaces (not curves) with gathered lobes, or with traced lobes only (a
+// mirror, glass, a thin pane: the eye path goes on through them as the photon does, without
+// next-event estimation there), and at least one of them not traced (a caustic at x stays the
+// merge's), are combined; at a delta lobe both sides count the probability of choosing it and
+// leave its delta out. A segment through a scattering medium is got across by the photon and by
+// the BSDF sample with the same probability (PathState::pass: the segment's depth is the same both
+// ways), which is left out of both products (where it would cancel), but for next-event
+// estimation's shadow ray, which gets across for certain: its density in B0 is divided by that
+// probability. At a point in a medium the phase function stands for the BSDF (its density is the
+// same both ways) and the free flight's density of stopping there over that of getting across,
+// about sigma_t there (DensityEnd: the mean over the wavelengths), for |cos|. Both passes compute
+// the same products, each from its own end of the path, so that the weights of a path sum to one.
 #pragma once
 #include <cmath>
 
@@ -60,22 +64,42 @@ inline float delta_choice_probability(const BsdfSample& bs) {
   return bs.is_specular() ? bs.pdf_solid_angle : 0.0f;
 }
 
-// A solid-angle density at `from` of the direction to `to`, turned into an area density at `to`
-// (whose geometric normal is n_to).
-inline double area_density(double pdf_solid_angle, Vec3 from, Vec3 to, Vec3 n_to) {
-  const Vec3 d = to - from;
-  const double d2 = double(length_squared(d));
-  if (!(d2 > 0)) return 0;
-  return pdf_solid_angle * std::fabs(double(dot(n_to, d))) / (d2 * std::sqrt(d2));
+// A vertex of a combined path where a segment ends, as the densities see it: a point on a surface
+// of geometric normal n, where a solid-angle density turns into an area density by |cos| / d^2;
+// or a point inside a medium (sigma > 0), where it turns into a volume density by sigma / d^2,
+// sigma the mean over the wavelengths of sigma_t there: a free flight's density of stopping there
+// over its probability of getting that far, which the products leave out (PathState::pass).
+struct DensityEnd {
+  Vec3 p, n;
+  double sigma = 0;
+  // |cos| or sigma for a segment along d (of length len) ending here.
+  double factor(Vec3 d, double len) const {
+    return sigma > 0 ? sigma : std::fabs(double(dot(n, d))) / len;
+  }
+};
+inline DensityEnd density_end(const RenderScene& scene, const PathVertex& v,
+                              const Wavelengths& wl) {
+  if (v.medium >= 0)
+    return {v.sp.p, Vec3(), double(medium_mean_sigma_t(scene, v.medium, v.sp.p, wl))};
+  return {v.sp.p, v.sp.ng};
 }
 
-// A0 A1 as an area density at p (of geometric normal n_p): the density of unguided emission (the
-// light by power; on an area light a uniform point and a cosine-weighted direction) of leaving
-// light `light` at y (geometric normal n, zero without a surface) along the unit direction w and
-// arriving at p; for a point-like light without its position's delta; for a light at infinity
-// the entry disc's density at p times that of the direction (a distant light's left out).
-double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w, Vec3 p,
-                        Vec3 n_p);
+// A solid-angle density at `from` of the direction to `to.p`, turned into an area (or volume)
+// density there.
+inline double area_density(double pdf_solid_angle, Vec3 from, const DensityEnd& to) {
+  const Vec3 d = to.p - from;
+  const double d2 = double(length_squared(d));
+  if (!(d2 > 0)) return 0;
+  return pdf_solid_angle * to.factor(d, std::sqrt(d2)) / d2;
+}
+
+// A0 A1 as an area (or volume) density at `at`: the density of unguided emission (the light by
+// power; on an area light a uniform point and a cosine-weighted direction) of leaving light
+// `light` at y (geometric normal n, zero without a surface) along the unit direction w and
+// arriving there; for a point-like light without its position's delta; for a light at infinity
+// the entry disc's density there times that of the direction (a distant light's left out).
+double emission_density(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w,
+                        const DensityEnd& at);
 
 // A solid-angle density at p of the direction toward the point y (normal n) of light l, in the
 // measure in which both sides count y: an area density at y; a light at infinity's direction
@@ -95,12 +119,15 @@ class PhotonMis {
   // The photon leaves light `light` at y, of geometric normal n (zero without a surface), along
   // the unit direction w.
   void start(const RenderScene& scene, int light, Vec3 y, Vec3 n, Vec3 w);
-  // The photon arrives at its k-th vertex v (k from 1).
-  void arrive(const RenderScene& scene, const PathVertex& v, int k);
+  // The photon arrives at its k-th vertex v (k from 1; on a surface or in a medium), having got
+  // across the media on the way with the probability `pass` (PathState::pass).
+  void arrive(const RenderScene& scene, const PathVertex& v, int k, float pass,
+              const Wavelengths& wl);
   // It leaves v, its k-th vertex, along the world direction wi, drawn as the sample bs.
   void scatter(const PathVertex& v, const BsdfSample& bs, Vec3 wi, int k);
-  // It crosses a scattering medium: the path is the photon's alone from here.
-  void stop() { on_ = false; }
+  // It leaves its k-th vertex, in a medium, along a direction that the phase function drew with
+  // the density `phase` (the same both ways).
+  void scatter_in_medium(float phase, int k);
   // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
   // the vertex before over the squared distance (the factor that turns the eye's solid-angle
   // density into the measure of that vertex; merges start at the second), so that the merge's
@@ -130,7 +157,8 @@ class PhotonMis {
   int light_ = -1, k_ = 0;
   Vec3 y_, n_y_, w_;  // the light's point and normal, the emission's direction
   bool at_infinity_ = false, delta_ = false;
-  Vec3 prev_, prev_n_;  // the vertex before the current one, and its geometric normal
+  DensityEnd prev_;  // the vertex before the current one
+  DensityEnd here_;  // the current one
   // |cos| at prev toward the current vertex and their squared distance; from a light at infinity
   // to the first vertex 1 and 1 (the direction's own measure; 0 and 1 for a distant light).
   double seg_cos_ = 0, seg_d2_ = 1;

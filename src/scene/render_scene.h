@@ -165,6 +165,18 @@ inline Spectrum medium_transmittance(const RenderScene& scene, int medium, const
   return t;
 }
 
+// The mean over the wavelengths of sigma_t (per unit length) at the point p of `medium`.
+inline float medium_mean_sigma_t(const RenderScene& scene, int medium, Vec3 p,
+                                 const Wavelengths& wl) {
+  const Medium& m = scene.media[size_t(medium)];
+  if (m.rgb_grid) {
+    Spectrum a, s;
+    m.rgb_grid->coefficients(p, wl, &a, &s);
+    return (a + s).average();
+  }
+  return (m.sigma_a.sample(wl) + m.sigma_s.sample(wl)).average() * m.density(p);
+}
+
 // An rgbgrid's glow along the first `distance` of a unit ray: per wavelength i the integral of
 // exp(-tau_i(t)) sigma_a_i(x) Le_i(x) dt, each wavelength with its own optical depth tau_i. One
 // distance, drawn from one wavelength's exponential in its optical depth cut at the piece's end
