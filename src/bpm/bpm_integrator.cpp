@@ -163,9 +163,9 @@ class BpmRender {
   void choose_photons();
   // Combined estimators run as asked (photons/merge_weights.h).
   CombineAt combined() const { return s_.combine; }
-  // Vertex connections run: asked for, with an image, in a scene without media.
+  // Vertex connections run: asked for, with an image.
   bool vertex_connections() const {
-    return s_.vertex_connections != ConnectionMode::kOff && opt_.image && scene_.media.empty();
+    return s_.vertex_connections != ConnectionMode::kOff && opt_.image;
   }
   // Checks that the iteration's fixed part fits the memory budget; returns its bytes.
   double reserve_memory() const;
@@ -317,10 +317,14 @@ double BpmRender::reserve_memory() const {
 
 CameraConnections BpmRender::camera_connections() const {
   CameraConnections cc;
-  // Only a pinhole sees the connections' point, and without media they need no transmittance.
-  if (!opt_.image || !caustics_ || !scene_.media.empty() || !camera_.camera().projects()) return cc;
+  // Only a pinhole sees the connections' point. Where the camera's rays split in media they cross
+  // the first pieces at full weight (gather_forced_in_medium), which the merges' densities would
+  // have to follow; there the merges count the caustics seen directly alone.
+  const bool split_camera_rays = s_.split_in_media && scene_.has_scattering_media();
+  if (!opt_.image || !caustics_ || split_camera_rays || !camera_.camera().projects()) return cc;
   cc.mode = s_.camera_connections;
   cc.camera = &camera_.camera();
+  cc.camera_medium = camera_.camera().medium();
   cc.filter = &camera_.filter();
   cc.width = film_->width();
   cc.height = film_->height();

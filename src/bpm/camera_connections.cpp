@@ -43,6 +43,18 @@ float merge_factor(const CameraConnections& cc, float chance, const CameraView& 
                (cc.world ? double(v.d2) : 1.0));
 }
 
+// The way from the point p (geometric normal ng, error bound `error`) to the pinhole: its
+// transmittance through the media (none where something blocks it), and in *pass the probability
+// that the camera's ray got across them (shadow_transmittance). The medium at p is found toward
+// the camera, alike for the photon and for the backward photon.
+Spectrum toward_camera(const RenderScene& scene, const CameraConnections& cc, Vec3 p, Vec3 ng,
+                       float error, Vec3 pinhole, const Wavelengths& wl, float* pass) {
+  const Vec3 w = normalize(pinhole - p);
+  const Vec3 origin = offset_origin(p, ng, w, error);
+  const int medium = scene.media.empty() ? -1 : medium_at(scene, origin, w, cc.camera_medium);
+  return shadow_transmittance(scene, origin, pinhole, medium, false, wl, pass);
+}
+
 // The merge's density at `pixel` for the filter offset `offset`: the factor times the filter's
 // sampling density there and the pixel's squared radius. Both sides use it, so the weights of a
 // path sum to one.
@@ -67,14 +79,15 @@ void connect_to_camera(const RenderScene& scene, const CameraConnections& cc, co
   if (!hero_only && material_is_dispersive(m)) value = hero_wavelength_only(value);
   if (value.is_black()) return;
   ++*rays;
-  const Vec3 origin = offset_origin(sp.p, sp.ng, wo, sp.error);
-  const Spectrum seen = shadow_transmittance(scene, origin, view->proj.pinhole, -1, false, wl);
+  float pass = 1;
+  const Spectrum seen =
+      toward_camera(scene, cc, sp.p, sp.ng, sp.error, view->proj.pinhole, wl, &pass);
   if (seen.is_black()) return;
   // The importance of the point to the image, per square pixel of the filter's offsets.
   const float importance = view->proj.pixels_per_solid_angle * view->cos_y / view->d2;
   const float chance = cc.mode == ConnectionMode::kOn ? gather_chance(cc, m, sp.ns, wo) : 0.0f;
   out.push_back(
-      {view->proj.raster, merge_factor(cc, chance, *view), seen * value * importance, odd});
+      {view->proj.raster, merge_factor(cc, chance, *view) * pass, seen * value * importance, odd});
 }
 
 std::pair<int, int> rows_reached(const CameraConnections& cc, const CameraHit& hit) {
@@ -104,8 +117,9 @@ void spread_to_pixels(const CameraConnections& cc, const CameraHit& hit, int row
     }
 }
 
-float merge_weight_against_camera(const CameraConnections& cc, const BackwardPhoton& bp,
-                                  const Material& m) {
+float merge_weight_against_camera(const RenderScene& scene, const CameraConnections& cc,
+                                  const BackwardPhoton& bp, const Material& m,
+                                  const Wavelengths& wl) {
   if (cc.mode == ConnectionMode::kAlone) return 0;
   const Vec2 radius = cc.filter->settings().radius;
   const auto view = view_from_camera(cc, bp.p, bp.ng, std::max(radius.x, radius.y) + 1);
@@ -116,8 +130,11 @@ float merge_weight_against_camera(const CameraConnections& cc, const BackwardPho
   const Vec2 u = view->proj.raster;
   const Vec2 offset{std::clamp(u.x - (float(bp.pixel % w) + 0.5f), -radius.x, radius.x),
                     std::clamp(u.y - (float(bp.pixel / w) + 0.5f), -radius.y, radius.y)};
+  float pass = 1;
+  if (!scene.media.empty())
+    toward_camera(scene, cc, bp.p, bp.ng, bp.error(), view->proj.pinhole, wl, &pass);
   const double merge = merge_density(
-      cc, merge_factor(cc, gather_chance(cc, m, bp.ns, bp.wo), *view), bp.pixel, offset);
+      cc, merge_factor(cc, gather_chance(cc, m, bp.ns, bp.wo), *view) * pass, bp.pixel, offset);
   return float(merge / (merge + 1));
 }
 

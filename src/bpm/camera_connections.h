@@ -5,10 +5,12 @@
 // eye path merges at its first vertex, over the disc that accepts caustic photons there; each
 // pixel weighs the two by the balance heuristic. Per photon emitted, the merge makes the path
 // camera - y with the density of its eye sample landing within r of y,
-//   p_e(y) pi r^2,   p_e(y) = filter density(u - pixel centre) (du/domega) |cos_y| / d^2
+//   p_e(y) pi r^2 P,   p_e(y) = filter density(u - pixel centre) (du/domega) |cos_y| / d^2
 // (u the point's place on the image, d its distance from the pinhole, cos_y at its geometric
-// normal), times the chance that the eye path gathered at y (1 where it took both parts of a
-// material, or the material has one); the connection makes it with density 1. With the pixel's
+// normal; P the probability that the camera's ray gets across the scattering media between, 1
+// without them), times the chance that the eye path gathered at y (1 where it took both parts of
+// a material, or the material has one); the connection makes it with density 1 (its shadow ray
+// gets across for certain, its transmittance a weight). With the pixel's
 // radius r = a d (a: its caustic disc's radius per unit of distance), d cancels. The connection's
 // value for the pixel is its weight times normalized filter(u - centre) (du/domega) |cos_y| / d^2
 // times f(y, wi, toward the camera) times the photon's flux over its hit's cosine (as a merge's
@@ -41,6 +43,7 @@ struct CameraConnections {
   // The eye path chose by chance between the parts of a material at its first vertex (with
   // probability 1 - bsdf_traced_part_probability of gathering); false where it takes both.
   bool gather_by_chance = false;
+  int camera_medium = -1;  // the medium the camera sits in
   bool on() const { return mode != ConnectionMode::kOff; }
 };
 
@@ -77,9 +80,11 @@ inline bool merges_against_camera(const CameraConnections& cc, const BackwardPho
 }
 
 // The weight of a merge of a caustic photon at bp (merges_against_camera) against the
-// connection: p_e pi r^2 / (p_e pi r^2 + 1) at bp's point, pixel and radius; 0 with kAlone. m is
-// bp's material.
-float merge_weight_against_camera(const CameraConnections& cc, const BackwardPhoton& bp,
-                                  const Material& m);
+// connection: p_e pi r^2 P / (p_e pi r^2 P + 1) at bp's point, pixel and radius, P the probability
+// that the camera's ray got across the scattering media on its way (PathState::pass; the
+// connection's shadow ray gets across for certain); 0 with kAlone. m is bp's material.
+float merge_weight_against_camera(const RenderScene& scene, const CameraConnections& cc,
+                                  const BackwardPhoton& bp, const Material& m,
+                                  const Wavelengths& wl);
 
 }  // namespace bpm

@@ -206,8 +206,8 @@ struct Continuation {
   double pass = 1;
   // Where x is the vertex connections' target: 1 / (pi r^2 P), so that their density over the
   // merge's is vertex_scale / A(x) (vertex_connections.h), with A(x) the photon's density of x
-  // from e_1 (a_x, known from j = 2 on; infinite where e_1 is traced: no connection joins it);
-  // else 0.
+  // from e_1 times the first segment's pass probability (a_x, known from j = 2 on; infinite where
+  // e_1 is traced or in a medium: no connection joins it); else 0.
   double vertex_scale = 0, a_x = 0;
   // The path leaves e_(j-1) = v (traced: its lobes are all traced) by the sample bs of `lobes`.
   void leave(const PathVertex& v, const BsdfSample& bs, BsdfPart lobes, bool traced, int j) {
@@ -233,7 +233,7 @@ inline double merge_and_connection(double merge, const Continuation& c, double a
   return c.vertex_scale > 0 && a_x > 0 ? merge * (1 + c.vertex_scale / a_x) : merge;
 }
 
-// The weight of light found by the BSDF sample that left e_(j-1) (c.prev_p): the point y of
+// The weight of light found by the BSDF sample that left e_(j-1) (c.prev): the point y of
 // light `li` (normal n; for a light at infinity, a point far along the sample's direction),
 // weighed against next-event estimation there and the merge at x.
 inline double found_light_weight(const RenderScene& scene, const Continuation& c, int li, Vec3 y,
@@ -282,7 +282,12 @@ inline double continued_light_weight(const RenderScene& scene, const Continuatio
   const double a_prev = photon_pdf * c.cos_prev / c.d2;
   const double merge =
       c.ratio * a_prev * emission_density(scene, li, ls.p_light, ls.n_light, -ls.wi, at);
-  const double others = merge_and_connection(merge, c, c.a_x > 0 ? c.a_x : a_prev);
+  // At e_1, A(x) is the photon's density from here, with the first segment's pass probability
+  // (PhotonMis::arrival_density); no connection joins a point in a medium to x.
+  const double a_x = c.a_x > 0      ? c.a_x
+                     : at.sigma > 0 ? std::numeric_limits<double>::infinity()
+                                    : a_prev * c.pass;
+  const double others = merge_and_connection(merge, c, a_x);
   return b_light / (b_light + b_bsdf + others);
 }
 
@@ -349,7 +354,8 @@ inline bool survives_past(const PathVertex& v, bool traced, const BsdfSample& bs
                                     delta_choice_probability(bs)) *
                    c.cos_prev / c.d2;
   c.ratio *= a;
-  if (j == 2) c.a_x = traced ? std::numeric_limits<double>::infinity() : a;
+  // A(x) counts the first segment's pass probability, as PhotonMis::arrival_density does.
+  if (j == 2) c.a_x = traced ? std::numeric_limits<double>::infinity() : a * c.pass;
   return true;
 }
 
@@ -368,7 +374,7 @@ inline bool leave_medium_vertex(const RenderScene& scene, const PathVertex& v, d
   if (!(phase > 0)) return false;
   const double a = double(phase) * c.cos_prev / c.d2;
   c.ratio *= a;
-  if (j == 2) c.a_x = a;
+  if (j == 2) c.a_x = std::numeric_limits<double>::infinity();  // no connection joins e_1 to x
   c.leave_medium(v, phase, sigma);
   s.ray = Ray{v.sp.p, ps.wi, kInf};
   return true;
@@ -424,7 +430,8 @@ inline bool arrive_at(const EyePath& path, const PathVertex& e, StepEnd end, int
                       PathState& s, Continuation& c, Spectrum& L) {
   const RenderScene& scene = path.scene;
   const Wavelengths& wl = path.prm.materials->wl;
-  if (c.pass < 1 && end != StepEnd::kAbsorbed) ++path.counters.continued_through_media;
+  if (c.pass < 1 && (end == StepEnd::kVertex || end == StepEnd::kEscaped))
+    ++path.counters.continued_through_media;
   if (end == StepEnd::kEscaped && c.gathered)
     L += s.beta * found_environment(scene, c, s.ray.d, wl);
   const bool in_medium = end == StepEnd::kMedium;

@@ -71,8 +71,9 @@ float camera_merge_weight(const LightPassParams& prm, uint32_t g, const Backward
   std::atomic_ref<float> known(prm.camera_weights[g]);
   float w = known.load(std::memory_order_relaxed);
   if (w >= 0) return w;
-  w = merges_against_camera(*prm.camera, bp) ? merge_weight_against_camera(*prm.camera, bp, m)
-                                             : 1.0f;
+  w = merges_against_camera(*prm.camera, bp)
+          ? merge_weight_against_camera(*prm.scene, *prm.camera, bp, m, prm.materials->wl)
+          : 1.0f;
   known.store(w, std::memory_order_relaxed);
   return w;
 }
@@ -218,8 +219,8 @@ void connect_hit_to_eye_vertex(const GroupTrace& g, uint64_t photon, const Photo
   const Material& m_x =
       g.prm.photon_materials.empty() ? wm.materials[bp.material] : g.prm.photon_materials[target];
   const size_t before = out.size();
-  connect_to_eye_vertex(g.scene, vc, h, m_z, bp, pixel, m_x, g.prm.max_depth, odd, &lc.vertex_rays,
-                        out);
+  connect_to_eye_vertex(g.scene, vc, h, m_z, bp, pixel, m_x, g.prm.max_depth, odd, wm.wl,
+                        &lc.vertex_rays, out);
   lc.vertex_hits += out.size() - before;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "base/color.h"
+#include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
 #include "photons/density.h"
 
@@ -24,7 +25,7 @@ void find_vertex_targets(const BackwardMaps& maps, size_t pixels, double photons
 void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc,
                            const PhotonHit& h, const Material& m_z, const BackwardPhoton& bp,
                            uint32_t pixel, const Material& m_x, int max_depth, bool odd,
-                           uint64_t* rays, std::vector<VertexHit>& out) {
+                           const Wavelengths& wl, uint64_t* rays, std::vector<VertexHit>& out) {
   // The photon would arrive at x after one more bounce: within the merge's depth.
   if (int(bp.eye_depth) + h.bounces + 1 > max_depth) return;
   const Vec3 d = bp.p - h.sp.p;
@@ -61,8 +62,7 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
       double(bsdf_gathered_probability(m_z, wo_z, wx_z, TransportMode::kImportance)) *
       bsdf_pdf(m_z, wo_z, wx_z, TransportMode::kImportance) * cos_x / d2;
   if (!(a_x > 0)) return;
-  const double merge = 1 / connection_over_merge(bp.radius, vc.pixels(), a_x);
-  double others = merge;
+  double merge = 1 / connection_over_merge(bp.radius, vc.pixels(), a_x), continuation = 0;
   if (bp.combined) {
     const Frame fx = Frame::from_z(bp.ns);
     const Vec3 wo_x = fx.to_local(bp.wo);
@@ -72,14 +72,31 @@ void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc
     const double b_x =
         double(bsdf_pdf(m_x, wo_x, fx.to_local(-w), TransportMode::kRadiance, part)) * cos_z / d2;
     const double b_z = bsdf_pdf(m_z, wx_z, wo_z, TransportMode::kRadiance);
-    others += std::ldexp(vc.pixels() / vc.photons, -int(bp.continue_level)) *
-              h.mis->connection_ratio(b_z) * b_x;
+    continuation = std::ldexp(vc.pixels() / vc.photons, -int(bp.continue_level)) *
+                   h.mis->connection_ratio(b_z) * b_x;
   }
+  if (!std::isfinite(merge + continuation)) return;
+  ++*rays;
+  const Vec3 origin = offset_origin(h.sp.p, h.sp.ng, w, h.sp.error);
+  Spectrum seen(1.0f);
+  if (scene.media.empty()) {
+    if (scene.occluded(origin, bp.p)) return;
+  } else {
+    // Through media the shadow ray carries their transmittance (a weight); the photon and the
+    // eye path from x get across them with the probability `pass`, which the merge's and the
+    // continuation's densities count and the connection's does not.
+    float pass = 1;
+    seen = shadow_transmittance(scene, origin, bp.p,
+                                medium_toward(scene, h.object, h.sp.ng, w, h.ray_medium), false, wl,
+                                &pass);
+    if (seen.is_black()) return;
+    merge *= double(pass);
+    continuation *= double(pass);
+  }
+  const double others = merge + continuation;
   const double weight = vc.alone ? (1 + merge) / (1 + others) : 1 / (1 + others);
   if (!(weight > 0) || !std::isfinite(weight)) return;
-  ++*rays;
-  if (scene.occluded(offset_origin(h.sp.p, h.sp.ng, w, h.sp.error), bp.p)) return;
-  out.push_back({pixel, bp.tau * value * float(vc.pixels() * weight), odd});
+  out.push_back({pixel, bp.tau * value * seen * float(vc.pixels() * weight), odd});
 }
 
 }  // namespace bpm

@@ -54,11 +54,13 @@ inline double connection_over_merge(double r, double pixels, double a_x) {
 
 // Joins photon hit h (h.mis set: the path may be combined; on a surface of material m_z) to
 // backward photon bp (the target of `pixel`; its material m_x), within max_depth scattering
-// events: appends the connection to `out` where nothing stands between. Counts its shadow ray in
-// *rays.
+// events: appends the connection to `out` where nothing but media stands between (their
+// transmittance at the wavelengths wl in its value; the probability of getting across them in
+// the merge's and the continuation's densities, which the shadow ray does not share). Counts its
+// shadow ray in *rays.
 void connect_to_eye_vertex(const RenderScene& scene, const VertexConnections& vc,
                            const PhotonHit& h, const Material& m_z, const BackwardPhoton& bp,
                            uint32_t pixel, const Material& m_x, int max_depth, bool odd,
-                           uint64_t* rays, std::vector<VertexHit>& out);
+                           const Wavelengths& wl, uint64_t* rays, std::vector<VertexHit>& out);
 
 }  // namespace bpm

@@ -78,6 +78,7 @@ class Camera {
   std::optional<ProjectedPoint> project(Vec3 p, float margin) const;
   bool projects() const { return projects_; }
   Projection projection() const { return projection_; }
+  int medium() const { return medium_; }  // the scene medium the camera sits in (-1: none)
 
  private:
   Vec3 camera_direction(Vec2 p_full) const;  // spherical cameras

@@ -136,6 +136,7 @@ struct PhotonHit {
   // The photon's products (photons/merge_weights.h) where its path so far may be combined; else
   // null.
   const PhotonMis* mis = nullptr;
+  int ray_medium = -1;  // the medium the photon arrived through (-1: vacuum)
 };
 
 // A straight piece of a photon's path, from ray.o along ray.d up to t_max (in units of ray.d; kInf
@@ -214,6 +215,10 @@ inline std::optional<PathState> emit_photon(const RenderScene& scene, const Wave
                              scene.objects[size_t(area->object)].medium_outside);
   else
     s.medium = scene.medium_of_light(size_t(e.light));
+  // From a light at infinity into a scattering medium, which then reaches past the scene: the
+  // merges' alone (PhotonMis::stop).
+  if (mis && light_is_infinite(light) && s.medium >= 0 && scene.media[size_t(s.medium)].scatters())
+    mis->stop();
   s.rng = &rng;
   return s;
 }
@@ -330,7 +335,7 @@ void trace_light_path(const RenderScene& scene, const WavelengthMaterials& wm, i
       ++counters.diffuse_hits;
       on_hit(PhotonHit{in_medium ? -1 : v.object(), v.sp, v.wo, s.beta, cls, bounces, s.hero_only,
                        in_medium ? v.medium : -1, mis && !in_medium ? mis->merge_factor() : 0.0f,
-                       mis && mis->on() && !in_medium ? mis : nullptr});
+                       mis && mis->on() && !in_medium ? mis : nullptr, s.medium});
     }
     if (bounces + 1 > depth) break;
     if (in_medium) {

@@ -114,7 +114,8 @@ void PhotonMis::arrive(const RenderScene& scene, const PathVertex& v, int k, flo
   } else {
     // The area part of A_k; no vertex connection joins a traced vertex to this one.
     r_ /= to_area;
-    arrival_ = last_traced_ ? 0.0 : a_ * to_area;
+    // It counts the way's pass probability, which the connection's shadow ray does not share.
+    arrival_ = last_traced_ || prev_.sigma > 0 ? 0.0 : a_ * to_area * double(pass);
   }
   // The segment's factor for B_(k-1): the eye's solid-angle density at v toward the vertex before,
   // turned into that vertex's measure (a light at infinity: the direction itself; none for a

@@ -41,12 +41,13 @@
 
 namespace bpm {
 
-// Whether a combined path may pass through v: a surface (not a curve) with gathered lobes, not
-// Phong's (whose sampling is not reciprocal), or one whose lobes are all traced, but for a coat's
-// (whose density is only estimated). Where a coat splits (BsdfPart), only the share of the light
-// that the photon draws through the gathered part is combined: the photon's vertex then counts in
-// A with the density of that draw, and the continuation's path is weighed by the same share
-// (bsdf_gathered_probability); the share drawn through the coat stays the photon's alone.
+// Whether a combined path may pass through v: a point in a medium, a surface (not a curve) with
+// gathered lobes, not Phong's (whose sampling is not reciprocal), or one whose lobes are all
+// traced, but for a coat's (whose density is only estimated). Where a coat splits (BsdfPart), only
+// the share of the light that the photon draws through the gathered part is combined: the photon's
+// vertex then counts in A with the density of that draw, and the continuation's path is weighed by
+// the same share (bsdf_gathered_probability); the share drawn through the coat stays the photon's
+// alone.
 bool combinable_vertex(const PathVertex& v);
 
 // The photon's density (A), in the combined products, of a path through the combinable vertex v
@@ -112,8 +113,9 @@ double light_end_density(const Light& l, double pdf_solid_angle, Vec3 p, Vec3 y,
 double light_sample_density(const RenderScene& scene, int light, Vec3 p, Vec3 y, Vec3 n);
 
 // The running products of a photon's path (the light pass's side): after its k-th vertex z_k,
-// B0 .. B(k-2) over A0 .. Ak. start() at emission, arrive() at each surface vertex, scatter() when
-// it leaves one; merge_factor() is what a merge at a backward photon needs of it.
+// B0 .. B(k-2) over A0 .. Ak. start() at emission, arrive() at each vertex (on a surface or in a
+// medium), scatter() or scatter_in_medium() when it leaves one; merge_factor() is what a merge at
+// a backward photon needs of it.
 class PhotonMis {
  public:
   // The photon leaves light `light` at y, of geometric normal n (zero without a surface), along
@@ -128,18 +130,24 @@ class PhotonMis {
   // It leaves its k-th vertex, in a medium, along a direction that the phase function drew with
   // the density `phase` (the same both ways).
   void scatter_in_medium(float phase, int k);
-  // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times the cosine at
-  // the vertex before over the squared distance (the factor that turns the eye's solid-angle
-  // density into the measure of that vertex; merges start at the second), so that the merge's
+  // The path is the photon's alone: from a light at infinity through a scattering medium that
+  // reaches past the scene (the photon enters at the scene's bounds, where the eye path's shadow
+  // ray toward the light never gets out).
+  void stop() { on_ = false; }
+  // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times |cos| (sigma
+  // in a medium, DensityEnd) at the vertex before over the squared distance (the factor that turns
+  // the eye's solid-angle density into the measure of that vertex; merges start at the second),
+  // so that the merge's
   // weight is
   // 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density at x of the photon's
   // direction. 0: not combined (the merge counts the path in full).
   float merge_factor() const { return on_ && gathered_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
   // Whether the path so far may be combined.
   bool on() const { return on_; }
-  // A of the vertex just arrived at (k >= 2): the adjoint BSDF's density at the vertex before, of
-  // the way here, as an area density here; 0 at the first vertex, after a traced vertex (no
-  // connection joins one) or when not combined.
+  // A of the vertex just arrived at (k >= 2): the adjoint BSDF's density at the vertex before (a
+  // surface), of the way here, as an area density here, times the probability of getting across the
+  // media on the way (which a connection's shadow ray does not share); 0 at the first vertex, after
+  // a traced vertex or a point in a medium (no connection joins one) or when not combined.
   float arrival_density() const { return on_ ? float(arrival_) : 0.0f; }
   // For a connection from the vertex just arrived at, z_k, to an eye vertex (vertex connections):
   // B0 .. B(k-1) over A0 .. Ak, given eye_pdf, the eye's BSDF density at z_k, arriving from the eye
@@ -159,8 +167,9 @@ class PhotonMis {
   bool at_infinity_ = false, delta_ = false;
   DensityEnd prev_;  // the vertex before the current one
   DensityEnd here_;  // the current one
-  // |cos| at prev toward the current vertex and their squared distance; from a light at infinity
-  // to the first vertex 1 and 1 (the direction's own measure; 0 and 1 for a distant light).
+  // |cos| (sigma in a medium) at prev toward the current vertex and their squared distance; from
+  // a light at infinity to the first vertex 1 and 1 (the direction's own measure; 0 and 1 for a
+  // distant light).
   double seg_cos_ = 0, seg_d2_ = 1;
 };
 
