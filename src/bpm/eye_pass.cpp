@@ -193,6 +193,7 @@ inline Spectrum direct_light_at_last(const EyePath& path, const PathVertex& v, c
 // phase) density there of the way to e_j.
 struct Continuation {
   double ratio;
+  DensityEnd here;  // the vertex the path is at (x, then e_j: density_end)
   DensityEnd prev;
   double pdf_prev = 0;  // for a delta lobe the probability of choosing it
   // The vertex before has traced lobes only (no next-event estimation there); one of e_1 ..
@@ -216,14 +217,14 @@ struct Continuation {
         delta > 0 ? delta : bsdf_pdf(v.m(), v.wo_local, bs.wi, TransportMode::kRadiance, lobes);
     prev_traced = traced;
     gathered = gathered || (j > 1 && !traced);
-    prev = {v.sp.p, v.sp.ng};
+    prev = here;
   }
-  // It leaves the medium vertex v (of mean sigma_t `sigma`) by a phase sample of density `phase`.
-  void leave_medium(const PathVertex& v, float phase, double sigma) {
+  // It leaves the medium vertex it is at by a phase sample of density `phase`.
+  void leave_medium(float phase) {
     pdf_prev = phase;
     prev_traced = false;
     gathered = true;
-    prev = {v.sp.p, Vec3(), sigma};
+    prev = here;
   }
 };
 
@@ -314,25 +315,22 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
       bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
   if (!(g > 0)) return {};
   const double w = continued_light_weight(
-      scene, c, *sample, DensityEnd{v.sp.p, v.sp.ng},
-      bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance),
+      scene, c, *sample, c.here, bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance),
       double(g) * bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kImportance));
   return weighted_light_sample(path, s, *sample, sample->f * g, w);
 }
 
-// At e_j (v, in a medium of mean sigma_t `sigma` there), next-event estimation of a light
-// (continued_light_weight; the phase function's density is the same both ways).
+// At e_j (v, in a medium), next-event estimation of a light (continued_light_weight; the phase
+// function's density is the same both ways).
 inline Spectrum continued_light_sample_in_medium(const EyePath& path, const PathVertex& v,
-                                                 const PathState& s, const Continuation& c,
-                                                 double sigma) {
+                                                 const PathState& s, const Continuation& c) {
   const RenderScene& scene = path.scene;
   const float g = scene.media[size_t(v.medium)].g;
   const auto sample =
       sample_light_in_medium(scene, v, g, *path.prm.materials, path.rng, path.counters.rays);
   if (!sample || !(sample->pass > 0)) return {};
   const double phase = henyey_greenstein(dot(-v.wo, sample->ls.wi), g);
-  const double w =
-      continued_light_weight(scene, c, *sample, DensityEnd{v.sp.p, Vec3(), sigma}, phase, phase);
+  const double w = continued_light_weight(scene, c, *sample, c.here, phase, phase);
   return weighted_light_sample(path, s, *sample, sample->f, w);
 }
 
@@ -359,11 +357,11 @@ inline bool survives_past(const PathVertex& v, bool traced, const BsdfSample& bs
   return true;
 }
 
-// Past e_1, at e_(j-1) = v in a medium (of mean sigma_t `sigma` there), reached with the throughput
-// beta_flight before its free flight: Russian roulette on the change since (the medium's albedo),
-// as a photon's there, then a phase sample (its weight is 1; its density the same both ways,
-// which is also the photon's of e_(j-2) from v). False where the path ends, else s and c updated.
-inline bool leave_medium_vertex(const RenderScene& scene, const PathVertex& v, double sigma,
+// Past e_1, at e_(j-1) = v in a medium, reached with the throughput beta_flight before its free
+// flight: Russian roulette on the change since (the medium's albedo), as a photon's there, then a
+// phase sample (its weight is 1; its density the same both ways, which is also the photon's of
+// e_(j-2) from v). False where the path ends, else s and c updated.
+inline bool leave_medium_vertex(const RenderScene& scene, const PathVertex& v,
                                 const Spectrum& beta_flight, int j, Rng& rng, PathState& s,
                                 Continuation& c) {
   const float q = std::fmax(0.0f, 1 - s.beta.max_component() / beta_flight.max_component());
@@ -375,7 +373,7 @@ inline bool leave_medium_vertex(const RenderScene& scene, const PathVertex& v, d
   const double a = double(phase) * c.cos_prev / c.d2;
   c.ratio *= a;
   if (j == 2) c.a_x = std::numeric_limits<double>::infinity();  // no connection joins e_1 to x
-  c.leave_medium(v, phase, sigma);
+  c.leave_medium(phase);
   s.ray = Ray{v.sp.p, ps.wi, kInf};
   return true;
 }
@@ -436,7 +434,7 @@ inline bool arrive_at(const EyePath& path, const PathVertex& e, StepEnd end, int
     L += s.beta * found_environment(scene, c, s.ray.d, wl);
   const bool in_medium = end == StepEnd::kMedium;
   if (end != StepEnd::kVertex && !in_medium) return false;
-  const DensityEnd here = density_end(scene, e, wl);
+  c.here = density_end(scene, e, wl);
   const Vec3 d = e.sp.p - c.prev.p;
   c.d2 = double(length_squared(d));
   if (!(c.d2 > 0)) return false;
@@ -457,11 +455,11 @@ inline bool arrive_at(const EyePath& path, const PathVertex& e, StepEnd end, int
     if (e.wo_local.z == 0) return false;
     keep_hero_wavelength_at(e, s);
   }
-  c.ratio /= c.pdf_prev * here.factor(d, len) / c.d2;  // B of e_j
+  c.ratio /= c.pdf_prev * c.here.factor(d, len) / c.d2;  // B of e_j
   if (!std::isfinite(c.ratio)) return false;
   if (in_medium) {
     ++path.counters.continued_in_media;
-    L += continued_light_sample_in_medium(path, e, s, c, here.sigma);
+    L += continued_light_sample_in_medium(path, e, s, c);
   } else if (bsdf_all_traced(e.m()))
     ++path.counters.continued_traced;
   else
@@ -488,7 +486,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
   PathCounters& rays = path.counters.rays;
   const uint64_t rays_before = rays.total();
   ++path.counters.continued;
-  Continuation c{merge_density, DensityEnd{x.sp.p, x.sp.ng}};
+  Continuation c{merge_density, DensityEnd{x.sp.p, x.sp.ng}, {}};
   c.vertex_scale = vertex_scale;
   Spectrum L;
   const PathVertex* at = &x;
@@ -499,8 +497,7 @@ inline Spectrum continue_eye_path(const EyePath& path, const PathVertex& x, Bsdf
     bool look_only = false;
     EmitterWeight found = EmitterWeight::none();
     if (v.medium >= 0) {
-      const double sigma = medium_mean_sigma_t(scene, v.medium, v.sp.p, wm.wl);
-      if (!leave_medium_vertex(scene, v, sigma, beta_flight, j, path.rng, s, c)) break;
+      if (!leave_medium_vertex(scene, v, beta_flight, j, path.rng, s, c)) break;
     } else if (!leave_surface_vertex(path, v, j, part, s, c, first, found, look_only)) {
       break;
     }
