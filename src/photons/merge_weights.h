@@ -137,10 +137,8 @@ class PhotonMis {
   // For a merge at the vertex just arrived at: B0 .. B(m-1) over A0 .. A(m+1) times |cos| (sigma
   // in a medium, DensityEnd) at the vertex before over the squared distance (the factor that turns
   // the eye's solid-angle density into the measure of that vertex; merges start at the second),
-  // so that the merge's
-  // weight is
-  // 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density at x of the photon's
-  // direction. 0: not combined (the merge counts the path in full).
+  // so that the merge's weight is 1 / (1 + factor * p / (pi r^2 N)) with p the eye's BSDF density
+  // at x of the photon's direction. 0: not combined (the merge counts the path in full).
   float merge_factor() const { return on_ && gathered_ ? float(r_ * seg_cos_ / seg_d2_) : 0.0f; }
   // Whether the path so far may be combined.
   bool on() const { return on_; }
