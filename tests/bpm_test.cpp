@@ -2670,8 +2670,9 @@ TEST(Accuracy, RequestedAccuracyEndsTheRender) {
   }
 }
 
-// Adaptive sampling changes where samples go, never what a pixel converges to: each pixel is the
-// mean of the passes that sampled it, and whether a pass samples it is decided before the pass.
+// Adaptive sampling changes where samples go, never what a pixel converges to: each pixel weighs
+// the mean of each round's passes that sampled it by the round's length, and which passes of a
+// round sample it is decided before the round (film/film.h).
 TEST(Accuracy, AdaptiveSamplingKeepsPixelsUnbiased) {
   LoadedScene ls = load(caustic_scene());
   RenderRun ref = render_with(ls, "path", 2048);

@@ -219,7 +219,7 @@ TEST_F(Cli, MemoryBudgetIsCheckedBeforeAllocating) {
     EXPECT_NE(r.err.find("--resolution"), std::string::npos) << r.err;
   }
   CliRun big = run("render " + scene + " -q --integrator bpm --k1 3 --photons 1000 --maxdepth 3 " +
-                   "--iterations 1 --memory 600M --resolution 1000x1000 -o " + out);
+                   "--iterations 1 --memory 800M --resolution 1000x1000 -o " + out);
   EXPECT_EQ(big.exit_code, 1);
   EXPECT_NE(big.err.find("backward photons per pixel"), std::string::npos) << big.err;
   EXPECT_NE(run("render " + scene + " --memory lots -o " + out).exit_code, 0);

@@ -107,26 +107,58 @@ double Film::sensor_standard_error(size_t i) const {
   return standard_error(s.sum, s.sum2, s.passes);
 }
 
+void Film::end_round() {
+  const size_t nb = size_t(spectral_.count);
+  for_pixels(pixels_.size(), [&](size_t i) {
+    Pixel& p = pixels_[i];
+    const double w = open_weight(p), n = std::max(1, p.round_passes);
+    if (w > 0) {
+      for (int c = 0; c < kChannels; ++c) p.sum_wl[c] += w * p.round_wl[c] / n;
+      for (size_t b = i * nb; b < (i + 1) * nb; ++b)
+        bucket_sums_[3 * b] += w * bucket_sums_[3 * b + 1] / n;
+      p.sum_w += w;
+      p.sum_w2_n += w * w / n;
+    }
+    for (int c = 0; c < kChannels; ++c) p.round_wl[c] = 0;
+    p.round_passes = 0;
+    for (size_t b = i * nb; b < (i + 1) * nb; ++b) bucket_sums_[3 * b + 1] = 0;
+  });
+  round_length_ = 0;
+}
+
+double Film::mean(size_t i, int c) const {
+  const Pixel& p = pixels_[i];
+  const double w = open_weight(p), total = p.sum_w + w;
+  if (total == 0 || p.weight_sum == 0) return 0;
+  const double open = w > 0 ? w * p.round_wl[c] / p.round_passes : 0.0;
+  return (p.sum_wl[c] + open) / total / (p.weight_sum / p.passes);
+}
+
 Image Film::image(float scale) const {
   Image img;
   img.width = width_;
   img.height = height_;
   img.rgb.resize(pixels_.size() * 3);
   for_pixels(pixels_.size(), [&](size_t i) {
-    const Pixel& p = pixels_[i];
-    for (int c = 0; c < 3; ++c)
-      img.rgb[3 * i + c] = p.sum_w != 0 ? float(scale * p.sum_wl[c] / p.sum_w) : 0.0f;
+    for (int c = 0; c < 3; ++c) img.rgb[3 * i + c] = float(scale * mean(i, c));
   });
   return img;
 }
 
 float Film::noise(size_t i, int c) const {
+  // The error of the mean of the passes (eq. 5, or the M images' spread), times what weighing
+  // the rounds by their lengths rather than by their passes makes of it: with n passes of
+  // variance V, the rounds' weights w_r over n_r passes each give V sum w_r^2 / n_r / (sum w_r)^2
+  // for V / n (1 where every pass sampled the pixel).
+  const Pixel& p = pixels_[i];
+  const double w = open_weight(p), total = p.sum_w + w;
+  const double w2_n = p.sum_w2_n + (w > 0 ? w * w / std::max(1, p.round_passes) : 0.0);
+  const double rounds = total > 0 ? std::sqrt(double(p.passes) * w2_n) / total : 1.0;
   if (!independent_) {
     const std::optional<float> e = image_spread(i, c);
-    if (e) return *e;
+    if (e) return float(*e * rounds);
   }
-  const Pixel& p = pixels_[i];
-  return standard_error(p.sum_e[c], p.sum_e2[c], p.passes);
+  return float(standard_error(p.sum_e[c], p.sum_e2[c], p.passes) * rounds);
 }
 
 std::vector<float> Film::rms_rgb() const {
@@ -145,10 +177,7 @@ std::vector<float> Film::rms() const {
 
 std::vector<float> Film::luminance_image() const {
   std::vector<float> out(pixels_.size(), 0.0f);
-  for_pixels(pixels_.size(), [&](size_t i) {
-    const Pixel& p = pixels_[i];
-    if (p.sum_w != 0) out[i] = float(p.sum_wl[kY] / p.sum_w);
-  });
+  for_pixels(pixels_.size(), [&](size_t i) { out[i] = float(mean(i, kY)); });
   return out;
 }
 
@@ -335,8 +364,12 @@ void Film::add(const Film& o) {
       p.sum_e2[c] += q.sum_e2[c];
       p.sum_b[c] += q.sum_b[c];
       p.sum_b2[c] += q.sum_b2[c];
+      p.round_wl[c] += q.round_wl[c];
     }
     p.sum_w += q.sum_w;
+    p.sum_w2_n += q.sum_w2_n;
+    p.weight_sum += q.weight_sum;
+    p.round_passes += q.round_passes;
     p.passes += q.passes;
     p.lit_passes += q.lit_passes;
     p.dropped += q.dropped;
@@ -356,6 +389,7 @@ void Film::add(const Film& o) {
   }
   BPM_CHECK(o.spectral_ == spectral_);
   for (size_t i = 0; i < bucket_sums_.size(); ++i) bucket_sums_[i] += o.bucket_sums_[i];
+  round_length_ += o.round_length_;
   for (size_t i = 0; i < m_sum_.size(); ++i) m_sum_[i] += o.m_sum_[i];
   for (size_t i = 0; i < m_count_.size(); ++i) m_count_[i] += o.m_count_[i];
 }
@@ -364,6 +398,7 @@ void Film::clear() {
   std::fill(pixels_.begin(), pixels_.end(), Pixel{});
   std::fill(sensors_.begin(), sensors_.end(), SensorSums{});
   std::fill(bucket_sums_.begin(), bucket_sums_.end(), 0.0);
+  round_length_ = 0;
   std::fill(m_sum_.begin(), m_sum_.end(), 0.0f);
   std::fill(m_count_.begin(), m_count_.end(), 0);
 }
@@ -377,6 +412,7 @@ void Film::save(ByteWriter& w) const {
   w.put_vector(m_count_);
   w.put_vector(sensors_);
   w.put_vector(bucket_sums_);
+  w.put(int32_t(round_length_));
 }
 
 void Film::load(ByteReader& r) {
@@ -393,6 +429,7 @@ void Film::load(ByteReader& r) {
   std::vector<int> m_count = r.get_vector<int>();
   std::vector<SensorSums> sensors = r.get_vector<SensorSums>();
   std::vector<double> buckets = r.get_vector<double>();
+  const int round_length = r.get<int32_t>();
   if (buckets.size() != bucket_sums_.size())
     throw Error(r.what() + " keeps " + std::to_string(buckets.size()) +
                 " spectral sums, this render's film " + std::to_string(bucket_sums_.size()));
@@ -407,14 +444,19 @@ void Film::load(ByteReader& r) {
   m_sum_ = std::move(m_sum);
   m_count_ = std::move(m_count);
   bucket_sums_ = std::move(buckets);
+  round_length_ = round_length;
 }
 
 std::vector<float> Film::bucket_image(int b) const {
   std::vector<float> out(pixels_.size());
-  const size_t n = 2 * size_t(spectral_.count);
+  const size_t n = size_t(spectral_.count);
   for_pixels(pixels_.size(), [&](size_t i) {
-    const double w = bucket_sums_[i * n + 2 * size_t(b) + 1];
-    out[i] = w > 0 ? float(bucket_sums_[i * n + 2 * size_t(b)] / w) : 0.0f;
+    const Pixel& p = pixels_[i];
+    const double* sums = &bucket_sums_[3 * (i * n + size_t(b))];
+    const double w = open_weight(p), total = p.sum_w + w;
+    if (total == 0 || sums[2] == 0) return void(out[i] = 0);
+    const double open = w > 0 ? w * sums[1] / p.round_passes : 0.0;
+    out[i] = float((sums[0] + open) / total / (sums[2] / p.passes));
   });
   return out;
 }

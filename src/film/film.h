@@ -4,7 +4,19 @@
 // scene states its light in pbrt-v4's photometric terms). Alongside the weighted sums, the film
 // keeps per pixel and channel the sum and sum of squares of the per-pass estimates, from which the
 // error estimate of the paper's eq. (5) follows.
+//
+// Adaptive sampling (integrator/control.h) decides from a pixel's passes so far how often the
+// next round of passes samples it. The plain mean over the passes that sampled a pixel would then
+// be biased: a pixel whose passes so far drew none of its rare bright paths looks converged, is
+// sampled less, and keeps its low mean longer, so in scenes of heavy-tailed estimates (a small
+// light in fog) whole images read percents dark. The film therefore keeps each round's mean apart
+// (the passes that sampled the pixel in it) and weighs the rounds by their lengths in passes,
+// which the pixels' data never change: each round's mean is unbiased (which passes of a round
+// sample a pixel is decided before the round), and so is their fixed-weight average. Every pixel
+// is sampled in the first pass of each round (RenderControl::sample_pixel), so no round of it is
+// empty.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -119,7 +131,7 @@ class Film {
   // Keeps spectral buckets (none by default); forgets what they held.
   void set_spectral(const SpectralBuckets& b) {
     spectral_ = b;
-    bucket_sums_.assign(pixels_.size() * 2 * size_t(b.count), 0.0);
+    bucket_sums_.assign(pixels_.size() * 3 * size_t(b.count), 0.0);
   }
   const SpectralBuckets& spectral() const { return spectral_; }
   // Records a sample's radiance at its wavelengths into the buckets (clamped as sample_of
@@ -128,11 +140,11 @@ class Film {
                     float max_value) {
     if (spectral_.count == 0 || !recordable(L)) return;
     const float m = L.max_component(), k = m > max_value ? max_value / m : 1;
-    double* sums = bucket_sums_.data() + (size_t(y) * width_ + x) * 2 * size_t(spectral_.count);
+    double* sums = bucket_sums_.data() + (size_t(y) * width_ + x) * 3 * size_t(spectral_.count);
     for (int i = 0; i < Spectrum::kChannels; ++i) {
       const int b = spectral_.bucket(wl.lambda[size_t(i)]);
-      sums[2 * b] += double(weight) * k * L[i];
-      sums[2 * b + 1] += weight;
+      sums[3 * b + 1] += double(weight) * k * L[i];
+      sums[3 * b + 2] += weight;
     }
   }
   // Bucket b's image (width * height), in pbrt-v4's units (SpectralBuckets).
@@ -152,11 +164,7 @@ class Film {
     Pixel& p = pixels_[size_t(y) * width_ + x];
     const Rgb c = colour(s.rgb);
     const float v[kChannels] = {c[0], c[1], c[2], s.luminance};
-    for (int c = 0; c < kChannels; ++c) {
-      p.sum_wl[c] += double(weight) * v[c];
-      p.pass_wl[c] += double(weight) * v[c];
-    }
-    p.sum_w += weight;
+    for (int c = 0; c < kChannels; ++c) p.pass_wl[c] += double(weight) * v[c];
     p.pass_w += weight;
   }
   // The photon methods' estimate of this pass's bias in the pixel (film colour, the same units as
@@ -178,8 +186,15 @@ class Film {
   uint64_t dropped_samples() const;
   // The render's index of the pass about to be recorded: it chooses each pixel's M-image (pass
   // j goes to image j mod M), so that passes rendered apart (render/distributed.h) land where one
-  // process puts them.
-  void begin_pass(int index) { pass_index_ = index; }
+  // process puts them. The pass counts in the length of the open round.
+  void begin_pass(int index) {
+    pass_index_ = index;
+    ++round_length_;
+  }
+  // Ends the open round of passes: each pixel's mean over the round's passes that sampled it joins
+  // its estimate with the weight of the round's length in passes (every pass begun since the last
+  // end_round, by this film or by the films added to it).
+  void end_round();
   // Ends the current pass for one pixel: its pass estimate joins the running moments.
   void end_pass(int x, int y) {
     Pixel& p = pixels_[size_t(y) * width_ + x];
@@ -190,6 +205,9 @@ class Film {
         p.sum_e[c] += e[c];
         p.sum_e2[c] += e[c] * e[c];
       }
+      for (int c = 0; c < kChannels; ++c) p.round_wl[c] += p.pass_wl[c];
+      p.weight_sum += p.pass_w;
+      ++p.round_passes;
       if (e[0] != 0 || e[1] != 0 || e[2] != 0) ++p.lit_passes;
       if (m_ > 0) {
         const size_t k = (size_t(y) * width_ + x) * size_t(m_) + size_t(pass_index_ % m_);
@@ -282,8 +300,16 @@ class Film {
   double delta_rgb(const std::vector<float>& rms_rgb) const;
   static constexpr int kChannels = 4, kY = 3;  // R, G, B and the luminance
   struct Pixel {
+    // The rounds ended (end_round): the sum over them of the round's length times its mean per
+    // pass of weight * value (over the passes that sampled the pixel), the sum of the lengths,
+    // and the sum of length^2 / those passes (for its error). The estimate divides the mean by
+    // the samples' mean weight over every pass (weight_sum / passes): a filter's weights,
+    // signed for a filter with negative lobes, which are too few in one round to divide by.
     double sum_wl[kChannels] = {};
-    double sum_w = 0;
+    double sum_w = 0, sum_w2_n = 0;
+    double round_wl[kChannels] = {};  // the open round's sums of weight * value
+    int round_passes = 0;             // the open round's passes that sampled the pixel
+    double weight_sum = 0;
     double pass_wl[kChannels] = {}, pass_w = 0;
     double sum_e[kChannels] = {}, sum_e2[kChannels] = {};  // per-pass estimates, per channel
     int passes = 0;
@@ -304,6 +330,14 @@ class Film {
     return Rgb(m[0] * c[0] + m[1] * c[1] + m[2] * c[2], m[3] * c[0] + m[4] * c[1] + m[5] * c[2],
                m[6] * c[0] + m[7] * c[1] + m[8] * c[2]);
   }
+  // Pixel i's estimate of channel c: its rounds' means weighted by their lengths, the open round's
+  // by the passes begun in it.
+  double mean(size_t i, int c) const;
+  // The open round's weight in pixel p: its length, or where passes were recorded without
+  // begin_pass, the passes that sampled p.
+  double open_weight(const Pixel& p) const {
+    return p.round_passes > 0 ? std::max(double(round_length_), double(p.round_passes)) : 0.0;
+  }
   // The standard error of pixel i's channel c (rms_rgb), and the M images' (none until each has
   // a pass).
   float noise(size_t i, int c) const;
@@ -313,14 +347,17 @@ class Film {
   std::vector<SensorSums> sensors_;
   int m_ = 0;
   int pass_index_ = 0;
+  int round_length_ = 0;  // passes begun since the last end_round
   bool independent_ = true;
   bool has_colour_matrix_ = false;
   std::shared_ptr<const CameraResponse> response_;
   std::array<float, 9> colour_matrix_{};
   SpectralBuckets spectral_;
-  std::vector<double> bucket_sums_;  // [pixel][bucket][radiance sum, weight sum]
-  std::vector<float> m_sum_;         // [pixel][image][channel]
-  std::vector<int> m_count_;         // [pixel][image]
+  // [pixel][bucket][3]: as Pixel's sum_wl, round_wl and weight_sum, of the radiance at the
+  // wavelengths that fell in the bucket and of their weights.
+  std::vector<double> bucket_sums_;
+  std::vector<float> m_sum_;  // [pixel][image][channel]
+  std::vector<int> m_count_;  // [pixel][image]
 };
 
 }  // namespace bpm

@@ -151,7 +151,8 @@ void RenderControl::print_progress(int passes, double t, uint64_t rays, const st
 bool RenderControl::sample_pixel(int pass, uint32_t pixel) const {
   if (probability_.empty()) return true;
   float p = probability_[pixel];
-  if (p >= 1) return true;
+  // The first pass of a round samples every pixel, so that no pixel's round is empty (Film).
+  if (p >= 1 || pass == 0 || ends_round(pass)) return true;
   Rng rng(stream_key(opt_.seed ^ kAdaptiveStream, uint64_t(opt_.first_iteration + pass), pixel));
   return rng.uniform() < p;
 }

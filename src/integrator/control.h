@@ -4,11 +4,13 @@
 // every so many seconds, and adaptive sampling: which pixels the next pass samples.
 //
 // Adaptive sampling keeps every pixel's estimate unbiased: a pixel is either sampled in a pass or
-// not, with a probability decided from the passes before (never from the pass itself), and its
-// value is the mean of the passes that sampled it. The probability follows the pixel's relative
-// RMS (eq. 5 over its mean), is 1 for the noisiest pixels and never below a floor, so that no
-// pixel starves and the error estimate of every pixel stays alive; it is 1 for a pixel whose
-// passes have all been black, which has no error estimate at all.
+// not, with a probability decided at the start of the pass's round from the rounds before, and
+// sampled in the round's first pass; its value weighs the mean of each round's passes that
+// sampled it by the round's length (film/film.h: the mean of all its passes would not be
+// unbiased, since how often a pixel is sampled follows what it drew). The probability follows the
+// pixel's relative RMS (eq. 5 over its mean), is 1 for the noisiest pixels and never below a floor,
+// so that no pixel starves and the error estimate of every pixel stays alive; it is 1 for a pixel
+// whose passes have all been black, which has no error estimate at all.
 #pragma once
 #include <algorithm>
 #include <atomic>

@@ -28,6 +28,7 @@ void run_passes_alone(const IntegratorOptions& opt, Film* film, const PassFuncti
         state.learnt(&learnt);
         state.merge(learnt);
       }
+      film->end_round();
       control.end_round(p + 1);
     }
     control.after_pass(p, r.rays, r.progress);
@@ -40,7 +41,8 @@ void run_passes_alone(const IntegratorOptions& opt, Film* film, const PassFuncti
 
 // At the end of a round with several processes: what every process learnt is added up and merged,
 // and process 0's control state (its sampling probabilities) goes to every process.
-void end_team_round(Team& team, int passes, const IntegratorState& state, RenderControl& control) {
+void end_team_round(Team& team, int passes, const IntegratorState& state, RenderControl& control,
+                    Film* film) {
   const bool root = team.rank() == 0;
   if (state.learnt) {
     std::vector<double> learnt;
@@ -48,7 +50,10 @@ void end_team_round(Team& team, int passes, const IntegratorState& state, Render
     team.sum(&learnt);
     state.merge(learnt);
   }
-  if (root) control.end_round(passes);
+  if (root) {
+    film->end_round();  // the round's passes are all in process 0's film (gather_film)
+    control.end_round(passes);
+  }
   ByteWriter w;
   if (root) control.save(w);
   std::vector<uint8_t> c = w.take();
@@ -134,7 +139,7 @@ bool run_team_passes(const IntegratorOptions& opt, Film* film, const PassFunctio
     const bool cut = completed < end - passes;
     passes += completed;
     stats->passes = passes;
-    if (ends_round(passes)) end_team_round(team, passes, state, control);
+    if (ends_round(passes)) end_team_round(team, passes, state, control, film);
     if (root) {
       control.after_pass(passes - 1, uint64_t(counts[1]), progress);
       if (!cut && control.checkpoint_due()) {
