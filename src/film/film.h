@@ -185,7 +185,7 @@ class Film {
   void drop_sample(int x, int y) { ++pixels_[size_t(y) * width_ + x].dropped; }
   uint64_t dropped_samples() const;
   // The render's index of the pass about to be recorded: it chooses each pixel's M-image (pass
-  // j goes to image j mod M), so that passes rendered apart (render/distributed.h) land where one
+  // j goes to image j mod M), so that passes rendered apart (integrator/team.h) land where one
   // process puts them. The pass counts in the length of the open round.
   void begin_pass(int index) {
     pass_index_ = index;

@@ -49,7 +49,7 @@ T reference_relative_error(std::vector<T> relative) {
 // they were at the round's start; at its end what the round learnt is merged. A round is a
 // quarter of the passes before it (one pass each for the first eight, at most 64), and where
 // rounds end depends on the pass count alone, so that one process, or several sharing a round's
-// passes (render/distributed.h), render the same passes from the same state.
+// passes (integrator/team.h), render the same passes from the same state.
 bool ends_round(int passes);
 
 class RenderControl {
