@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include "base/interrupt.h"
 #include "base/rng.h"
@@ -16,9 +17,21 @@ namespace {
 constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
 }  // namespace
 
+namespace {
+// The round after `end` passes: its length in passes.
+int round_length_after(int end) { return std::clamp(end / 4, 1, 64); }
+
+// The first pass of the round that holds pass `pass` (0-based), and the round's length.
+std::pair<int, int> round_of(int pass) {
+  int start = 0;
+  while (start + round_length_after(start) <= pass) start += round_length_after(start);
+  return {start, round_length_after(start)};
+}
+}  // namespace
+
 bool ends_round(int passes) {
   int end = 0;
-  while (end < passes) end += std::clamp(end / 4, 1, 64);
+  while (end < passes) end += round_length_after(end);
   return end == passes;
 }
 
@@ -150,11 +163,15 @@ void RenderControl::print_progress(int passes, double t, uint64_t rays, const st
 
 bool RenderControl::sample_pixel(int pass, uint32_t pixel) const {
   if (probability_.empty()) return true;
-  float p = probability_[pixel];
-  // The first pass of a round samples every pixel, so that no pixel's round is empty (Film).
-  if (p >= 1 || pass == 0 || ends_round(pass)) return true;
+  const float p = probability_[pixel];
+  // The first pass of a round samples every pixel, so that no pixel's round is empty (Film); the
+  // round's other passes make up the rest of its p * length samples, where there is any.
+  const auto [first, length] = round_of(pass);
+  if (p >= 1 || pass == first) return true;
+  const float rest = (p * float(length) - 1) / float(length - 1);
+  if (!(rest > 0)) return false;
   Rng rng(stream_key(opt_.seed ^ kAdaptiveStream, uint64_t(opt_.first_iteration + pass), pixel));
-  return rng.uniform() < p;
+  return rng.uniform() < rest;
 }
 
 double RenderControl::mean_sampling_probability() const {
