@@ -97,9 +97,27 @@ void RenderControl::update_probabilities() {
   });
   double image_mean = 0;
   for (size_t i = 0; i < n; ++i) image_mean += value[i] / double(n);
-  std::vector<float> rel(n);
+  std::vector<float> own(n), rel(n);
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
-    rel[i] = float(error[i] / (value[i] + 0.01 * image_mean + 1e-12));
+    own[i] = float(error[i] / (value[i] + 0.01 * image_mean + 1e-12));
+  });
+  // Each pixel takes at least the RMS of the relative errors about it (3 x 3): a pixel whose
+  // passes have not yet drawn the rare bright paths that its neighbours', which see much the same
+  // light, have drawn looks converged by its own RMS and would be sampled at the floor; since its
+  // value weighs each round's passes as the round's length (film/film.h), such a path drawn in a
+  // round that samples it rarely then weighs all the more.
+  const int w = film_.width(), h = film_.height();
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      double sum2 = 0;
+      int count = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx, ++count)
+          sum2 += double(own[size_t(yy) * size_t(w) + size_t(xx)]) *
+                  own[size_t(yy) * size_t(w) + size_t(xx)];
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      rel[i] = std::max(own[i], float(std::sqrt(sum2 / count)));
+    }
   });
   // The noisiest tenth of the pixels is sampled every pass; the rest in proportion.
   const float ref = reference_relative_error(rel);
