@@ -128,10 +128,8 @@ void Film::end_round() {
 
 double Film::mean(size_t i, int c) const {
   const Pixel& p = pixels_[i];
-  const double w = open_weight(p), total = p.sum_w + w;
-  if (total == 0 || p.weight_sum == 0) return 0;
-  const double open = w > 0 ? w * p.round_wl[c] / p.round_passes : 0.0;
-  return (p.sum_wl[c] + open) / total / (p.weight_sum / p.passes);
+  if (p.weight_sum == 0) return 0;
+  return per_pass(p, p.sum_wl[c], p.round_wl[c]) / (p.weight_sum / p.passes);
 }
 
 Image Film::image(float scale) const {
@@ -453,10 +451,7 @@ std::vector<float> Film::bucket_image(int b) const {
   for_pixels(pixels_.size(), [&](size_t i) {
     const Pixel& p = pixels_[i];
     const double* sums = &bucket_sums_[3 * (i * n + size_t(b))];
-    const double w = open_weight(p), total = p.sum_w + w;
-    if (total == 0 || sums[2] == 0) return void(out[i] = 0);
-    const double open = w > 0 ? w * sums[1] / p.round_passes : 0.0;
-    out[i] = float((sums[0] + open) / total / (sums[2] / p.passes));
+    out[i] = sums[2] != 0 ? float(per_pass(p, sums[0], sums[1]) / (sums[2] / p.passes)) : 0.0f;
   });
   return out;
 }

@@ -333,6 +333,12 @@ class Film {
   // Pixel i's estimate of channel c: its rounds' means weighted by their lengths, the open round's
   // by the passes begun in it.
   double mean(size_t i, int c) const;
+  // The same weighing of one sum per pass, given its rounds ended (`ended`, as Pixel::sum_wl) and
+  // its open round (`open`, as Pixel::round_wl); 0 where p has no pass.
+  double per_pass(const Pixel& p, double ended, double open) const {
+    const double w = open_weight(p), total = p.sum_w + w;
+    return total != 0 ? (ended + (w > 0 ? w * open / p.round_passes : 0.0)) / total : 0.0;
+  }
   // The open round's weight in pixel p: its length, or where passes were recorded without
   // begin_pass, the passes that sampled p.
   double open_weight(const Pixel& p) const {

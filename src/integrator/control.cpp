@@ -15,25 +15,18 @@
 namespace bpm {
 namespace {
 constexpr uint64_t kAdaptiveStream = 0x6164617074ull;
-}  // namespace
 
-namespace {
-// The round after `end` passes: its length in passes.
-int round_length_after(int end) { return std::clamp(end / 4, 1, 64); }
-
-// The first pass of the round that holds pass `pass` (0-based), and the round's length.
+// The first pass of the round that holds pass `pass` (0-based), and the round's length: a quarter
+// of the passes before it, at least 1 and at most 64.
 std::pair<int, int> round_of(int pass) {
+  const auto length_after = [](int start) { return std::clamp(start / 4, 1, 64); };
   int start = 0;
-  while (start + round_length_after(start) <= pass) start += round_length_after(start);
-  return {start, round_length_after(start)};
+  while (start + length_after(start) <= pass) start += length_after(start);
+  return {start, length_after(start)};
 }
 }  // namespace
 
-bool ends_round(int passes) {
-  int end = 0;
-  while (end < passes) end += round_length_after(end);
-  return end == passes;
-}
+bool ends_round(int passes) { return round_of(passes).first == passes; }
 
 RenderControl::RenderControl(const IntegratorOptions& opt, const Film& film, const char* unit)
     : opt_(opt), film_(film), unit_(unit), t0_(std::chrono::steady_clock::now()) {}
@@ -112,9 +105,10 @@ void RenderControl::update_probabilities() {
       double sum2 = 0;
       int count = 0;
       for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx, ++count)
-          sum2 += double(own[size_t(yy) * size_t(w) + size_t(xx)]) *
-                  own[size_t(yy) * size_t(w) + size_t(xx)];
+        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx, ++count) {
+          const double e = own[size_t(yy) * size_t(w) + size_t(xx)];
+          sum2 += e * e;
+        }
       const size_t i = size_t(y) * size_t(w) + size_t(x);
       rel[i] = std::max(own[i], float(std::sqrt(sum2 / count)));
     }
