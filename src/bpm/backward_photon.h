@@ -57,7 +57,8 @@ struct BackwardPhoton {
   uint8_t disc_found = 0;  // and those that found some
   uint8_t place = 0;       // its rank among its eye path's backward photons, in storing order
   // A point inside a scattering medium, this one (-1: a surface point): a sphere that gathers
-  // photon beams, with no normals, surface coordinates or material.
+  // photon beams, with no surface coordinates or material, and no normals: ng holds instead its
+  // offset from the plane of a surface that cuts its discs (photons/medium_cuts.h; zero: none).
   int16_t medium = -1;
   // The point's floating-point error bound (SurfacePoint::error), for the pending probes: the upper
   // half of its float, rounded up.

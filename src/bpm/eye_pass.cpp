@@ -12,6 +12,7 @@
 #include "integrator/direct_light.h"
 #include "integrator/path_vertex.h"
 #include "photons/disc_probes.h"
+#include "photons/medium_cuts.h"
 #include "photons/merge_weights.h"
 
 namespace bpm {
@@ -99,6 +100,10 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
       combinable_vertex(v))
     bp.vertex_target = path.targeted = true;
   if (v.medium >= 0) {  // after the objects' lists, one per medium
+    bp.ng = prm.disc_probes
+                ? medium_cut(path.scene, v.sp.p, v.piece.ray.d, v.piece.length - v.piece.t,
+                             v.piece.t, bp.radius, path.counters.rays)
+                : Vec3{};
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
     ++path.counters.backward_photons;
     return {};

@@ -57,7 +57,8 @@ struct EyePassParams {
   // Photons count only where the normals agree to within this cosine (PhotonSettings).
   float normal_cos = 0.5f;
   // Measure the share of each backward photon's disc where photons can land (disc_probes.h),
-  // at first vertices seen directly only where near_edges marks the pixel (all when null).
+  // at first vertices seen directly only where near_edges marks the pixel (all when null), and
+  // in media the surfaces that cut the discs across beams (photons/medium_cuts.h).
   bool disc_probes = true;
   const NearEdges* near_edges = nullptr;
   // Direct light in media also sampled along the rays that lead to diffuse vertices

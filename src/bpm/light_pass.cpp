@@ -14,6 +14,7 @@
 #include "base/error.h"
 #include "photons/density.h"
 #include "photons/disc_probes.h"
+#include "photons/medium_cuts.h"
 
 namespace bpm {
 namespace {
@@ -582,6 +583,33 @@ void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, cons
   } while (done < n_gather);
 }
 
+// add_entry for a beam at a sphere whose discs a surface cuts (photons/medium_cuts.h): each nested
+// disc's sum is divided by its own share across the beam, as one entry per disc the beam passes
+// through, counted in it and the larger ones, so that every sum comes out right.
+float add_cut_beam_entries(const MediumSphere& bp, float d2, const Spectrum& value,
+                           const PendingBeam& b, const LightPassParams& prm,
+                           const std::vector<uint16_t>& owner,
+                           std::vector<std::vector<PhotonEntry>>& out) {
+  const float r = bp.radius, r2 = r * r;
+  const Spectrum all = value / beam_disc_share(bp.cut, b.ray.d, r),
+                 half = value / beam_disc_share(bp.cut, b.ray.d, r * float(M_SQRT1_2)),
+                 quarter = value / beam_disc_share(bp.cut, b.ray.d, r / 2);
+  const uint32_t odd = b.photon & 1 ? PhotonEntry::kOddBit : 0u;
+  std::vector<PhotonEntry>& list = out[owner[bp.pixel]];
+  if (4 * d2 < r2) {
+    list.push_back({bp.index | PhotonEntry::kInnerBit | PhotonEntry::kQuarterBit | odd, quarter});
+    list.push_back({bp.index | PhotonEntry::kInnerBit | odd, half - quarter});
+    list.push_back({bp.index | odd, all - half});
+  } else if (2 * d2 < r2) {
+    list.push_back({bp.index | PhotonEntry::kInnerBit | odd, half});
+    list.push_back({bp.index | odd, all - half});
+  } else {
+    list.push_back({bp.index | odd, all});
+  }
+  if (!prm.pixel_weight) return 0;
+  return (bp.tau * all).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * r2);
+}
+
 // The entries of one beam: at each sphere it reaches, its flux at the point nearest the centre
 // times the phase function toward the sphere's eye path (before 1 / (pi r^2 N), as a hit's).
 // Returns the beam's score, as gather_at_hit's.
@@ -613,8 +641,10 @@ float gather_beam(const RenderScene& scene, const LightPassParams& prm,
         b.flux * transmittance(t) *
         (henyey_greenstein(dot(bp.wo, b.ray.d), m.g) * hero_join_factor(bp.hero_only, b.hero_only));
     if (value.is_black()) continue;
-    score += add_entry(bp, bp.index, length_squared(b.ray.o + b.ray.d * t - bp.p), value, b.photon,
-                       prm, owner, out);
+    const float d2 = length_squared(b.ray.o + b.ray.d * t - bp.p);
+    score += length_squared(bp.cut) == 0
+                 ? add_entry(bp, bp.index, d2, value, b.photon, prm, owner, out)
+                 : add_cut_beam_entries(bp, d2, value, b, prm, owner, out);
   }
   return score;
 }

@@ -84,7 +84,7 @@ void MediumSpheres::build(const BackwardMaps& maps, size_t object_count, size_t 
         const BackwardPhoton& bp = maps.photons[g];
         if (!(bp.accepts & accepts)) continue;
         spheres.push_back(
-            {bp.p, bp.radius, bp.wo, bp.pixel, bp.tau, g, bp.eye_depth, bool(bp.hero_only)});
+            {bp.p, bp.radius, bp.wo, bp.pixel, bp.tau, g, bp.eye_depth, bool(bp.hero_only), bp.ng});
         s.max_radius[k] = std::max(s.max_radius[k], bp.radius);
       }
       if (spheres.empty()) continue;

@@ -18,7 +18,7 @@ namespace bpm {
 
 // What a beam's gathering reads of a backward photon in a medium, in one record: the sphere (the
 // first 16 bytes, which Embree reads as the sphere point's centre and radius), and the photon's
-// direction, pixel, throughput and depth.
+// direction, pixel, throughput and depth, and its offset from a surface that cuts its discs.
 struct alignas(16) MediumSphere {
   Vec3 p;
   float radius;
@@ -28,6 +28,7 @@ struct alignas(16) MediumSphere {
   uint32_t index;  // the backward photon's in the maps
   uint16_t eye_depth;
   bool hero_only;
+  Vec3 cut;  // photons/medium_cuts.h (zero: none)
 };
 
 class MediumSpheres {

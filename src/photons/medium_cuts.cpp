@@ -1,0 +1,63 @@
+#include "photons/medium_cuts.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace bpm {
+
+namespace {
+
+// The offset from the plane of the surface that the probe from p along dir meets within `reach`:
+// the surface's normal there, turned toward p, and p's foot along it, found by a second probe
+// within `radius` (a surface that curves away before the foot cuts nothing). Zero where either
+// probe meets nothing.
+Vec3 cut_along(const RenderScene& scene, Vec3 p, Vec3 dir, float reach, float radius,
+               PathCounters& rays) {
+  const Ray probe{p, dir, reach};
+  Hit hit;
+  ++rays.probe_rays;
+  if (!scene.intersect(probe, &hit)) return {};
+  const Vec3 toward = face_forward(scene.surface(probe, hit).ng, -dir);
+  const Ray foot{p, -toward, radius};
+  Hit at;
+  ++rays.probe_rays;
+  if (!scene.intersect(foot, &at)) return {};
+  const SurfacePoint sp = scene.surface(foot, at);
+  const Vec3 n = face_forward(sp.ng, toward);
+  const float h = dot(p - sp.p, n);
+  return h > 0 && h < radius ? n * h : Vec3{};
+}
+
+}  // namespace
+
+Vec3 medium_cut(const RenderScene& scene, Vec3 p, Vec3 d, float to_end, float from_start,
+                float radius, PathCounters& rays) {
+  Vec3 cut;
+  float nearest = radius;
+  const float reach = kCutReach * radius;
+  for (const auto& [dir, along] : {std::pair{d, to_end}, std::pair{-d, from_start}}) {
+    if (!(along < reach)) continue;
+    // A little past the piece's end, so that the surface it ended at is met.
+    const Vec3 c = cut_along(scene, p, dir, along + 0.01f * radius, radius, rays);
+    const float h = length(c);
+    if (h > 0 && h < nearest) {
+      nearest = h;
+      cut = c;
+    }
+  }
+  return cut;
+}
+
+float beam_disc_share(Vec3 cut, Vec3 d, float radius) {
+  const float h2 = length_squared(cut);
+  if (h2 == 0) return 1;
+  // The plane's line across the disc lies h / sin(theta) from its centre, theta the angle
+  // between the beam and the plane's normal.
+  const float sin2 = std::max(0.0f, 1 - dot(cut, d) * dot(cut, d) / h2);
+  if (h2 >= radius * radius * sin2) return 1;
+  const float u = std::sqrt(h2 / sin2) / radius;
+  // The circular segment beyond the line, over the disc's area.
+  return 1 - (std::acos(u) - u * std::sqrt(1 - u * u)) / kPi;
+}
+
+}  // namespace bpm

@@ -1,0 +1,37 @@
+// Where a surface cuts the disc over which a point in a scattering medium gathers photon beams.
+// A backward photon in a medium gathers each beam that passes within its radius r, blurred over
+// the disc of radius r across the beam (bpm/medium_spheres.h). Beams end at surfaces: where a wall
+// stands within r of the point, the part of that disc beyond the wall's plane holds no beam, and
+// the estimate falls short, by up to half next to the wall. Over an image of fog above a floor
+// that is a darkening of order r (the radii's usual bias is of order r^2), which the two-radius
+// bias estimate sees about half of. As on surfaces (disc_probes.h), each beam's contribution is
+// divided instead by the share of its disc on the point's side of the plane, which tends to 1 as
+// the radius shrinks.
+//
+// The surface that matters most is the one the point's own ray left or met: a point drawn on a
+// camera ray lies near a surface when it lies near the ray's end. So the ray's piece is probed
+// both ways where its end lies within a few radii, and where a surface is met, the point's foot on
+// it, which gives the plane.
+#pragma once
+#include "base/vec.h"
+#include "integrator/counters.h"
+#include "scene/render_scene.h"
+
+namespace bpm {
+
+// The point p's offset from the plane of the nearest surface within `radius` of it, found along
+// its ray's direction d where the piece ends within kCutReach radii (to_end; from_start the other
+// way, kInf where the piece starts at the camera or a light): the vector from the plane to p, whose
+// length is the distance; zero where no surface was found. Up to two probe rays each way, counted
+// in rays.probe_rays.
+constexpr float kCutReach = 4;
+Vec3 medium_cut(const RenderScene& scene, Vec3 p, Vec3 d, float to_end, float from_start,
+                float radius, PathCounters& rays);
+
+// The share of the disc of radius `radius` about the point, across a beam of unit direction d,
+// that lies on the point's side of the plane of `cut` (medium_cut): 1 without a cut, or where the
+// plane's line across the disc lies beyond it; 1/2 for a beam parallel to a plane through the
+// point.
+float beam_disc_share(Vec3 cut, Vec3 d, float radius);
+
+}  // namespace bpm
