@@ -82,11 +82,17 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 // looked at, and probed, on its own.) Returns what was found of the disc (nothing: not looked
 // at). With merge_density, the eye path goes on from the vertex (combined estimators): the
 // backward photon is marked so, and *merge_density set to its pi r^2 N (0 where none is stored).
+// In a medium, `cut` keeps the surface that cuts the discs about v, found for the first radius
+// stored there (photons/medium_cuts.h) and kept for any smaller one.
+struct MediumCut {
+  float radius = 0;
+  Vec3 offset;
+};
 inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
                                         const PathState& s, int depth, int diffuse,
                                         bool seen_directly, uint8_t accepts,
                                         const DiscProbes& larger, double* merge_density,
-                                        uint8_t continue_level) {
+                                        uint8_t continue_level, MediumCut& cut) {
   const EyePassParams& prm = path.prm;
   BackwardPhoton bp = backward_photon_at(v, s, prm, path.footprint, path.scales, path.pixel, depth,
                                          diffuse, accepts);
@@ -100,10 +106,12 @@ inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v
       combinable_vertex(v))
     bp.vertex_target = path.targeted = true;
   if (v.medium >= 0) {  // after the objects' lists, one per medium
-    bp.ng = prm.disc_probes
-                ? medium_cut(path.scene, v.sp.p, v.piece.ray.d, v.piece.length - v.piece.t,
-                             v.piece.t, bp.radius, path.counters.rays)
-                : Vec3{};
+    if (prm.disc_probes && cut.radius < bp.radius) {
+      cut.offset = medium_cut(path.scene, v.sp.p, v.piece.ray.d, v.piece.length - v.piece.t,
+                              v.piece.t, bp.radius, path.counters.rays);
+      cut.radius = bp.radius;
+    }
+    bp.ng = cut.offset;
     path.out[path.scene.objects.size() + size_t(v.medium)].push_back(bp);
     ++path.counters.backward_photons;
     return {};
@@ -141,10 +149,11 @@ inline void store_backward_photons(const EyePath& path, const PathVertex& v, con
   // Seen straight from the camera: the screen around the pixel says whether its discs may be
   // cut (disc_probes.h).
   const bool seen_directly = diffuse == 1 && depth == 1;
+  MediumCut cut;
   auto store = [&](uint8_t accepts, const DiscProbes& larger) {
     return store_backward_photon(path, v, s, depth, diffuse, seen_directly, accepts, larger,
                                  accepts & kAcceptsIndirect ? merge_density : nullptr,
-                                 continue_level);
+                                 continue_level, cut);
   };
   if (!prm.caustics) {
     if (last) store(kAcceptsIndirect, {});

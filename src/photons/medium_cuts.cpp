@@ -2,10 +2,33 @@
 
 #include <algorithm>
 #include <cmath>
+#include <variant>
 
 namespace bpm {
 
 namespace {
+
+// Whether light can pass through a surface of `material` (a mix: through either of its two).
+bool lets_light_through(const RenderScene& scene, int material, int depth = 0) {
+  const MaterialDesc& m = scene.materials[size_t(material)];
+  if (const auto* mix = std::get_if<MixDesc>(&m))
+    return depth > 8 || lets_light_through(scene, mix->materials[0], depth + 1) ||
+           lets_light_through(scene, mix->materials[1], depth + 1);
+  return std::holds_alternative<DielectricMaterial>(m) ||
+         std::holds_alternative<ThinDielectricMaterial>(m) ||
+         std::holds_alternative<DiffuseTransmissionDesc>(m) ||
+         std::holds_alternative<InterfaceMaterial>(m);
+}
+
+// Whether the medium's beams end at a surface of `object`: it leads into another medium, or no
+// light passes through it. Not a curve (thinner than any disc), nor a surface with the same medium
+// on both sides that light crosses (glass in fog, a cut-out): beams lie beyond those too.
+bool ends_beams(const RenderScene& scene, int object) {
+  const Object& o = scene.objects[size_t(object)];
+  if (std::holds_alternative<Curves>(o.shape)) return false;
+  if (o.medium_inside != o.medium_outside) return true;
+  return !o.has_alpha() && !lets_light_through(scene, o.material);
+}
 
 // The offset from the plane of the surface that the probe from p along dir meets within `reach`:
 // the surface's normal there, turned toward p, and p's foot along it, found by a second probe
@@ -16,12 +39,12 @@ Vec3 cut_along(const RenderScene& scene, Vec3 p, Vec3 dir, float reach, float ra
   const Ray probe{p, dir, reach};
   Hit hit;
   ++rays.probe_rays;
-  if (!scene.intersect(probe, &hit)) return {};
+  if (!scene.intersect(probe, &hit) || !ends_beams(scene, hit.object)) return {};
   const Vec3 toward = face_forward(scene.surface(probe, hit).ng, -dir);
   const Ray foot{p, -toward, radius};
   Hit at;
   ++rays.probe_rays;
-  if (!scene.intersect(foot, &at)) return {};
+  if (!scene.intersect(foot, &at) || !ends_beams(scene, at.object)) return {};
   const SurfacePoint sp = scene.surface(foot, at);
   const Vec3 n = face_forward(sp.ng, toward);
   const float h = dot(p - sp.p, n);
@@ -55,7 +78,7 @@ float beam_disc_share(Vec3 cut, Vec3 d, float radius) {
   // between the beam and the plane's normal.
   const float sin2 = std::max(0.0f, 1 - dot(cut, d) * dot(cut, d) / h2);
   if (h2 >= radius * radius * sin2) return 1;
-  const float u = std::sqrt(h2 / sin2) / radius;
+  const float u = std::min(1.0f, std::sqrt(h2 / sin2) / radius);
   // The circular segment beyond the line, over the disc's area.
   return 1 - (std::acos(u) - u * std::sqrt(1 - u * u)) / kPi;
 }

@@ -11,7 +11,10 @@
 // The surface that matters most is the one the point's own ray left or met: a point drawn on a
 // camera ray lies near a surface when it lies near the ray's end. So the ray's piece is probed
 // both ways where its end lies within a few radii, and where a surface is met, the point's foot on
-// it, which gives the plane.
+// it, which gives the plane. A wall that the ray passes near but does not meet (nor meets within a
+// few radii: a grazing ray), and the second wall of a corner, are not seen; a thin opaque sheet in
+// the medium, lit on both sides, is taken for a wall (its discs, which gather the beams beyond it
+// through it, are then divided by their shares all the same: too bright near it).
 #pragma once
 #include "base/vec.h"
 #include "integrator/counters.h"
@@ -21,9 +24,10 @@ namespace bpm {
 
 // The point p's offset from the plane of the nearest surface within `radius` of it, found along
 // its ray's direction d where the piece ends within kCutReach radii (to_end; from_start the other
-// way, kInf where the piece starts at the camera or a light): the vector from the plane to p, whose
-// length is the distance; zero where no surface was found. Up to two probe rays each way, counted
-// in rays.probe_rays.
+// way, back to the piece's origin, which may be a surface, the camera or a point in the medium):
+// the vector from the plane to p, whose length is the distance; zero where no surface was found.
+// Only a surface at which the medium's beams end counts: not a curve, nor one that light crosses
+// into the same medium. Up to two probe rays each way, counted in rays.probe_rays.
 constexpr float kCutReach = 4;
 Vec3 medium_cut(const RenderScene& scene, Vec3 p, Vec3 d, float to_end, float from_start,
                 float radius, PathCounters& rays);

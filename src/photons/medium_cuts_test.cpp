@@ -34,8 +34,10 @@ double counted_share(Vec3 n, float h, Vec3 d, float radius) {
 TEST(MediumCuts, DiscShareIsThePartOnThePointsSide) {
   Rng rng(stream_key(11, 0));
   for (int trial = 0; trial < 200; ++trial) {
-    const Vec3 n = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
-    const Vec3 d = normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
+    const Vec3 n =
+        normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
+    const Vec3 d =
+        normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f));
     const float h = 0.02f + 0.98f * rng.uniform(), radius = 0.5f + rng.uniform();
     EXPECT_NEAR(beam_disc_share(n * h, d, radius), counted_share(n, h, d, radius), 2e-3)
         << "n " << n.x << " " << n.y << " " << n.z << ", d " << d.x << " " << d.y << " " << d.z
@@ -77,8 +79,8 @@ TEST(MediumCuts, FoundAlongThePointsRay) {
   c = medium_cut(ls.scene, Vec3(0, 0.3f, 0), normalize(Vec3(20, -1, 0)), 0.3f * std::sqrt(401.f),
                  kInf, 1.0f, rays);
   EXPECT_EQ(length_squared(c), 0);
-  c = medium_cut(ls.scene, Vec3(0, 1.5f, 0), normalize(Vec3(1, -1, 0)), 1.5f * std::sqrt(2.f),
-                 kInf, 1.0f, rays);
+  c = medium_cut(ls.scene, Vec3(0, 1.5f, 0), normalize(Vec3(1, -1, 0)), 1.5f * std::sqrt(2.f), kInf,
+                 1.0f, rays);
   EXPECT_EQ(length_squared(c), 0);
   // Under the roof, going up along y: the roof's plane is 0.5 / sqrt 2 away along its normal.
   c = medium_cut(ls.scene, Vec3(6, 4.5f, 0), Vec3(0, 1, 0), 0.5f, kInf, 1.0f, rays);
@@ -90,6 +92,46 @@ TEST(MediumCuts, FoundAlongThePointsRay) {
   c = medium_cut(ls.scene, Vec3(-3, 2, 0), Vec3(0, 0, 1), 0.5f, 0.5f, 1.0f, rays);
   EXPECT_EQ(length_squared(c), 0);
   EXPECT_EQ(rays.probe_rays - before, 2u);
+}
+
+// Beams go on past glass into the same medium: no cut there. Past glass into another medium, or
+// a bare interface to vacuum, they end.
+TEST(MediumCuts, OnlySurfacesWhereBeamsEnd) {
+  const std::string head =
+      "LookAt 0 3 -5  0 0 0  0 1 0\nCamera \"perspective\"\nFilm \"rgb\" \"integer xresolution\" 8 "
+      "\"integer yresolution\" 8\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+      "WorldBegin\n";
+  const std::string floor =
+      "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-10 0 -10  -10 0 10  "
+      "10 0 10  10 0 -10]\n";
+  struct Case {
+    const char* what;
+    std::string scene;
+    bool cut;
+  };
+  const Case cases[] = {
+      {"glass in fog", "MediumInterface \"fog\" \"fog\"\nMaterial \"dielectric\"\n" + floor, false},
+      {"glass without media", "Material \"dielectric\"\n" + floor, false},
+      {"a cut-out",
+       "Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \"point3 P\" [-10 0 "
+       "-10  -10 0 10  10 0 10  10 0 -10] \"float alpha\" 0.5\n",
+       false},
+      {"glass over vacuum", "MediumInterface \"\" \"fog\"\nMaterial \"dielectric\"\n" + floor,
+       true},
+      {"an interface", "MediumInterface \"\" \"fog\"\nMaterial \"interface\"\n" + floor, true},
+      {"a mix of diffuse and glass",
+       "MakeNamedMaterial \"a\" \"string type\" \"diffuse\"\nMakeNamedMaterial \"b\" \"string "
+       "type\" \"dielectric\"\nMaterial \"mix\" \"string materials\" [\"a\" \"b\"]\n" +
+           floor,
+       false},
+      {"diffuse", floor, true},
+  };
+  for (const Case& c : cases) {
+    LoadedScene ls = flatten_scene(parse_scene_string(head + c.scene));
+    PathCounters rays;
+    const Vec3 cut = medium_cut(ls.scene, Vec3(0, 0.3f, 0), Vec3(0, -1, 0), 0.3f, kInf, 1, rays);
+    EXPECT_EQ(length_squared(cut) > 0, c.cut) << c.what;
+  }
 }
 
 }  // namespace
