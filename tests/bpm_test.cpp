@@ -547,8 +547,9 @@ TEST(Bpm, CurvesInAFurnaceMatchPath) {
 // at its centre: the radiance is 1 everywhere, however often light scatters. bpm's eye paths
 // gather at their first scattering point in the medium (next-event estimation, a phase sample for
 // the light, photon beams for the rest): no light may be lost or counted twice. A sphere of radius
-// r within r of the wall misses the beams beyond it (at most half its light), and that shell holds
-// at most 3 r / R of the medium's points: a bias within 1.5 r / R.
+// r within r of the wall would miss the beams beyond it (at most half its light; the cuts of
+// photons/medium_cuts.h make up for it, up to the wall's curvature), and that shell holds at most
+// 3 r / R of the medium's points: a bias within 1.5 r / R.
 TEST(Bpm, AlbedoOneFurnaceInAMedium) {
   const LoadedScene ls = load(test::albedo_one_furnace("1 1 1", 16));
   BpmSettings s;
