@@ -75,6 +75,13 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
                                       path.counters.rays, part);
 }
 
+// The surface that cuts the discs about a point in a medium (photons/medium_cuts.h), found for the
+// first radius stored there and kept for any smaller one.
+struct MediumCut {
+  float radius = 0;
+  Vec3 offset;
+};
+
 // Stores one backward photon at diffuse vertex v. Where its disc may be cut (disc_probes.h) and
 // is not whole on plain sight, it is probed after the light pass, if it gathers light
 // (bpm/disc_shares.h); where a larger disc about the same point was whole on plain sight
@@ -82,12 +89,7 @@ inline Spectrum direct_light_at(const EyePath& path, const PathVertex& v, const 
 // looked at, and probed, on its own.) Returns what was found of the disc (nothing: not looked
 // at). With merge_density, the eye path goes on from the vertex (combined estimators): the
 // backward photon is marked so, and *merge_density set to its pi r^2 N (0 where none is stored).
-// In a medium, `cut` keeps the surface that cuts the discs about v, found for the first radius
-// stored there (photons/medium_cuts.h) and kept for any smaller one.
-struct MediumCut {
-  float radius = 0;
-  Vec3 offset;
-};
+// In a medium, `cut` keeps the surface that cuts the discs about v (MediumCut).
 inline DiscProbes store_backward_photon(const EyePath& path, const PathVertex& v,
                                         const PathState& s, int depth, int diffuse,
                                         bool seen_directly, uint8_t accepts,

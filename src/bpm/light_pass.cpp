@@ -22,10 +22,18 @@ namespace {
 // Domain separation of photon streams from pixel streams.
 constexpr uint64_t kPhotonStream = 0x70686f746f6e73ull;
 
+// The part of a photon's score for the guide of an entry of `value` (before 1 / (pi r^2 N)) at
+// backward photon bp: 0 when prm.pixel_weight is not set. `bp` is the backward photon's record,
+// or its sphere's (MediumSphere): its radius, pixel and tau are read.
+template <class Record>
+float entry_score(const Record& bp, const Spectrum& value, const LightPassParams& prm) {
+  if (!prm.pixel_weight) return 0;
+  return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
+}
+
 // Appends backward photon g's entry for a photon (or a beam's nearest point) at squared distance d2
 // from its centre with `value`, to the list of the slot that owns its pixel. Returns the entry's
-// part of the photon's score for the guide (0 when prm.pixel_weight is not set). `bp` is the
-// backward photon's record, or its sphere's (MediumSphere): its radius, pixel and tau are read.
+// score (entry_score).
 template <class Record>
 float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, uint32_t photon,
                 const LightPassParams& prm, const std::vector<uint16_t>& owner,
@@ -35,8 +43,7 @@ float add_entry(const Record& bp, uint32_t g, float d2, const Spectrum& value, u
                         (4 * d2 < r2 ? PhotonEntry::kQuarterBit : 0u) |
                         (photon & 1 ? PhotonEntry::kOddBit : 0u);
   out[owner[bp.pixel]].push_back({g | bits, value});
-  if (!prm.pixel_weight) return 0;
-  return (bp.tau * value).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * bp.radius * bp.radius);
+  return entry_score(bp, value, prm);
 }
 
 // The weight of merging photon hit h (whose path may be combined) at backward photon bp: against
@@ -590,10 +597,10 @@ float add_cut_beam_entries(const MediumSphere& bp, float d2, const Spectrum& val
                            const PendingBeam& b, const LightPassParams& prm,
                            const std::vector<uint16_t>& owner,
                            std::vector<std::vector<PhotonEntry>>& out) {
-  const float r = bp.radius, r2 = r * r;
-  const Spectrum all = value / beam_disc_share(bp.cut, b.ray.d, r),
-                 half = value / beam_disc_share(bp.cut, b.ray.d, r * float(M_SQRT1_2)),
-                 quarter = value / beam_disc_share(bp.cut, b.ray.d, r / 2);
+  const float r = bp.radius, r2 = r * r, line = cut_line_distance(bp.cut, b.ray.d);
+  const Spectrum all = value / disc_share_before(line, r),
+                 half = value / disc_share_before(line, r * float(M_SQRT1_2)),
+                 quarter = value / disc_share_before(line, r / 2);
   const uint32_t odd = b.photon & 1 ? PhotonEntry::kOddBit : 0u;
   std::vector<PhotonEntry>& list = out[owner[bp.pixel]];
   if (4 * d2 < r2) {
@@ -606,8 +613,7 @@ float add_cut_beam_entries(const MediumSphere& bp, float d2, const Spectrum& val
   } else {
     list.push_back({bp.index | odd, all});
   }
-  if (!prm.pixel_weight) return 0;
-  return (bp.tau * all).average() * (*prm.pixel_weight)[bp.pixel] / (kPi * r2);
+  return entry_score(bp, all, prm);
 }
 
 // The entries of one beam: at each sphere it reaches, its flux at the point nearest the centre

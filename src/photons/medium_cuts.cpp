@@ -71,14 +71,16 @@ Vec3 medium_cut(const RenderScene& scene, Vec3 p, Vec3 d, float to_end, float fr
   return cut;
 }
 
-float beam_disc_share(Vec3 cut, Vec3 d, float radius) {
+float cut_line_distance(Vec3 cut, Vec3 d) {
   const float h2 = length_squared(cut);
-  if (h2 == 0) return 1;
-  // The plane's line across the disc lies h / sin(theta) from its centre, theta the angle
-  // between the beam and the plane's normal.
-  const float sin2 = std::max(0.0f, 1 - dot(cut, d) * dot(cut, d) / h2);
-  if (h2 >= radius * radius * sin2) return 1;
-  const float u = std::min(1.0f, std::sqrt(h2 / sin2) / radius);
+  if (h2 == 0) return kInf;
+  const float sin2 = 1 - dot(cut, d) * dot(cut, d) / h2;
+  return sin2 > 0 ? std::sqrt(h2 / sin2) : kInf;
+}
+
+float disc_share_before(float line, float radius) {
+  if (!(line < radius)) return 1;
+  const float u = line / radius;
   // The circular segment beyond the line, over the disc's area.
   return 1 - (std::acos(u) - u * std::sqrt(1 - u * u)) / kPi;
 }

@@ -32,10 +32,17 @@ constexpr float kCutReach = 4;
 Vec3 medium_cut(const RenderScene& scene, Vec3 p, Vec3 d, float to_end, float from_start,
                 float radius, PathCounters& rays);
 
-// The share of the disc of radius `radius` about the point, across a beam of unit direction d,
-// that lies on the point's side of the plane of `cut` (medium_cut): 1 without a cut, or where the
-// plane's line across the disc lies beyond it; 1/2 for a beam parallel to a plane through the
-// point.
-float beam_disc_share(Vec3 cut, Vec3 d, float radius);
+// The distance from the point to the line where the plane of `cut` (medium_cut) crosses the
+// plane across a beam of unit direction d: h / sin(theta), theta the angle between the beam and
+// the plane's normal; kInf without a cut, or for a beam along the normal.
+float cut_line_distance(Vec3 cut, Vec3 d);
+// The share of the disc of radius `radius` about the point that lies before a line at distance
+// `line` from its centre: 1 where the line lies beyond the disc, 1/2 where it passes through the
+// centre.
+float disc_share_before(float line, float radius);
+// Both: the share of the disc across the beam on the point's side of the plane.
+inline float beam_disc_share(Vec3 cut, Vec3 d, float radius) {
+  return disc_share_before(cut_line_distance(cut, d), radius);
+}
 
 }  // namespace bpm
