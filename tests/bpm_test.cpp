@@ -574,8 +574,8 @@ TEST(Bpm, AlbedoOneFurnaceInAMedium) {
 // glass sphere in it: light focused into the fog (a volumetric caustic) and onto the floor through
 // the fog, interreflection between fog and floor. bpm's (without and with splitting in media)
 // and fpm's blocks agree with path's within 4.5 sigma plus the edge bias of the radii.
-TEST(Bpm, FogWithAGlassSphereMatchesPath) {
-  const LoadedScene ls = load(R"(LookAt 0 1 -4  0 1 0  0 1 0
+std::string fog_with_glass_scene() {
+  return R"(LookAt 0 1 -4  0 1 0  0 1 0
 Camera "perspective" "float fov" 40
 Film "rgb" "integer xresolution" 24 "integer yresolution" 24
 PixelFilter "box"
@@ -602,7 +602,11 @@ AttributeBegin
   Translate 0 1.8 0
   Shape "sphere" "float radius" 0.4
 AttributeEnd
-)");
+)";
+}
+
+TEST(Bpm, FogWithAGlassSphereMatchesPath) {
+  const LoadedScene ls = load(fog_with_glass_scene());
   const RenderRun ref = render_with(ls, "path", 2048, 0, 7);
   const BpmSettings s;
   expect_blocks_agree(render_iterations(ls, "bpm", 24, 3, s), ref.film, 6, edge_bias(s, 24, 6),
@@ -2491,18 +2495,16 @@ TEST(Bpm, LargerGroupsAtHigherResolutionDoNotDependOnTheThreads) {
 // A memory budget: too small for the film and one iteration's backward photons, the render stops
 // before it starts with an error that names the budget; just large enough, the light pass applies
 // the entries of its groups of photons in more rounds, and the image is exactly the unlimited one
-// (the entries are applied in the same order whatever the rounds).
-TEST(Bpm, MemoryBudgetSplitsBatchesWithoutChangingTheImage) {
-  LoadedScene ls = load(caustic_scene());
-  BpmSettings s = small_batches(0);
-  s.photons_per_iteration = 40000;
-  s.k1 = 8;  // large spheres: many entries per photon, against the slack of the memory estimate
+// (the entries are applied in the same order whatever the rounds). Unlimited, a group takes
+// `rounds` rounds (the hits', and the beams' in a medium).
+void expect_budget_splits_rounds(const LoadedScene& ls, const BpmSettings& s, uint64_t rounds) {
   const int iterations = 2;
   RenderRun unlimited = render_with(ls, "bpm", iterations, 2, 9, s);
   const nlohmann::json& light = unlimited.stats.details["light"];
   const uint64_t group = group_size(0).photons;  // the smallest group: few backward photons here
-  ASSERT_EQ(light["batches"].get<uint64_t>(),
-            uint64_t(iterations) * ((uint64_t(s.photons_per_iteration) + group - 1) / group));
+  ASSERT_EQ(
+      light["batches"].get<uint64_t>(),
+      rounds * uint64_t(iterations) * ((uint64_t(s.photons_per_iteration) + group - 1) / group));
   const size_t unlimited_entries =
       unlimited.stats.details["maps"]["peak_entry_bytes"].get<size_t>();
 
@@ -2540,6 +2542,21 @@ TEST(Bpm, MemoryBudgetSplitsBatchesWithoutChangingTheImage) {
   EXPECT_GT(r->stats.details["light"]["batches"].get<uint64_t>(), light["batches"].get<uint64_t>());
   EXPECT_LT(r->stats.details["maps"]["peak_entry_bytes"].get<size_t>(), unlimited_entries);
   EXPECT_EQ(r->film.image().rgb, unlimited.film.image().rgb);
+}
+
+TEST(Bpm, MemoryBudgetSplitsBatchesWithoutChangingTheImage) {
+  BpmSettings s = small_batches(0);
+  s.photons_per_iteration = 40000;
+  s.k1 = 8;  // large spheres: many entries per photon, against the slack of the memory estimate
+  expect_budget_splits_rounds(load(caustic_scene()), s, 1);
+}
+
+// The same in fog, where the photons' beams add entries at the spheres in the medium: their
+// rounds are held to the same budget.
+TEST(Bpm, MemoryBudgetSplitsBeamRoundsWithoutChangingTheImage) {
+  BpmSettings s = small_batches(0);
+  s.photons_per_iteration = 40000;
+  expect_budget_splits_rounds(load(fog_with_glass_scene()), s, 2);
 }
 
 // fpm checks its worst iteration (every photon stored at every allowed bounce) before it starts.

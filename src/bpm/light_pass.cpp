@@ -407,42 +407,31 @@ void sort_hits(const BackwardMaps& maps, int chunks, LightPassBuffers* buf) {
     for (PendingHit& h : buf->hits[size_t(c)]) buf->order[start[h.bucket]++] = &h;
 }
 
-// Gather: gather chunks from `first` on (kHitsPerGather hits of `order` each) add their entries
-// to their own lists, until all have run or the entries reach the memory limit (the first always
-// runs). Returns how many ran, a prefix (the lists of any past them are emptied: they run again in
-// the next round), and the bytes all the lists hold.
+// Gather: gather chunks from `first` on (gather(g, lists) fills chunk g's lists, one per mask
+// slot) add their entries, until all n have run or the entries reach the memory limit (the first
+// always runs). Returns how many ran, a prefix (the lists of any past them are emptied: they run
+// again in the next round), and the bytes all the lists hold.
 struct GatherRound {
   int kept;
   size_t bytes;
 };
-GatherRound gather_round(const BackwardMaps& maps, const LightPassParams& prm,
-                         const PixelMasks& masks, int first, int n_gather, LightPassBuffers* buf) {
+template <class Gather>
+GatherRound gather_round(const LightPassParams& prm, const PixelMasks& masks, int first, int n,
+                         const Gather& gather, LightPassBuffers* buf) {
   std::atomic<size_t> bytes{0};
   for (auto& by_slot : buf->chunks) {
     by_slot.resize(size_t(masks.slots()));
     bytes += chunk_bytes(by_slot);
   }
   auto full = [&] { return prm.entry_bytes_limit && bytes.load() > prm.entry_bytes_limit; };
-  const size_t n_hits = buf->order.size();
-  const int kept = run_chunks_until(n_gather - first, full, [&](int i) {
+  const int kept = run_chunks_until(n - first, full, [&](int i) {
     std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(first + i)];
     const size_t bytes_before = chunk_bytes(by_slot);
     for (auto& v : by_slot) v.clear();
-    const size_t begin = size_t(first + i) * kHitsPerGather;
-    const size_t end = std::min(n_hits, begin + kHitsPerGather);
-    for (size_t k = begin; k < end; ++k) {
-      // The hits lie in their chunks' lists, read here out of order: fetched a few ahead.
-      if (k + 4 < end) {
-        const char* next = reinterpret_cast<const char*>(buf->order[k + 4]);
-        __builtin_prefetch(next);
-        __builtin_prefetch(next + sizeof(PendingHit) - 1);
-      }
-      PendingHit& h = *buf->order[k];
-      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot, buf->counters.local());
-    }
+    gather(first + i, by_slot);
     bytes += chunk_bytes(by_slot) - bytes_before;
   });
-  for (int g = first + kept; g < n_gather; ++g)
+  for (int g = first + kept; g < n; ++g)
     for (auto& v : buf->chunks[size_t(g)]) v.clear();
   return {kept, bytes.load()};
 }
@@ -561,17 +550,18 @@ void add_vertex_hits(int chunks, const LightPassBuffers& buf, LightPassResult& r
     }
 }
 
-// Rounds of gather and apply over the sorted hits: one, unless the entries reach the memory
-// limit; a round keeps a prefix of the gather chunks and the next goes on from there, so that the
-// entries are applied in the same order whatever the rounds.
-void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, const PixelMasks& masks,
-                      LightPassBuffers* buf, LightPassResult& res, StageClock& clock) {
-  const int n_gather = int((buf->order.size() + kHitsPerGather - 1) / kHitsPerGather);
-  if (buf->chunks.size() < size_t(n_gather)) buf->chunks.resize(size_t(n_gather));
+// Rounds of gather and apply over n gather chunks (gather_round's): one, unless the entries reach
+// the memory limit; a round keeps a prefix of the chunks and the next goes on from there, so that
+// the entries are applied in the same order whatever the rounds.
+template <class Gather>
+void gather_and_apply(int n, const Gather& gather, const LightPassParams& prm,
+                      const PixelMasks& masks, LightPassBuffers* buf, LightPassResult& res,
+                      StageClock& clock) {
+  if (buf->chunks.size() < size_t(n)) buf->chunks.resize(size_t(n));
   int done = 0;
   do {
     const GatherRound round =
-        n_gather > 0 ? gather_round(maps, prm, masks, done, n_gather, buf) : GatherRound{0, 0};
+        n > 0 ? gather_round(prm, masks, done, n, gather, buf) : GatherRound{0, 0};
     const int kept = round.kept;
     size_t entries = 0;
     for (int g = done; g < done + kept; ++g)
@@ -584,10 +574,33 @@ void gather_and_apply(const BackwardMaps& maps, const LightPassParams& prm, cons
     ++res.batches;
     done += kept;
     // The limit ended the round: the lists' memory goes back, so that the next round has it.
-    if (done < n_gather)
+    if (done < n)
       for (auto& by_slot : buf->chunks)
         for (auto& v : by_slot) std::vector<PhotonEntry>().swap(v);
-  } while (done < n_gather);
+  } while (done < n);
+}
+
+// The sorted hits, kHitsPerGather of `order` per gather chunk.
+void gather_and_apply_hits(const BackwardMaps& maps, const LightPassParams& prm,
+                           const PixelMasks& masks, LightPassBuffers* buf, LightPassResult& res,
+                           StageClock& clock) {
+  const size_t n_hits = buf->order.size();
+  const int n_gather = int((n_hits + kHitsPerGather - 1) / kHitsPerGather);
+  auto gather = [&](int g, std::vector<std::vector<PhotonEntry>>& by_slot) {
+    const size_t begin = size_t(g) * kHitsPerGather;
+    const size_t end = std::min(n_hits, begin + kHitsPerGather);
+    for (size_t k = begin; k < end; ++k) {
+      // The hits lie in their chunks' lists, read here out of order: fetched a few ahead.
+      if (k + 4 < end) {
+        const char* next = reinterpret_cast<const char*>(buf->order[k + 4]);
+        __builtin_prefetch(next);
+        __builtin_prefetch(next + sizeof(PendingHit) - 1);
+      }
+      PendingHit& h = *buf->order[k];
+      h.score = gather_at_hit(maps, prm, masks.owner(), h, by_slot, buf->counters.local());
+    }
+  };
+  gather_and_apply(n_gather, gather, prm, masks, buf, res, clock);
 }
 
 // add_entry for a beam at a sphere whose discs a surface cuts (photons/medium_cuts.h): each nested
@@ -655,26 +668,23 @@ float gather_beam(const RenderScene& scene, const LightPassParams& prm,
   return score;
 }
 
-// The beams of the first `chunks` chunks: gathered chunk by chunk in parallel, each into lists of
-// its own, then applied chunk by chunk in order (as the hits' entries).
+// The beams of the first `chunks` chunks, a trace chunk's per gather chunk, in rounds as the hits'
+// (after them, in the same lists: the memory limit holds for both; a round may pass it by about
+// a trace chunk's beam entries per thread, coarser than the hits' gather chunks).
 void gather_and_apply_beams(const RenderScene& scene, const LightPassParams& prm,
                             const PixelMasks& masks, int chunks, LightPassBuffers* buf,
-                            LightPassResult& res) {
+                            LightPassResult& res, StageClock& clock) {
   if (!prm.medium_spheres || prm.medium_spheres->empty()) return;
-  if (buf->beam_entries.size() < size_t(chunks)) buf->beam_entries.resize(size_t(chunks));
-  tbb::parallel_for(0, chunks, [&](int c) {
-    std::vector<std::vector<PhotonEntry>>& by_slot = buf->beam_entries[size_t(c)];
-    by_slot.resize(size_t(masks.slots()));
-    for (auto& v : by_slot) v.clear();
+  // Under a limit, the hits' lists past the beams' chunks give their memory back first.
+  if (prm.entry_bytes_limit)
+    for (size_t g = size_t(chunks); g < buf->chunks.size(); ++g)
+      for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
+  auto gather = [&](int c, std::vector<std::vector<PhotonEntry>>& by_slot) {
     thread_local std::vector<std::pair<const MediumSphere*, float>> found;
     for (PendingBeam& b : buf->beams[size_t(c)])
       b.score = gather_beam(scene, prm, masks.owner(), b, found, by_slot);
-  });
-  size_t entries = 0;
-  for (int c = 0; c < chunks; ++c)
-    for (const auto& v : buf->beam_entries[size_t(c)]) entries += v.size();
-  buf->counters.local().entries += entries;
-  apply_entries(buf->beam_entries, 0, chunks, masks.slots(), &res);
+  };
+  gather_and_apply(chunks, gather, prm, masks, buf, res, clock);
 }
 
 // Each photon's score is the sum of its hits' and beams', in the order of its path, as if it had
@@ -753,9 +763,8 @@ void run_light_pass(const RenderScene& scene, const BackwardMaps& maps, const Li
     if (prm.vertex) add_vertex_hits(tr.chunks, *buf, res);
     res.cut = tr.stopped;
     sort_hits(maps, tr.chunks, buf);
-    gather_and_apply(maps, prm, masks, buf, res, clock);
-    gather_and_apply_beams(scene, prm, masks, tr.chunks, buf, res);
-    clock.lap(res.gather_s);
+    gather_and_apply_hits(maps, prm, masks, buf, res, clock);
+    gather_and_apply_beams(scene, prm, masks, tr.chunks, buf, res, clock);
     if (guide && prm.pixel_weight) learn_scores(tr.chunks, buf, *guide);
     clock.lap(res.apply_s);
     if (res.cut) break;

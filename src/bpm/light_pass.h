@@ -131,16 +131,16 @@ struct EmittedPhoton {
 
 // What the light pass keeps between iterations (so that their memory is allocated once): per
 // chunk of a group's photons their hits and emissions, the hits in gather order, per gather chunk
-// the entry lists, per chunk its photons' scores, and the per-thread counters.
+// the entry lists (the hits', then the beams', a trace chunk's each), per chunk its photons'
+// scores, and the per-thread counters.
 struct LightPassBuffers {
-  std::vector<std::vector<PendingHit>> hits;                        // [chunk]
-  std::vector<std::vector<EmittedPhoton>> emitted;                  // [chunk]
-  std::vector<std::vector<SensorCrossing>> crossings;               // [chunk], with sensors
-  std::vector<std::vector<PendingBeam>> beams;                      // [chunk], with medium spheres
-  std::vector<std::vector<CameraHit>> camera_hits;                  // [chunk], with connections
-  std::vector<std::vector<const CameraHit*>> camera_bands;          // [band of 8 rows]
-  std::vector<std::vector<VertexHit>> vertex_hits;                  // [chunk], with connections
-  std::vector<std::vector<std::vector<PhotonEntry>>> beam_entries;  // [chunk][slot]
+  std::vector<std::vector<PendingHit>> hits;                // [chunk]
+  std::vector<std::vector<EmittedPhoton>> emitted;          // [chunk]
+  std::vector<std::vector<SensorCrossing>> crossings;       // [chunk], with sensors
+  std::vector<std::vector<PendingBeam>> beams;              // [chunk], with medium spheres
+  std::vector<std::vector<CameraHit>> camera_hits;          // [chunk], with connections
+  std::vector<std::vector<const CameraHit*>> camera_bands;  // [band of 8 rows]
+  std::vector<std::vector<VertexHit>> vertex_hits;          // [chunk], with connections
   std::vector<PendingHit*> order;
   std::vector<uint32_t> bucket_start;                         // of the counting sort
   std::vector<std::vector<std::vector<PhotonEntry>>> chunks;  // [gather chunk][slot]
@@ -162,12 +162,15 @@ struct LightPassResult {
   std::vector<Spectrum> vertex, vertex_odd;
   uint64_t emitted = 0;  // photons emitted, N of eq. (2)
   bool cut = false;      // a stop request ended the pass before all its photons
-  int batches = 0;       // gather rounds: one per group, more where the memory limit split one
+  // Gather rounds: one per group (two where the iteration has backward photons in media: the
+  // hits', then the beams'), more where the memory limit split one.
+  int batches = 0;
   // Fraction of the backward photons accepting indirect light that were hit (a statistic only).
   double coverage = 0;
   // Seconds, every part of the pass in one of them: tracing the photons (emission, rays,
   // scattering, each hit's leaf); gathering at the hits (their sort by leaf, the backward photons
-  // found, their entries); applying the entries, the emission guide's learning and the coverage.
+  // found, their entries) and at the spheres in media that the beams reach; applying the entries,
+  // the emission guide's learning and the coverage.
   double trace_s = 0, gather_s = 0, apply_s = 0;
   size_t peak_entry_bytes = 0;
 };
