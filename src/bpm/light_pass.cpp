@@ -308,11 +308,16 @@ void trace_chunk(const GroupTrace& g, int c, LightPassBuffers* buf) {
   buf->chunk_counters[size_t(c)] = lc;
 }
 
-// Workers take chunks in order and stop taking them once the hits of the chunks traced reach
-// group_hits, or a stop is requested; at most one chunk per worker is traced past the prefix
-// kept. The prefix never needs a chunk no worker took: a worker skips chunk c only when the
-// chunks before it that have finished, all of them kept, already hold group_hits hits. So
-// without a stop request the prefix ends at group_hits or at the group's end. Returns per chunk
+// What chunk c holds toward a group's cap: its hits and its beams (each at most kHitBytes).
+size_t chunk_records(const LightPassBuffers& buf, int c) {
+  return buf.hits[size_t(c)].size() + buf.beams[size_t(c)].size();
+}
+
+// Workers take chunks in order and stop taking them once the records (chunk_records) of the
+// chunks traced reach group_hits, or a stop is requested; at most one chunk per worker is traced
+// past the prefix kept. The prefix never needs a chunk no worker took: a worker skips chunk c only
+// when the chunks before it that have finished, all of them kept, already hold group_hits records.
+// So without a stop request the prefix ends at group_hits or at the group's end. Returns per chunk
 // whether it ran.
 template <class Stop>
 std::vector<uint8_t> trace_chunks_in_order(const GroupTrace& g, int n_chunks, int workers,
@@ -327,26 +332,26 @@ std::vector<uint8_t> trace_chunks_in_order(const GroupTrace& g, int n_chunks, in
           if (c > 0 && (stop() || traced.load() >= group_hits)) break;
           trace_chunk(g, c, buf);
           ran[size_t(c)] = 1;
-          traced += buf->hits[size_t(c)].size();
+          traced += chunk_records(*buf, c);
         }
       },
       tbb::simple_partitioner());
   return ran;
 }
 
-// The longest prefix of the chunks that ran that starts before group_hits hits; its counters join
-// the thread's.
+// The longest prefix of the chunks that ran that starts before group_hits records; its counters
+// join the thread's.
 TraceResult keep_prefix(const std::vector<uint8_t>& ran, int workers, uint64_t count,
                         uint64_t group_hits, LightPassBuffers* buf) {
   const int n_chunks = int(ran.size());
   int kept = 0;
-  uint64_t kept_hits = 0;
-  while (kept < n_chunks && ran[size_t(kept)] && kept_hits < group_hits)
-    kept_hits += buf->hits[size_t(kept++)].size();
-  const bool stopped = kept < n_chunks && kept_hits < group_hits;
-  // A group ended by its hits leaves the lists past those it may use unused: their memory, from a
-  // larger group, goes back.
-  if (kept_hits >= group_hits)
+  uint64_t kept_records = 0;
+  while (kept < n_chunks && ran[size_t(kept)] && kept_records < group_hits)
+    kept_records += chunk_records(*buf, kept++);
+  const bool stopped = kept < n_chunks && kept_records < group_hits;
+  // A group ended by its records leaves the lists past those it may use unused: their memory, from
+  // a larger group, goes back.
+  if (kept_records >= group_hits)
     for (size_t c = size_t(kept) + size_t(workers); c < buf->hits.size(); ++c) {
       std::vector<PendingHit>().swap(buf->hits[c]);
       std::vector<EmittedPhoton>().swap(buf->emitted[c]);
@@ -362,10 +367,10 @@ TraceResult keep_prefix(const std::vector<uint8_t>& ran, int workers, uint64_t c
 
 // Trace: chunks of photons are traced in parallel, each recording its photons' hits and
 // emissions (and counters). A group keeps the longest prefix of its chunks that starts before
-// group_hits hits, so that its memory is bounded whatever the paths and its size does not depend
-// on the threads (a chunk traced past the prefix is traced again in the next group); or fewer
-// whole chunks when prm.stop ended the trace. The first chunk always runs, except after a stop
-// request in a later group.
+// group_hits records (hits and beams), so that its memory is bounded whatever the paths and its
+// size does not depend on the threads (a chunk traced past the prefix is traced again in the next
+// group); or fewer whole chunks when prm.stop ended the trace. The first chunk always runs, except
+// after a stop request in a later group.
 TraceResult trace_group(const RenderScene& scene, const BackwardMaps& maps,
                         const LightPassParams& prm, uint64_t seed, int pass_index,
                         uint64_t first_photon, uint64_t count, uint64_t group_hits,

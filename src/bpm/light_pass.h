@@ -176,17 +176,18 @@ struct LightPassResult {
 };
 
 // Photons per group: the hits of a group are sorted together, and its entries are held in memory
-// until they are applied. A group ends earlier, at a chunk, once its hits reach `hits` (where
-// photons leave many hits), so that its memory is bounded; where it ends depends on the paths
-// alone, so the order of every sum is fixed by the scene, the seed and the settings.
-// A group has about as many hits as the iteration has backward photons, so that a leaf of the
-// trees is reached by about as many hits of a group, and read from cache by all but the first, at
-// any resolution; within [131072, 1048576] hits, and half as many photons.
+// until they are applied. A group ends earlier, at a chunk, once its hits and its beams in media
+// together reach `hits` (where photons leave many), so that its memory is bounded; where it ends
+// depends on the paths alone, so the order of every sum is fixed by the scene, the seed and the
+// settings. A group has about as many hits as the iteration has backward photons, so that a leaf of
+// the trees is reached by about as many hits of a group, and read from cache by all but the first,
+// at any resolution; within [131072, 1048576] hits, and half as many photons.
 struct GroupSize {
   uint64_t photons, hits;
 };
 GroupSize group_size(size_t backward_photons);
 constexpr uint64_t kHitBytes = sizeof(PendingHit) + sizeof(PendingHit*);
+static_assert(sizeof(PendingBeam) <= kHitBytes, "a beam counts as a hit toward a group's cap");
 // What the light pass's hits (and with `camera` and `vertex`, its camera and vertex connections)
 // may take with at most `backward_photons`, for the memory budget.
 double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons,
