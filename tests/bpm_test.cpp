@@ -2492,6 +2492,27 @@ TEST(Bpm, LargerGroupsAtHigherResolutionDoNotDependOnTheThreads) {
   EXPECT_EQ(three.stats.details["light"]["batches"], d["light"]["batches"]);
 }
 
+// In a medium a group also ends when its photons' beams fill it: a group of photons whose beams
+// alone pass its cap of records is split, and the image does not depend on the threads.
+TEST(Bpm, BeamsEndGroupsAsHitsDo) {
+  std::string dense = fog_with_glass_scene();  // eight times the scattering: many beams a photon
+  const std::string thin = "\"rgb sigma_s\" [0.4 0.4 0.4]";
+  ASSERT_NE(dense.find(thin), std::string::npos);
+  dense.replace(dense.find(thin), thin.size(), "\"rgb sigma_s\" [3.2 3.2 3.2]");
+  const LoadedScene ls = load(dense);
+  BpmSettings s = small_batches(0);
+  const GroupSize group = group_size(0);  // few backward photons here: the smallest group
+  s.photons_per_iteration = int(group.photons);
+  RenderRun one = render_with(ls, "bpm", 1, 1, 4, s);
+  const nlohmann::json& light = one.stats.details["light"];
+  ASSERT_GT(light["beams"].get<uint64_t>(), group.hits) << "too few beams to fill a group";
+  // Two rounds (hits, beams) per group; by photons alone it would be one group.
+  EXPECT_GE(light["batches"].get<uint64_t>(), 4u);
+  RenderRun three = render_with(ls, "bpm", 1, 3, 4, s);
+  EXPECT_EQ(three.film.image().rgb, one.film.image().rgb);
+  EXPECT_EQ(three.stats.details["light"]["batches"], light["batches"]);
+}
+
 // A memory budget: too small for the film and one iteration's backward photons, the render stops
 // before it starts with an error that names the budget; just large enough, the light pass applies
 // the entries of its groups of photons in more rounds, and the image is exactly the unlimited one
