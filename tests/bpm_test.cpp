@@ -1298,12 +1298,13 @@ TEST(Bpm, GlassSphereCausticConvergesToPath) {
 // filter's samples carry weights of either sign; on a rough dispersive floor the connection keeps
 // the hero wavelength as the eye path does. In thin fog filling the scene the connection's shadow
 // ray carries the transmittance and the merge's density the probability that the camera's ray got
-// across (a merge weighed without it, or a connection without the transmittance, shows).
+// across (a merge weighed without it, or a connection without the transmittance, shows); where the
+// camera's rays split in the fog (and cross it for certain) the connections are made too.
 TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
   struct Case {
     std::string name, floor, filter;
     int diffuse_depth;
-    bool split_coats = true, one_radius = false, fog = false;
+    bool split_coats = true, one_radius = false, fog = false, split_in_media = false;
   };
   const std::string diffuse = "Material \"diffuse\" \"rgb reflectance\" [0.75 0.75 0.75]",
                     coated =
@@ -1316,7 +1317,8 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
       {"diffuse floor, k0 = k1", diffuse, "mitchell", 0, true, true},
       {"rough dispersive floor",
        "Material \"dielectric\" \"spectrum eta\" \"glass-F11\" \"float roughness\" 0.3", "box", 0},
-      {"diffuse floor in fog", diffuse, "gaussian", 0, true, false, true}};
+      {"diffuse floor in fog", diffuse, "gaussian", 0, true, false, true},
+      {"diffuse floor in fog, split", diffuse, "gaussian", 0, true, false, true, true}};
   for (const Case& k : cases) {
     std::string scene = caustic_in_view_scene();
     if (k.fog) {
@@ -1339,6 +1341,7 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
       s.camera_connections = mode;
       s.split_coats = k.split_coats;
       if (k.one_radius) s.k1 = s.k0;  // one disc, narrow enough to keep the caustic sharp
+      s.split_in_media = k.split_in_media;
       const Iterations its = render_iterations(ls, "bpm", 96, 7, s);
       const std::string what = k.name + " (" + k.filter +
                                "), D=" + std::to_string(k.diffuse_depth) + ", connections " +

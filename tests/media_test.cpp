@@ -318,6 +318,50 @@ WorldBegin
   }
 }
 
+// A shadow ray through three spheres of scattering media and one of an absorbing medium, on a
+// line: its transmittance is the product of all four; the probability that a free flight gets
+// across is that of the scattering ones alone, less the last `certain_last` of them (those that a
+// path from the target crosses for certain: bpm's camera rays split there), whatever their number
+// (within 1e-3: each crossing of an interface starts a hair past it).
+TEST(Media, ShadowRayPassLeavesOutTheStretchesCrossedForCertain) {
+  std::string scene = "LookAt 0 0 -4  0 0 0  0 1 0\nCamera \"perspective\"\n";
+  const float sigma_s[] = {0.2f, 0.5f, 0.9f};
+  for (int i = 0; i < 3; ++i) {
+    const std::string v = std::to_string(sigma_s[i]);
+    scene += "MakeNamedMedium \"m" + std::to_string(i) +
+             "\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.1 0.1 0.1] "
+             "\"rgb sigma_s\" [" +
+             v + " " + v + " " + v + "]\n";
+  }
+  scene +=
+      "MakeNamedMedium \"dark\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 1 1] "
+      "\"rgb sigma_s\" [0 0 0]\nWorldBegin\n";
+  for (int i = 0; i < 3; ++i)
+    scene += "AttributeBegin\nMediumInterface \"m" + std::to_string(i) +
+             "\" \"\"\nMaterial \"interface\"\nTranslate 0 0 " + std::to_string(3 * i) +
+             "\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n";
+  scene +=
+      "AttributeBegin\nMediumInterface \"dark\" \"\"\nMaterial \"interface\"\nTranslate 0 0 "
+      "4.5\nShape \"sphere\" \"float radius\" 0.4\nAttributeEnd\n";
+  const LoadedScene ls = load(scene);
+  const Wavelengths wl = sample_wavelengths(0.3f);
+  const Vec3 from(0, 0, -2), to(0, 0, 8);
+  double all = 1;
+  std::vector<double> chord;  // each scattering sphere's probability, in the ray's order
+  for (float s : sigma_s) {
+    chord.push_back(std::exp(-2.0 * (s + 0.1)));
+    all *= chord.back();
+  }
+  for (int certain = 0; certain <= 5; ++certain) {
+    float pass = -1;
+    const Spectrum T = shadow_transmittance(ls.scene, from, to, -1, false, wl, &pass, certain);
+    double expected = 1;
+    for (int i = 0; i < 3 - certain; ++i) expected *= chord[size_t(i)];
+    EXPECT_NEAR(pass, expected, 1e-3 * expected) << certain;
+    EXPECT_NEAR(T.average(), all * std::exp(-0.8), 1e-3 * all) << certain;
+  }
+}
+
 // In a grid medium unscattered light keeps exp(-sigma_t tau), tau the integral of the density
 // along the pixel's ray (here by the midpoint rule over the medium's own trilinear density, not
 // the lattice walk under test). Chromatic, scattering, depth 0.

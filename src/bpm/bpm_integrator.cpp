@@ -305,6 +305,7 @@ double BpmRender::reserve_memory() const {
       double(n_pixels_) * (kPixelBytes + (vertex_connections() ? kVertexPixelBytes : 0.0)) +
       light_pass_hit_bytes(opt_.max_depth, tbb::this_task_arena::max_concurrency(),
                            n_pixels_ * size_t(photons_per_path(s_, scene_)),
+                           scene_.has_scattering_media(),
                            s_.camera_connections != ConnectionMode::kOff, vertex_connections());
   check_memory(
       "bpm at " + size_ + " with diffuse depth " + std::to_string(s_.diffuse_depth) + " (up to " +
@@ -317,12 +318,12 @@ double BpmRender::reserve_memory() const {
 
 CameraConnections BpmRender::camera_connections() const {
   CameraConnections cc;
-  // Only a pinhole sees the connections' point. Where the camera's rays split in media they cross
-  // the first pieces at full weight (gather_forced_in_medium), which the merges' densities would
-  // have to follow; there the merges count the caustics seen directly alone.
-  const bool split_camera_rays = s_.split_in_media && scene_.has_scattering_media();
-  if (!opt_.image || !caustics_ || split_camera_rays || !camera_.camera().projects()) return cc;
+  // Only a pinhole sees the connections' point.
+  if (!opt_.image || !caustics_ || !camera_.camera().projects()) return cc;
   cc.mode = s_.camera_connections;
+  // Where the camera's rays split in media (toward the last diffuse vertex, so at D = 0) they
+  // cross the first kMaxMediumSplits pieces at full weight (gather_forced_in_medium, eye_pass.cpp).
+  if (s_.split_in_media && s_.diffuse_depth == 0) cc.certain_pieces = kMaxMediumSplits;
   cc.camera = &camera_.camera();
   cc.camera_medium = camera_.camera().medium();
   cc.filter = &camera_.filter();

@@ -46,13 +46,14 @@ float merge_factor(const CameraConnections& cc, float chance, const CameraView& 
 // The way from the point p (geometric normal ng, error bound `error`) to the pinhole: its
 // transmittance through the media (none where something blocks it), and in *pass the probability
 // that the camera's ray got across them (shadow_transmittance). The medium at p is found toward
-// the camera, alike for the photon and for the backward photon.
+// the camera, alike for the photon and for the backward photon; the pieces the camera's rays
+// cross for certain (CameraConnections::certain_pieces) are the last ones on the way.
 Spectrum toward_camera(const RenderScene& scene, const CameraConnections& cc, Vec3 p, Vec3 ng,
                        float error, Vec3 pinhole, const Wavelengths& wl, float* pass) {
   const Vec3 w = normalize(pinhole - p);
   const Vec3 origin = offset_origin(p, ng, w, error);
   const int medium = scene.media.empty() ? -1 : medium_at(scene, origin, w, cc.camera_medium);
-  return shadow_transmittance(scene, origin, pinhole, medium, false, wl, pass);
+  return shadow_transmittance(scene, origin, pinhole, medium, false, wl, pass, cc.certain_pieces);
 }
 
 // The merge's density at `pixel` for the filter offset `offset`: the factor times the filter's

@@ -8,13 +8,13 @@
 //   p_e(y) pi r^2 P,   p_e(y) = filter density(u - pixel centre) (du/domega) |cos_y| / d^2
 // (u the point's place on the image, d its distance from the pinhole, cos_y at its geometric
 // normal; P the probability that the camera's ray gets across the scattering media between, 1
-// without them), times the chance that the eye path gathered at y (1 where it took both parts of
-// a material, or the material has one); the connection makes it with density 1 (its shadow ray
-// gets across for certain, its transmittance a weight). With the pixel's
-// radius r = a d (a: its caustic disc's radius per unit of distance), d cancels. The connection's
-// value for the pixel is its weight times normalized filter(u - centre) (du/domega) |cos_y| / d^2
-// times f(y, wi, toward the camera) times the photon's flux over its hit's cosine (as a merge's
-// entry, photons/density.h).
+// without them or where it crosses them for certain), times the chance that the eye path gathered
+// at y (1 where it took both parts of a material, or the material has one); the connection makes it
+// with density 1 (its shadow ray gets across for certain, its transmittance a weight). With the
+// pixel's radius r = a d (a: its caustic disc's radius per unit of distance), d cancels. The
+// connection's value for the pixel is its weight times normalized filter(u - centre) (du/domega)
+// |cos_y| / d^2 times f(y, wi, toward the camera) times the photon's flux over its hit's cosine (as
+// a merge's entry, photons/density.h).
 #pragma once
 #include <cstdint>
 #include <utility>
@@ -44,6 +44,10 @@ struct CameraConnections {
   // probability 1 - bsdf_traced_part_probability of gathering); false where it takes both.
   bool gather_by_chance = false;
   int camera_medium = -1;  // the medium the camera sits in
+  // The number of pieces through scattering media nearest the camera that its rays cross for
+  // certain, where they split there (EyePassParams::split_in_media at D = 0: kMaxMediumSplits); P
+  // leaves them out.
+  int certain_pieces = 0;
   bool on() const { return mode != ConnectionMode::kOff; }
 };
 

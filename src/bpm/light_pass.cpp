@@ -472,19 +472,21 @@ GroupSize group_size(size_t backward_photons) {
   return {hits / 2, hits};
 }
 
-double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons, bool camera,
-                            bool vertex) {
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons, bool beams,
+                            bool camera, bool vertex) {
   // The kept chunks' hits with their lists' spare capacity, and a chunk per thread traced past
-  // them or kept from an earlier group (max_depth + 1 hits per photon at most); the emissions.
-  // A camera connection is made at a caustic photon's hit in view, most of which are also hits
-  // recorded: counted as many as those. A vertex connection is made at most once per hit,
-  // recorded or not (a photon's first hit is not): counted as many as the hits and the photons.
+  // them or kept from an earlier group (max_depth + 1 hits per photon at most, and in scattering
+  // media about as many beams, one per stretch of a segment through one medium, each no larger
+  // than a hit); the emissions. A camera connection is made at a caustic photon's hit in view, most
+  // of which are also hits recorded: counted as many as those. A vertex connection is made at most
+  // once per hit, recorded or not (a photon's first hit is not): counted as many as the hits and
+  // the photons.
   const GroupSize g = group_size(backward_photons);
   const double per_hit = double(kHitBytes) +
                          (camera ? double(sizeof(CameraHit) + sizeof(CameraHit*)) : 0.0) +
                          (vertex ? double(sizeof(VertexHit)) : 0.0);
-  return per_hit * (2.0 * double(g.hits) +
-                    2.0 * double(threads) * kPhotonsPerChunk * double(std::max(max_depth, 0) + 1)) +
+  const double per_photon = double(std::max(max_depth, 0) + 1) * (beams ? 2.0 : 1.0);
+  return per_hit * (2.0 * double(g.hits) + 2.0 * double(threads) * kPhotonsPerChunk * per_photon) +
          2.0 * double(g.photons) * (sizeof(EmittedPhoton) + (vertex ? sizeof(VertexHit) : 0));
 }
 

@@ -188,10 +188,11 @@ struct GroupSize {
 GroupSize group_size(size_t backward_photons);
 constexpr uint64_t kHitBytes = sizeof(PendingHit) + sizeof(PendingHit*);
 static_assert(sizeof(PendingBeam) <= kHitBytes, "a beam counts as a hit toward a group's cap");
-// What the light pass's hits (and with `camera` and `vertex`, its camera and vertex connections)
-// may take with at most `backward_photons`, for the memory budget.
-double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons,
-                            bool camera = false, bool vertex = false);
+// What the light pass's hits (and with `beams`, its beams through scattering media; with `camera`
+// and `vertex`, its camera and vertex connections) may take with at most `backward_photons`, for
+// the memory budget.
+double light_pass_hit_bytes(int max_depth, int threads, size_t backward_photons, bool beams,
+                            bool camera, bool vertex);
 // Hits per gather chunk.
 constexpr int kHitsPerGather = 1024;
 

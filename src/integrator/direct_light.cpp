@@ -1,20 +1,37 @@
 #include "integrator/direct_light.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 
+#include "base/error.h"
 #include "base/sampling.h"
 
 namespace bpm {
 
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
-                              bool infinite, const Wavelengths& wl, float* pass) {
+                              bool infinite, const Wavelengths& wl, float* pass, int certain_last) {
+  // The last certain_last probabilities of getting across, held back until a later stretch in a
+  // scattering medium shows that they were not among the last (a ring, oldest at `held`).
+  constexpr int kHeld = 8;
+  BPM_CHECK(certain_last >= 0 && certain_last <= kHeld);
+  std::array<float, kHeld> ring{};
+  int held = 0, count = 0;
   // A stretch of `length` along r in `in`: its transmittance; in a scattering medium its mean is
   // the probability that a free flight gets across (next_vertex's PathState::pass).
   const auto stretch = [&](int in, const Ray& r, float length) {
     const Spectrum T = medium_transmittance(scene, in, r, length, wl);
-    if (pass && scene.media[size_t(in)].scatters()) *pass *= T.average();
+    if (!pass || !scene.media[size_t(in)].scatters()) return T;
+    if (certain_last == 0) {
+      *pass *= T.average();
+    } else if (count < certain_last) {
+      ring[size_t((held + count++) % kHeld)] = T.average();
+    } else {
+      *pass *= ring[size_t(held)];
+      ring[size_t((held + count) % kHeld)] = T.average();
+      held = (held + 1) % kHeld;
+    }
     return T;
   };
   if (pass) *pass = 1;

@@ -17,9 +17,12 @@ namespace bpm {
 // medium transmittance, the medium changing at each. `infinite`: the target stands for a
 // direction, the last stretch infinitely long. With `pass`, *pass is the probability that a free
 // flight gets across the whole way (as PathState::pass: the product over the stretches in
-// scattering media of their mean transmittance).
+// scattering media of their mean transmittance); the last `certain_last` of those stretches (the
+// ones nearest target, at most 8), which a path from target crosses for certain
+// (PathState::cross_media), are left out of it.
 Spectrum shadow_transmittance(const RenderScene& scene, Vec3 origin, Vec3 target, int medium,
-                              bool infinite, const Wavelengths& wl, float* pass = nullptr);
+                              bool infinite, const Wavelengths& wl, float* pass = nullptr,
+                              int certain_last = 0);
 
 // One sample for next-event estimation at sp: a light chosen by power (light, pmf), a point on it
 // by its own sampling (ls), and f, the BSDF of `part` times |cos| times the shadow ray's
