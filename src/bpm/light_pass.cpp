@@ -565,6 +565,11 @@ void gather_and_apply(int n, const Gather& gather, const LightPassParams& prm,
                       const PixelMasks& masks, LightPassBuffers* buf, LightPassResult& res,
                       StageClock& clock) {
   if (buf->chunks.size() < size_t(n)) buf->chunks.resize(size_t(n));
+  // Under a limit, the lists past the n chunks (left by a larger group or by the hits before the
+  // beams) give their memory back first.
+  if (prm.entry_bytes_limit)
+    for (size_t g = size_t(n); g < buf->chunks.size(); ++g)
+      for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
   int done = 0;
   do {
     const GatherRound round =
@@ -682,10 +687,6 @@ void gather_and_apply_beams(const RenderScene& scene, const LightPassParams& prm
                             const PixelMasks& masks, int chunks, LightPassBuffers* buf,
                             LightPassResult& res, StageClock& clock) {
   if (!prm.medium_spheres || prm.medium_spheres->empty()) return;
-  // Under a limit, the hits' lists past the beams' chunks give their memory back first.
-  if (prm.entry_bytes_limit)
-    for (size_t g = size_t(chunks); g < buf->chunks.size(); ++g)
-      for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
   auto gather = [&](int c, std::vector<std::vector<PhotonEntry>>& by_slot) {
     thread_local std::vector<std::pair<const MediumSphere*, float>> found;
     for (PendingBeam& b : buf->beams[size_t(c)])
