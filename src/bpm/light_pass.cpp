@@ -565,11 +565,16 @@ void gather_and_apply(int n, const Gather& gather, const LightPassParams& prm,
                       const PixelMasks& masks, LightPassBuffers* buf, LightPassResult& res,
                       StageClock& clock) {
   if (buf->chunks.size() < size_t(n)) buf->chunks.resize(size_t(n));
-  // Under a limit, the lists past the n chunks (left by a larger group or by the hits before the
-  // beams) give their memory back first.
-  if (prm.entry_bytes_limit)
-    for (size_t g = size_t(n); g < buf->chunks.size(); ++g)
-      for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
+  // The lists keep their memory for the next call. Where all of them already hold more than the
+  // limit, those past the n chunks (left by a larger group, or by the hits before the beams) give
+  // it back first, so that they do not end the first round at its first chunk.
+  if (prm.entry_bytes_limit) {
+    size_t held = 0;
+    for (const auto& by_slot : buf->chunks) held += chunk_bytes(by_slot);
+    if (held > prm.entry_bytes_limit)
+      for (size_t g = size_t(n); g < buf->chunks.size(); ++g)
+        for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
+  }
   int done = 0;
   do {
     const GatherRound round =
