@@ -171,6 +171,13 @@ size_t chunk_bytes(const std::vector<std::vector<PhotonEntry>>& by_slot) {
   return b;
 }
 
+// Bytes the entry lists of all the chunks hold.
+size_t lists_bytes(const LightPassBuffers& buf) {
+  size_t b = 0;
+  for (const auto& by_slot : buf.chunks) b += chunk_bytes(by_slot);
+  return b;
+}
+
 struct TraceResult {
   uint64_t kept = 0;     // photons traced, from the group's first one
   int chunks = 0;        // the chunks that traced them
@@ -423,11 +430,8 @@ struct GatherRound {
 template <class Gather>
 GatherRound gather_round(const LightPassParams& prm, const PixelMasks& masks, int first, int n,
                          const Gather& gather, LightPassBuffers* buf) {
-  std::atomic<size_t> bytes{0};
-  for (auto& by_slot : buf->chunks) {
-    by_slot.resize(size_t(masks.slots()));
-    bytes += chunk_bytes(by_slot);
-  }
+  for (auto& by_slot : buf->chunks) by_slot.resize(size_t(masks.slots()));
+  std::atomic<size_t> bytes{lists_bytes(*buf)};
   auto full = [&] { return prm.entry_bytes_limit && bytes.load() > prm.entry_bytes_limit; };
   const int kept = run_chunks_until(n - first, full, [&](int i) {
     std::vector<std::vector<PhotonEntry>>& by_slot = buf->chunks[size_t(first + i)];
@@ -568,13 +572,9 @@ void gather_and_apply(int n, const Gather& gather, const LightPassParams& prm,
   // The lists keep their memory for the next call. Where all of them already hold more than the
   // limit, those past the n chunks (left by a larger group, or by the hits before the beams) give
   // it back first, so that they do not end the first round at its first chunk.
-  if (prm.entry_bytes_limit) {
-    size_t held = 0;
-    for (const auto& by_slot : buf->chunks) held += chunk_bytes(by_slot);
-    if (held > prm.entry_bytes_limit)
-      for (size_t g = size_t(n); g < buf->chunks.size(); ++g)
-        for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
-  }
+  if (prm.entry_bytes_limit && lists_bytes(*buf) > prm.entry_bytes_limit)
+    for (size_t g = size_t(n); g < buf->chunks.size(); ++g)
+      for (auto& v : buf->chunks[g]) std::vector<PhotonEntry>().swap(v);
   int done = 0;
   do {
     const GatherRound round =
