@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Builds the whole tree with clang in build-fuzz/ (ASan, UBSan and libFuzzer's coverage) and runs
-# each fuzz target for SECONDS (default 30) from its seed corpus: the scene parser with flattening,
-# the PLY reader, image textures through OpenImageIO, and the IES and EULUMDAT readers. Seeds come
-# from scenes/ and fuzz/seeds/; what a run learns is kept in build-fuzz/corpus/. A finding (crash, sanitizer report, leak, hang
-# over 10 s, more than 4 GiB) stops its target, leaves the input in build-fuzz/findings/ and makes
-# the script fail.
+# Builds the library, the program and the fuzz targets with clang in build-fuzz/ (ASan, UBSan and
+# libFuzzer's coverage; no tests or benchmarks) and runs each fuzz target for SECONDS (default 30)
+# from its seed corpus: the scene parser with flattening, the PLY reader, image textures through
+# OpenImageIO, and the IES and EULUMDAT readers. Seeds come from scenes/ and fuzz/seeds/; what a
+# run learns is kept in build-fuzz/corpus/. A finding (crash, sanitizer report, leak, hang over
+# 10 s, more than 4 GiB) stops its target, leaves the input in build-fuzz/findings/ and makes the
+# script fail.
 # FUZZ_SEED fixes libFuzzer's random seed (CI uses 1); unset, each run draws its own.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
 set -euo pipefail
@@ -18,7 +19,7 @@ build="$root/build-fuzz"
 "$root/scripts/install-deps.sh"
 if [ ! -f "$build/build.ninja" ]; then
   CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DBPM_FUZZ=ON >/dev/null
+    -DBPM_FUZZ=ON -DBPM_BUILD_TESTS=OFF -DBPM_BUILD_BENCH=OFF >/dev/null
 fi
 ninja -C "$build" ${BPM_JOBS:+-j "$BPM_JOBS"}
 
