@@ -1319,6 +1319,7 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
        "Material \"dielectric\" \"spectrum eta\" \"glass-F11\" \"float roughness\" 0.3", "box", 0},
       {"diffuse floor in fog", diffuse, "gaussian", 0, true, false, true},
       {"diffuse floor in fog, split", diffuse, "gaussian", 0, true, false, true, true}};
+  std::map<std::string, Film> refs;  // one reference per scene: the two fog cases share one
   for (const Case& k : cases) {
     std::string scene = caustic_in_view_scene();
     if (k.fog) {
@@ -1331,7 +1332,8 @@ TEST(Bpm, CameraConnectionsCountCausticsSeenDirectlyOnce) {
     scene.replace(scene.find("PixelFilter \"box\""), 17, "PixelFilter \"" + k.filter + "\"");
     scene.replace(scene.find(diffuse), diffuse.size(), k.floor);
     LoadedScene ls = load(scene);
-    const Film ref = render_with(ls, "path", 4096).film;
+    if (!refs.contains(scene)) refs.emplace(scene, render_with(ls, "path", 4096).film);
+    const Film& ref = refs.at(scene);
     const BlockStats mr = block_stats(ref, 32)[0];
     // The first two cases also run the merges alone; the others, the connections' variants.
     std::vector<ConnectionMode> modes = {ConnectionMode::kAlone, ConnectionMode::kOn};
@@ -1410,9 +1412,11 @@ TEST(Bpm, VertexConnectionsCountEachPathOnce) {
       {"box, on, combined", cornell(), ConnectionMode::kOn, CombineAt::kEverywhere},
       {"planes in fog, alone, partition", foggy, ConnectionMode::kAlone, CombineAt::kNowhere, true},
       {"planes in fog, on, combined", foggy, ConnectionMode::kOn, CombineAt::kEverywhere, true}};
+  std::map<std::string, Film> refs;  // one reference per scene: several cases share one
   for (const Case& k : cases) {
     LoadedScene ls = load(k.scene);
-    const Film ref = render_with(ls, "path", 4096).film;
+    if (!refs.contains(k.scene)) refs.emplace(k.scene, render_with(ls, "path", 4096).film);
+    const Film& ref = refs.at(k.scene);
     const BlockStats mr = block_stats(ref, 32)[0];
     BpmSettings s = small_batches(0);
     s.vertex_connections = k.mode;
