@@ -157,10 +157,6 @@ constexpr double kPdfA = 0.0072, kPdfMu = 540;
 double tanh_lo() { return std::tanh(kPdfA * (kLambdaMin - kPdfMu)); }
 double tanh_hi() { return std::tanh(kPdfA * (kLambdaMax - kPdfMu)); }
 
-float normalised_lambda(float lambda) { return (lambda - kLambdaMin) / (kLambdaMax - kLambdaMin); }
-
-float sigmoid(float x) { return 0.5f + x / (2 * std::sqrt(1 + x * x)); }
-
 // Colour (under D65) of the sigmoid spectrum with coefficients c, and its Jacobian: summed at 1 nm,
 // or (coarse) with the spectrum sampled every 5 nm and joined linearly, which is five times faster
 // and within about 5e-4 of the 1 nm sum.
@@ -282,9 +278,10 @@ float spectrum_to_luminance(const Spectrum& L, const Wavelengths& wl) {
   return y;
 }
 
+float normalised_lambda(float lambda) { return (lambda - kLambdaMin) / (kLambdaMax - kLambdaMin); }
+
 float sigmoid_spectrum(const std::array<float, 3>& c, float lambda) {
-  float u = normalised_lambda(lambda);
-  return sigmoid((c[0] * u + c[1]) * u + c[2]);
+  return sigmoid_spectrum_at(c, normalised_lambda(lambda));
 }
 
 namespace {

@@ -11,6 +11,7 @@
 // of 1 under D65 is white (1, 1, 1).
 #pragma once
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -130,6 +131,13 @@ class SpectrumCurve {
 // returns the largest remaining channel error.
 float fit_sigmoid(Rgb rgb, std::array<float, 3>* coeff);
 float sigmoid_spectrum(const std::array<float, 3>& coeff, float lambda);
+// The same at u = normalised_lambda(lambda) (0 to 1 over the visible range), for a caller that
+// evaluates many spectra at the same wavelengths.
+float normalised_lambda(float lambda);
+inline float sigmoid_spectrum_at(const std::array<float, 3>& c, float u) {
+  const float x = (c[0] * u + c[1]) * u + c[2];
+  return 0.5f + x / (2 * std::sqrt(1 + x * x));
+}
 // The same coefficients interpolated in a table of fits over the colour cube, built on the first
 // call (about 2 s of CPU, 1 s on two cores): what per-texel colours use.
 std::array<float, 3> sigmoid_coefficients_lookup(Rgb rgb);

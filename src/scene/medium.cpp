@@ -245,12 +245,48 @@ Spectrum voxel_spectrum(const RgbGrid& g, const std::vector<RgbGrid::Voxel>& vox
   return s;
 }
 
-Cell<Spectrum> sigma_t_cell(const RgbGrid& g, const int c[3], const Wavelengths& wl) {
-  return Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-    return voxel_spectrum(g, g.sigma_a, i, j, k, wl, g.scale) +
-           voxel_spectrum(g, g.sigma_s, i, j, k, wl, g.scale);
-  });
-}
+// sigma_t at the voxels of the cells a walk along one ray crosses, as voxel_spectrum gives it. A
+// step to a neighbouring cell keeps the four corners of their shared face: each corner has a slot
+// by the parity of its (i, j, k), which such a step leaves the same, so each voxel's spectra are
+// computed once per walk (the sigmoids are most of an rgbgrid's cost).
+class SigmaTVoxels {
+ public:
+  SigmaTVoxels(const RgbGrid& g, const Wavelengths& wl) : g_(g) {
+    for (int c = 0; c < Spectrum::kChannels; ++c) u_[size_t(c)] = normalised_lambda(wl.lambda[c]);
+  }
+  Cell<Spectrum> cell(const int c[3]) {
+    return Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) { return at(i, j, k); });
+  }
+
+ private:
+  Spectrum at(int i, int j, int k) {
+    const size_t slot = size_t((i & 1) | (j & 1) << 1 | (k & 1) << 2);
+    const std::array<int, 3> key{i, j, k};
+    if (!known_[slot] || keys_[slot] != key) {
+      keys_[slot] = key;
+      known_[slot] = true;
+      values_[slot] = voxel(g_.sigma_a, i, j, k) + voxel(g_.sigma_s, i, j, k);
+    }
+    return values_[slot];
+  }
+  Spectrum voxel(const std::vector<RgbGrid::Voxel>& voxels, int i, int j, int k) const {
+    if (voxels.empty()) return Spectrum(g_.scale);
+    if (i < 0 || j < 0 || k < 0 || i >= g_.nx || j >= g_.ny || k >= g_.nz) return {};
+    const RgbGrid::Voxel& v =
+        voxels[(size_t(k) * size_t(g_.ny) + size_t(j)) * size_t(g_.nx) + size_t(i)];
+    Spectrum s;
+    if (v.scale == 0) return s;
+    for (int c = 0; c < Spectrum::kChannels; ++c)
+      s[c] = g_.scale * v.scale * sigmoid_spectrum_at(v.coeff, u_[size_t(c)]);
+    return s;
+  }
+
+  const RgbGrid& g_;
+  std::array<float, Spectrum::kChannels> u_{};
+  std::array<std::array<int, 3>, 8> keys_{};
+  std::array<bool, 8> known_{};
+  std::array<Spectrum, 8> values_{};
+};
 
 }  // namespace
 
@@ -292,8 +328,9 @@ Spectrum RgbGrid::glow(Vec3 p, const Wavelengths& wl) const {
 Spectrum RgbGrid::depth(const Ray& ray, float t0, float t1, const Wavelengths& wl) const {
   const int n[3] = {nx, ny, nz};
   Spectrum depth;
+  SigmaTVoxels voxels(*this, wl);
   walk_lattice(lattice_from_world, n, ray, t0, t1, [&](const LatticePiece& p) {
-    depth += p.integral(p.values(sigma_t_cell(*this, p.c, wl)));
+    depth += p.integral(p.values(voxels.cell(p.c)));
     return true;
   });
   return depth;
@@ -304,8 +341,9 @@ float RgbGrid::flight(const Ray& ray, int channel, float tau, float t_max, const
   const int n[3] = {nx, ny, nz};
   float t = -1;
   *depth = Spectrum();
+  SigmaTVoxels voxels(*this, wl);
   const float end = walk_lattice(lattice_from_world, n, ray, 0, t_max, [&](const LatticePiece& p) {
-    const std::array<Spectrum, 4> ys = p.values(sigma_t_cell(*this, p.c, wl));
+    const std::array<Spectrum, 4> ys = p.values(voxels.cell(p.c));
     const Spectrum add = p.integral(ys);
     if ((*depth)[channel] + add[channel] >= tau) {
       const float h = p.tb - p.ta;
