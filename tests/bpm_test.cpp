@@ -1085,9 +1085,10 @@ TEST(Bpm, CombinedEstimatorsCountPathsFromAnEnvironmentImageOnce) {
 // With --estimators auto the eye path goes on from a last vertex that is not glossy with a
 // probability each pixel chooses (continue_level): its light over the probability, its density
 // times it in the weights on both sides. With many photons over wide discs the merges take nearly
-// all the weight, and the pixels lower their probability; the image still agrees with path's,
-// block by block and in its mean within 4.5 sigma (a probability left out of either side's weight,
-// or of the light's division, shows).
+// all the weight, and the pixels lower their probability, most to 0 (the merge alone, but in
+// every eighth iteration, where they go on with 1/16); the image still agrees with path's, block
+// by block and in its mean within 4.5 sigma (a probability left out of either side's weight, or of
+// the light's division, shows).
 TEST(Bpm, ContinuationsTakenByChanceConvergeToPath) {
   LoadedScene ls = load(cornell());
   const Film ref = render_with(ls, "path", 2048).film;
@@ -1101,8 +1102,7 @@ TEST(Bpm, ContinuationsTakenByChanceConvergeToPath) {
               mr.mean, std::sqrt(mc.var + mr.var));
   EXPECT_EQ(c.last.details["settings"]["estimators"], "auto");
   EXPECT_GT(c.last.details["eye"]["continued_paths"].get<double>(), 0.0);
-  EXPECT_LT(q, 0.9);
-  EXPECT_GT(q, 0.0);
+  EXPECT_LT(q, 0.5);
   expect_blocks_agree(c, ref, 8, edge_bias(s, 40, 8), "auto");
   EXPECT_NEAR(mc.mean, mr.mean, 4.5 * std::sqrt(mc.var + mr.var));
 }
@@ -1923,37 +1923,83 @@ TEST(Bpm, DirectSampleCountBalancesVarianceAndCost) {
   EXPECT_EQ(count(odd, 7.5, 8), 3);
 }
 
+// What a continuation notes for the pixel's choice of q: a light v found with the weight share
+// 1 - phi left to it by the merge, at the probability q, stands for y = v / (1 - phi) with the
+// merge's density a = q phi / (1 - phi) times the continuation's; at each level q_l the
+// continuation's variance and the merges' on the same path sum to the balance heuristic's
+// y^2 / (q_l + a), and to y^2 / a with q = 0. A light the merge cannot find (phi = 0) forbids
+// q = 0.
+TEST(Bpm, ContinuationNotesItsVarianceAtEveryLevel) {
+  EyeContinuation c;
+  c.q = 0.25;
+  c.found(0.3, 0.6, 0.4);
+  c.add(0.3, 12);
+  const double y = 0.3 / 0.6, a = 0.25 * 0.4 / 0.6;
+  for (int l = 0; l < kContinueLevels; ++l)
+    EXPECT_NEAR(c.variance_at[size_t(l)], y * y / (std::ldexp(1.0, -l) + a), 1e-12) << l;
+  EXPECT_NEAR(c.merges_alone, y * y / a, 1e-12);
+  EXPECT_EQ(c.unmergeable, 0);
+  EXPECT_EQ(c.taken, 1);
+  EXPECT_EQ(c.rays, 12);
+  EXPECT_NEAR(c.sum, 0.3 / 0.25, 1e-12);
+  // A second path: a light only the continuation finds, y^2 / q_l; the one before kept.
+  c.q = 1;
+  c.found(0.5, 1, 0);
+  c.add(0.5, 3);
+  EXPECT_NEAR(c.variance_at[2], y * y / (0.25 + a) + 0.25 / 0.25, 1e-12);
+  EXPECT_EQ(c.unmergeable, 1);
+  EXPECT_NEAR(c.merges_alone, y * y / a, 1e-12);
+}
+
 // A pixel's probability of going on from a last vertex that is not glossy minimises its variance
-// times its cost: q = sqrt(E[X^2] C / (V_rest c)), as a level k with q = 2^-k in [0, 4]; 1 until
-// two continuations and two estimates are known.
+// times its cost over the levels q = 2^-l, l in [0, 4], and q = 0 where allowed; 1 until two
+// continuations and two estimates are known.
 TEST(Bpm, ContinueLevelBalancesVarianceAndCost) {
-  // Ten iterations met such a vertex and added 2 or 0 in turn (variance 10/9); of `taken`
-  // continuations, E[X^2] = x2 and `rays` rays each.
-  auto stats = [](double taken, double x2, double rays) {
-    SampleStats<double> s;
-    constexpr int c = SampleStats<double>::kContinued;
-    s.v[c] = 10;
-    s.v[c + 1] = 10;
-    s.v[c + 2] = 20;
-    s.v[c + 3] = taken;
-    s.v[c + 4] = taken * x2;
-    s.v[c + 5] = taken * rays;
+  using S = SampleStats<double>;
+  // Ten iterations, all of which met such a vertex; five continuations taken, `rays` rays each,
+  // that would add v_l at level l in all (per continuation) and v_never with q = 0, and found
+  // `unmergeable` lights the merge cannot find.
+  auto stats = [](std::array<double, kContinueLevels> v, double v_never, double unmergeable,
+                  double rays) {
+    S s;
+    s.v[S::kContinued] = 10;
+    s.v[S::kContinued + 3] = 5;
+    s.v[S::kContinued + 4] = 5 * rays;
+    for (int l = 0; l < kContinueLevels; ++l)
+      s.v[size_t(S::kContinuedLevels + l)] = 5 * v[size_t(l)];
+    s.v[S::kContinuedNever] = 5 * v_never;
+    s.v[S::kContinuedNever + 1] = unmergeable;
+    s.v[S::kLit] = 10;
     return s;
   };
-  // V_rest = 16 (the estimate's variance less the continuations'), C = 100 rays per iteration.
-  const double v = 16 + 10.0 / 9;
-  // E[X^2] = 1, c = 100: q = sqrt(1 * 100 / (16 * 100)) = 1/4.
-  const SampleStats<double> s = stats(5, 1, 100);
-  EXPECT_EQ(continue_level(s, 10, v, 100), 2);
-  // Costly continuations, or none that found light: the least probability; cheap ones: 1.
-  EXPECT_EQ(continue_level(stats(5, 1, 1e6), 10, v, 100), kMaxContinueLevel);
-  EXPECT_EQ(continue_level(stats(5, 0, 100), 10, v, 100), kMaxContinueLevel);
-  EXPECT_EQ(continue_level(stats(5, 1, 1), 10, v, 100), 0);
+  // Light only the continuation finds, E[y^2] = 1: v_l = 2^l. With the pixel at level 0 the
+  // estimate's variance 17 leaves 16 to the rest; C = 100 rays per iteration, c = 100 per
+  // continuation: (16 + 2^l) (100 + 100 / 2^l) is least at l = 2 (2500 against 2700 at 1 and 3).
+  const std::array<double, kContinueLevels> alone = {1, 2, 4, 8, 16};
+  const S s = stats(alone, 0, 1, 100);
+  EXPECT_EQ(continue_level(s, 10, 17, 100, 0), 2);
+  // Costly continuations: the least probability; cheap ones: 1.
+  EXPECT_EQ(continue_level(stats(alone, 0, 1, 1e6), 10, 17, 100, 0), kMaxContinueLevel);
+  EXPECT_EQ(continue_level(stats(alone, 0, 1, 1), 10, 17, 100, 0), 0);
+  // Where the merges would take the weight at no loss (the variance the same at every level and
+  // with q = 0), q = 0; unless a light was found that only the continuation finds.
+  const std::array<double, kContinueLevels> flat = {0.5, 0.5, 0.5, 0.5, 0.5};
+  EXPECT_EQ(continue_level(stats(flat, 0.5, 0, 100), 10, 17, 100, 0), kNeverContinue);
+  EXPECT_EQ(continue_level(stats(flat, 0.5, 1, 100), 10, 17, 100, 0), kMaxContinueLevel);
+  // Merges much noisier than the continuation on its paths: q = 1, not q = 0.
+  EXPECT_EQ(continue_level(stats({1, 1.5, 2, 2.5, 3}, 50, 0, 1), 10, 17, 100, 0), 0);
+  // The rest of the variance is the estimate's less what the continuations add at the pixel's
+  // level now: at level 2 the same estimate leaves 13 ((13 + 4) 125 = 2125 least: l = 2 still),
+  // at level 4 only 1 ((1 + 1) 200 = 400 least: l = 0).
+  EXPECT_EQ(continue_level(s, 10, 17, 100, 2), 2);
+  EXPECT_EQ(continue_level(s, 10, 17, 100, 4), 0);
   // Not yet known: one continuation, one estimate, no cost.
-  EXPECT_EQ(continue_level(stats(1, 1, 100), 10, v, 100), 0);
-  EXPECT_EQ(continue_level(s, 1, v, 100), 0);
-  EXPECT_EQ(continue_level(s, 10, v, 0), 0);
-  EXPECT_EQ(continue_level(SampleStats<double>{}, 10, v, 100), 0);
+  S one = s;
+  one.v[S::kContinued + 3] = 1;
+  EXPECT_EQ(continue_level(one, 10, 17, 100, 0), 0);
+  EXPECT_EQ(continue_level(s, 1, 17, 100, 0), 0);
+  EXPECT_EQ(continue_level(s, 10, 17, 0, 0), 0);
+  EXPECT_EQ(continue_level(S{}, 10, 17, 100, 0), 0);
 }
 
 // A pixel whose own few continuations found nothing borrows its neighbours' (the rare light they
@@ -1963,25 +2009,32 @@ TEST(Bpm, RareStatisticsCountThePixelsNeighbours) {
   constexpr int w = 4, h = 3;
   constexpr int c = SampleStats<double>::kContinued;
   std::vector<SampleStats<double>> stats(w * h);
+  constexpr int levels = SampleStats<double>::kContinuedLevels;
+  constexpr int lit = SampleStats<double>::kLit;
   for (size_t p = 0; p < stats.size(); ++p) {
     stats[p].v[c] = 100;
     stats[p].v[c + 3] = 6;      // continuations taken
-    stats[p].v[c + 5] = 6 * 4;  // 4 rays each
+    stats[p].v[c + 4] = 6 * 4;  // 4 rays each
+    stats[p].v[lit] = 100;      // iterations
     stats[p].v[0] = double(p);  // another statistic, kept per pixel
   }
   // Pixel (1, 1) found no light; one neighbour (2, 2) found some, another pixel far off (3, 0)
-  // too. Sums of X / q and of X^2: one continuation of light 2 at q = 1/16.
+  // too. Sums of X / q and of X^2: one continuation of light 2 at q = 1/16, which the merge
+  // cannot find: 4 / q_l at level l.
   const size_t lone = 1 * w + 1, near = 2 * w + 2, far = 0 * w + 3;
   for (size_t p : {near, far}) {
     stats[p].v[c + 1] = 32;
     stats[p].v[c + 2] = 32 * 32;
-    stats[p].v[c + 4] = 4;
+    for (int l = 0; l < kContinueLevels; ++l) stats[p].v[size_t(levels + l)] = std::ldexp(4.0, l);
+    stats[p].v[SampleStats<double>::kContinuedNever + 1] = 1;
   }
   const SampleStats<double> s = with_neighbours_rare(stats, w, h, lone);
   EXPECT_EQ(s.v[c + 3], 9 * 6);
-  EXPECT_EQ(s.v[c + 4], 4);  // the neighbour's, not the far pixel's
-  EXPECT_EQ(s.v[c + 5], 9 * 6 * 4);
+  EXPECT_EQ(s.v[levels + 2], 16);  // the neighbour's, not the far pixel's
+  EXPECT_EQ(s.v[SampleStats<double>::kContinuedNever + 1], 1);
+  EXPECT_EQ(s.v[c + 4], 9 * 6 * 4);
   EXPECT_EQ(s.v[c], 900);
+  EXPECT_EQ(s.v[lit], 900);
   EXPECT_EQ(s.v[0], double(lone));
   // The direct light's variances too (count and sum), not the pixel's own 1 / samples.
   constexpr int d = SampleStats<double>::kDirect;
@@ -1996,10 +2049,11 @@ TEST(Bpm, RareStatisticsCountThePixelsNeighbours) {
   for (size_t corner : {size_t(0), size_t(w - 1), size_t(w * h - w), size_t(w * h - 1)})
     EXPECT_EQ(with_neighbours_rare(stats, w, h, corner).v[c + 3], 4 * 6) << corner;
   EXPECT_EQ(with_neighbours_rare(stats, w, h, 1).v[c + 3], 6 * 6);
-  // Alone the pixel would take the least probability; with its neighbours a larger one.
+  // Alone the pixel would not go on; with its neighbours it does, with q = 1/4: with r = 1,
+  // the rest 1 - 4 / 54 and (rest + 2^l 4 / 54) (4 + 4 / 2^l) least at l = 2.
   const double v = 1;
-  EXPECT_EQ(continue_level(stats[lone], 10, v, 4), kMaxContinueLevel);
-  EXPECT_LT(continue_level(s, 10, v, 4), kMaxContinueLevel);
+  EXPECT_EQ(continue_level(stats[lone], 10, v, 4, 0), kNeverContinue);
+  EXPECT_EQ(continue_level(s, 10, v, 4, 0), 2);
 }
 
 // pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon

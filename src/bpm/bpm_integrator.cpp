@@ -577,8 +577,8 @@ void BpmRender::set_sample_counts() {
     eye_.direct_samples[p] = shared(
         p, direct_sample_count(pooled, n, std::max(0.0, variance), direct, s_.direct_samples));
     if (combined() == CombineAt::kChosen)
-      eye_.continue_level[p] =
-          uint8_t(continue_level(pooled, n, std::max(0.0, variance), cost_sum_.base_rays()));
+      eye_.continue_level[p] = uint8_t(continue_level(
+          pooled, n, std::max(0.0, variance), cost_sum_.base_rays(), eye_.continue_level[p]));
     eye_.lit_share[p] = st.lit_share();
   }
 }
@@ -772,7 +772,8 @@ RenderStats BpmRender::finish(RenderStats stats) {
   tot_.vertex_connections = vertex_connections();
   if (combined() == CombineAt::kChosen) {
     double sum = 0;
-    for (uint8_t level : eye_.continue_level) sum += std::ldexp(1.0, -int(level));
+    for (uint8_t level : eye_.continue_level)
+      sum += level == kNeverContinue ? 0.0 : std::ldexp(1.0, -int(level));
     tot_.continue_probability = n_pixels_ > 0 ? sum / double(n_pixels_) : -1;
   }
   if (s_.radius_policy == RadiusPolicy::kPerPixel && stats.passes > 0) {

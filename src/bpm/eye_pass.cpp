@@ -250,33 +250,53 @@ inline double merge_and_connection(double merge, const Continuation& c, double a
   return c.vertex_scale > 0 && a_x > 0 ? merge * (1 + c.vertex_scale / a_x) : merge;
 }
 
+// A continued path's weight, and the share of its denominator that the merge at x (with the
+// vertex connection) holds (EyeContinuation::found).
+struct ContinuedWeight {
+  double w = 0, merge_share = 0;
+  static ContinuedWeight of(double own, double continued, double others) {
+    const double sum = continued + others;
+    return {own / sum, others / sum};
+  }
+};
+
 // The weight of light found by the BSDF sample that left e_(j-1) (c.prev): the point y of
 // light `li` (normal n; for a light at infinity, a point far along the sample's direction),
 // weighed against next-event estimation there and the merge at x.
-inline double found_light_weight(const RenderScene& scene, const Continuation& c, int li, Vec3 y,
-                                 Vec3 n) {
+inline ContinuedWeight found_light_weight(const RenderScene& scene, const Continuation& c, int li,
+                                          Vec3 y, Vec3 n) {
   const Light& light = scene.lights[size_t(li)];
   const Vec3 d = y - c.prev.p;
   const float len = length(d);
-  if (!(len > 0)) return 0;
+  if (!(len > 0)) return {};
   const double b_bsdf = light_end_density(light, c.pdf_prev, c.prev.p, y, n);
-  if (!(c.pass > 0)) return 0;
+  if (!(c.pass > 0)) return {};
   const double b_light =
       c.prev_traced ? 0.0 : light_sample_density(scene, li, c.prev.p, y, n) / c.pass;
   const double merge = c.ratio * emission_density(scene, li, y, n, -d / len, c.prev);
-  return b_bsdf / (b_bsdf + b_light + merge_and_connection(merge, c, c.a_x));
+  return ContinuedWeight::of(b_bsdf, b_bsdf + b_light, merge_and_connection(merge, c, c.a_x));
+}
+
+// Light Le (before its weight) found by the continuation with the throughput beta: its weighed
+// light, noted for the pixel's choice of q.
+inline Spectrum found_light(const EyePath& path, const Spectrum& beta, const Spectrum& Le,
+                            ContinuedWeight cw) {
+  if (!std::isfinite(cw.w) || !(cw.w > 0)) return {};
+  const Spectrum L = beta * Le * float(cw.w);
+  path.continued.found(L.average(), cw.w, cw.merge_share);
+  return L;
 }
 
 // The environment lights found by the BSDF sample that left e_(j-1) and escaped along dir, weighed
 // as found_light_weight says.
-inline Spectrum found_environment(const RenderScene& scene, const Continuation& c, Vec3 dir,
-                                  const Wavelengths& wl) {
+inline Spectrum found_environment(const EyePath& path, const Continuation& c, Vec3 dir,
+                                  const Spectrum& beta) {
+  const RenderScene& scene = path.scene;
   Spectrum L;
   const Vec3 far = c.prev.p + dir * (2 * scene.bounds_info.radius);
   for (const int li : scene.infinite_lights) {
-    const Spectrum Le = environment_radiance(scene.lights[size_t(li)], dir, wl);
-    const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, far, Vec3());
-    if (std::isfinite(w) && w > 0) L += Le * float(w);
+    const Spectrum Le = environment_radiance(scene.lights[size_t(li)], dir, path.prm.materials->wl);
+    if (!Le.is_black()) L += found_light(path, beta, Le, found_light_weight(scene, c, li, far, {}));
   }
   return L;
 }
@@ -284,9 +304,9 @@ inline Spectrum found_environment(const RenderScene& scene, const Continuation& 
 // The weight of next-event estimation's sample of a light at e_j (`at`), against the BSDF (or
 // phase) sample that could find it (an area or environment light), of density eye_pdf there, and
 // the merge at x, whose photon leaves e_j toward e_(j-1) with the density photon_pdf.
-inline double continued_light_weight(const RenderScene& scene, const Continuation& c,
-                                     const LightSampleAt& sample, const DensityEnd& at,
-                                     double eye_pdf, double photon_pdf) {
+inline ContinuedWeight continued_light_weight(const RenderScene& scene, const Continuation& c,
+                                              const LightSampleAt& sample, const DensityEnd& at,
+                                              double eye_pdf, double photon_pdf) {
   const int li = sample.light;
   const LightLiSample& ls = sample.ls;
   // A delta light: next-event estimation's density and the emission's without their delta, and
@@ -304,18 +324,19 @@ inline double continued_light_weight(const RenderScene& scene, const Continuatio
   const double a_x = c.a_x > 0      ? c.a_x
                      : at.sigma > 0 ? std::numeric_limits<double>::infinity()
                                     : a_prev * c.pass;
-  const double others = merge_and_connection(merge, c, a_x);
-  return b_light / (b_light + b_bsdf + others);
+  return ContinuedWeight::of(b_light, b_light + b_bsdf, merge_and_connection(merge, c, a_x));
 }
 
-// The light of next-event estimation's sample with its weight w, f its BSDF (or phase) times
+// The light of next-event estimation's sample with its weight, f its BSDF (or phase) times
 // transmittance.
 inline Spectrum weighted_light_sample(const EyePath& path, const PathState& s,
-                                      const LightSampleAt& sample, const Spectrum& f, double w) {
-  if (!std::isfinite(w)) return {};
+                                      const LightSampleAt& sample, const Spectrum& f,
+                                      ContinuedWeight cw) {
+  if (!std::isfinite(cw.w)) return {};
   if (sample.pass < 1) ++path.counters.continued_through_media;
-  return s.beta * f * sample.ls.radiance *
-         float(w / (double(sample.pmf) * sample.ls.pdf_solid_angle));
+  return found_light(
+      path, s.beta,
+      f * sample.ls.radiance * float(1 / (double(sample.pmf) * sample.ls.pdf_solid_angle)), cw);
 }
 
 // At e_j (v, on a surface), next-event estimation of a light (continued_light_weight).
@@ -330,7 +351,7 @@ inline Spectrum continued_light_sample(const EyePath& path, const PathVertex& v,
   const float g =
       bsdf_gathered_probability(v.m(), wi_local, v.wo_local, TransportMode::kImportance);
   if (!(g > 0)) return {};
-  const double w = continued_light_weight(
+  const ContinuedWeight w = continued_light_weight(
       scene, c, *sample, c.here, bsdf_pdf(v.m(), v.wo_local, wi_local, TransportMode::kRadiance),
       double(g) * bsdf_pdf(v.m(), wi_local, v.wo_local, TransportMode::kImportance));
   return weighted_light_sample(path, s, *sample, sample->f * g, w);
@@ -346,7 +367,7 @@ inline Spectrum continued_light_sample_in_medium(const EyePath& path, const Path
       sample_light_in_medium(scene, v, g, *path.prm.materials, path.rng, path.counters.rays);
   if (!sample || !(sample->pass > 0)) return {};
   const double phase = henyey_greenstein(dot(-v.wo, sample->ls.wi), g);
-  const double w = continued_light_weight(scene, c, *sample, c.here, phase, phase);
+  const ContinuedWeight w = continued_light_weight(scene, c, *sample, c.here, phase, phase);
   return weighted_light_sample(path, s, *sample, sample->f, w);
 }
 
@@ -446,8 +467,7 @@ inline bool arrive_at(const EyePath& path, const PathVertex& e, StepEnd end, int
   const Wavelengths& wl = path.prm.materials->wl;
   if (c.pass < 1 && (end == StepEnd::kVertex || end == StepEnd::kEscaped))
     ++path.counters.continued_through_media;
-  if (end == StepEnd::kEscaped && c.gathered)
-    L += s.beta * found_environment(scene, c, s.ray.d, wl);
+  if (end == StepEnd::kEscaped && c.gathered) L += found_environment(path, c, s.ray.d, s.beta);
   const bool in_medium = end == StepEnd::kMedium;
   if (end != StepEnd::kVertex && !in_medium) return false;
   c.here = density_end(scene, e, wl);
@@ -462,8 +482,8 @@ inline bool arrive_at(const EyePath& path, const PathVertex& e, StepEnd end, int
   if (c.gathered && li >= 0) {
     const Spectrum Le = area_light_radiance(std::get<AreaLight>(scene.lights[size_t(li)]), e.sp.ng,
                                             e.sp.uv, -s.ray.d, wl);
-    const double w = Le.is_black() ? 0.0 : found_light_weight(scene, c, li, e.sp.p, e.sp.ng);
-    if (std::isfinite(w) && w > 0) L += s.beta * Le * float(w);
+    if (!Le.is_black())
+      L += found_light(path, s.beta, Le, found_light_weight(scene, c, li, e.sp.p, e.sp.ng));
   }
   // Paths of j vertices between the light and x: within the merge's depth.
   if (vertices > path.prm.max_depth || !combinable_vertex(e)) return false;
@@ -557,6 +577,10 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   if (go_on && at != CombineAt::kEverywhere && !bsdf_gathers_glossy(v.m(), choice.part)) {
     go_on = chosen_here = at == CombineAt::kChosen;
     level = path.continue_level;
+    if (chosen_here && level == kNeverContinue) {
+      path.continued.at_vertex = true;  // met, for the share of the iterations that do
+      go_on = false;
+    }
   }
   double merge_density = 0;
   const bool targeted_before = path.targeted;
@@ -574,12 +598,13 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   const double q = std::ldexp(1.0, -level);
   if (level > 0 && !(path.rng.uniform() < q)) return direct_at_last();
   const uint64_t rays = path.counters.rays.total();
+  path.continued.q = q;
   const Spectrum c =
       continue_eye_path(path, v, choice.part, s, depth, merge_density / q, vertex_scale, first);
   continued = true;
   L += c / float(q);
   if (chosen_here)
-    path.continued.add(c.average(), q, path.counters.rays.total() - rays - (first.shared ? 1 : 0));
+    path.continued.add(c.average(), path.counters.rays.total() - rays - (first.shared ? 1 : 0));
   return direct_at_last();
 }
 
@@ -848,39 +873,64 @@ int direct_sample_count(const SampleStats<double>& s, double estimates, double e
 }
 
 int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
-                   double base_rays) {
-  const double n = s.v[SampleStats<double>::kContinued],
-               taken = s.v[SampleStats<double>::kContinued + 3];
-  if (estimates < 2 || n < 2 || taken < 2 || !(base_rays > 0)) return 0;
-  const double x2 = s.v[SampleStats<double>::kContinued + 4] / taken,
-               rays = s.v[SampleStats<double>::kContinued + 5] / taken;
-  if (!(x2 > 0) || !(rays > 0)) return kMaxContinueLevel;
-  // What the continuations added varies by this much of the estimate's variance; the rest, at
-  // least 2% of it.
-  const double v_continued = s.variance(SampleStats<double>::kContinued);
-  const double v_rest = std::max(estimate_variance - v_continued, 0.02 * estimate_variance);
-  if (!(v_rest > 0)) return 0;
-  const double q = std::sqrt(x2 * base_rays / (v_rest * rays));
-  if (!(q < 1)) return 0;
-  return int(std::clamp(std::round(-std::log2(q)), 0.0, double(kMaxContinueLevel)));
+                   double base_rays, int level) {
+  using S = SampleStats<double>;
+  const double met = s.v[S::kContinued], taken = s.v[S::kContinued + 3], iterations = s.v[S::kLit];
+  if (estimates < 2 || met < 2 || taken < 2 || !(base_rays > 0) || !(iterations > 0)) return 0;
+  const double r = std::min(1.0, met / iterations), rays = s.v[S::kContinued + 4] / taken;
+  if (!(rays > 0)) return kMaxContinueLevel;
+  // What the continuations met would add at level l (with the merges' on their paths).
+  const bool never = s.v[S::kContinuedNever + 1] == 0;
+  const auto added = [&](int l) {
+    return r * s.v[size_t(l == kNeverContinue ? S::kContinuedNever : S::kContinuedLevels + l)] /
+           taken;
+  };
+  const double fixed =
+      std::max(estimate_variance - added(level == kNeverContinue && never
+                                             ? kNeverContinue
+                                             : std::clamp(level, 0, kMaxContinueLevel)),
+               0.02 * estimate_variance);
+  int best = 0;
+  double best_product = std::numeric_limits<double>::infinity();
+  const auto consider = [&](int l, double cost) {
+    const double product = (fixed + added(l)) * cost;
+    if (product < best_product) {
+      best = l;
+      best_product = product;
+    }
+  };
+  for (int l = 0; l < kContinueLevels; ++l) consider(l, base_rays + r * std::ldexp(rays, -l));
+  if (never) consider(kNeverContinue, base_rays);
+  return best;
 }
 
 SampleStats<double> with_neighbours_rare(const std::vector<SampleStats<double>>& stats, int width,
                                          int height, size_t p) {
   using S = SampleStats<double>;
-  // The direct variances' count and sum; the continuations' six values.
-  constexpr size_t kPooled[] = {S::kDirect,        S::kDirect + 1,    S::kContinued,
-                                S::kContinued + 1, S::kContinued + 2, S::kContinued + 3,
-                                S::kContinued + 4, S::kContinued + 5};
+  // The direct variances' count and sum, the continuations' values and the iterations they
+  // were met in.
+  constexpr auto pooled = [] {
+    std::array<size_t, 3 + S::kLit - S::kContinued> k{S::kDirect, S::kDirect + 1, S::kLit};
+    for (size_t i = 3; i < k.size(); ++i) k[i] = S::kContinued + i - 3;
+    return k;
+  }();
   S s = stats[p];
-  for (size_t k : kPooled) s.v[k] = 0;
+  for (size_t k : pooled) s.v[k] = 0;
   const int px = int(p % size_t(width)), py = int(p / size_t(width));
   for (int y = std::max(0, py - 1); y <= std::min(height - 1, py + 1); ++y)
     for (int x = std::max(0, px - 1); x <= std::min(width - 1, px + 1); ++x) {
       const S& n = stats[size_t(y) * size_t(width) + size_t(x)];
-      for (size_t k : kPooled) s.v[k] += n.v[k];
+      for (size_t k : pooled) s.v[k] += n.v[k];
     }
   return s;
+}
+
+// The pixel's level of going on in this iteration: kMaxContinueLevel in place of q = 0 in every
+// kContinueExploreEvery-th iteration.
+int continue_level_now(const EyePassParams& prm, const EyePixels* px, uint32_t pixel) {
+  const int level = px->continue_level[pixel];
+  return level == kNeverContinue && prm.iteration % kContinueExploreEvery == 0 ? kMaxContinueLevel
+                                                                               : level;
 }
 
 bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const CameraSampler& camera,
@@ -917,11 +967,11 @@ bool run_eye_pass(const RenderScene& scene, const EyePassParams& prm, const Came
                                                  prm.first_iteration, px->lit_share[pixel])
                                 : DiscScales{};
             // Where the camera's ray scatters in a medium, stratified over the pixel's iterations.
-            EyeRadiance r =
-                trace_eye_path(scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec,
-                               false, prm.near_edges ? prm.near_edges->at(pixel) : 3,
-                               flights ? camera.stream_uniform(pass_index, pixel) : -1.0f,
-                               px->direct_samples[pixel], px->continue_level[pixel], scales);
+            EyeRadiance r = trace_eye_path(
+                scene, prm, cs.camera_ray(), cs.footprint, pixel, cs.rng, lists, ec, false,
+                prm.near_edges ? prm.near_edges->at(pixel) : 3,
+                flights ? camera.stream_uniform(pass_index, pixel) : -1.0f,
+                px->direct_samples[pixel], continue_level_now(prm, px, pixel), scales);
             px->round_stats[pixel].add_direct_variance(r.direct_variance);
             px->round_stats[pixel].add_continuation(r.continued);
             px->filter_weight[pixel] = cs.filter_weight;

@@ -44,8 +44,8 @@ struct EyePassParams {
   // (BpmSettings::radius, times the iteration's radius scale as k0 and k1 are).
   float world_radius = 0;
   // With RadiusPolicy::kPerPixel, the settings whose schedule each pixel follows at its own pace
-  // (DiscScales::of), the iteration's index and that of the render's first; null: the radii above
-  // are the iteration's.
+  // (DiscScales::of), the iteration's index (also for kContinueExploreEvery) and that of the
+  // render's first; null: the radii above are the iteration's.
   const PhotonSettings* pixel_radii = nullptr;
   int iteration = 0, first_iteration = 0;
   // In a scattering medium the radii are never those of a shorter path than this
@@ -114,20 +114,63 @@ struct EyeCounters {
 // Backward photons of one thread, one list per scene object (no locks: each thread has its own).
 using ObjectPhotonLists = std::vector<std::vector<BackwardPhoton>>;
 
-// With CombineAt::kChosen, what the path's continuations from last vertices whose gathered lobes
-// are not glossy brought (each taken with the probability q of EyePixels::continue_level, its
-// light then divided by q): whether it met such a vertex, the sum of what they added, and of those
-// taken their count, the sum of the squares of their light before the division, and their rays.
-// Light as means over the wavelengths.
+// The levels of the probability q = 2^-level of going on from a last vertex whose gathered lobes
+// are not glossy (EyePixels::continue_level; continue_level below says why at least 1/16), and
+// the level of q = 0: the merge alone, as the partition (but in every kContinueExploreEvery-th
+// iteration, where such a pixel takes q = 2^-kMaxContinueLevel, so that it goes on measuring).
+constexpr int kMaxContinueLevel = 4;
+constexpr int kContinueLevels = kMaxContinueLevel + 1;
+constexpr int kNeverContinue = 7;
+constexpr int kContinueExploreEvery = 8;
+
+// With CombineAt::kChosen, what the path's continuation from a last vertex whose gathered lobes
+// are not glossy brought (taken with the probability q of EyePixels::continue_level, its light
+// then divided by q): whether it met such a vertex, what it added, and if taken its rays and, for
+// each level l, what it would add to the pixel's variance with q_l = 2^-l: its light X_l as the
+// weights give it at q_l (each light found, of light y before the merge's part of its weight and
+// a = the merge's density over the continuation's at q = 1, counts y q_l / (q_l + a)) squared
+// over q_l, plus the merges' variance on the same paths, y^2 a / (q_l + a)^2 per light found (the
+// balance heuristic's variance of one sample of each, the merge's density a times the
+// continuation's); and with q = 0, the merges' alone, y^2 / a, which only lights the merge could
+// find (a > 0) allow: `unmergeable` counts the others. Light as means over the wavelengths.
 struct EyeContinuation {
   bool at_vertex = false;
-  double sum = 0, taken = 0, squares = 0, rays = 0;
-  void add(double x, double q, uint64_t continuation_rays) {
-    if (!std::isfinite(x)) return;
-    sum += x / q;
-    taken += 1;
-    squares += x * x;
-    rays += double(continuation_rays);
+  double sum = 0, taken = 0, rays = 0, merges_alone = 0, unmergeable = 0;
+  std::array<double, kContinueLevels> variance_at{};
+  // Of the continuation under way (taken with the probability q): X_l and the merges' variance.
+  double q = 1, merges_alone_now = 0, unmergeable_now = 0;
+  std::array<double, kContinueLevels> light_at{}, merges_at{};
+  // A light found with the weight w, of whose denominator the merge (with the vertex connection)
+  // holds the share `merge_share`.
+  void found(double light, double w, double merge_share) {
+    if (!std::isfinite(light) || light == 0 || !(w > 0) || !(merge_share < 1)) return;
+    const double y = light / (1 - merge_share), a = q * merge_share / (1 - merge_share);
+    if (a > 0)
+      merges_alone_now += y * y / a;
+    else
+      unmergeable_now += 1;
+    for (int l = 0; l < kContinueLevels; ++l) {
+      const double ql = std::ldexp(1.0, -l);
+      light_at[size_t(l)] += y * ql / (ql + a);
+      merges_at[size_t(l)] += y * y * a / ((ql + a) * (ql + a));
+    }
+  }
+  // The continuation under way ended having added x (before the division by q).
+  void add(double x, uint64_t continuation_rays) {
+    if (std::isfinite(x)) {
+      sum += x / q;
+      taken += 1;
+      rays += double(continuation_rays);
+      for (int l = 0; l < kContinueLevels; ++l) {
+        const double ql = std::ldexp(1.0, -l);
+        variance_at[size_t(l)] +=
+            light_at[size_t(l)] * light_at[size_t(l)] / ql + merges_at[size_t(l)];
+      }
+      merges_alone += merges_alone_now;
+      unmergeable += unmergeable_now;
+    }
+    light_at = merges_at = {};
+    merges_alone_now = unmergeable_now = 0;
   }
 };
 
@@ -187,19 +230,23 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params
 // how many of its iterations its discs received photons, for its radii (DiscScales).
 template <class T>
 struct SampleStats {
-  static constexpr int kValues = 18;
+  static constexpr int kValues = 14 + kContinueLevels + 2 + 3;
   // Where each group starts in v: count, sum and sum of squares for the first two; then the sum
   // of 1 / direct samples over the estimates, and the count and sum of direct variances; then the
   // iterations whose path met a vertex where the continuation is chosen, the sum and squares of
-  // what the continuations added there, and of those taken the count, squares and rays; then the
-  // iterations accumulated, and those in which a small disc, and another disc, received photons.
+  // what the continuations added there, and of those taken the count, rays, the variance they
+  // would add at each level and with q = 0, and the lights only they find (EyeContinuation); then
+  // the iterations accumulated, and those in which a small disc, and another disc, received
+  // photons.
   enum : int {
     kEmission = 0,
     kRest = 3,
     kInverseSamples = 6,
     kDirect = 7,
     kContinued = 9,
-    kLit = 15
+    kContinuedLevels = 14,
+    kContinuedNever = 14 + kContinueLevels,
+    kLit = 14 + kContinueLevels + 2
   };
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
@@ -215,8 +262,11 @@ struct SampleStats {
     if (!c.at_vertex) return;
     add(kContinued, c.sum);
     v[kContinued + 3] += T(c.taken);
-    v[kContinued + 4] += T(c.squares);
-    v[kContinued + 5] += T(c.rays);
+    v[kContinued + 4] += T(c.rays);
+    for (int l = 0; l < kContinueLevels; ++l)
+      v[kContinuedLevels + l] += T(c.variance_at[size_t(l)]);
+    v[kContinuedNever] += T(c.merges_alone);
+    v[kContinuedNever + 1] += T(c.unmergeable);
   }
   void add_lit(bool small, bool large) {
     v[kLit] += 1;
@@ -289,27 +339,31 @@ int direct_sample_count(const SampleStats<double>& s, double estimates, double e
                         double cost_ratio, int max_samples);
 
 // The probability q = 2^-level with which the pixel's eye paths go on from last vertices whose
-// gathered lobes are not glossy (CombineAt::kChosen), by the same balance: taken with the
-// probability q, a continuation adds E[X^2] / q - E[X]^2 to the pixel's variance per iteration
-// (X its light) and q c to its cost (c its rays), so that (V_rest + E[X^2] / q) (C + q c) is
-// least at q = sqrt(E[X^2] C / (V_rest c)); V_rest is the rest of the estimate's variance, C an
-// iteration's rays per pixel (`base_rays`, the light pass's included). Within [2^-kMaxLevel, 1]:
-// 1 until two continuations and two estimates are known. At least 1/16: once a round (a quarter of
-// the iterations before it) has 16 iterations, a pixel still takes a continuation about once a
-// round, and what it measures keeps up with the radii as they shrink.
-constexpr int kMaxContinueLevel = 4;
+// gathered lobes are not glossy (CombineAt::kChosen), by the same balance: the level l whose
+// (V_fixed + r V_l) (C + r q_l c) is least, where r is the share of the iterations that met such
+// a vertex, V_l the variance a continuation met would add with q_l (with the merges' on its paths,
+// which the weights hand back to them as q falls: EyeContinuation), c its rays, C an iteration's
+// rays per pixel (`base_rays`, the light pass's included) and V_fixed the rest of the estimate's
+// variance (its variance less r V at the pixel's level now, `level`; at least 2% of it). Levels
+// 0 to kMaxContinueLevel, or kNeverContinue (q = 0, cost C) where no continuation measured found
+// light that the merge cannot find. 1 until two continuations and two estimates are known. At
+// least 1/16 but for q = 0: once a round (a quarter of the iterations before it) has 16
+// iterations, a pixel still takes a continuation about once a round, and what it measures keeps
+// up with the radii as they shrink. Where q = 0 wins in every pixel, no backward photon is
+// combined and the photons carry no densities: the partition's cost.
 int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
-                   double base_rays);
+                   double base_rays, int level);
 
 // Pixel p's statistics (of a width x height image) with those of its direct light's variance and
-// of its continuations summed over it and its eight neighbours, for direct_sample_count and
-// continue_level; the rest its own. What these measure is often rare: the light a continuation
-// finds (a wall that BSDF samples from an open floor seldom reach), a shadow's edge that one of a
-// pixel's direct samples crosses now and then. A pixel's own few samples tend to miss it, so that
-// its figure reads too small, and the rule then gives it fewer samples still (one direct sample
-// measures no variance at all). Its neighbours see nearly the same scene around them: nine pixels'
-// samples (six at an edge, four at a corner) estimate it from that many times as many. Pooled are
-// the sums themselves, so that a pooled variance also holds the spread between the pixels' means.
+// of its continuations (with the iterations counted) summed over it and its eight neighbours, for
+// direct_sample_count and continue_level; the rest its own. What these measure is often rare: the
+// light a continuation finds (a wall that BSDF samples from an open floor seldom reach), a shadow's
+// edge that one of a pixel's direct samples crosses now and then. A pixel's own few samples tend to
+// miss it, so that its figure reads too small, and the rule then gives it fewer samples still (one
+// direct sample measures no variance at all). Its neighbours see nearly the same scene around them:
+// nine pixels' samples (six at an edge, four at a corner) estimate it from that many times as many.
+// Pooled are the sums themselves, so that a pooled variance also holds the spread between the
+// pixels' means.
 SampleStats<double> with_neighbours_rare(const std::vector<SampleStats<double>>& stats, int width,
                                          int height, size_t p);
 
