@@ -1925,81 +1925,88 @@ TEST(Bpm, DirectSampleCountBalancesVarianceAndCost) {
 
 // What a continuation notes for the pixel's choice of q: a light v found with the weight share
 // 1 - phi left to it by the merge, at the probability q, stands for y = v / (1 - phi) with the
-// merge's density a = q phi / (1 - phi) times the continuation's; at each level q_l the
-// continuation's variance and the merges' on the same path sum to the balance heuristic's
+// merge's density a = q phi / (1 - phi) times the continuation's; at each level q_l the second
+// moments of the continuation and of the merges on the same path sum to the balance heuristic's
 // y^2 / (q_l + a), and to y^2 / a with q = 0. A light the merge cannot find (phi = 0) forbids
-// q = 0.
-TEST(Bpm, ContinuationNotesItsVarianceAtEveryLevel) {
+// q = 0. What a continuation noted that is not the pixel's to count (start without add) is gone.
+TEST(Bpm, ContinuationNotesItsSecondMomentAtEveryLevel) {
   EyeContinuation c;
-  c.q = 0.25;
+  c.start(1);
+  c.found(7, 0.5, 0.5);  // a continuation not taken by chance (a glossy vertex): not added
+  c.start(0.25);
   c.found(0.3, 0.6, 0.4);
-  c.add(0.3, 12);
+  c.add(12);
   const double y = 0.3 / 0.6, a = 0.25 * 0.4 / 0.6;
   for (int l = 0; l < kContinueLevels; ++l)
-    EXPECT_NEAR(c.variance_at[size_t(l)], y * y / (std::ldexp(1.0, -l) + a), 1e-12) << l;
+    EXPECT_NEAR(c.moment_at[size_t(l)], y * y / (std::ldexp(1.0, -l) + a), 1e-12) << l;
+  EXPECT_NEAR(c.moment_now, y * y / (0.25 + a), 1e-12);
   EXPECT_NEAR(c.merges_alone, y * y / a, 1e-12);
   EXPECT_EQ(c.unmergeable, 0);
   EXPECT_EQ(c.taken, 1);
   EXPECT_EQ(c.rays, 12);
-  EXPECT_NEAR(c.sum, 0.3 / 0.25, 1e-12);
   // A second path: a light only the continuation finds, y^2 / q_l; the one before kept.
-  c.q = 1;
+  c.start(1);
   c.found(0.5, 1, 0);
-  c.add(0.5, 3);
-  EXPECT_NEAR(c.variance_at[2], y * y / (0.25 + a) + 0.25 / 0.25, 1e-12);
+  c.add(3);
+  EXPECT_NEAR(c.moment_at[2], y * y / (0.25 + a) + 0.25 / 0.25, 1e-12);
+  EXPECT_NEAR(c.moment_now, y * y / (0.25 + a) + 0.25, 1e-12);
   EXPECT_EQ(c.unmergeable, 1);
   EXPECT_NEAR(c.merges_alone, y * y / a, 1e-12);
 }
 
 // A pixel's probability of going on from a last vertex that is not glossy minimises its variance
-// times its cost over the levels q = 2^-l, l in [0, 4], and q = 0 where allowed; 1 until two
-// continuations and two estimates are known.
+// times its cost over the levels q = 2^-l, l in [0, 4], and q = 0 where allowed; of equal
+// products the cheaper; 1 until two continuations and two estimates are known.
 TEST(Bpm, ContinueLevelBalancesVarianceAndCost) {
   using S = SampleStats<double>;
   // Ten iterations, all of which met such a vertex; five continuations taken, `rays` rays each,
-  // that would add v_l at level l in all (per continuation) and v_never with q = 0, and found
-  // `unmergeable` lights the merge cannot find.
-  auto stats = [](std::array<double, kContinueLevels> v, double v_never, double unmergeable,
-                  double rays) {
+  // that added the second moment `now` each and would add m_l at level l and m_never with q = 0,
+  // and found `unmergeable` lights the merge cannot find.
+  auto stats = [](std::array<double, kContinueLevels> m, double now, double m_never,
+                  double unmergeable, double rays) {
     S s;
     s.v[S::kContinued] = 10;
-    s.v[S::kContinued + 3] = 5;
-    s.v[S::kContinued + 4] = 5 * rays;
+    s.v[S::kContinued + 1] = 5;
+    s.v[S::kContinued + 2] = 5 * rays;
+    s.v[S::kContinued + 3] = 5 * now;
     for (int l = 0; l < kContinueLevels; ++l)
-      s.v[size_t(S::kContinuedLevels + l)] = 5 * v[size_t(l)];
-    s.v[S::kContinuedNever] = 5 * v_never;
+      s.v[size_t(S::kContinuedLevels + l)] = 5 * m[size_t(l)];
+    s.v[S::kContinuedNever] = 5 * m_never;
     s.v[S::kContinuedNever + 1] = unmergeable;
     s.v[S::kLit] = 10;
     return s;
   };
-  // Light only the continuation finds, E[y^2] = 1: v_l = 2^l. With the pixel at level 0 the
+  // Light only the continuation finds, E[y^2] = 1: m_l = 2^l. Taken at q = 1 (now = 1), the
   // estimate's variance 17 leaves 16 to the rest; C = 100 rays per iteration, c = 100 per
   // continuation: (16 + 2^l) (100 + 100 / 2^l) is least at l = 2 (2500 against 2700 at 1 and 3).
   const std::array<double, kContinueLevels> alone = {1, 2, 4, 8, 16};
-  const S s = stats(alone, 0, 1, 100);
-  EXPECT_EQ(continue_level(s, 10, 17, 100, 0), 2);
+  EXPECT_EQ(continue_level(stats(alone, 1, 0, 1, 100), 10, 17, 100), 2);
+  // Taken at 1/4, the same estimate leaves 13 ((13 + 4) 125 = 2125 least: l = 2 still); taken at
+  // 1/16, only 1 ((1 + 1) 200 = 400 least: l = 0).
+  EXPECT_EQ(continue_level(stats(alone, 4, 0, 1, 100), 10, 17, 100), 2);
+  EXPECT_EQ(continue_level(stats(alone, 16, 0, 1, 100), 10, 17, 100), 0);
   // Costly continuations: the least probability; cheap ones: 1.
-  EXPECT_EQ(continue_level(stats(alone, 0, 1, 1e6), 10, 17, 100, 0), kMaxContinueLevel);
-  EXPECT_EQ(continue_level(stats(alone, 0, 1, 1), 10, 17, 100, 0), 0);
-  // Where the merges would take the weight at no loss (the variance the same at every level and
+  EXPECT_EQ(continue_level(stats(alone, 1, 0, 1, 1e6), 10, 17, 100), kMaxContinueLevel);
+  EXPECT_EQ(continue_level(stats(alone, 1, 0, 1, 1), 10, 17, 100), 0);
+  // Where the merges would take the weight at no loss (the same second moment at every level and
   // with q = 0), q = 0; unless a light was found that only the continuation finds.
   const std::array<double, kContinueLevels> flat = {0.5, 0.5, 0.5, 0.5, 0.5};
-  EXPECT_EQ(continue_level(stats(flat, 0.5, 0, 100), 10, 17, 100, 0), kNeverContinue);
-  EXPECT_EQ(continue_level(stats(flat, 0.5, 1, 100), 10, 17, 100, 0), kMaxContinueLevel);
+  EXPECT_EQ(continue_level(stats(flat, 0.5, 0.5, 0, 100), 10, 17, 100), kNeverContinue);
+  EXPECT_EQ(continue_level(stats(flat, 0.5, 0.5, 1, 100), 10, 17, 100), kMaxContinueLevel);
+  // A dark pixel whose continuations found nothing: q = 0, or the least probability.
+  const std::array<double, kContinueLevels> none = {};
+  EXPECT_EQ(continue_level(stats(none, 0, 0, 0, 100), 10, 0, 100), kNeverContinue);
+  EXPECT_EQ(continue_level(stats(none, 0, 0, 1, 100), 10, 0, 100), kMaxContinueLevel);
   // Merges much noisier than the continuation on its paths: q = 1, not q = 0.
-  EXPECT_EQ(continue_level(stats({1, 1.5, 2, 2.5, 3}, 50, 0, 1), 10, 17, 100, 0), 0);
-  // The rest of the variance is the estimate's less what the continuations add at the pixel's
-  // level now: at level 2 the same estimate leaves 13 ((13 + 4) 125 = 2125 least: l = 2 still),
-  // at level 4 only 1 ((1 + 1) 200 = 400 least: l = 0).
-  EXPECT_EQ(continue_level(s, 10, 17, 100, 2), 2);
-  EXPECT_EQ(continue_level(s, 10, 17, 100, 4), 0);
+  EXPECT_EQ(continue_level(stats({1, 1.5, 2, 2.5, 3}, 1, 50, 0, 1), 10, 17, 100), 0);
   // Not yet known: one continuation, one estimate, no cost.
+  const S s = stats(alone, 1, 0, 1, 100);
   S one = s;
-  one.v[S::kContinued + 3] = 1;
-  EXPECT_EQ(continue_level(one, 10, 17, 100, 0), 0);
-  EXPECT_EQ(continue_level(s, 1, 17, 100, 0), 0);
-  EXPECT_EQ(continue_level(s, 10, 17, 0, 0), 0);
-  EXPECT_EQ(continue_level(S{}, 10, 17, 100, 0), 0);
+  one.v[S::kContinued + 1] = 1;
+  EXPECT_EQ(continue_level(one, 10, 17, 100), 0);
+  EXPECT_EQ(continue_level(s, 1, 17, 100), 0);
+  EXPECT_EQ(continue_level(s, 10, 17, 0), 0);
+  EXPECT_EQ(continue_level(S{}, 10, 17, 100), 0);
 }
 
 // A pixel whose own few continuations found nothing borrows its neighbours' (the rare light they
@@ -2013,26 +2020,26 @@ TEST(Bpm, RareStatisticsCountThePixelsNeighbours) {
   constexpr int lit = SampleStats<double>::kLit;
   for (size_t p = 0; p < stats.size(); ++p) {
     stats[p].v[c] = 100;
-    stats[p].v[c + 3] = 6;      // continuations taken
-    stats[p].v[c + 4] = 6 * 4;  // 4 rays each
+    stats[p].v[c + 1] = 6;      // continuations taken
+    stats[p].v[c + 2] = 6 * 4;  // 4 rays each
     stats[p].v[lit] = 100;      // iterations
     stats[p].v[0] = double(p);  // another statistic, kept per pixel
   }
   // Pixel (1, 1) found no light; one neighbour (2, 2) found some, another pixel far off (3, 0)
-  // too. Sums of X / q and of X^2: one continuation of light 2 at q = 1/16, which the merge
-  // cannot find: 4 / q_l at level l.
+  // too: one continuation of light 2 at q = 1/16, which the merge cannot find: the second
+  // moment 4 / q_l at level l, 64 at its own.
   const size_t lone = 1 * w + 1, near = 2 * w + 2, far = 0 * w + 3;
   for (size_t p : {near, far}) {
-    stats[p].v[c + 1] = 32;
-    stats[p].v[c + 2] = 32 * 32;
+    stats[p].v[c + 3] = 64;
     for (int l = 0; l < kContinueLevels; ++l) stats[p].v[size_t(levels + l)] = std::ldexp(4.0, l);
     stats[p].v[SampleStats<double>::kContinuedNever + 1] = 1;
   }
   const SampleStats<double> s = with_neighbours_rare(stats, w, h, lone);
-  EXPECT_EQ(s.v[c + 3], 9 * 6);
+  EXPECT_EQ(s.v[c + 1], 9 * 6);
   EXPECT_EQ(s.v[levels + 2], 16);  // the neighbour's, not the far pixel's
+  EXPECT_EQ(s.v[c + 3], 64);
   EXPECT_EQ(s.v[SampleStats<double>::kContinuedNever + 1], 1);
-  EXPECT_EQ(s.v[c + 4], 9 * 6 * 4);
+  EXPECT_EQ(s.v[c + 2], 9 * 6 * 4);
   EXPECT_EQ(s.v[c], 900);
   EXPECT_EQ(s.v[lit], 900);
   EXPECT_EQ(s.v[0], double(lone));
@@ -2047,13 +2054,13 @@ TEST(Bpm, RareStatisticsCountThePixelsNeighbours) {
   EXPECT_EQ(sd.v[SampleStats<double>::kInverseSamples], 0);
   // At the image's corners, four pixels; at an edge, six.
   for (size_t corner : {size_t(0), size_t(w - 1), size_t(w * h - w), size_t(w * h - 1)})
-    EXPECT_EQ(with_neighbours_rare(stats, w, h, corner).v[c + 3], 4 * 6) << corner;
-  EXPECT_EQ(with_neighbours_rare(stats, w, h, 1).v[c + 3], 6 * 6);
-  // Alone the pixel would not go on; with its neighbours it does, with q = 1/4: with r = 1,
-  // the rest 1 - 4 / 54 and (rest + 2^l 4 / 54) (4 + 4 / 2^l) least at l = 2.
+    EXPECT_EQ(with_neighbours_rare(stats, w, h, corner).v[c + 1], 4 * 6) << corner;
+  EXPECT_EQ(with_neighbours_rare(stats, w, h, 1).v[c + 1], 6 * 6);
+  // Alone the pixel would not go on; with its neighbours it does: with r = 1 the rest is the 2%
+  // floor (1 - 64 / 54 < 0), and (0.02 + 2^l 4 / 54) (4 + 4 / 2^l) is least at l = 0.
   const double v = 1;
-  EXPECT_EQ(continue_level(stats[lone], 10, v, 4, 0), kNeverContinue);
-  EXPECT_EQ(continue_level(s, 10, v, 4, 0), 2);
+  EXPECT_EQ(continue_level(stats[lone], 10, v, 4), kNeverContinue);
+  EXPECT_EQ(continue_level(s, 10, v, 4), 0);
 }
 
 // pbrt-v4's sppm line gives bpm at diffuse depth 0 with sppm's world-space radius and photon

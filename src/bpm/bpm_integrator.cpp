@@ -577,8 +577,8 @@ void BpmRender::set_sample_counts() {
     eye_.direct_samples[p] = shared(
         p, direct_sample_count(pooled, n, std::max(0.0, variance), direct, s_.direct_samples));
     if (combined() == CombineAt::kChosen)
-      eye_.continue_level[p] = uint8_t(continue_level(
-          pooled, n, std::max(0.0, variance), cost_sum_.base_rays(), eye_.continue_level[p]));
+      eye_.continue_level[p] =
+          uint8_t(continue_level(pooled, n, std::max(0.0, variance), cost_sum_.base_rays()));
     eye_.lit_share[p] = st.lit_share();
   }
 }

@@ -598,13 +598,12 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   const double q = std::ldexp(1.0, -level);
   if (level > 0 && !(path.rng.uniform() < q)) return direct_at_last();
   const uint64_t rays = path.counters.rays.total();
-  path.continued.q = q;
+  path.continued.start(q);
   const Spectrum c =
       continue_eye_path(path, v, choice.part, s, depth, merge_density / q, vertex_scale, first);
   continued = true;
   L += c / float(q);
-  if (chosen_here)
-    path.continued.add(c.average(), path.counters.rays.total() - rays - (first.shared ? 1 : 0));
+  if (chosen_here) path.continued.add(path.counters.rays.total() - rays - (first.shared ? 1 : 0));
   return direct_at_last();
 }
 
@@ -873,11 +872,11 @@ int direct_sample_count(const SampleStats<double>& s, double estimates, double e
 }
 
 int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
-                   double base_rays, int level) {
+                   double base_rays) {
   using S = SampleStats<double>;
-  const double met = s.v[S::kContinued], taken = s.v[S::kContinued + 3], iterations = s.v[S::kLit];
+  const double met = s.v[S::kContinued], taken = s.v[S::kContinued + 1], iterations = s.v[S::kLit];
   if (estimates < 2 || met < 2 || taken < 2 || !(base_rays > 0) || !(iterations > 0)) return 0;
-  const double r = std::min(1.0, met / iterations), rays = s.v[S::kContinued + 4] / taken;
+  const double r = std::min(1.0, met / iterations), rays = s.v[S::kContinued + 2] / taken;
   if (!(rays > 0)) return kMaxContinueLevel;
   // What the continuations met would add at level l (with the merges' on their paths).
   const bool never = s.v[S::kContinuedNever + 1] == 0;
@@ -886,10 +885,8 @@ int continue_level(const SampleStats<double>& s, double estimates, double estima
            taken;
   };
   const double fixed =
-      std::max(estimate_variance - added(level == kNeverContinue && never
-                                             ? kNeverContinue
-                                             : std::clamp(level, 0, kMaxContinueLevel)),
-               0.02 * estimate_variance);
+      std::max(estimate_variance - r * s.v[S::kContinued + 3] / taken, 0.02 * estimate_variance);
+  // From the cheapest up, so that of equal products the cheaper stays.
   int best = 0;
   double best_product = std::numeric_limits<double>::infinity();
   const auto consider = [&](int l, double cost) {
@@ -899,8 +896,8 @@ int continue_level(const SampleStats<double>& s, double estimates, double estima
       best_product = product;
     }
   };
-  for (int l = 0; l < kContinueLevels; ++l) consider(l, base_rays + r * std::ldexp(rays, -l));
   if (never) consider(kNeverContinue, base_rays);
+  for (int l = kMaxContinueLevel; l >= 0; --l) consider(l, base_rays + r * std::ldexp(rays, -l));
   return best;
 }
 

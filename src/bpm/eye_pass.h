@@ -125,21 +125,28 @@ constexpr int kContinueExploreEvery = 8;
 
 // With CombineAt::kChosen, what the path's continuation from a last vertex whose gathered lobes
 // are not glossy brought (taken with the probability q of EyePixels::continue_level, its light
-// then divided by q): whether it met such a vertex, what it added, and if taken its rays and, for
-// each level l, what it would add to the pixel's variance with q_l = 2^-l: its light X_l as the
+// then divided by q): whether it met such a vertex, and if taken its rays and, for each level l,
+// the second moment it would add to the pixel's estimate with q_l = 2^-l: its light X_l as the
 // weights give it at q_l (each light found, of light y before the merge's part of its weight and
 // a = the merge's density over the continuation's at q = 1, counts y q_l / (q_l + a)) squared
-// over q_l, plus the merges' variance on the same paths, y^2 a / (q_l + a)^2 per light found (the
-// balance heuristic's variance of one sample of each, the merge's density a times the
-// continuation's); and with q = 0, the merges' alone, y^2 / a, which only lights the merge could
-// find (a > 0) allow: `unmergeable` counts the others. Light as means over the wavelengths.
+// over q_l, plus the merges' on the same paths, y^2 a / (q_l + a)^2 per light found (the balance
+// heuristic's second moments of one sample of each, the merge's density a times the
+// continuation's); the same at its own q (`moment_now`); and with q = 0, the merges' alone,
+// y^2 / a, which only lights the merge could find (a > 0) allow: `unmergeable` counts the others.
+// Light as means over the wavelengths.
 struct EyeContinuation {
   bool at_vertex = false;
-  double sum = 0, taken = 0, rays = 0, merges_alone = 0, unmergeable = 0;
-  std::array<double, kContinueLevels> variance_at{};
-  // Of the continuation under way (taken with the probability q): X_l and the merges' variance.
-  double q = 1, merges_alone_now = 0, unmergeable_now = 0;
+  double taken = 0, rays = 0, moment_now = 0, merges_alone = 0, unmergeable = 0;
+  std::array<double, kContinueLevels> moment_at{};
+  // Of the continuation under way (taken with the probability q; `start` clears them): X_l, the
+  // merges' second moments, and the same at q.
+  double q = 1, light_now = 0, merges_now = 0, merges_alone_now = 0, unmergeable_now = 0;
   std::array<double, kContinueLevels> light_at{}, merges_at{};
+  void start(double probability) {
+    q = probability;
+    light_at = merges_at = {};
+    light_now = merges_now = merges_alone_now = unmergeable_now = 0;
+  }
   // A light found with the weight w, of whose denominator the merge (with the vertex connection)
   // holds the share `merge_share`.
   void found(double light, double w, double merge_share) {
@@ -149,28 +156,25 @@ struct EyeContinuation {
       merges_alone_now += y * y / a;
     else
       unmergeable_now += 1;
+    light_now += light;
+    merges_now += y * y * a / ((q + a) * (q + a));
     for (int l = 0; l < kContinueLevels; ++l) {
       const double ql = std::ldexp(1.0, -l);
       light_at[size_t(l)] += y * ql / (ql + a);
       merges_at[size_t(l)] += y * y * a / ((ql + a) * (ql + a));
     }
   }
-  // The continuation under way ended having added x (before the division by q).
-  void add(double x, uint64_t continuation_rays) {
-    if (std::isfinite(x)) {
-      sum += x / q;
-      taken += 1;
-      rays += double(continuation_rays);
-      for (int l = 0; l < kContinueLevels; ++l) {
-        const double ql = std::ldexp(1.0, -l);
-        variance_at[size_t(l)] +=
-            light_at[size_t(l)] * light_at[size_t(l)] / ql + merges_at[size_t(l)];
-      }
-      merges_alone += merges_alone_now;
-      unmergeable += unmergeable_now;
+  // The continuation under way ended, having cast `continuation_rays`.
+  void add(uint64_t continuation_rays) {
+    taken += 1;
+    rays += double(continuation_rays);
+    for (int l = 0; l < kContinueLevels; ++l) {
+      const double ql = std::ldexp(1.0, -l);
+      moment_at[size_t(l)] += light_at[size_t(l)] * light_at[size_t(l)] / ql + merges_at[size_t(l)];
     }
-    light_at = merges_at = {};
-    merges_alone_now = unmergeable_now = 0;
+    moment_now += light_now * light_now / q + merges_now;
+    merges_alone += merges_alone_now;
+    unmergeable += unmergeable_now;
   }
 };
 
@@ -214,7 +218,8 @@ struct DiscScales {
 // (PathState::flight_u). direct_samples: the samples of direct light at the last diffuse vertex
 // of a surface, at most params.direct_samples. continue_level: with CombineAt::kChosen, the path
 // goes on from a last vertex whose gathered lobes are not glossy with the probability
-// 2^-continue_level (EyeRadiance::continued). scales: the pixel's DiscScales.
+// 2^-continue_level, never at kNeverContinue (EyeRadiance::continued). scales: the pixel's
+// DiscScales.
 EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params, CameraRay ray,
                            PixelFootprint footprint, uint32_t pixel, Rng& rng,
                            ObjectPhotonLists& out, EyeCounters& counters,
@@ -230,23 +235,22 @@ EyeRadiance trace_eye_path(const RenderScene& scene, const EyePassParams& params
 // how many of its iterations its discs received photons, for its radii (DiscScales).
 template <class T>
 struct SampleStats {
-  static constexpr int kValues = 14 + kContinueLevels + 2 + 3;
+  static constexpr int kValues = 13 + kContinueLevels + 2 + 3;
   // Where each group starts in v: count, sum and sum of squares for the first two; then the sum
   // of 1 / direct samples over the estimates, and the count and sum of direct variances; then the
-  // iterations whose path met a vertex where the continuation is chosen, the sum and squares of
-  // what the continuations added there, and of those taken the count, rays, the variance they
-  // would add at each level and with q = 0, and the lights only they find (EyeContinuation); then
-  // the iterations accumulated, and those in which a small disc, and another disc, received
-  // photons.
+  // iterations whose path met a vertex where the continuation is chosen, and of the continuations
+  // taken the count, rays, the second moments they added and would add at each level and with
+  // q = 0, and the lights only they find (EyeContinuation); then the iterations accumulated, and
+  // those in which a small disc, and another disc, received photons.
   enum : int {
     kEmission = 0,
     kRest = 3,
     kInverseSamples = 6,
     kDirect = 7,
     kContinued = 9,
-    kContinuedLevels = 14,
-    kContinuedNever = 14 + kContinueLevels,
-    kLit = 14 + kContinueLevels + 2
+    kContinuedLevels = 13,
+    kContinuedNever = 13 + kContinueLevels,
+    kLit = 13 + kContinueLevels + 2
   };
   std::array<T, kValues> v{};
   // Non-finite values (numerical accidents) are left out.
@@ -260,11 +264,11 @@ struct SampleStats {
   }
   void add_continuation(const EyeContinuation& c) {
     if (!c.at_vertex) return;
-    add(kContinued, c.sum);
-    v[kContinued + 3] += T(c.taken);
-    v[kContinued + 4] += T(c.rays);
-    for (int l = 0; l < kContinueLevels; ++l)
-      v[kContinuedLevels + l] += T(c.variance_at[size_t(l)]);
+    v[kContinued] += 1;
+    v[kContinued + 1] += T(c.taken);
+    v[kContinued + 2] += T(c.rays);
+    v[kContinued + 3] += T(c.moment_now);
+    for (int l = 0; l < kContinueLevels; ++l) v[kContinuedLevels + l] += T(c.moment_at[size_t(l)]);
     v[kContinuedNever] += T(c.merges_alone);
     v[kContinuedNever + 1] += T(c.unmergeable);
   }
@@ -341,18 +345,19 @@ int direct_sample_count(const SampleStats<double>& s, double estimates, double e
 // The probability q = 2^-level with which the pixel's eye paths go on from last vertices whose
 // gathered lobes are not glossy (CombineAt::kChosen), by the same balance: the level l whose
 // (V_fixed + r V_l) (C + r q_l c) is least, where r is the share of the iterations that met such
-// a vertex, V_l the variance a continuation met would add with q_l (with the merges' on its paths,
-// which the weights hand back to them as q falls: EyeContinuation), c its rays, C an iteration's
-// rays per pixel (`base_rays`, the light pass's included) and V_fixed the rest of the estimate's
-// variance (its variance less r V at the pixel's level now, `level`; at least 2% of it). Levels
-// 0 to kMaxContinueLevel, or kNeverContinue (q = 0, cost C) where no continuation measured found
-// light that the merge cannot find. 1 until two continuations and two estimates are known. At
+// a vertex, V_l the second moment a continuation met would add with q_l (with the merges' on its
+// paths, which the weights hand back to them as q falls: EyeContinuation), c its rays, C an
+// iteration's rays per pixel (`base_rays`, the light pass's included) and V_fixed the rest of the
+// estimate's variance (its variance less r times the second moment the continuations added at the
+// probabilities they were taken with; at least 2% of it). Levels 0 to kMaxContinueLevel, or
+// kNeverContinue (q = 0, cost C) where no continuation measured found light that the merge cannot
+// find; of equal products the cheaper. 1 until two continuations and two estimates are known. At
 // least 1/16 but for q = 0: once a round (a quarter of the iterations before it) has 16
 // iterations, a pixel still takes a continuation about once a round, and what it measures keeps
 // up with the radii as they shrink. Where q = 0 wins in every pixel, no backward photon is
 // combined and the photons carry no densities: the partition's cost.
 int continue_level(const SampleStats<double>& s, double estimates, double estimate_variance,
-                   double base_rays, int level);
+                   double base_rays);
 
 // Pixel p's statistics (of a width x height image) with those of its direct light's variance and
 // of its continuations (with the iterations counted) summed over it and its eight neighbours, for

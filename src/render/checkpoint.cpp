@@ -14,8 +14,9 @@ namespace {
 constexpr char kMagic[8] = {'B', 'P', 'M', 'C', 'K', 'P', 'T', '\n'};
 // 2: bpm keeps emission statistics per pixel; 3: the film keeps the luminance and the sensors;
 // 4: and the sensors' bias estimates; 7: bpm keeps its photon count and what it is chosen from;
-// 9: bpm's pixel statistics keep what its continuations brought.
-constexpr uint32_t kVersion = 11;
+// 9: bpm's pixel statistics keep what its continuations brought; 12: and its second moments at
+// every probability of going on.
+constexpr uint32_t kVersion = 12;
 
 std::string read_file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
