@@ -1931,9 +1931,15 @@ TEST(Bpm, DirectSampleCountBalancesVarianceAndCost) {
 // q = 0. What a continuation noted that is not the pixel's to count (start without add) is gone.
 TEST(Bpm, ContinuationNotesItsSecondMomentAtEveryLevel) {
   EyeContinuation c;
-  c.start(1);
-  c.found(7, 0.5, 0.5);  // a continuation not taken by chance (a glossy vertex): not added
-  c.start(0.25);
+  c.start(1, true);
+  c.found(7, 0.5, 0.5);  // noted, then dropped: not added
+  c.start(1, false);
+  c.found(7, 0.5, 0.5);  // a continuation not taken by chance (a glossy vertex): not noted
+  c.add(5);
+  EXPECT_EQ(c.moment_now, 0);
+  EXPECT_EQ(c.merges_alone, 0);
+  c = {};
+  c.start(0.25, true);
   c.found(0.3, 0.6, 0.4);
   c.add(12);
   const double y = 0.3 / 0.6, a = 0.25 * 0.4 / 0.6;
@@ -1945,7 +1951,7 @@ TEST(Bpm, ContinuationNotesItsSecondMomentAtEveryLevel) {
   EXPECT_EQ(c.taken, 1);
   EXPECT_EQ(c.rays, 12);
   // A second path: a light only the continuation finds, y^2 / q_l; the one before kept.
-  c.start(1);
+  c.start(1, true);
   c.found(0.5, 1, 0);
   c.add(3);
   EXPECT_NEAR(c.moment_at[2], y * y / (0.25 + a) + 0.25 / 0.25, 1e-12);

@@ -598,7 +598,7 @@ inline bool gather_at_diffuse_vertex(const EyePath& path, const PathVertex& v, c
   const double q = std::ldexp(1.0, -level);
   if (level > 0 && !(path.rng.uniform() < q)) return direct_at_last();
   const uint64_t rays = path.counters.rays.total();
-  path.continued.start(q);
+  path.continued.start(q, chosen_here);
   const Spectrum c =
       continue_eye_path(path, v, choice.part, s, depth, merge_density / q, vertex_scale, first);
   continued = true;

@@ -139,10 +139,12 @@ struct EyeContinuation {
   double taken = 0, rays = 0, moment_now = 0, merges_alone = 0, unmergeable = 0;
   std::array<double, kContinueLevels> moment_at{};
   // Of the continuation under way (taken with the probability q; `start` clears them): X_l, the
-  // merges' second moments, and the same at q.
+  // merges' second moments, and the same at q; noted only where the pixel chose q (`noting`).
+  bool noting = false;
   double q = 1, light_now = 0, merges_now = 0, merges_alone_now = 0, unmergeable_now = 0;
   std::array<double, kContinueLevels> light_at{}, merges_at{};
-  void start(double probability) {
+  void start(double probability, bool chosen) {
+    noting = chosen;
     q = probability;
     light_at = merges_at = {};
     light_now = merges_now = merges_alone_now = unmergeable_now = 0;
@@ -150,7 +152,7 @@ struct EyeContinuation {
   // A light found with the weight w, of whose denominator the merge (with the vertex connection)
   // holds the share `merge_share`.
   void found(double light, double w, double merge_share) {
-    if (!std::isfinite(light) || light == 0 || !(w > 0) || !(merge_share < 1)) return;
+    if (!noting || !std::isfinite(light) || light == 0 || !(w > 0) || !(merge_share < 1)) return;
     const double y = light / (1 - merge_share), a = q * merge_share / (1 - merge_share);
     if (a > 0)
       merges_alone_now += y * y / a;

@@ -231,9 +231,18 @@ RgbGrid::RgbGrid(int nx_, int ny_, int nz_, const std::vector<Rgb>& a, const std
 
 namespace {
 
+// The wavelengths' places in the sigmoids' polynomial (normalised_lambda), computed once for the
+// many voxels of a lookup or a walk.
+using LambdaPlaces = std::array<float, Spectrum::kChannels>;
+LambdaPlaces places_of(const Wavelengths& wl) {
+  LambdaPlaces u;
+  for (int c = 0; c < Spectrum::kChannels; ++c) u[size_t(c)] = normalised_lambda(wl.lambda[c]);
+  return u;
+}
+
 // One voxel's colour at the wavelengths, times `scale`; 1 where the grid gives none, 0 beyond it.
 Spectrum voxel_spectrum(const RgbGrid& g, const std::vector<RgbGrid::Voxel>& voxels, int i, int j,
-                        int k, const Wavelengths& wl, float factor) {
+                        int k, const LambdaPlaces& u, float factor) {
   if (voxels.empty()) return Spectrum(factor);
   if (i < 0 || j < 0 || k < 0 || i >= g.nx || j >= g.ny || k >= g.nz) return {};
   const RgbGrid::Voxel& v =
@@ -241,7 +250,7 @@ Spectrum voxel_spectrum(const RgbGrid& g, const std::vector<RgbGrid::Voxel>& vox
   Spectrum s;
   if (v.scale == 0) return s;
   for (int c = 0; c < Spectrum::kChannels; ++c)
-    s[c] = factor * v.scale * sigmoid_spectrum(v.coeff, wl.lambda[c]);
+    s[c] = factor * v.scale * sigmoid_spectrum_at(v.coeff, u[size_t(c)]);
   return s;
 }
 
@@ -251,9 +260,7 @@ Spectrum voxel_spectrum(const RgbGrid& g, const std::vector<RgbGrid::Voxel>& vox
 // computed once per walk (the sigmoids are most of an rgbgrid's cost).
 class SigmaTVoxels {
  public:
-  SigmaTVoxels(const RgbGrid& g, const Wavelengths& wl) : g_(g) {
-    for (int c = 0; c < Spectrum::kChannels; ++c) u_[size_t(c)] = normalised_lambda(wl.lambda[c]);
-  }
+  SigmaTVoxels(const RgbGrid& g, const Wavelengths& wl) : g_(g), u_(places_of(wl)) {}
   Cell<Spectrum> cell(const int c[3]) {
     return Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) { return at(i, j, k); });
   }
@@ -265,24 +272,13 @@ class SigmaTVoxels {
     if (!known_[slot] || keys_[slot] != key) {
       keys_[slot] = key;
       known_[slot] = true;
-      values_[slot] = voxel(g_.sigma_a, i, j, k) + voxel(g_.sigma_s, i, j, k);
+      values_[slot] = voxel_spectrum(g_, g_.sigma_a, i, j, k, u_, g_.scale) +
+                      voxel_spectrum(g_, g_.sigma_s, i, j, k, u_, g_.scale);
     }
     return values_[slot];
   }
-  Spectrum voxel(const std::vector<RgbGrid::Voxel>& voxels, int i, int j, int k) const {
-    if (voxels.empty()) return Spectrum(g_.scale);
-    if (i < 0 || j < 0 || k < 0 || i >= g_.nx || j >= g_.ny || k >= g_.nz) return {};
-    const RgbGrid::Voxel& v =
-        voxels[(size_t(k) * size_t(g_.ny) + size_t(j)) * size_t(g_.nx) + size_t(i)];
-    Spectrum s;
-    if (v.scale == 0) return s;
-    for (int c = 0; c < Spectrum::kChannels; ++c)
-      s[c] = g_.scale * v.scale * sigmoid_spectrum_at(v.coeff, u_[size_t(c)]);
-    return s;
-  }
-
   const RgbGrid& g_;
-  std::array<float, Spectrum::kChannels> u_{};
+  const LambdaPlaces u_;
   std::array<std::array<int, 3>, 8> keys_{};
   std::array<bool, 8> known_{};
   std::array<Spectrum, 8> values_{};
@@ -297,11 +293,12 @@ void RgbGrid::coefficients(Vec3 p, const Wavelengths& wl, Spectrum* a, Spectrum*
   *a = *s = Spectrum();
   if (!cell_of(q, n, c)) return;
   const Vec3 f = q - Vec3{float(c[0]), float(c[1]), float(c[2])};
+  const LambdaPlaces u = places_of(wl);
   *a = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-         return voxel_spectrum(*this, sigma_a, i, j, k, wl, scale);
+         return voxel_spectrum(*this, sigma_a, i, j, k, u, scale);
        }).at(f);
   *s = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-         return voxel_spectrum(*this, sigma_s, i, j, k, wl, scale);
+         return voxel_spectrum(*this, sigma_s, i, j, k, u, scale);
        }).at(f);
 }
 
@@ -317,8 +314,9 @@ Spectrum RgbGrid::glow(Vec3 p, const Wavelengths& wl) const {
   int c[3];
   if (!glows() || !cell_of(q, n, c)) return e;
   const Vec3 f = q - Vec3{float(c[0]), float(c[1]), float(c[2])};
+  const LambdaPlaces u = places_of(wl);
   e = Cell<Spectrum>(c[0], c[1], c[2], [&](int i, int j, int k) {
-        return voxel_spectrum(*this, Le, i, j, k, wl, 1);
+        return voxel_spectrum(*this, Le, i, j, k, u, 1);
       }).at(f);
   const float k = le_scale * float(ybar_integral());
   for (int i = 0; i < Spectrum::kChannels; ++i) e[i] *= k * d65_unit(wl.lambda[i]);
